@@ -1,0 +1,1 @@
+"""Analytic and manufactured references; never imports pdverify."""

@@ -1,0 +1,1 @@
+"""Classical-elasticity FEM references (scikit-fem); never imports pdverify."""
