@@ -1,0 +1,12 @@
+"""Boundary treatments ('methods'), one module per method; this is their name index."""
+
+METHODS = {
+    "none": "uncorrected PD: truncated neighbourhoods, BCs on the nodes nearest the boundary",
+    "taylor-fictitious": "seed 000: fictitious layer by nearest-node Taylor extrapolation, "
+                         "Dirichlet/Neumann via Lagrange multipliers",
+    "fem": "classical-elasticity FEM reference (reference_fem)",
+}
+
+
+def describe(name: str) -> str:
+    return METHODS.get(name, "")

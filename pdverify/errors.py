@@ -1,0 +1,17 @@
+"""Error types: bad input (exit 2) versus numerical trouble (a failed run)."""
+
+
+class InputError(ValueError):
+    """Bad user input: unknown scene/method/key or a value out of range.
+
+    The message is one line that names the offending input and what is allowed;
+    the CLI prints it and exits with code 2 before any work starts.
+    """
+
+
+class NumericalError(RuntimeError):
+    """Numerical trouble during a run (singular system, NaN, unstable step, ...).
+
+    The message says what happened and where; the run is recorded as failed and
+    never aborts a report.
+    """

@@ -1,0 +1,111 @@
+"""Typed, range-checked parameters for scenes and methods (the --set KEY=VALUE layer)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Callable, Mapping
+
+from .errors import InputError
+
+Check = Callable[[Any], "str | None"]
+
+
+@dataclass(frozen=True)
+class Param:
+    """One named parameter with its default (the paper's value), type and check.
+
+    ``check`` returns ``None`` when a value is allowed, else a short phrase such as
+    ``"must be > 0"``; ``choices`` restricts string or numeric values to a set.
+    """
+
+    name: str
+    default: Any
+    doc: str = ""
+    check: Check | None = None
+    choices: tuple | None = None
+
+    @property
+    def kind(self) -> type:
+        return type(self.default)
+
+    def convert(self, raw: Any, where: str) -> Any:
+        kind = self.kind
+        try:
+            if isinstance(raw, str):
+                if kind is bool:
+                    low = raw.strip().lower()
+                    if low not in ("true", "false", "1", "0", "yes", "no"):
+                        raise ValueError(raw)
+                    value = low in ("true", "1", "yes")
+                elif kind is int:
+                    as_float = float(raw)
+                    if as_float != int(as_float):
+                        raise ValueError(raw)
+                    value = int(as_float)
+                else:
+                    value = kind(raw)
+            elif kind is float and isinstance(raw, (int, float)) and not isinstance(raw, bool):
+                value = float(raw)
+            elif kind is int and isinstance(raw, float) and raw == int(raw):
+                value = int(raw)
+            else:
+                value = raw
+            if not isinstance(value, kind):
+                raise ValueError(raw)
+        except (TypeError, ValueError):
+            raise InputError(f"{where}: {self.name}={raw!r} is not a valid {kind.__name__}") from None
+        if kind is float and value != value:  # NaN
+            raise InputError(f"{where}: {self.name}={raw!r} is not a number")
+        if self.choices is not None and value not in self.choices:
+            allowed = ", ".join(str(c) for c in self.choices)
+            raise InputError(f"{where}: {self.name}={raw!r} is not allowed; allowed: {allowed}")
+        if self.check is not None:
+            problem = self.check(value)
+            if problem:
+                raise InputError(f"{where}: {self.name}={raw!r} {problem}")
+        return value
+
+
+def positive(value) -> str | None:
+    return None if value > 0 and value != float("inf") else "must be a finite number > 0"
+
+
+def at_least(bound) -> Check:
+    def check(value):
+        return None if value >= bound else f"must be >= {bound}"
+    return check
+
+
+def open_interval(lo, hi) -> Check:
+    def check(value):
+        return None if lo < value < hi else f"must be in ({lo}, {hi})"
+    return check
+
+
+def resolve(specs: tuple[Param, ...], overrides: Mapping[str, Any], where: str) -> dict:
+    """Defaults of ``specs`` updated with converted, checked ``overrides``.
+
+    Unknown keys raise :class:`InputError` listing the allowed ones.
+    """
+    by_name = {p.name: p for p in specs}
+    unknown = [k for k in overrides if k not in by_name]
+    if unknown:
+        allowed = ", ".join(sorted(by_name)) or "(none)"
+        raise InputError(f"{where}: unknown key {unknown[0]!r}; allowed: {allowed}")
+    values = {p.name: p.default for p in specs}
+    for key, raw in overrides.items():
+        values[key] = by_name[key].convert(raw, where)
+    return values
+
+
+def parse_assignments(items) -> dict:
+    """Parse ``KEY=VALUE`` strings (from ``--set``) into a dict of raw strings."""
+    out = {}
+    for item in items or ():
+        key, sep, value = item.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise InputError(f"--set {item!r}: expected KEY=VALUE")
+        if key in out:
+            raise InputError(f"--set {item!r}: key {key!r} given twice")
+        out[key] = value.strip()
+    return out

@@ -1,0 +1,159 @@
+"""The result record of one (scene, method, params) run and its JSON (pdverify.results/1)."""
+from __future__ import annotations
+
+import json
+import os
+import platform
+import sys
+import tempfile
+import time
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from datetime import datetime, timezone
+from typing import Any
+
+import numpy as np
+
+SCHEMA = "pdverify.results/1"
+
+
+@dataclass
+class RunResult:
+    """One run. ``fields`` holds arrays for figures and is never written to JSON."""
+
+    scene: str
+    method: str
+    params: dict
+    reference: str
+    status: str = "ok"
+    message: str = ""
+    metrics: dict = field(default_factory=dict)
+    timings: dict = field(default_factory=dict)
+    size: dict = field(default_factory=dict)
+    diagnostics: dict = field(default_factory=dict)
+    fields: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def key(self) -> tuple:
+        return run_key(self.scene, self.method, self.params)
+
+    def to_json(self) -> dict:
+        return {
+            "scene": self.scene,
+            "method": self.method,
+            "params": _plain(self.params),
+            "reference": self.reference,
+            "status": self.status,
+            "message": self.message,
+            "metrics": _plain(self.metrics),
+            "timings": _plain(self.timings),
+            "size": _plain(self.size),
+            "diagnostics": _plain(self.diagnostics),
+        }
+
+
+def run_key(scene: str, method: str, params: dict) -> tuple:
+    """Identity of a run across result files: scene, method and canonical params."""
+    return scene, method, json.dumps(_plain(params), sort_keys=True)
+
+
+class Timer:
+    """Accumulates wall time per phase (``setup``, ``solve``) of one run."""
+
+    def __init__(self):
+        self.phases: dict[str, float] = {}
+        self._start = time.perf_counter()
+
+    @contextmanager
+    def phase(self, name: str):
+        t0 = time.perf_counter()
+        try:
+            yield
+        finally:
+            self.phases[name] = self.phases.get(name, 0.0) + time.perf_counter() - t0
+
+    def as_dict(self) -> dict:
+        out = {f"{k}_s": v for k, v in self.phases.items()}
+        out.setdefault("setup_s", 0.0)
+        out.setdefault("solve_s", 0.0)
+        out["total_s"] = time.perf_counter() - self._start
+        return out
+
+
+def _plain(value: Any) -> Any:
+    """JSON-ready copy: numpy scalars to Python, non-finite floats to strings."""
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return [_plain(v) for v in value.tolist()]
+    if isinstance(value, (np.floating, float)):
+        v = float(value)
+        if v != v or v in (float("inf"), float("-inf")):
+            return str(v)
+        return v
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.bool_):
+        return bool(value)
+    return value
+
+
+def machine_info() -> dict:
+    return {"python": platform.python_version(), "platform": platform.platform(),
+            "cpus": os.cpu_count()}
+
+
+def document(runs: list[RunResult]) -> dict:
+    from . import __version__
+    return {
+        "schema": SCHEMA,
+        "pdverify_version": __version__,
+        "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "machine": machine_info(),
+        "runs": [r.to_json() for r in runs],
+    }
+
+
+def atomic_write_text(path: str | os.PathLike, text: str) -> None:
+    """Write ``text`` to ``path`` so that a reader sees the old file or the new, never half."""
+    path = os.fspath(path)
+    folder = os.path.dirname(os.path.abspath(path))
+    os.makedirs(folder, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=".tmp-", dir=folder)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def write_results(path, runs: list[RunResult]) -> dict:
+    doc = document(runs)
+    atomic_write_text(path, json.dumps(doc, indent=1, allow_nan=False) + "\n")
+    return doc
+
+
+def load_results(path) -> dict:
+    """Read a results file and check its schema; raises ValueError with the reason."""
+    with open(path, encoding="utf-8") as fh:
+        try:
+            doc = json.load(fh)
+        except json.JSONDecodeError as exc:
+            raise ValueError(f"{path}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
+    if not isinstance(doc, dict) or doc.get("schema") != SCHEMA:
+        raise ValueError(f"{path}: schema is {doc.get('schema') if isinstance(doc, dict) else None!r}, "
+                         f"expected {SCHEMA!r}")
+    if not isinstance(doc.get("runs"), list):
+        raise ValueError(f"{path}: 'runs' must be a list")
+    return doc
+
+
+def python_executable() -> str:
+    return sys.executable

@@ -1,0 +1,244 @@
+"""Seed 000 §5: 1D state-based bars (traction, uniform, linear and sine loads)."""
+from __future__ import annotations
+
+import numpy as np
+
+from manufactured import bar1d as closed
+
+from ..errors import InputError
+from ..metrics import max_relative_error_pct, nodal_relative_error_pct, rel_l2_error
+from ..operators import Bar1D
+from ..params import Param, at_least, open_interval, positive
+from ..solvers.static import solve_constrained
+from . import MethodSpec, Outcome, Published, Scene, register
+
+#: Table 3 of seed 000.
+BAR_PARAMS = (
+    Param("length", 1.0, "bar length l [m]", positive),
+    Param("area", 0.01, "cross-section A [m^2]", positive),
+    Param("E", 1e9, "Young's modulus [Pa]", positive),
+    Param("nu", 0.3, "Poisson's ratio", open_interval(-1.0, 0.5)),
+    Param("spacing", 0.05, "grid spacing Delta [m]", positive),
+    Param("m_ratio", 3.0, "horizon / spacing", at_least(1.0)),
+)
+
+TAYLOR = MethodSpec("taylor-fictitious", (Param("order", 1, "Taylor order n", at_least(1)),))
+NONE = MethodSpec("none")
+
+
+def check_bar_grid(scene_id: str, method: str, p: dict, min_horizons: float = 0.0) -> int:
+    """Common checks: the spacing divides the length, enough nodes for the Taylor order."""
+    where = f"{scene_id} --method {method}"
+    n = p["length"] / p["spacing"]
+    if abs(n - round(n)) > 1e-9 * max(n, 1.0) or round(n) < 2:
+        raise InputError(f"{where}: spacing={p['spacing']} must divide length={p['length']} "
+                         f"into a whole number (>= 2) of cells")
+    n = int(round(n))
+    if min_horizons and p["length"] < min_horizons * p["m_ratio"] * p["spacing"]:
+        raise InputError(f"{where}: length={p['length']} must be at least {min_horizons:g} "
+                         f"horizons (m_ratio * spacing = {p['m_ratio'] * p['spacing']:g})")
+    if method == TAYLOR.name and n <= 2 * p["order"]:
+        raise InputError(f"{where}: order={p['order']} is too large for {n} nodes; "
+                         f"seed 000 App. D needs nodes > 2 * order (order <= {(n - 1) // 2})")
+    return n
+
+
+class StaticBar(Scene):
+    """Shared machinery of the four bars of seed 000 §5 (clamped at x = 0).
+
+    Uncorrected baseline ``none`` (ERRATA seed 000): no fictitious nodes, m_i from
+    Eq. (50) over real neighbours, the Dirichlet value imposed on the node nearest the
+    boundary (its classical value u_cl(x_1)), an end force applied to the node nearest
+    the end. ``taylor-fictitious`` (order n): fictitious layers at both ends (Eqs. 40-47),
+    u(0) = 0 by Taylor extrapolation (Eq. 58) and the end force (or zero traction) as the
+    force flux of the bonds crossing x = l (Eq. 60), both by Lagrange multipliers (Eq. 63).
+    Nodal loads are b(x_i) A Delta (Eq. 54).
+    Metrics: ``max_error_pct`` (Eq. 64 against the classical solution), ``rel_l2_error``,
+    ``reaction_force`` (force flux through x = 0, tension positive, Remark 3; for ``none``
+    the reaction at the constrained node), ``reaction_error_pct`` against the total load,
+    and ``gap_nonlinearity``: max |d - linear fit of d| / max |u_cl| with d = u - u_cl
+    (zero when PD and classical differ only by the App. C flux term).
+    """
+
+    seed = "000"
+    reference = "analytic"
+    figure = "bar1d"
+    load_param: Param
+    methods = (NONE, TAYLOR)
+    paper_orders: tuple[int, ...] = (1,)
+
+    @property
+    def params(self):
+        return BAR_PARAMS + (self.load_param,)
+
+    # subclass hooks --------------------------------------------------------------
+    def classical(self, x, p):
+        raise NotImplementedError
+
+    def body_force(self, x, p):
+        return np.zeros_like(x)
+
+    def end_force(self, p) -> float:
+        return 0.0
+
+    def total_load(self, p) -> float:
+        raise NotImplementedError
+
+    # -------------------------------------------------------------------------------
+    def check(self, method, p):
+        check_bar_grid(self.id, method, p, min_horizons=2.0)
+
+    def cases(self, quick=False):
+        return [("none", {})] + [(TAYLOR.name, {"order": n}) for n in self.paper_orders]
+
+    def solve(self, method, p, timer):
+        with timer.phase("setup"):
+            order = p.get("order") if method == TAYLOR.name else None
+            bar = Bar1D(p["length"], p["area"], p["E"], p["nu"], p["spacing"], p["m_ratio"],
+                        taylor_order=order)
+            x = bar.x_real
+            V = p["area"] * p["spacing"]
+            f = self.body_force(x, p) * V
+            u_ref = self.classical(x, p)
+            if order is None:
+                f[-1] += self.end_force(p)
+                B = np.zeros((1, bar.n_real))
+                B[0, 0] = 1.0
+                c = [u_ref[0]]
+            else:
+                B = np.vstack([bar.boundary_value_row("left"),
+                               bar.flux_rows([p["length"]]).toarray()])
+                c = [0.0, self.end_force(p)]
+        with timer.phase("solve"):
+            u, lam, info = solve_constrained(bar.K, f, B, c, where=f"{self.id}/{method}")
+        if order is None:
+            reaction = -float((bar.K @ u - f)[0])
+        else:
+            reaction = float((bar.flux_rows([0.0]) @ u)[0])
+        total = self.total_load(p)
+        d = u - u_ref
+        fit = np.polyval(np.polyfit(x, d, 1), x)
+        metrics = {
+            "max_error_pct": max_relative_error_pct(u, u_ref),
+            "rel_l2_error": rel_l2_error(u, u_ref),
+            "reaction_force": reaction,
+            "reaction_error_pct": abs(reaction - total) / abs(total) * 100.0,
+            "gap_nonlinearity": float(np.max(np.abs(d - fit)) / np.max(np.abs(u_ref))),
+        }
+        fields = {"x": x, "u": u, "u_ref": u_ref, "error_pct": nodal_relative_error_pct(u, u_ref),
+                  "horizon": bar.horizon, "length": p["length"]}
+        return Outcome(metrics=metrics, size=bar.size(), fields=fields, diagnostics=info)
+
+
+@register
+class Traction(StaticBar):
+    """Seed 000 §5.1: clamped bar, end force f = 1e4 N at x = l; u_cl of Eq. (65).
+
+    The classical solution is linear, so it is also the PD solution (Ref. 46 of the
+    paper) and order 1 must be exact to round-off (Figs. 15-16).
+    """
+
+    id = "bar1d-traction"
+    title = "Clamped bar under end traction"
+    seed = "000 §5.1"
+    load_param = Param("force", 1e4, "end force f [N]")
+    published = (Published("max_error_pct", "machine precision", "seed 000 §5.1, Fig. 16",
+                           method="taylor-fictitious", where={"order": 1}),)
+
+    def classical(self, x, p):
+        return closed.traction_displacement(x, force=p["force"], E=p["E"], area=p["area"])
+
+    def end_force(self, p):
+        return p["force"]
+
+    def total_load(self, p):
+        return p["force"]
+
+    def check(self, method, p):
+        super().check(method, p)
+        if p["force"] == 0:
+            raise InputError(f"{self.id} --method {method}: force=0 leaves Eq. (64) undefined; "
+                             "use a non-zero force")
+
+
+class _DistributedLoad(StaticBar):
+    def check(self, method, p):
+        super().check(method, p)
+        if p[self.load_param.name] == 0:
+            raise InputError(f"{self.id} --method {method}: {self.load_param.name}=0 leaves "
+                             "Eq. (64) undefined; use a non-zero load")
+
+
+@register
+class UniformLoad(_DistributedLoad):
+    """Seed 000 §5.2: clamped-free bar, b = b0 = 1e6 N/m^3; u_cl of Eq. (66).
+
+    The classical solution is quadratic, hence also the PD one: order 2 must be exact
+    to round-off; order 1 is not (Figs. 18-19).
+    """
+
+    id = "bar1d-uniform-load"
+    title = "Clamped-free bar under uniform load"
+    seed = "000 §5.2"
+    load_param = Param("b0", 1e6, "uniform body force [N/m^3]")
+    paper_orders = (1, 2)
+    published = (Published("max_error_pct", "machine precision", "seed 000 §5.2, Fig. 19",
+                           method="taylor-fictitious", where={"order": 2}),)
+
+    def classical(self, x, p):
+        return closed.uniform_load_displacement(x, b0=p["b0"], E=p["E"], length=p["length"])
+
+    def body_force(self, x, p):
+        return np.full_like(x, p["b0"])
+
+    def total_load(self, p):
+        return p["b0"] * p["area"] * p["length"]
+
+
+@register
+class LinearLoad(_DistributedLoad):
+    """Seed 000 §5.3: clamped-free bar, b = b1 x with b1 = 1e6 N/m^4; u_cl of Eq. (67).
+
+    The solution is cubic, so PD and classical theory differ (App. C): with order 3 the
+    discrete PD solution is u_cl plus a linear function (the flux term
+    delta^2 u''' of Eq. C5 shifts the free-end condition), which ``gap_nonlinearity``
+    measures.
+    """
+
+    id = "bar1d-linear-load"
+    title = "Clamped-free bar under linearly varying load"
+    seed = "000 §5.3"
+    load_param = Param("b1", 1e6, "load gradient [N/m^4]")
+    paper_orders = (1, 2, 3)
+
+    def classical(self, x, p):
+        return closed.linear_load_displacement(x, b1=p["b1"], E=p["E"], length=p["length"])
+
+    def body_force(self, x, p):
+        return p["b1"] * x
+
+    def total_load(self, p):
+        return p["b1"] * p["area"] * p["length"] ** 2 / 2
+
+
+@register
+class SineLoad(_DistributedLoad):
+    """Seed 000 §5.4: clamped-free bar, b = bs sin(pi x / l), bs = 1e6 N/m^3; Eq. (68).
+
+    Orders 1, 3, 5 as in the text and Fig. 24 (ERRATA: Fig. 25's caption says 1, 3, 9).
+    """
+
+    id = "bar1d-sine-load"
+    title = "Clamped-free bar under sinusoidal load"
+    seed = "000 §5.4"
+    load_param = Param("bs", 1e6, "load amplitude [N/m^3]")
+    paper_orders = (1, 3, 5)
+
+    def classical(self, x, p):
+        return closed.sine_load_displacement(x, bs=p["bs"], E=p["E"], length=p["length"])
+
+    def body_force(self, x, p):
+        return p["bs"] * np.sin(np.pi * x / p["length"])
+
+    def total_load(self, p):
+        return p["bs"] * p["area"] * 2 * p["length"] / np.pi

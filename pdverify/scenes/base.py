@@ -1,0 +1,127 @@
+"""The scene contract: parameters, supported methods, run, and the report's cases."""
+from __future__ import annotations
+
+import traceback
+from dataclasses import dataclass, field
+from typing import Any, Mapping
+
+import numpy as np
+
+from ..errors import InputError, NumericalError
+from ..params import Param, resolve
+from ..results import RunResult, Timer
+
+
+@dataclass(frozen=True)
+class MethodSpec:
+    """A method as a scene offers it: its name and the parameters it takes there."""
+
+    name: str
+    params: tuple[Param, ...] = ()
+
+
+@dataclass
+class Outcome:
+    """What a scene's ``solve`` returns: numbers for JSON and arrays for figures."""
+
+    metrics: dict
+    size: dict = field(default_factory=dict)
+    fields: dict = field(default_factory=dict)
+    diagnostics: dict = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Published:
+    """A number a paper prints, for the report's 'paper' column."""
+
+    metric: str
+    value: Any
+    source: str
+    method: str | None = None
+    where: Mapping[str, Any] | None = None
+
+    def applies(self, method: str, params: Mapping[str, Any]) -> bool:
+        if self.method is not None and self.method != method:
+            return False
+        return all(params.get(k) == v for k, v in (self.where or {}).items())
+
+
+class Scene:
+    """Base class of a verification case; subclasses set the class attributes.
+
+    ``params`` are the scene's own parameters (defaults = the paper's values),
+    ``methods`` the boundary treatments it supports (the first is the default),
+    ``solve(method, params, timer)`` does the work and returns an :class:`Outcome`,
+    ``cases(quick)`` lists the (method, overrides) pairs the report runs.
+    """
+
+    id: str = ""
+    title: str = ""
+    seed: str = ""
+    reference: str = "analytic"
+    params: tuple[Param, ...] = ()
+    methods: tuple[MethodSpec, ...] = ()
+    published: tuple[Published, ...] = ()
+    figure: str = ""  # name of the report figure family that draws this scene's runs
+
+    # -- parameters -------------------------------------------------------------------
+    def method(self, name: str) -> MethodSpec:
+        for m in self.methods:
+            if m.name == name:
+                return m
+        allowed = ", ".join(m.name for m in self.methods)
+        raise InputError(f"{self.id}: unknown method {name!r}; allowed: {allowed}")
+
+    @property
+    def default_method(self) -> str:
+        return self.methods[0].name
+
+    def resolve(self, method: str, overrides: Mapping[str, Any] | None = None) -> dict:
+        """Effective parameters (scene + method) with ``overrides`` applied and checked."""
+        spec = self.method(method)
+        where = f"{self.id} --method {method}"
+        values = resolve(self.params + spec.params, dict(overrides or {}), where)
+        self.check(method, values)
+        return values
+
+    def check(self, method: str, params: dict) -> None:
+        """Cross-parameter checks; raise :class:`InputError` with a one-line message."""
+
+    # -- running ----------------------------------------------------------------------
+    def solve(self, method: str, params: dict, timer: Timer) -> Outcome:
+        raise NotImplementedError
+
+    def cases(self, quick: bool = False) -> list[tuple[str, dict]]:
+        return [(m.name, {}) for m in self.methods]
+
+    def run(self, method: str, overrides: Mapping[str, Any] | None = None) -> RunResult:
+        """Resolve, solve and record one run; numerical trouble becomes a failed result.
+
+        Bad input raises :class:`InputError` before any work starts.
+        """
+        params = self.resolve(method, overrides)
+        result = RunResult(scene=self.id, method=method, params=params, reference=self.reference)
+        timer = Timer()
+        try:
+            out = self.solve(method, params, timer)
+            bad = [k for k, v in out.metrics.items()
+                   if isinstance(v, float) and not np.isfinite(v)]
+            if bad:
+                raise NumericalError(f"metric {bad[0]} is not finite ({out.metrics[bad[0]]})")
+            result.metrics, result.size = out.metrics, out.size
+            result.fields, result.diagnostics = out.fields, out.diagnostics
+        except NumericalError as exc:
+            result.status, result.message = "failed", str(exc)
+        except (FloatingPointError, ArithmeticError, np.linalg.LinAlgError) as exc:
+            result.status = "failed"
+            result.message = f"numerical error: {type(exc).__name__}: {exc}"
+        except Exception as exc:  # never crash a whole report on one run
+            frame = traceback.extract_tb(exc.__traceback__)[-1]
+            result.status = "failed"
+            result.message = (f"internal error: {type(exc).__name__}: {exc} "
+                              f"({frame.filename.rsplit('/', 1)[-1]}:{frame.lineno})")
+        result.timings = timer.as_dict()
+        return result
+
+    def published_for(self, method: str, params: dict) -> dict:
+        return {p.metric: p for p in self.published if p.applies(method, params)}

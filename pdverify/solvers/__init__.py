@@ -1,0 +1,1 @@
+"""Solvers: static (direct, with constraints); later explicit dynamics and contact."""
