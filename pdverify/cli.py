@@ -1,0 +1,79 @@
+"""pdverify: verification suite for peridynamic boundary corrections.
+
+usage:
+  python -m pdverify list                                   scenes and their methods
+  python -m pdverify run SCENE [--method M] [--set KEY=VALUE ...] [--json FILE]
+  python -m pdverify report [--out DIR] [--quick] [--only SCENE ...] [--jobs N]
+  python -m pdverify compare BASELINE.json NEW.json [--rtol R] [--atol A]
+
+Exit codes: 0 success; 1 a run failed numerically or a regression was found;
+2 bad input (one line naming the input and what is allowed).
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+
+from .errors import InputError
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # argparse's own usage errors: one line, exit 2
+        raise InputError(message)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="pdverify", description=__doc__,
+                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = parser.add_subparsers(dest="command", parser_class=_Parser)
+    sub.add_parser("list", help="list scenes, methods and parameters")
+    run = sub.add_parser("run", help="run one scene with one method")
+    run.add_argument("scene")
+    run.add_argument("--method", default=None)
+    run.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    run.add_argument("--json", default=None, metavar="FILE")
+    rep = sub.add_parser("report", help="run every scene and method, write the HTML report")
+    rep.add_argument("--out", default=None, metavar="DIR")
+    rep.add_argument("--quick", action="store_true")
+    rep.add_argument("--only", nargs="+", default=None, metavar="SCENE")
+    rep.add_argument("--jobs", type=int, default=1)
+    cmp_ = sub.add_parser("compare", help="compare a results file against a baseline")
+    cmp_.add_argument("baseline")
+    cmp_.add_argument("new")
+    cmp_.add_argument("--rtol", type=float, default=None)
+    cmp_.add_argument("--atol", type=float, default=None)
+    return parser
+
+
+def main(argv=None) -> int:
+    try:
+        args = build_parser().parse_args(argv)
+        if args.command is None:
+            print(__doc__)
+            return 2
+        return _dispatch(args)
+    except InputError as exc:
+        print(f"pdverify: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("pdverify: interrupted", file=sys.stderr)
+        return 130
+
+
+def _dispatch(args) -> int:
+    if args.command == "list":
+        from .listing import format_listing
+        print(format_listing())
+        return 0
+    if args.command == "run":
+        from .params import parse_assignments
+        from .runner import run_one
+        return run_one(args.scene, method=args.method, overrides=parse_assignments(args.set),
+                       json_path=args.json)
+    if args.command == "report":
+        from .report import build_report
+        return build_report(out=args.out, quick=args.quick, only=args.only, jobs=args.jobs)
+    if args.command == "compare":
+        from .compare import compare_files
+        return compare_files(args.baseline, args.new, rtol=args.rtol, atol=args.atol)
+    raise InputError(f"unknown command {args.command!r}")

@@ -1,0 +1,96 @@
+"""The report's index.html: a summary, then per scene a table of runs and its figures."""
+from __future__ import annotations
+
+import html
+
+from ..corrections import describe
+
+CSS = """
+body{font-family:system-ui,sans-serif;margin:2em auto;max-width:1250px;color:#222}
+table{border-collapse:collapse;margin:.6em 0;font-size:13px}
+th,td{border:1px solid #ccc;padding:3px 7px;text-align:right;vertical-align:top}
+th{background:#f2f2f2} td.l,th.l{text-align:left}
+.failed{background:#fde2e2} .doc{white-space:pre-wrap;font-size:12px;color:#444;
+background:#fafafa;border-left:3px solid #ddd;padding:.4em .8em}
+figure{margin:1em 0} figcaption{font-size:12px;color:#555} code{font-size:12px}
+"""
+
+
+def _num(v) -> str:
+    if isinstance(v, float):
+        return f"{v:.4g}"
+    return html.escape(str(v))
+
+
+def _params(result, scene) -> str:
+    defaults = {p.name: p.default for p in scene.params}
+    shown = {k: v for k, v in result.params.items() if defaults.get(k, object()) != v}
+    return ", ".join(f"{k}={_num(v)}" for k, v in shown.items()) or "defaults"
+
+
+def scene_section(scene, results, figures) -> str:
+    parts = [f'<h2 id="{scene.id}">{html.escape(scene.id)}: {html.escape(scene.title)}</h2>',
+             f"<p>Seed {html.escape(scene.seed)}; reference: <b>{scene.reference}</b>.</p>",
+             f'<details><summary>What is implemented and every choice</summary>'
+             f'<div class="doc">{html.escape((type(scene).__doc__ or "").strip())}</div></details>']
+    metric_names = []
+    for r in results:
+        for k in r.metrics:
+            if k not in metric_names:
+                metric_names.append(k)
+    head = ("<tr><th class=l>method</th><th class=l>params</th><th>status</th>"
+            + "".join(f"<th>{html.escape(m)}</th>" for m in metric_names)
+            + "<th>setup s</th><th>solve s</th><th>total s</th><th>size</th></tr>")
+    rows = []
+    for r in results:
+        paper = scene.published_for(r.method, r.params)
+        cells = []
+        for m in metric_names:
+            v = r.metrics.get(m, "")
+            cell = _num(v)
+            if m in paper:
+                cell += f'<br><small title="{html.escape(paper[m].source)}">paper: {_num(paper[m].value)}</small>'
+            cells.append(f"<td>{cell}</td>")
+        status = r.status if r.status == "ok" else f"failed: {html.escape(r.message)}"
+        cls = "" if r.status == "ok" else ' class="failed"'
+        size = ", ".join(f"{k} {v}" for k, v in r.size.items())
+        t = r.timings
+        rows.append(f"<tr{cls}><td class=l>{html.escape(r.method)}</td>"
+                    f"<td class=l>{_params(r, scene)}</td><td class=l>{status}</td>{''.join(cells)}"
+                    f"<td>{t.get('setup_s', 0):.3g}</td><td>{t.get('solve_s', 0):.3g}</td>"
+                    f"<td>{t.get('total_s', 0):.3g}</td><td class=l>{size}</td></tr>")
+    parts.append(f"<table>{head}{''.join(rows)}</table>")
+    sources = sorted({p.source for p in scene.published})
+    if sources:
+        parts.append("<p><small>paper values from: " + "; ".join(map(html.escape, sources))
+                     + "</small></p>")
+    for name, caption in figures:
+        parts.append(f'<figure><img src="figures/{name}" style="max-width:100%">'
+                     f"<figcaption>{html.escape(caption)}</figcaption></figure>")
+    return "\n".join(parts)
+
+
+def page(doc: dict, sections: list[tuple], total_time: float) -> str:
+    runs = doc["runs"]
+    failed = [r for r in runs if r["status"] != "ok"]
+    methods = sorted({r["method"] for r in runs})
+    toc = "".join(f'<li><a href="#{s.id}">{html.escape(s.id)}</a> — {html.escape(s.title)}</li>'
+                  for s, _ in sections)
+    legend = "".join(f"<li><code>{html.escape(m)}</code>: {html.escape(describe(m))}</li>"
+                     for m in methods)
+    body = "\n".join(text for _, text in sections)
+    return f"""<!doctype html><html><head><meta charset="utf-8"><title>pdverify report</title>
+<style>{CSS}</style></head><body>
+<h1>pdverify report</h1>
+<p>pdverify {html.escape(doc['pdverify_version'])}, created {html.escape(doc['created'])},
+Python {html.escape(str(doc['machine']['python']))} on {doc['machine']['cpus']} CPUs.
+{len(runs)} runs, {len(failed)} failed, {total_time:.1f} s in all. Machine-readable:
+<a href="results.json">results.json</a> (schema <code>{html.escape(doc['schema'])}</code>).</p>
+<p>Each table lists one run per row: the method, the parameters that differ from the scene's
+defaults (the paper's values), the metrics with the paper's number beneath where the paper
+prints one, and the cost (setup and solve time, size).</p>
+<h3>Methods</h3><ul>{legend}</ul>
+<h3>Scenes</h3><ul>{toc}</ul>
+{body}
+</body></html>
+"""
