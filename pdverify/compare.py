@@ -1,0 +1,129 @@
+"""Baseline versus new results.json: per-run metric changes, regressions and the exit code."""
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass
+
+from .errors import InputError
+from .results import load_results, run_key
+
+#: Default thresholds. A metric counts as changed when
+#: |new - old| > atol + rtol * |old|. rtol 1e-3 keeps legitimate round-off differences
+#: between machines (BLAS, LU pivoting) out while catching any change of substance;
+#: atol absorbs metrics that sit at round-off level (e.g. 1e-12 % for an exact method),
+#: whose relative change is meaningless. Per-metric overrides below.
+DEFAULT_RTOL = 1e-3
+DEFAULT_ATOL = 1e-9
+METRIC_ATOL = {
+    "_pct": 1e-6,          # percentages: 1e-6 percentage points
+    "rel_l2_error": 1e-10,
+    "gap_nonlinearity": 1e-10,
+}
+
+
+def is_error_metric(name: str) -> bool:
+    """Error-like metrics regress only when they grow; others regress on any change."""
+    return "error" in name or "diff" in name or name.startswith("gap_")
+
+
+def thresholds(name: str, rtol=None, atol=None) -> tuple[float, float]:
+    r = DEFAULT_RTOL if rtol is None else rtol
+    a = DEFAULT_ATOL
+    for suffix, value in METRIC_ATOL.items():
+        if name.endswith(suffix) or name == suffix:
+            a = value
+    return r, (a if atol is None else atol)
+
+
+@dataclass
+class Change:
+    scene: str
+    method: str
+    params: str
+    metric: str
+    old: object
+    new: object
+    verdict: str  # "regression", "improved", "new", "note"
+
+    @property
+    def is_regression(self) -> bool:
+        return self.verdict == "regression"
+
+
+def compare_docs(base: dict, new: dict, *, rtol=None, atol=None) -> list[Change]:
+    """All differences between two pdverify.results/1 documents that exceed the thresholds."""
+    old_runs = {run_key(r["scene"], r["method"], r["params"]): r for r in base["runs"]}
+    new_runs = {run_key(r["scene"], r["method"], r["params"]): r for r in new["runs"]}
+    out: list[Change] = []
+    for key, old in old_runs.items():
+        scene, method, params = key
+        cur = new_runs.get(key)
+        if cur is None:
+            out.append(Change(scene, method, params, "(run)", "present", "missing", "regression"))
+            continue
+        if old["status"] == "ok" and cur["status"] != "ok":
+            out.append(Change(scene, method, params, "(status)", "ok",
+                              f"failed: {cur.get('message', '')}", "regression"))
+            continue
+        if old["status"] != "ok" and cur["status"] == "ok":
+            out.append(Change(scene, method, params, "(status)", "failed", "ok", "improved"))
+        for name, ov in old.get("metrics", {}).items():
+            nv = cur.get("metrics", {}).get(name)
+            if nv is None:
+                out.append(Change(scene, method, params, name, ov, "missing", "regression"))
+                continue
+            if not isinstance(ov, (int, float)) or not isinstance(nv, (int, float)):
+                if ov != nv:
+                    out.append(Change(scene, method, params, name, ov, nv, "regression"))
+                continue
+            r, a = thresholds(name, rtol, atol)
+            if abs(nv - ov) <= a + r * abs(ov):
+                continue
+            if is_error_metric(name) and nv < ov:
+                verdict = "improved"
+            else:
+                verdict = "regression"
+            out.append(Change(scene, method, params, name, ov, nv, verdict))
+    for key in new_runs.keys() - old_runs.keys():
+        scene, method, params = key
+        out.append(Change(scene, method, params, "(run)", "absent", "new", "new"))
+    return out
+
+
+def _short_params(params_json: str) -> str:
+    import json
+    params = json.loads(params_json)
+    return ",".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in params.items())
+
+
+def format_changes(changes: list[Change]) -> str:
+    if not changes:
+        return "no changes beyond the thresholds"
+    rows = [("verdict", "scene", "method", "params", "metric", "baseline", "new")]
+    for c in changes:
+        fmt = (lambda v: f"{v:.6g}" if isinstance(v, float) else str(v))
+        rows.append((c.verdict, c.scene, c.method, _short_params(c.params), c.metric,
+                     fmt(c.old), fmt(c.new)))
+    widths = [min(max(len(r[i]) for r in rows), 90) for i in range(len(rows[0]))]
+    return "\n".join("  ".join(cell[:90].ljust(w) for cell, w in zip(row, widths)) for row in rows)
+
+
+def compare_files(baseline: str, new: str, *, rtol=None, atol=None, stream=None) -> int:
+    """``pdverify compare``: print the table of changes; 1 on any regression, else 0."""
+    stream = stream or sys.stdout
+    for value, flag in ((rtol, "--rtol"), (atol, "--atol")):
+        if value is not None and not value >= 0:
+            raise InputError(f"{flag}={value} must be >= 0")
+    docs = []
+    for path in (baseline, new):
+        try:
+            docs.append(load_results(path))
+        except FileNotFoundError:
+            raise InputError(f"results file {path!r} does not exist") from None
+        except ValueError as exc:
+            raise InputError(str(exc)) from None
+    changes = compare_docs(docs[0], docs[1], rtol=rtol, atol=atol)
+    print(format_changes(changes), file=stream)
+    n_reg = sum(c.is_regression for c in changes)
+    print(f"compare: {n_reg} regression(s), {len(changes) - n_reg} other change(s)", file=stream)
+    return 1 if n_reg else 0
