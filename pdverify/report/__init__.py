@@ -12,8 +12,9 @@ from ..scenes import get_scene
 DEFAULT_OUT = os.path.join("reports", "latest")
 
 
-def build_report(*, out=None, quick=False, only=None, jobs=1, progress=sys.stderr) -> int:
+def build_report(*, out=None, quick=False, only=None, jobs=1, progress=None) -> int:
     """Run the report; returns 0, or 1 if any run failed. Bad input raises before work."""
+    progress = progress or sys.stderr
     out = out or DEFAULT_OUT
     cases = plan(only=only, quick=quick)  # raises InputError on unknown scenes
     if jobs < 1:

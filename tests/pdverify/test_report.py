@@ -1,0 +1,70 @@
+"""The report: files written, atomic results.json, failures recorded, not fatal."""
+import json
+
+import pytest
+
+from pdverify import results as results_mod
+from pdverify.report import build_report
+
+
+def test_quick_report_writes_results_html_and_figures(tmp_path, capsys):
+    out = tmp_path / "rep"
+    rc = build_report(out=str(out), quick=True, only=["bar1d-traction", "bar1d-force-flux"])
+    assert rc == 0
+    doc = json.loads((out / "results.json").read_text())
+    assert doc["schema"] == "pdverify.results/1"
+    scenes = {r["scene"] for r in doc["runs"]}
+    assert scenes == {"bar1d-traction", "bar1d-force-flux"}
+    html = (out / "index.html").read_text()
+    assert "bar1d-traction" in html and "paper:" in html
+    pngs = list((out / "figures").glob("*.png"))
+    assert len(pngs) >= 2
+    # one progress line per run
+    err = capsys.readouterr().err
+    assert err.count("] bar1d-") == len(doc["runs"])
+
+
+def test_interrupted_write_keeps_the_old_results(tmp_path, monkeypatch):
+    out = tmp_path / "rep"
+    assert build_report(out=str(out), only=["bar1d-traction"]) == 0
+    before = (out / "results.json").read_text()
+
+    def broken(*a, **k):
+        raise KeyboardInterrupt  # interruption in the middle of serialising
+
+    monkeypatch.setattr(results_mod.json, "dumps", broken)
+    with pytest.raises(KeyboardInterrupt):
+        build_report(out=str(out), only=["bar1d-traction"])
+    assert (out / "results.json").read_text() == before
+    assert not [p for p in out.iterdir() if p.name.startswith(".tmp-")]
+
+
+def test_a_failed_run_is_recorded_and_the_report_goes_on(tmp_path, monkeypatch):
+    import pdverify.scenes.bar1d as mod
+    from pdverify.errors import NumericalError
+    real = mod.solve_constrained
+    calls = {"n": 0}
+
+    def sometimes(*a, **k):
+        calls["n"] += 1
+        if calls["n"] == 1:
+            raise NumericalError("bar1d-traction/none: near-singular system")
+        return real(*a, **k)
+
+    monkeypatch.setattr(mod, "solve_constrained", sometimes)
+    out = tmp_path / "rep"
+    assert build_report(out=str(out), only=["bar1d-traction"]) == 1
+    doc = json.loads((out / "results.json").read_text())
+    status = [r["status"] for r in doc["runs"]]
+    assert status[0] == "failed" and "near-singular" in doc["runs"][0]["message"]
+    assert all(s == "ok" for s in status[1:])
+    assert "failed: bar1d-traction/none: near-singular" in (out / "index.html").read_text()
+
+
+def test_parallel_jobs_give_the_same_numbers(tmp_path):
+    a, b = tmp_path / "a", tmp_path / "b"
+    assert build_report(out=str(a), only=["bar1d-sine-load"], jobs=1) == 0
+    assert build_report(out=str(b), only=["bar1d-sine-load"], jobs=2) == 0
+    ra = json.loads((a / "results.json").read_text())["runs"]
+    rb = json.loads((b / "results.json").read_text())["runs"]
+    assert [r["metrics"] for r in ra] == [r["metrics"] for r in rb]
