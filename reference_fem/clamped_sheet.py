@@ -93,6 +93,11 @@ class ClampedSheetResult(ReferenceResult):
     uniform_refinement: tuple
     observed_rate: float
 
+    def metrics(self) -> dict:
+        """Scene metrics of issue 5."""
+        return {"tensile_stress_mpa": self.tensile_stress_mpa,
+                "refinement_change_pct": float(self.refinement_change_pct)}
+
 
 def solve_level(p: ClampedSheetParams, n: int, power: float):
     """One mesh with n elements per side: returns (model, stress_top, stress_bottom, field,

@@ -73,6 +73,11 @@ class PlateResult(ReferenceResult):
     max_abs_u: float
     max_abs_v: float
 
+    def metrics(self) -> dict:
+        """Scene metrics of issue 5."""
+        return {"max_displacement": self.max_displacement,
+                "refinement_change_pct": float(self.refinement_change_pct)}
+
 
 def _sample_points(p: PlateParams) -> np.ndarray:
     nx = int(round(p.length / p.sample_spacing))

@@ -24,7 +24,7 @@ class RefinementRow:
     change_pct : 100 |q_l - q_{l-1}| / |q_l| (NaN at level 0).
     setup_s : mesh, basis and assembly wall time (s).
     solve_s : condensation, factorisation, solve(s) and post-processing wall time (s).
-    extra : further compared values of this level (name -> float).
+    extra : further compared values of this level (name -> number).
     """
 
     level: int
@@ -88,6 +88,30 @@ class ReferenceResult:
     def to_vtu(self, path: str | Path) -> Path:
         """Write the converged field to VTU (meshio)."""
         return self.field.to_vtu(path)
+
+    def metrics(self) -> dict:
+        """Scene metrics of issue 5 (floats): the reference-specific ones plus
+        ``refinement_change_pct``."""
+        return {"refinement_change_pct": float(self.refinement_change_pct)}
+
+    def timings(self) -> dict:
+        """Wall times (s): converged level setup and solve, and the whole study."""
+        return {"setup_s": float(self.setup_s), "solve_s": float(self.solve_s),
+                "total_s": float(self.study_s)}
+
+    def sample_grid(self, shape: tuple = (81, 81)) -> dict:
+        """Fields on a regular grid over the domain box (for plots): ``x``, ``y`` of the
+        given shape ('ij' indexing), displacement ``ux``, ``uy`` (m) and
+        ``strain_energy_density`` (J/m^3)."""
+        b = self.field.bounds
+        axes = [np.linspace(lo, hi, n) for (lo, hi), n in zip(b, shape)]
+        grids = np.meshgrid(*axes, indexing="ij")
+        pts = np.stack([g.ravel() for g in grids], axis=1)
+        u = self.field.evaluate(pts)
+        out = {"x": grids[0], "y": grids[1], "ux": u[:, 0].reshape(shape),
+               "uy": u[:, 1].reshape(shape),
+               "strain_energy_density": self.field.strain_energy_density(pts).reshape(shape)}
+        return out
 
     def refinement_table(self) -> list[dict]:
         """The refinement study as a list of plain dicts (for JSON or a report table)."""

@@ -88,6 +88,12 @@ class TensionSheetResult(ReferenceResult):
         return closed_form(points, **{k: self.params[k]
                                       for k in ("traction", "E", "nu", "mode")})
 
+    def metrics(self) -> dict:
+        """Scene metrics of issue 5."""
+        return {"max_error_pct": self.max_error_pct, "max_error_ux_pct": self.max_error_ux_pct,
+                "max_error_uy_pct": self.max_error_uy_pct,
+                "refinement_change_pct": float(self.refinement_change_pct)}
+
 
 def closed_form(points: np.ndarray, *, traction: float, E: float, nu: float,
                 mode: str = "plane_stress") -> np.ndarray:

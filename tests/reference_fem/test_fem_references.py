@@ -117,8 +117,10 @@ def test_clamped_sheet_graded_convergence(clamped):
 def test_indentation_converged(indent):
     # issue 5: change of the full-depth force over the last refinement below 1 %
     assert indent.refinement_change_pct < 1.0
-    # the whole curve and the step count stay within the same 1 % budget
+    # the whole curve stays within the same 1 % budget, also step by step relative to
+    # each step's own force, and against doubling the contact increments
     assert indent.curve_change_pct < 1.0
+    assert indent.curve_rel_change_pct < 1.0
     assert indent.step_change_pct < 1.0
     assert len(indent.depths) >= 21 and indent.depths[-1] == pytest.approx(0.002, rel=1e-12)
 
@@ -129,7 +131,9 @@ def test_indentation_curve_monotone_and_width_grows(indent):
     assert np.all(np.diff(w) >= 0)          # no separation: stuck nodes never release
     first = w[np.flatnonzero(w > 0)[0]]
     assert w[-1] > 1.5 * first              # and contact spreads as the indenter sinks
+    assert np.all(np.diff(indent.contact_nodes) >= 0)
     assert indent.max_force == indent.forces[-1] == indent.quantity
+    assert indent.metrics()["force_monotone"] == 1.0
 
 
 def test_indentation_contact_kinematics_and_equilibrium(indent):
@@ -175,6 +179,12 @@ def test_result_records(name, request):
     dofs = [r.dofs for r in res.refinement]
     assert dofs == sorted(dofs) and len(set(dofs)) == len(dofs)
     assert res.setup_s > 0 and res.solve_s > 0 and res.study_s >= res.setup_s + res.solve_s
+    metrics = res.metrics()
+    assert metrics["refinement_change_pct"] == res.refinement_change_pct
+    assert all(isinstance(v, float) for v in metrics.values())
+    assert set(res.timings()) == {"setup_s", "solve_s", "total_s"}
+    grid = res.sample_grid((5, 7))
+    assert grid["ux"].shape == grid["strain_energy_density"].shape == (5, 7)
     bounds = res.field.bounds
     outside = np.array([[bounds[0, 1] + 1.0, bounds[1, 0]]])
     with pytest.raises(ValueError, match="1 of 1 points lie outside the domain"):
