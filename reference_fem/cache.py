@@ -71,6 +71,7 @@ def cached(reference: str, params: dict, compute: Callable[[], results.Reference
         os.close(fd)
         try:
             results.to_npz(res, Path(tmp))
+            os.chmod(tmp, 0o644)  # mkstemp creates 0600; the cache is plain shared data
             # the temporary name ends in .npz, so np.savez writes exactly that file
             os.replace(tmp, path)
         finally:

@@ -60,7 +60,7 @@ class ClampedSheetParams:
     def __post_init__(self):
         _p.positive(REFERENCE, horizon=self.horizon, side_factor=self.side_factor,
                     E=self.E, thickness=self.thickness, grading_power=self.grading_power)
-        _p.require(-1 < self.nu < 1, REFERENCE, f"nu must lie in (-1, 1), got {self.nu}")
+        _p.require(-1 < self.nu < 0.5, REFERENCE, f"nu must lie in (-1, 0.5), got {self.nu}")
         _p.require(self.strain != 0, REFERENCE, "strain must be nonzero")
         _p.require(self.elements >= 2 and self.elements % 2 == 0, REFERENCE,
                    f"elements must be even and >= 2, got {self.elements}")

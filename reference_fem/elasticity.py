@@ -40,9 +40,8 @@ class Material:
             raise ValueError(f"mode {self.mode!r} unknown; allowed: {', '.join(MODES)}")
         if not self.E > 0:
             raise ValueError(f"E must be positive, got {self.E!r}")
-        upper = 1.0 if self.mode == "plane_stress" else 0.5
-        if not -1.0 < self.nu < upper:
-            raise ValueError(f"nu must lie in (-1, {upper}) for {self.mode}, got {self.nu!r}")
+        if not -1.0 < self.nu < 0.5:
+            raise ValueError(f"nu must lie in (-1, 0.5), got {self.nu!r}")
         if not self.thickness > 0:
             raise ValueError(f"thickness must be positive, got {self.thickness!r}")
 

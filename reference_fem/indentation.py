@@ -90,7 +90,7 @@ class IndentationParams:
                     depth=self.depth, E=self.E, thickness=self.thickness,
                     spacing=self.spacing, fine_half_width=self.fine_half_width,
                     fine_depth=self.fine_depth)
-        _p.require(-1 < self.nu < 1, REFERENCE, f"nu must lie in (-1, 1), got {self.nu}")
+        _p.require(-1 < self.nu < 0.5, REFERENCE, f"nu must lie in (-1, 0.5), got {self.nu}")
         _p.require(self.n_steps >= 1, REFERENCE, f"n_steps must be >= 1, got {self.n_steps}")
         _p.require(self.substeps >= 1, REFERENCE, f"substeps must be >= 1, got {self.substeps}")
         _p.require(self.depth < self.radius, REFERENCE, "depth must be below the radius")

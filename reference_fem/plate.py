@@ -50,7 +50,7 @@ class PlateParams:
     def __post_init__(self):
         _p.positive(REFERENCE, length=self.length, width=self.width, thickness=self.thickness,
                     E=self.E, spacing=self.spacing, sample_spacing=self.sample_spacing)
-        _p.require(-1 < self.nu < 1, REFERENCE, f"nu must lie in (-1, 1), got {self.nu}")
+        _p.require(-1 < self.nu < 0.5, REFERENCE, f"nu must lie in (-1, 0.5), got {self.nu}")
         _p.require(self.body_force != 0, REFERENCE, "body_force must be nonzero")
         _p.require(2 <= self.levels <= 7, REFERENCE, f"levels must be 2..7, got {self.levels}")
         for name, L in (("length", self.length), ("width", self.width)):

@@ -58,6 +58,7 @@ class TensionSheetParams:
                     thickness=self.thickness, spacing=self.spacing)
         _p.require(self.mode in MODES[:2], REFERENCE,
                    f"mode must be plane_stress or plane_strain, got {self.mode!r}")
+        _p.require(-1 < self.nu < 0.5, REFERENCE, f"nu must lie in (-1, 0.5), got {self.nu}")
         _p.require(self.traction != 0, REFERENCE, "traction must be nonzero")
         _p.require(2 <= self.levels <= 6, REFERENCE, f"levels must be 2..6, got {self.levels}")
         for name, L in (("width", self.width), ("length", self.length)):
