@@ -15,7 +15,10 @@ Contact law (our exact choice; the paper gives only the sentence above):
 - Candidates are all DOF nodes of the top edge (vertices and edge midpoints of the Q2
   mesh); the rest of the boundary cannot be reached for depth < R <= W/2.
 - Small-strain linear elasticity; contact is checked on the deformed position
-  x = X + u of each free candidate node.
+  x = X + u of each free candidate node. The paper does not state its FEM kinematics
+  ("moving away from small-displacement situations"); at full depth the compressive
+  strain under the indenter reaches about 13 %, so a finite-strain FEM may differ by an
+  amount of that order (not quantified here).
 - The depth is ramped in n_steps * substeps equal increments (20 * 8 = 160 by default)
   and reported at the n_steps output depths. The law is path dependent: with only 20
   increments the first one catches the whole geometric chord 2 sqrt(2 R Delta d) before
@@ -210,6 +213,7 @@ def solve_level(p: IndentationParams, level: int, check_steps: bool = False) -> 
     return dict(model=model, field=model.field(u), depths=out["depths"], forces=out["forces"],
                 widths=out["widths"], counts=out["counts"], contact_x=X0[S] + target[:, 0],
                 contact_y=target[:, 1], constraint_error=float(err / p.depth),
+                stuck_dofs=np.stack([cx[S], cy[S]]), stuck_targets=target,
                 bottom_reaction=bottom_reaction, n_solves=store.n_solves + 1,
                 step_change_pct=step_change, setup_s=t_setup, solve_s=solve_s,
                 h_min=float(min(np.diff(model.coords[0]).min(), np.diff(model.coords[1]).min())))

@@ -4,6 +4,7 @@ import pytest
 
 import reference_fem as rf
 from reference_fem.clamped_sheet import observed_rate
+from reference_fem.field import midpoint_refined
 
 
 @pytest.fixture(scope="module")
@@ -149,6 +150,37 @@ def test_indentation_contact_kinematics_and_equilibrium(indent):
     centre = indent.evaluate(np.array([[0.0, 0.0]]))[0]
     np.testing.assert_allclose(centre, [0.0, -d], atol=1e-9 * d)
     assert indent.contact_x.size == indent.contact_nodes[-1]
+
+
+def test_indentation_no_free_node_penetrates(indent):
+    p = indent.params
+    R, d = p["radius"], p["depth"]
+    x_top = midpoint_refined(indent.field.coords[0])
+    pts = np.stack([x_top, np.zeros_like(x_top)], axis=1)
+    pos = pts + indent.evaluate(pts)
+    gap = np.hypot(pos[:, 0], pos[:, 1] - (R - d)) - R
+    # catch threshold of the contact law (module docstring): penetration > 1e-9 R
+    assert gap.min() >= -1e-9 * R
+    assert np.sum(np.abs(gap) < 1e-12 * R) >= indent.contact_nodes[-1]
+
+
+def test_indentation_flexibility_solver_matches_direct_condensation(cache_env):
+    """Cross-check of the G = K^-1 contact solver: the final stuck set imposed as plain
+    Dirichlet data (skfem.condense) reproduces the force (round-off tolerance)."""
+    from reference_fem.indentation import IndentationParams, solve_level
+
+    p = IndentationParams(n_steps=20, substeps=2)
+    s = solve_level(p, 0)
+    model = s["model"]
+    bottom = model.dofs(lambda x, y: y < -p.height + 1e-12)
+    fixed = np.concatenate([bottom, s["stuck_dofs"][0], s["stuck_dofs"][1]])
+    vals = np.concatenate([np.zeros(bottom.size), s["stuck_targets"][:, 0],
+                           s["stuck_targets"][:, 1]])
+    u = model.solve(np.zeros(model.basis.N), fixed, vals)
+    force = -model.reactions(u)[s["stuck_dofs"][1]].sum()
+    np.testing.assert_allclose(force, s["forces"][-1], rtol=1e-9)
+    np.testing.assert_allclose(model.field(u).values, s["field"].values, rtol=0,
+                               atol=1e-9 * p.depth)
 
 
 def test_indentation_fields_at_full_depth(indent):
