@@ -88,7 +88,8 @@ class TensorElasticity:
                              f"(needs {material.dim})")
         for k, c in enumerate(self.coords):
             if c.ndim != 1 or c.size < 2 or np.any(np.diff(c) <= 0):
-                raise ValueError(f"axis {k}: coordinates must be 1D, >= 2 values, strictly increasing")
+                raise ValueError(f"axis {k}: coordinates must be 1D, >= 2 values, "
+                                 "strictly increasing")
         self.material = material
         self.dim = material.dim
         if self.dim == 2:

@@ -305,6 +305,7 @@ def compute(p: IndentationParams) -> IndentationResult:
     for level in range(p.levels):
         s = solve_level(p, level, check_steps=level == p.levels - 1)
         q = float(s["forces"][-1])
+        q_prev = None if prev is None else prev["forces"][-1]
         extra = {"contact_width_m": float(s["widths"][-1]),
                  "contact_nodes": int(s["counts"][-1]), "solves": int(s["n_solves"])}
         if prev is not None:
@@ -312,7 +313,7 @@ def compute(p: IndentationParams) -> IndentationResult:
             extra["curve_change_pct"] = float(100 * np.max(dF) / abs(q))
             extra["curve_rel_change_pct"] = float(100 * np.max(dF / s["forces"][1:]))
         rows.append(RefinementRow(level=level, dofs=int(s["model"].basis.N), h_min=s["h_min"],
-                                  quantity=q, change_pct=change_pct(q, None if prev is None else prev["forces"][-1]),
+                                  quantity=q, change_pct=change_pct(q, q_prev),
                                   setup_s=s["setup_s"], solve_s=s["solve_s"], extra=extra))
         prev = s
     forces = s["forces"]
