@@ -1,0 +1,340 @@
+"""block2d-indentation: seed 003 Sec. 4.2, rigid circular indenter with sticking contact.
+
+Seed 003 (Ritter et al.), Sec. 4.2: square block of edge 40 mm, rigid circular indenter
+of radius R = 15 mm pressed into the middle of the top edge, depth ramped from 0 to 2 mm;
+"parts of the surface that get in contact with the indenter move without slip along with
+the indenter surface". The paper's FEM used square elements of 0.25 mm. ERRATA (chosen):
+E = 1 GPa, nu = 1/3, plane stress, unit thickness, bottom edge fixed, sides free, indenter
+centred, at least 20 depth steps, a surface node sticks once the indenter reaches it.
+
+Frame: x in [-W/2, W/2], y in [-H, 0]; the top surface is y = 0 and the indenter at
+depth d is the disc of radius R centred at (0, R - d).
+
+Contact law (our exact choice; the paper gives only the sentence above):
+
+- Candidates are all DOF nodes of the top edge (vertices and edge midpoints of the Q2
+  mesh); the rest of the boundary cannot be reached for depth < R <= W/2.
+- Small-strain linear elasticity; contact is checked on the deformed position
+  x = X + u of each free candidate node. The paper does not state its FEM kinematics
+  ("moving away from small-displacement situations"); at full depth the compressive
+  strain under the indenter reaches about 13 %, so a finite-strain FEM may differ by an
+  amount of that order (not quantified here).
+- The depth is ramped in n_steps * substeps equal increments (20 * 8 = 160 by default)
+  and reported at the n_steps output depths. The law is path dependent: with only 20
+  increments the first one catches the whole geometric chord 2 sqrt(2 R Delta d) before
+  the surface can deform, and the force at 0.1 mm comes out about 25 % low (0.2 mm: 4 %;
+  2 mm: < 0.01 %); from 160 increments on, doubling changes every output force by less
+  than 0.2 %. ``substeps=1`` gives the plain 20-step process, e.g. to match a PD run
+  stepped the same way.
+- At each increment the indenter moves down by Delta d. Every stuck
+  node moves rigidly with it: u_y decreases by Delta d, u_x stays frozen (no slip, no
+  separation; stuck nodes never release, whatever the sign of their force).
+- Within the step: solve; every free candidate whose deformed position lies inside the
+  disc (penetration > 1e-9 R) is caught: its u_x is frozen at its current value and its
+  u_y is set so that it lies on the indenter surface at that x (vertical projection);
+  re-solve; repeat until no free node penetrates. The set of stuck nodes only grows, so
+  this terminates. A node so caught stays on the indenter surface at fixed x afterwards.
+- Force = sum of the y reactions of the stuck nodes (positive = pushing the block
+  down), for the given thickness (N; with unit thickness this is N per metre).
+- Contact width = x distance between the outermost stuck nodes (deformed positions); it
+  is quantised by the surface node spacing h / 2.
+
+Solution method: the bottom-fixed stiffness is factorised once per mesh. Stuck DOFs carry
+unknown point forces only, so the candidate displacements are u_C = G_CS f_S with
+G = K^-1 restricted to the candidate rows; the columns of G for a node are computed (two
+solves) when it is caught. Each contact iteration is then a dense solve of size 2 |S|.
+The full field is one more solve at full depth.
+
+Mesh: tensor-product Q2 mesh with uniform spacing h in |x| <= fine_half_width and in
+y >= -fine_depth, growing geometrically (grading_ratio) outside; level l bisects every
+element of level 0 l times (nested meshes, every element halves). The compared quantity
+is the force at full depth; its level-to-level change (and that of the whole force-depth
+curve) is recorded.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse.linalg as spla
+
+from . import params as _p
+from .cache import cached
+from .elasticity import Material, TensorElasticity
+from .field import midpoint_refined
+from .meshing import fine_then_geometric
+from .results import ReferenceResult, RefinementRow, change_pct
+
+REFERENCE = "block2d-indentation"
+
+
+@dataclass(frozen=True)
+class IndentationParams:
+    """Parameters (defaults: seed 003 Sec. 4.2 and ERRATA)."""
+
+    width: float = 0.040           # m, Sec. 4.2
+    height: float = 0.040          # m, Sec. 4.2
+    radius: float = 0.015          # indenter radius (m), Sec. 4.2
+    depth: float = 0.002           # final indentation depth (m), Sec. 4.2
+    n_steps: int = 20              # output depth steps, ERRATA: at least 20
+    substeps: int = 8              # contact increments per output step (path dependence)
+    E: float = 1e9                 # Pa, ERRATA (chosen)
+    nu: float = 1.0 / 3.0          # ERRATA (chosen)
+    thickness: float = 1.0         # m, ERRATA: unit thickness
+    spacing: float = 0.001         # fine element edge of level 0 (m)
+    fine_half_width: float = 0.010  # |x| range of the fine zone (m); contact half-width ~4.4 mm
+    fine_depth: float = 0.004      # depth of the fine zone below the top (m)
+    grading_ratio: float = 1.3     # element growth factor outside the fine zone (level 0)
+    levels: int = 3                # level l halves every element l times
+
+    def __post_init__(self):
+        _p.positive(REFERENCE, width=self.width, height=self.height, radius=self.radius,
+                    depth=self.depth, E=self.E, thickness=self.thickness,
+                    spacing=self.spacing, fine_half_width=self.fine_half_width,
+                    fine_depth=self.fine_depth)
+        _p.require(-1 < self.nu < 0.5, REFERENCE, f"nu must lie in (-1, 0.5), got {self.nu}")
+        _p.require(self.n_steps >= 1, REFERENCE, f"n_steps must be >= 1, got {self.n_steps}")
+        _p.require(self.substeps >= 1, REFERENCE, f"substeps must be >= 1, got {self.substeps}")
+        _p.require(self.depth < self.radius, REFERENCE, "depth must be below the radius")
+        _p.require(self.radius <= self.width / 2, REFERENCE,
+                   "radius must not exceed width / 2 (only the top edge can be reached)")
+        _p.require(self.depth < self.height / 4, REFERENCE, "depth must be below height / 4")
+        _p.require(1.0 <= self.grading_ratio <= 2.0, REFERENCE,
+                   f"grading_ratio must lie in [1, 2], got {self.grading_ratio}")
+        _p.require(2 <= self.levels <= 5, REFERENCE, f"levels must be 2..5, got {self.levels}")
+
+
+@dataclass(frozen=True, eq=False, kw_only=True)
+class IndentationResult(ReferenceResult):
+    """Converged indentation (see :class:`ReferenceResult`; ``field`` is at full depth).
+
+    Attributes
+    ----------
+    depths : indenter depth per step, 0 first (m), shape (n_steps + 1,).
+    forces : indentation force per step (N, for the thickness), same shape.
+    contact_widths : contact width per step (m), same shape.
+    contact_nodes : number of stuck surface nodes per step, same shape.
+    max_force : force at full depth (N); equals ``quantity``.
+    force_monotone : True if the force increases strictly with depth.
+    contact_x, contact_y : deformed positions of the stuck nodes at full depth (m).
+    curve_change_pct : max over output steps of the force change between the last two
+        levels, relative to the full-depth force (percent).
+    curve_rel_change_pct : the same change relative to each step's own force (percent);
+        dominated by the first steps, where the contact spans few elements.
+    max_constraint_error : max |u - prescribed| over stuck DOFs in the full-depth field,
+        relative to the depth (a solver check).
+    bottom_reaction : total y reaction of the fixed bottom edge at full depth (N); equals
+        ``max_force`` by equilibrium (a check).
+    step_change_pct : max over output steps of the relative force change when the finest
+        mesh is stepped with twice the substeps (path dependence of the sticking law), %.
+    """
+
+    depths: np.ndarray
+    forces: np.ndarray
+    contact_widths: np.ndarray
+    contact_nodes: np.ndarray
+    max_force: float
+    force_monotone: bool
+    contact_x: np.ndarray
+    contact_y: np.ndarray
+    curve_change_pct: float
+    curve_rel_change_pct: float
+    max_constraint_error: float
+    bottom_reaction: float
+    step_change_pct: float
+
+    def metrics(self) -> dict:
+        """Scene metrics of issue 5."""
+        return {"max_force": self.max_force, "force_monotone": float(self.force_monotone),
+                "refinement_change_pct": float(self.refinement_change_pct)}
+
+
+def _bisect(c: np.ndarray, times: int) -> np.ndarray:
+    for _ in range(times):
+        c = midpoint_refined(c)
+    return c
+
+
+def mesh_coordinates(p: IndentationParams, level: int):
+    """Vertex coordinates (x, y) of refinement level ``level``."""
+    xs = fine_then_geometric(-p.width / 2, p.width / 2, -p.fine_half_width, p.fine_half_width,
+                             p.spacing, p.grading_ratio)
+    ys = fine_then_geometric(-p.height, 0.0, -p.fine_depth, 0.0, p.spacing, p.grading_ratio)
+    return _bisect(xs, level), _bisect(ys, level)
+
+
+def solve_level(p: IndentationParams, level: int, check_steps: bool = False) -> dict:
+    """Quasi-static sticking-contact stepping on one mesh (see the module docstring);
+    with ``check_steps`` the stepping is repeated with 2 n_steps on the same mesh."""
+    t0 = time.perf_counter()
+    model = TensorElasticity(mesh_coordinates(p, level),
+                             Material(p.E, p.nu, "plane_stress", p.thickness))
+    K = model.stiffness
+    N = model.basis.N
+    tol = 1e-9 * p.height
+    bottom = model.dofs(lambda x, y: y < -p.height + tol)
+    free = np.setdiff1d(np.arange(N), bottom)
+    lu = spla.splu(K[free][:, free].tocsc(), permc_spec="MMD_AT_PLUS_A")
+    row_of = np.full(N, -1)
+    row_of[free] = np.arange(free.size)
+    on_top = lambda x, y: y > -tol  # noqa: E731
+    cx, cy = model.dofs(on_top, [0]), model.dofs(on_top, [1])
+    cx = cx[np.argsort(model.dof_coords[0, cx])]
+    cy = cy[np.argsort(model.dof_coords[0, cy])]
+    X0 = model.dof_coords[0, cx]
+    if not np.allclose(X0, model.dof_coords[0, cy]):
+        raise RuntimeError("top-edge x and y DOFs do not pair up")
+    nc = X0.size
+    cand_rows = row_of[np.concatenate([cx, cy])]   # candidate DOF order: all u_x, then all u_y
+    t_setup = time.perf_counter() - t0
+
+    t1 = time.perf_counter()
+    store = _FlexibilityColumns(lu, free.size, cand_rows)
+    out = _contact_steps(p, p.substeps, store, X0)
+    S, fS = out["order"], out["fS"]
+    # full field at full depth: point forces on the stuck DOFs, bottom fixed
+    f = np.zeros(N)
+    f[cx[S]], f[cy[S]] = fS[0::2], fS[1::2]
+    u = np.zeros(N)
+    u[free] = lu.solve(f[free])
+    if not np.all(np.isfinite(u)):
+        raise FloatingPointError("indentation: non-finite displacement")
+    target = out["target"]
+    err = max(np.max(np.abs(u[cx[S]] - target[:, 0])), np.max(np.abs(u[cy[S]] - target[:, 1])))
+    bottom_y = model.dofs(lambda x, y: y < -p.height + tol, [1])
+    bottom_reaction = float((model.reactions(u)[bottom_y]).sum())
+    solve_s = time.perf_counter() - t1
+    step_change = float("nan")
+    if check_steps:
+        twice = _contact_steps(p, 2 * p.substeps, store, X0)
+        step_change = float(100 * np.max(np.abs(twice["forces"] - out["forces"])[1:]
+                                         / twice["forces"][1:]))
+    return dict(model=model, field=model.field(u), depths=out["depths"], forces=out["forces"],
+                widths=out["widths"], counts=out["counts"], contact_x=X0[S] + target[:, 0],
+                contact_y=target[:, 1], constraint_error=float(err / p.depth),
+                stuck_dofs=np.stack([cx[S], cy[S]]), stuck_targets=target,
+                bottom_reaction=bottom_reaction, n_solves=store.n_solves + 1,
+                step_change_pct=step_change, setup_s=t_setup, solve_s=solve_s,
+                h_min=float(min(np.diff(model.coords[0]).min(), np.diff(model.coords[1]).min())))
+
+
+class _FlexibilityColumns:
+    """Columns of G = K^-1 (rows: candidate DOFs) for unit forces at candidate nodes,
+    computed once per node (two solves) when first needed.
+
+    ``cand_rows`` are the rows (in the numbering of the factorised system) of the top-edge
+    DOFs, all u_x then all u_y; column 2 i (2 i + 1) of :attr:`G` is the response to a
+    unit x (y) force at candidate node i.
+    """
+
+    def __init__(self, lu, n_free: int, cand_rows: np.ndarray):
+        self.lu, self.n_free, self.rows = lu, n_free, cand_rows
+        self.nc = cand_rows.size // 2
+        self.G = np.zeros((2 * self.nc, 2 * self.nc))
+        self.known = np.zeros(self.nc, dtype=bool)
+        self.n_solves = 0
+
+    def ensure(self, nodes: np.ndarray) -> None:
+        new = nodes[~self.known[nodes]]
+        if new.size == 0:
+            return
+        rhs = np.zeros((self.n_free, 2 * new.size))
+        k = np.arange(new.size)
+        rhs[self.rows[new], 2 * k] = 1.0
+        rhs[self.rows[self.nc + new], 2 * k + 1] = 1.0
+        cols = self.lu.solve(rhs)[self.rows]
+        self.G[:, 2 * new] = cols[:, 0::2]
+        self.G[:, 2 * new + 1] = cols[:, 1::2]
+        self.known[new] = True
+        self.n_solves += rhs.shape[1]
+
+
+def _contact_steps(p: IndentationParams, substeps: int, store: _FlexibilityColumns,
+                   X0: np.ndarray) -> dict:
+    """Depth stepping with the sticking contact law of the module docstring, in
+    ``p.n_steps * substeps`` equal increments, recorded at the ``p.n_steps`` output depths.
+    ``X0`` are the x coordinates of the candidate nodes (the order of ``store``).
+    """
+    nc = X0.size
+    n_inc = p.n_steps * substeps
+    R, dd = p.radius, p.depth / n_inc
+    stuck = np.zeros(nc, dtype=bool)
+    target = np.zeros((nc, 2))         # prescribed (u_x, u_y) of stuck nodes
+    uc = np.zeros((nc, 2))             # current candidate displacements
+    S = np.zeros(0, dtype=np.int64)    # stuck nodes
+    fS = np.zeros(0)                   # their forces, interleaved (x, y)
+    depths, forces, widths, counts = [0.0], [0.0], [0.0], [0]
+    for step in range(1, n_inc + 1):
+        d = p.depth * step / n_inc
+        yc = R - d
+        target[stuck, 1] -= dd
+        while True:
+            if S.size:
+                cols = np.stack([2 * S, 2 * S + 1], axis=1).ravel()
+                rows = np.stack([S, nc + S], axis=1).ravel()
+                GS = store.G[:, cols]
+                fS = np.linalg.solve(GS[rows], target[S].ravel())
+                u = GS @ fS
+                uc = np.stack([u[:nc], u[nc:]], axis=1)
+            x, y = X0 + uc[:, 0], uc[:, 1]
+            gap = np.hypot(x, y - yc) - R
+            new = np.flatnonzero(~stuck & (gap < -1e-9 * R))
+            if new.size == 0:
+                break
+            stuck[new] = True
+            target[new, 0] = uc[new, 0]
+            target[new, 1] = yc - np.sqrt(R ** 2 - x[new] ** 2)
+            store.ensure(new)
+            S = np.concatenate([S, new])
+        if step % substeps:
+            continue
+        xs_stuck = X0[stuck] + target[stuck, 0]
+        depths.append(d)
+        forces.append(-float(fS[1::2].sum()))
+        widths.append(float(xs_stuck.max() - xs_stuck.min()) if xs_stuck.size else 0.0)
+        counts.append(int(stuck.sum()))
+    return dict(order=S, fS=fS, target=target[S], depths=np.array(depths),
+                forces=np.array(forces), widths=np.array(widths), counts=np.array(counts))
+
+
+def compute(p: IndentationParams) -> IndentationResult:
+    """Run the refinement study (no cache)."""
+    t_start = time.perf_counter()
+    rows, prev = [], None
+    for level in range(p.levels):
+        s = solve_level(p, level, check_steps=level == p.levels - 1)
+        q = float(s["forces"][-1])
+        q_prev = None if prev is None else prev["forces"][-1]
+        extra = {"contact_width_m": float(s["widths"][-1]),
+                 "contact_nodes": int(s["counts"][-1]), "solves": int(s["n_solves"])}
+        if prev is not None:
+            dF = np.abs(s["forces"] - prev["forces"])[1:]
+            extra["curve_change_pct"] = float(100 * np.max(dF) / abs(q))
+            extra["curve_rel_change_pct"] = float(100 * np.max(dF / s["forces"][1:]))
+        rows.append(RefinementRow(level=level, dofs=int(s["model"].basis.N), h_min=s["h_min"],
+                                  quantity=q, change_pct=change_pct(q, q_prev),
+                                  setup_s=s["setup_s"], solve_s=s["solve_s"], extra=extra))
+        prev = s
+    forces = s["forces"]
+    return IndentationResult(
+        reference=REFERENCE, params=_p.as_dict(p), quantity_name="force at full depth (N)",
+        quantity=q, refinement=tuple(rows), refinement_change_pct=rows[-1].change_pct,
+        setup_s=s["setup_s"], solve_s=s["solve_s"], study_s=time.perf_counter() - t_start,
+        field=s["field"], depths=s["depths"], forces=forces, contact_widths=s["widths"],
+        contact_nodes=s["counts"], max_force=float(forces.max()),
+        force_monotone=bool(np.all(np.diff(forces) > 0)), contact_x=s["contact_x"],
+        contact_y=s["contact_y"], curve_change_pct=rows[-1].extra["curve_change_pct"],
+        curve_rel_change_pct=rows[-1].extra["curve_rel_change_pct"],
+        max_constraint_error=s["constraint_error"], bottom_reaction=s["bottom_reaction"],
+        step_change_pct=s["step_change_pct"])
+
+
+def indentation(*, use_cache: bool = True, **params) -> IndentationResult:
+    """Converged, cached FEM reference of the rigid-indenter problem (seed 003 Sec. 4.2).
+
+    Keyword arguments override :class:`IndentationParams`.
+    """
+    p = _p.build(IndentationParams, REFERENCE, params)
+    return cached(REFERENCE, _p.as_dict(p), lambda: compute(p),
+                  {"IndentationResult": IndentationResult}, use_cache=use_cache)
