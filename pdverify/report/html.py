@@ -60,6 +60,9 @@ def scene_section(scene, results, figures) -> str:
                     f"<td>{t.get('setup_s', 0):.3g}</td><td>{t.get('solve_s', 0):.3g}</td>"
                     f"<td>{t.get('total_s', 0):.3g}</td><td class=l>{size}</td></tr>")
     parts.append(f"<table>{head}{''.join(rows)}</table>")
+    for r in results:
+        if r.fields.get("refinement"):
+            parts.append(refinement_table(r))
     sources = sorted({p.source for p in scene.published})
     if sources:
         parts.append("<p><small>paper values from: " + "; ".join(map(html.escape, sources))
@@ -68,6 +71,23 @@ def scene_section(scene, results, figures) -> str:
         parts.append(f'<figure><img src="figures/{name}" style="max-width:100%">'
                      f"<figcaption>{html.escape(caption)}</figcaption></figure>")
     return "\n".join(parts)
+
+
+def refinement_table(result) -> str:
+    """The refinement study of a reference run: one row per level, coarsest first."""
+    rows = result.fields["refinement"]
+    extra = sorted({k for row in rows for k in row.get("extra", {})})
+    head = ("<tr><th>level</th><th>dofs</th><th>h_min</th>"
+            f"<th>{html.escape(result.fields.get('quantity_name', 'quantity'))}</th>"
+            "<th>change %</th><th>setup s</th><th>solve s</th>"
+            + "".join(f"<th>{html.escape(k)}</th>" for k in extra) + "</tr>")
+    body = "".join(
+        f"<tr><td>{row['level']}</td><td>{row['dofs']}</td><td>{_num(row['h_min'])}</td>"
+        f"<td>{row['quantity']:.8g}</td><td>{_num(row['change_pct'])}</td>"
+        f"<td>{_num(row['setup_s'])}</td><td>{_num(row['solve_s'])}</td>"
+        + "".join(f"<td>{_num(row.get('extra', {}).get(k, ''))}</td>" for k in extra) + "</tr>"
+        for row in rows)
+    return f"<p><b>Refinement study</b> ({html.escape(result.method)}):</p><table>{head}{body}</table>"
 
 
 def page(doc: dict, sections: list[tuple], total_time: float) -> str:

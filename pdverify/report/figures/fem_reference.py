@@ -1,0 +1,52 @@
+"""Figures of the FEM references: fields, refinement convergence, force-depth (issue #5)."""
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from . import family, save
+
+
+@family("fem-reference")
+def fem_figures(scene, results, folder):
+    out = []
+    for k, r in enumerate(results):
+        f = r.fields
+        g = f["grid"]
+        mag = np.hypot(g["ux"], g["uy"])
+        fig, axes = plt.subplots(1, 3, figsize=(16, 4.2), layout="constrained")
+        for ax, (title, data) in zip(axes[:2], (("|u| [m]", mag),
+                                                 ("strain energy density [J/m^3]",
+                                                  g["strain_energy_density"]))):
+            pc = ax.pcolormesh(g["x"], g["y"], data, shading="auto", cmap="viridis")
+            ax.set_aspect("equal")
+            ax.set_title(title)
+            fig.colorbar(pc, ax=ax, shrink=0.8)
+        rows = f["refinement"]
+        dofs = np.array([row["dofs"] for row in rows], dtype=float)
+        change = np.array([row["change_pct"] for row in rows], dtype=float)
+        ok = np.isfinite(change) & (change > 0)
+        if ok.sum() >= 1:
+            axes[2].loglog(dofs[ok], change[ok], "o-")
+        axes[2].set_xlabel("dofs")
+        axes[2].set_ylabel(f"change of {f['quantity_name']} [%]")
+        axes[2].set_title("refinement study")
+        axes[2].grid(True, which="both", alpha=0.3)
+        name = save(fig, folder, f"{scene.id}-{k}.png")
+        out.append((name, "Converged FEM field (displacement magnitude, strain energy density) "
+                          "and the change of the compared quantity per refinement level."))
+        if "forces" in f:
+            fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4))
+            a1.plot(np.r_[0, f["depths"]] * 1e3, np.r_[0, f["forces"]] / 1e3, "o-", ms=3)
+            a1.set_xlabel("depth [mm]")
+            a1.set_ylabel("force [kN per m thickness]")
+            a1.set_title("force-depth")
+            a2.plot(f["depths"] * 1e3, f["contact_widths"] * 1e3, "o-", ms=3)
+            a2.set_xlabel("depth [mm]")
+            a2.set_ylabel("contact width [mm]")
+            a2.set_title("contact width")
+            for a in (a1, a2):
+                a.grid(alpha=0.3)
+            out.append((save(fig, folder, f"{scene.id}-{k}-force.png"),
+                        "Force-depth curve and contact width per step (sticking contact)."))
+    return out
