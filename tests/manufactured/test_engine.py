@@ -63,20 +63,23 @@ def test_seed001_stress_eq41():
 
 
 def test_seed001_delta2_term_is_visible_in_tau12():
-    # ERRATA 001: the Delta_2 term is 0.25-2.7 % of tau_12 on the chosen body
-    # (x in [0, 1], delta = 3 h = 0.15 m); the numeric solution must carry it.
+    # The numeric tau_12 must carry the c_v k_e Delta_2/(35 Delta_1) term of Eq. (41) on the
+    # ERRATA 001 body (x in [0, 1] m, delta = 3 h = 0.15 m, E = 200 GPa, nu = 0.3).
     sol = solution(SEED001_FIELD, model="state-based", dim=3, horizon=0.15, E=200e9, nu=0.3,
                    influence="gaussian", params=SEED001_PARAMS)
     c = sol.constants.as_floats()
     term = SEED001_PARAMS["c_v"] * c["k_e"] / 35 * (0.0333661374 * 0.15**2 / 0.1002687981)
-    x = np.linspace(0.2, 1.0, 5)
+    x = np.linspace(0.5, 1.0, 6)
     pts = np.column_stack([x, np.zeros_like(x), np.zeros_like(x)])
     tau12 = sol.stress(pts)[:, 0, 1]
     without = SEED001_PARAMS["c_u"] * c["k_e"] / 15 * x + SEED001_PARAMS["c_v"] * c["k_e"] / 5 * x**2
-    # rtol 1e-9: Delta_1, Delta_2 printed to 10 digits in ERRATA 001
+    # rtol 1e-9: Delta_1, Delta_2 printed to 10 significant digits in ERRATA 001
     np.testing.assert_allclose(tau12 - without, term, rtol=1e-9, atol=0)
+    # the term is 0.15 % (x = 1) to 0.96 % (x = 0.5) of tau_12 here, so a check of tau_12
+    # at rtol 1e-3 or tighter sees it (ERRATA 001: "0.25-2.7 %", which holds for
+    # x in about [0.38, 0.81]; it grows without bound near the zero of tau_12 at x = 0.274)
     share = np.abs(term / tau12)
-    assert share.max() > 2.5e-3  # ERRATA 001: the term is at least 0.25 % of tau_12
+    assert share.min() > 1e-3
 
 
 LINEAR = {1: ["a + b*x"],
