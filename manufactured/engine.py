@@ -15,7 +15,7 @@ from tokenize import TokenError
 import numpy as np
 import sympy as sp
 
-from .constants import DELTA, check_model_args, constants as _constants
+from .constants import DELTA, PDConstants, check_model_args, constants as _constants
 from .influence import radial_moment_unit, sphere_moment
 
 X, Y, Z = sp.symbols("x y z")
@@ -294,9 +294,10 @@ def _finite_real(value):
 
 
 def _number(value):
-    """Exact sympy number: ints and sympy numbers as given, floats at _DPS digits (exact)."""
+    """Sympy number: ints and sympy numbers as given; a float as the decimal of its shortest
+    round-tripping repr at _DPS digits (0.05 -> 0.05000..., which rounds back to the same double)."""
     if isinstance(value, (float, np.floating)):
-        return sp.Float(float(value), _DPS)
+        return sp.Float(repr(float(value)), _DPS)
     return sp.sympify(value)
 
 
@@ -338,25 +339,43 @@ def _cache_key(inputs):
     return hashlib.sha256(blob.encode()).hexdigest()
 
 
+def _to_json(obj):
+    """Nested dicts/lists of sympy objects -> JSON-able data (sympy objects as srepr)."""
+    if isinstance(obj, dict):
+        return {"dict": [[_to_json(k), _to_json(v)] for k, v in obj.items()]}
+    if isinstance(obj, (list, tuple, sp.MatrixBase)):
+        return {"list": [_to_json(v) for v in (obj.tolist() if isinstance(obj, sp.MatrixBase)
+                                              else obj)]}
+    if obj is None or isinstance(obj, (str, int)):
+        return {"py": obj}
+    return {"sympy": sp.srepr(obj)}
+
+
+def _from_json(data):
+    if "dict" in data:
+        return {_from_json(k): _from_json(v) for k, v in data["dict"]}
+    if "list" in data:
+        return [_from_json(v) for v in data["list"]]
+    if "py" in data:
+        return data["py"]
+    return sp.sympify(data["sympy"])
+
+
 def _cache_load(key):
     path = cache_dir() / "manufactured" / f"{key}.json"
     try:
-        data = json.loads(path.read_text())
-        return {k: (sp.sympify(v) if isinstance(v, str) else [sp.sympify(s) for s in v])
-                for k, v in data.items()}
-    except (OSError, ValueError, TypeError, sp.SympifyError, SyntaxError):
+        return _from_json(json.loads(path.read_text()))
+    except (OSError, ValueError, TypeError, KeyError, AttributeError, sp.SympifyError, SyntaxError):
         return None  # missing or unreadable: derive again
 
 
-def _cache_store(key, exprs):
+def _cache_store(key, entry):
     folder = cache_dir() / "manufactured"
     try:
         folder.mkdir(parents=True, exist_ok=True)
-        data = {k: (sp.srepr(v) if isinstance(v, sp.Basic) and not isinstance(v, sp.MatrixBase)
-                    else [sp.srepr(s) for s in v]) for k, v in exprs.items()}
         fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
         with os.fdopen(fd, "w") as fh:
-            json.dump(data, fh)
+            json.dump(_to_json(entry), fh)
         os.replace(tmp, folder / f"{key}.json")
     except OSError:
         pass  # a read-only or full cache only costs time
@@ -496,36 +515,62 @@ def solution(displacement, *, model, dim, horizon, E, nu, influence, plane=None,
             raise ValueError(f"{name}: must be a number for solution() (got {value}); "
                              "use derive() for symbolic constants")
     horizon_n, E_n, nu_n = _number(horizon), _number(E), _number(nu)
-    consts = _constants(model=model, dim=dim, influence=influence, horizon=horizon_n,
-                        E=E_n, nu=nu_n, plane=plane)
     u = _parse_displacement(displacement, dim, params)
-    symbolic = _derive_cached(tuple(sp.srepr(c) for c in u), model, dim, influence)
     param_values = {sp.Symbol(k): _number(v) for k, v in (params or {}).items()}
-    missing = sorted(s.name for s in sp.Matrix(u).free_symbols
-                     if s not in COORDINATES and s not in param_values)
-    if missing:  # unreachable through _parse_displacement; kept as a guard
-        raise ValueError(f"params: no value for {', '.join(missing)}")
-
     key = _cache_key({
         "displacement": [sp.srepr(c) for c in u], "model": model, "dim": dim,
         "influence": influence, "plane": plane, "horizon": sp.srepr(horizon_n),
         "E": sp.srepr(E_n), "nu": sp.srepr(nu_n),
         "params": {k.name: sp.srepr(v) for k, v in param_values.items()}})
-    exprs = _cache_load(key) if cache else None
-    if exprs is None:
-        subs = dict(param_values)
-        subs.update({DELTA: horizon_n, C_THETA: consts.c_theta})
-        subs.update({k: sp.N(v, _DPS) for k, v in symbolic.radial_moments.items()})
-        if model == "state-based":
-            subs.update({K_THETA: consts.k_theta, K_E: consts.k_e})
-        else:
-            subs[C_BOND] = consts.micromodulus
-        fix = lambda e: sp.expand(e.xreplace(subs))  # noqa: E731
-        exprs = {"displacement": [fix(c) for c in symbolic.displacement],
-                 "dilatation": fix(symbolic.dilatation),
-                 "body_force": [fix(c) for c in symbolic.body_force],
-                 "stress": [fix(c) for c in symbolic.stress]}
+    entry = _cache_load(key) if cache else None
+    if entry is None:
+        entry = _derive_entry(u, param_values, model=model, dim=dim, influence=influence,
+                              plane=plane, horizon=horizon_n, E=E_n, nu=nu_n)
         if cache:
-            _cache_store(key, exprs)
-    return ManufacturedSolution(model=model, dim=dim, plane=plane, influence=influence,
-                                constants=consts, symbolic=symbolic, exprs=exprs)
+            _cache_store(key, entry)
+    try:
+        consts = PDConstants(model=model, dim=dim, plane=plane, influence=influence,
+                             horizon=horizon_n, E=E_n, nu=nu_n, **entry["constants"])
+        sym = entry["symbolic"]
+        symbolic = Derivation(model=model, dim=dim, influence=influence,
+                              coordinates=COORDINATES[:dim],
+                              displacement=sp.Matrix(sym["displacement"]),
+                              dilatation=sym["dilatation"],
+                              body_force=sp.Matrix(sym["body_force"]),
+                              stress=sp.Matrix(sym["stress"]),
+                              radial_moments=sym["radial_moments"])
+        return ManufacturedSolution(model=model, dim=dim, plane=plane, influence=influence,
+                                    constants=consts, symbolic=symbolic, exprs=entry["numeric"])
+    except (KeyError, TypeError, ValueError, AttributeError, sp.SympifyError):
+        if not cache:
+            raise
+        return solution(displacement, model=model, dim=dim, horizon=horizon, E=E, nu=nu,
+                        influence=influence, plane=plane, params=params, cache=False)
+
+
+def _derive_entry(u, param_values, *, model, dim, influence, plane, horizon, E, nu):
+    """Constants, generic derivation and numeric expressions of one solution (cacheable)."""
+    consts = _constants(model=model, dim=dim, influence=influence, horizon=horizon,
+                        E=E, nu=nu, plane=plane)
+    symbolic = _derive_cached(tuple(sp.srepr(c) for c in u), model, dim, influence)
+    subs = dict(param_values)
+    subs.update({DELTA: horizon, C_THETA: consts.c_theta})
+    subs.update({k: sp.N(v, _DPS) for k, v in symbolic.radial_moments.items()})
+    if model == "state-based":
+        subs.update({K_THETA: consts.k_theta, K_E: consts.k_e})
+    else:
+        subs[C_BOND] = consts.micromodulus
+    fix = lambda e: sp.expand(e.xreplace(subs))  # noqa: E731
+    names = ("c_theta", "weighted_volume", "k_theta", "k_e", "micromodulus")
+    return {
+        "constants": {n: getattr(consts, n) for n in names},
+        "symbolic": {"displacement": list(symbolic.displacement),
+                     "dilatation": symbolic.dilatation,
+                     "body_force": list(symbolic.body_force),
+                     "stress": symbolic.stress.tolist(),
+                     "radial_moments": dict(symbolic.radial_moments)},
+        "numeric": {"displacement": [fix(c) for c in symbolic.displacement],
+                    "dilatation": fix(symbolic.dilatation),
+                    "body_force": [fix(c) for c in symbolic.body_force],
+                    "stress": [fix(c) for c in symbolic.stress]},
+    }

@@ -7,6 +7,7 @@ import pytest
 import sympy as sp
 
 import manufactured
+from manufactured import engine
 from manufactured.constants import classical_moduli, derive_constants, E_SYM, NU_SYM
 from manufactured.engine import (C_THETA, DELTA, K_E, K_THETA, X, Y, Z, cache_dir, derive,
                                  radial_moment_symbol, solution)
@@ -194,9 +195,9 @@ def test_cache_written_read_and_keyed(tmp_path, monkeypatch):
     solution(SEED001_FIELD, **{**kw, "nu": 0.25})  # another input, another entry
     assert len(list((tmp_path / "c1" / "manufactured").glob("*.json"))) == 2
     # a cached entry is really used: tamper with it and read it back
-    data = json.loads(files[0].read_text())
-    data["dilatation"] = sp.srepr(sp.Integer(7))
-    files[0].write_text(json.dumps(data))
+    entry = engine._from_json(json.loads(files[0].read_text()))
+    entry["numeric"]["dilatation"] = sp.Integer(7)
+    files[0].write_text(json.dumps(engine._to_json(entry)))
     assert solution(SEED001_FIELD, **kw).dilatation_expr == 7
     # a corrupt entry is ignored and rewritten
     files[0].write_text("{not json")
