@@ -46,10 +46,10 @@ class Derivation:
     ----------
     model, dim, influence : as passed to :func:`derive`
     coordinates : tuple of sympy.Symbol, (x,), (x, y) or (x, y, z)
-    displacement : sympy.Matrix, shape (dim, 1)
+    displacement : sympy.ImmutableMatrix, shape (dim, 1)
     dilatation : sympy.Expr, theta(x) (seed 001, Eq. 9)
-    body_force : sympy.Matrix, shape (dim, 1), b(x) (seed 001, Eq. 46)
-    stress : sympy.Matrix, shape (dim, dim), tau(x) (seed 001, Eq. 47)
+    body_force : sympy.ImmutableMatrix, shape (dim, 1), b(x) (seed 001, Eq. 46)
+    stress : sympy.ImmutableMatrix, shape (dim, dim), tau(x) (seed 001, Eq. 47)
     radial_moments : dict, symbol R_k -> exact value for this influence function
     """
 
@@ -57,10 +57,10 @@ class Derivation:
     dim: int
     influence: str
     coordinates: tuple
-    displacement: sp.Matrix
+    displacement: sp.ImmutableMatrix
     dilatation: sp.Expr
-    body_force: sp.Matrix
-    stress: sp.Matrix
+    body_force: sp.ImmutableMatrix
+    stress: sp.ImmutableMatrix
     radial_moments: dict
 
     def explicit(self, expr):
@@ -183,8 +183,9 @@ def _derive_cached(components, model, dim, influence):
             stress[j, k] = stress[k, j] = _tidy(t / 2, coords)
     moments = {radial_moment_symbol(k): radial_moment_unit(influence, k) for k in sorted(used)}
     return Derivation(model=model, dim=dim, influence=influence, coordinates=coords,
-                      displacement=sp.Matrix(u), dilatation=theta,
-                      body_force=sp.Matrix(body), stress=stress, radial_moments=moments)
+                      displacement=sp.ImmutableMatrix(u), dilatation=theta,
+                      body_force=sp.ImmutableMatrix(body), stress=sp.ImmutableMatrix(stress),
+                      radial_moments=moments)
 
 
 def derive(displacement, *, model, dim, influence, params=None):
@@ -211,6 +212,24 @@ def derive(displacement, *, model, dim, influence, params=None):
     R_k = int_0^delta omega l^k dl (see :mod:`manufactured.influence`) and, in Eq. (47),
     int_0^r [(r - s)^n -+ (-s)^n] ds = r^(n+1) (1 -+ (-1)^n) / (n + 1) after swapping the
     s and r integrations. Nothing is approximated.
+
+    Choices (where the seeds are silent or differ):
+
+    * Linearisation: e = (u(x') - u(x)) . m and the force along the reference direction m,
+      as in seed 001's appendix (Eq. 57); "infinite body": m(x) = m(x') is the complete
+      neighbourhood value (seed 001 Eq. 56 for the Gaussian).
+    * f(x, x') is the force on x from x' (so b = -int f dV, Eq. 4); in Eq. (47),
+      f(x', x'') is the force on x' (the end with (x - x') . m >= 0) from x''.
+    * 2D and 1D analogues of Eq. (47) replace r^2 dOmega (S^2) by r dphi (circle) and by
+      a sum over m = +-1; this is the force per unit length / per unit area across the
+      line / point through x (Lehoucq and Silling 2008, seed 001 ref. [54]).
+    * The dilatation is reported with the c_theta of
+      :func:`manufactured.constants.derive_constants` (theta = tr eps for affine fields
+      in 2D/3D, (1 - 2 nu) eps in 1D); a bond-based model does not use theta, it is
+      reported with the same c_theta and m for comparison.
+    * Bond-based micromodulus: c_bond omega(l) is the micromodulus function, so the
+      influence function also shapes bond-based kernels (constant -> c_0, conical ->
+      c_0 (1 - l/delta) as in seed 004, Eq. 6).
 
     Parameters
     ----------
@@ -392,10 +411,10 @@ class ManufacturedSolution:
     model, dim, plane, influence : as passed to :func:`solution`
     constants : manufactured.constants.PDConstants
     coordinates : tuple of sympy.Symbol
-    displacement_expr : sympy.Matrix (dim, 1)
+    displacement_expr : sympy.ImmutableMatrix (dim, 1)
     dilatation_expr : sympy.Expr
-    body_force_expr : sympy.Matrix (dim, 1)
-    stress_expr : sympy.Matrix (dim, dim), symmetric
+    body_force_expr : sympy.ImmutableMatrix (dim, 1)
+    stress_expr : sympy.ImmutableMatrix (dim, dim), symmetric
     symbolic : Derivation, the same fields in terms of the PD constants
     """
 
@@ -404,10 +423,10 @@ class ManufacturedSolution:
         self.constants = constants
         self.symbolic = symbolic
         self.coordinates = COORDINATES[:dim]
-        self.displacement_expr = sp.Matrix(exprs["displacement"])
+        self.displacement_expr = sp.ImmutableMatrix(exprs["displacement"])
         self.dilatation_expr = exprs["dilatation"]
-        self.body_force_expr = sp.Matrix(exprs["body_force"])
-        self.stress_expr = sp.Matrix(dim, dim, list(exprs["stress"]))
+        self.body_force_expr = sp.ImmutableMatrix(exprs["body_force"])
+        self.stress_expr = sp.ImmutableMatrix(dim, dim, list(exprs["stress"]))
         self._u = self._compile(list(self.displacement_expr))
         self._theta = self._compile([self.dilatation_expr])
         self._b = self._compile(list(self.body_force_expr))
@@ -507,6 +526,14 @@ def solution(displacement, *, model, dim, horizon, E, nu, influence, plane=None,
     ------
     ValueError
         On any bad argument, with a one-line message naming it and what is allowed.
+
+    Notes
+    -----
+    Numbers: floats are read as the decimal of their shortest repr (0.05 is 5/100) and
+    the expressions carry 30-digit coefficients, so the lambdified callables use correctly
+    rounded double coefficients. The numeric expressions (``*_expr``) are expanded
+    polynomials in the coordinates; :attr:`ManufacturedSolution.symbolic` keeps the exact
+    form in the PD constants.
     """
     check_model_args(model=model, dim=dim, plane=plane, influence=influence,
                      horizon=horizon, E=E, nu=nu)
@@ -534,10 +561,10 @@ def solution(displacement, *, model, dim, horizon, E, nu, influence, plane=None,
         sym = entry["symbolic"]
         symbolic = Derivation(model=model, dim=dim, influence=influence,
                               coordinates=COORDINATES[:dim],
-                              displacement=sp.Matrix(sym["displacement"]),
+                              displacement=sp.ImmutableMatrix(sym["displacement"]),
                               dilatation=sym["dilatation"],
-                              body_force=sp.Matrix(sym["body_force"]),
-                              stress=sp.Matrix(sym["stress"]),
+                              body_force=sp.ImmutableMatrix(sym["body_force"]),
+                              stress=sp.ImmutableMatrix(sym["stress"]),
                               radial_moments=sym["radial_moments"])
         return ManufacturedSolution(model=model, dim=dim, plane=plane, influence=influence,
                                     constants=consts, symbolic=symbolic, exprs=entry["numeric"])
