@@ -549,33 +549,36 @@ def solution(displacement, *, model, dim, horizon, E, nu, influence, plane=None,
         "influence": influence, "plane": plane, "horizon": sp.srepr(horizon_n),
         "E": sp.srepr(E_n), "nu": sp.srepr(nu_n),
         "params": {k.name: sp.srepr(v) for k, v in param_values.items()}})
+    build = dict(model=model, dim=dim, plane=plane, influence=influence,
+                 horizon=horizon_n, E=E_n, nu=nu_n)
     entry = _cache_load(key) if cache else None
-    if entry is None:
-        entry = _derive_entry(u, param_values, model=model, dim=dim, influence=influence,
-                              plane=plane, horizon=horizon_n, E=E_n, nu=nu_n)
-        if cache:
-            _cache_store(key, entry)
-    try:
-        consts = PDConstants(model=model, dim=dim, plane=plane, influence=influence,
-                             horizon=horizon_n, E=E_n, nu=nu_n, **entry["constants"])
-        sym = entry["symbolic"]
-        symbolic = Derivation(model=model, dim=dim, influence=influence,
-                              coordinates=COORDINATES[:dim],
-                              displacement=sp.ImmutableMatrix(sym["displacement"]),
-                              dilatation=sym["dilatation"],
-                              body_force=sp.ImmutableMatrix(sym["body_force"]),
-                              stress=sp.ImmutableMatrix(sym["stress"]),
-                              radial_moments=sym["radial_moments"])
-        return ManufacturedSolution(model=model, dim=dim, plane=plane, influence=influence,
-                                    constants=consts, symbolic=symbolic, exprs=entry["numeric"])
-    except (KeyError, TypeError, ValueError, AttributeError, sp.SympifyError):
-        if not cache:
-            raise
-        return solution(displacement, model=model, dim=dim, horizon=horizon, E=E, nu=nu,
-                        influence=influence, plane=plane, params=params, cache=False)
+    if entry is not None:
+        try:
+            return _build_solution(entry, **build)
+        except (KeyError, TypeError, ValueError, AttributeError, sp.SympifyError):
+            pass  # a stale or damaged entry: derive again and overwrite it
+    entry = _derive_entry(u, param_values, **build)
+    if cache:
+        _cache_store(key, entry)
+    return _build_solution(entry, **build)
 
 
-def _derive_entry(u, param_values, *, model, dim, influence, plane, horizon, E, nu):
+def _build_solution(entry, *, model, dim, plane, influence, horizon, E, nu):
+    consts = PDConstants(model=model, dim=dim, plane=plane, influence=influence,
+                         horizon=horizon, E=E, nu=nu, **entry["constants"])
+    sym = entry["symbolic"]
+    symbolic = Derivation(model=model, dim=dim, influence=influence,
+                          coordinates=COORDINATES[:dim],
+                          displacement=sp.ImmutableMatrix(sym["displacement"]),
+                          dilatation=sym["dilatation"],
+                          body_force=sp.ImmutableMatrix(sym["body_force"]),
+                          stress=sp.ImmutableMatrix(sym["stress"]),
+                          radial_moments=sym["radial_moments"])
+    return ManufacturedSolution(model=model, dim=dim, plane=plane, influence=influence,
+                                constants=consts, symbolic=symbolic, exprs=entry["numeric"])
+
+
+def _derive_entry(u, param_values, *, model, dim, plane, influence, horizon, E, nu):
     """Constants, generic derivation and numeric expressions of one solution (cacheable)."""
     consts = _constants(model=model, dim=dim, influence=influence, horizon=horizon,
                         E=E, nu=nu, plane=plane)

@@ -200,6 +200,12 @@ def test_cache_written_read_and_keyed(tmp_path, monkeypatch):
     entry["numeric"]["dilatation"] = sp.Integer(7)
     files[0].write_text(json.dumps(engine._to_json(entry)))
     assert solution(SEED001_FIELD, **kw).dilatation_expr == 7
+    # a structurally damaged entry is derived again and overwritten
+    entry = engine._from_json(json.loads(files[0].read_text()))
+    del entry["symbolic"]
+    files[0].write_text(json.dumps(engine._to_json(entry)))
+    assert solution(SEED001_FIELD, **kw).dilatation_expr == first.dilatation_expr
+    assert "symbolic" in engine._from_json(json.loads(files[0].read_text()))
     # a corrupt entry is ignored and rewritten
     files[0].write_text("{not json")
     assert solution(SEED001_FIELD, **kw).dilatation_expr == first.dilatation_expr
