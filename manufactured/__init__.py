@@ -1,1 +1,2 @@
 """Analytic and manufactured references; never imports pdverify."""
+from .engine import solution  # noqa: F401
