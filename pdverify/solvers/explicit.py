@@ -101,10 +101,11 @@ def central_difference(stiffness, u0, v0, dt: float, n_steps: int, *, mass=None,
     indices n (0..n_steps) whose u_n is returned.
 
     Raises :class:`NumericalError` (i) before any step when ``dt`` exceeds the stability
-    limit 2 / sqrt(lambda_max(M^-1 K)), naming the limit: steps below the Gershgorin bound
-    are accepted at once, others are checked against the sharp limit of
-    :func:`stability_limit`; (ii) when that extreme eigenvalue is complex or negative (no
-    stable step exists); (iii) when u stops being finite, naming the step.
+    limit 2 / sqrt(lambda_max(M^-1 K)), naming the limit: for a symmetric K, steps below the
+    Gershgorin bound are accepted at once, others (and every step for a non-symmetric K) are
+    checked against the sharp limit of :func:`stability_limit`; (ii) when that extreme
+    eigenvalue is complex or negative (no stable step exists; eigenvalues that are not
+    extreme are not examined); (iii) when u stops being finite, naming the step.
     """
     K = sp.csr_matrix(stiffness)
     n = K.shape[0]
@@ -116,10 +117,13 @@ def central_difference(stiffness, u0, v0, dt: float, n_steps: int, *, mass=None,
     if sample_steps.size and (sample_steps[0] < 0 or sample_steps[-1] > n_steps):
         raise ValueError(f"sample steps must lie in 0..{n_steps}")
 
-    # Below the Gershgorin limit the step is stable for sure and nothing more is computed;
-    # above it the limit is sharpened from the extreme eigenvalue before refusing.
+    # Symmetric K: the spectrum is real, and below the Gershgorin limit the step is stable
+    # for sure, so nothing more is computed; above it the limit is sharpened from the
+    # extreme eigenvalue before refusing. Non-symmetric K (extrapolated fictitious nodes):
+    # the extreme eigenvalue is always computed, to catch complex or negative ones.
     limit = gershgorin_limit(K, mass)
-    if dt > limit.dt_limit:
+    symmetric = abs(K - K.T).max() <= 1e-12 * limit.gershgorin if n else True
+    if dt > limit.dt_limit or not symmetric:
         limit = stability_limit(K, mass)
     if limit.imag_ratio > 1e-6:
         raise NumericalError(f"{where}: M^-1 K has a complex eigenvalue (|Im|/|lambda| = "
