@@ -9,7 +9,7 @@ import scipy.sparse as sp
 from .bonds import partial_volumes_1d
 from .corrections.taylor import taylor_extrapolation_weights
 
-BOUNDARIES = ("surface-nodes", "none")
+BOUNDARIES = ("surface-nodes", "none", "odd-image")
 
 
 def bond_coefficients(horizon: float, m_ratio: float, wave_speed: float):
@@ -55,7 +55,12 @@ class WaveBar1D:
     end nodes (the first and last real node, Delta/2 inside the bar) held at the Dirichlet
     value; the N - 2 others are unknowns.
 
-    In both cases the free accelerations are ``a = A u_free + A_bc u_bc`` with
+    ``boundary="odd-image"`` (a reference model, not a method of the paper): like
+    surface nodes, but the fictitious layer is the odd image about the surface value,
+    u(x_s - xi) = 2 u_s - u(x_s + xi). This is the extension the sine series of Eq. (11)
+    implies, so it isolates the quadrature error from the extrapolation's model error.
+
+    In every case the free accelerations are ``a = A u_free + A_bc u_bc`` with
     ``A = lattice @ extension`` multiplied out once (N x N, a banded matrix plus the few
     columns the extrapolation adds): one sparse product per time step.
     """
@@ -78,7 +83,7 @@ class WaveBar1D:
         self.n_real = int(round(n))
         self.offsets, self.beta_k, self.c_k = bond_coefficients(self.horizon, self.m_ratio,
                                                                 self.wave_speed)
-        surface = self.boundary == "surface-nodes"
+        surface = self.boundary != "none"
         if surface and self.n_real < self.taylor_order + 1:
             raise ValueError(f"order {self.taylor_order} needs at least {self.taylor_order + 1} "
                              f"real nodes, got {self.n_real}")
@@ -117,6 +122,13 @@ class WaveBar1D:
         nf, nr, n = self.n_fict, self.n_real, self.taylor_order
         xr = self.x_lattice[nf:nf + nr]
         rows, cols, vals = [np.arange(nr) + nf], [np.arange(nr)], [np.ones(nr)]
+        if self.boundary == "odd-image":
+            j = np.arange(nf)  # fictitious node at -(j + 1/2) Delta mirrors real node j
+            rows += [nf - 1 - j, nf - 1 - j, nf + nr + j, nf + nr + j]
+            cols += [j, np.full(nf, nr), nr - 1 - j, np.full(nf, nr + 1)]
+            vals += [-np.ones(nf), np.full(nf, 2.0), -np.ones(nf), np.full(nf, 2.0)]
+            return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                                 shape=(nr + 2 * nf, nr + 2))
         for side in ("left", "right"):
             if side == "left":
                 anchor, near, tgt, s_col = 0.0, np.arange(n), np.arange(nf), nr
@@ -134,7 +146,7 @@ class WaveBar1D:
     def _build(self):
         lattice = self._lattice_rows()
         nr = self.n_real
-        if self.boundary == "surface-nodes":
+        if self.boundary != "none":
             full = (lattice @ self._extension()).tocsc()
             self.free = np.arange(nr)
             self.x_bc = np.array([0.0, self.length])
@@ -161,7 +173,7 @@ class WaveBar1D:
     def real_displacements(self, u_free, u_bc=(0.0, 0.0)) -> np.ndarray:
         """All real nodes' displacements from the free ones (``none``: the end nodes get ``u_bc``)."""
         u_free = np.asarray(u_free, dtype=float)
-        if self.boundary == "surface-nodes":
+        if self.boundary != "none":
             return u_free
         out = np.empty(u_free.shape[:-1] + (self.n_real,))
         out[..., self.free] = u_free
@@ -169,7 +181,7 @@ class WaveBar1D:
         return out
 
     def size(self) -> dict:
-        surface = 2 if self.boundary == "surface-nodes" else 0
+        surface = 2 if self.boundary != "none" else 0
         return {"nodes": int(self.n_real + 2 * self.n_fict + surface), "real_nodes": int(self.n_real),
                 "fictitious_nodes": int(2 * self.n_fict), "dofs": int(self.free.size),
                 "bonds": int(self.n_bonds), "operator_nnz": int(self.A.nnz)}

@@ -54,10 +54,12 @@ class Wave1DSurfaceNodes(Scene):
     Findings: the error falls at first order in 1/m because the one-point quadrature of
     Eq. (3) leaves out the node's own cell (psi - psi_h = k^2 / (2m), see
     ``micromodulus1d.lattice_symbol``). Order-1 extrapolation is not the odd extension the
-    analytic series implies, which leaves a model gap of about 0.28 % of the peak that does
-    not shrink with m (order 2: about 0.09 %); it is below the quadrature error for m <= 100
-    but bounds the convergence beyond m of a few hundred. Higher orders stiffen the
-    fictitious layer: at m = 100 order 3 needs dt < 7.4e-8 s.
+    analytic series implies (``WaveBar1D(boundary="odd-image")``): the two discrete solutions
+    differ by about 0.27-0.28 % of the peak at m = 25 and 100 alike (order 2: 0.11-0.09 %).
+    That gap is below the quadrature error for m <= 100, so the paper's convergence shows,
+    but it bounds it beyond a few hundred (at m = 400 the order-1 error, 0.33 %, already
+    exceeds the odd image's, 0.26 %). Higher orders stiffen the fictitious layer: at
+    m = 100 order 3 needs dt < 7.4e-8 s and the default dt fails the run.
     """
 
     id = "wave1d-surface-nodes"

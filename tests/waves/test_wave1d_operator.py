@@ -92,3 +92,15 @@ def test_surface_node_spectrum_is_real_and_positive_at_order_one():
     lam = np.linalg.eigvals(-bar.A.toarray())
     assert np.max(np.abs(lam.imag)) <= 1e-9 * np.max(np.abs(lam))
     assert lam.real.min() > 0
+
+
+@pytest.mark.parametrize("j", [1, 4, 13])
+def test_odd_image_makes_every_sine_mode_an_exact_eigenvector(j):
+    # The odd image about the surface nodes is the extension the series of Eq. (11)
+    # implies: sin(j pi x / l) is then an eigenvector at every real node, ends included.
+    bar = WaveBar1D(L, DELTA, 10, V, boundary="odd-image")
+    k = j * np.pi / L
+    u = np.sin(k * bar.x_real)
+    a = bar.A @ u
+    expected = -V ** 2 * lattice_symbol(k, horizon=DELTA, m_ratio=10) * u
+    assert_allclose(a, expected, rtol=0, atol=_roundoff(bar.A, u).max())
