@@ -49,7 +49,8 @@ class Wave1DSurfaceNodes(Scene):
     those step times (exact for the default dt); T = 0.2 ms is fixed; ``none`` fixes the
     nodes nearest the ends at zero (the paper shows no uncorrected run); a dt above the
     central-difference limit 2 / sqrt(lambda_max) of the discrete operator fails the run
-    with that limit named (checked by Gershgorin, sharpened by ARPACK before refusing).
+    with that limit named (lambda_max by ARPACK; for the symmetric ``none`` operator a
+    Gershgorin bound first, sharpened only when the step exceeds it).
 
     Findings: the error falls at first order in 1/m because the one-point quadrature of
     Eq. (3) leaves out the node's own cell (psi - psi_h = k^2 / (2m), see

@@ -50,3 +50,17 @@ def test_order_one_extrapolation_leaves_a_gap_that_does_not_shrink_with_m(soluti
     print(f"\ngap to the odd image [% of peak]: {gap}")
     assert abs(gap[(100, 1)] / gap[(25, 1)] - 1) < 0.1
     assert gap[(100, 2)] < gap[(100, 1)]
+
+
+@pytest.mark.slow
+def test_the_gap_bounds_convergence_beyond_a_few_hundred():
+    # At m = 400 the quadrature error (~ 1/m) has fallen below the order-1 model gap
+    # (~0.28 % of the peak, above), so the order-1 surface-node error exceeds the odd
+    # image's: the method converges to its own limit, 0.28 % away from the PD series.
+    series = wave_series(horizon=DELTA, wave_speed=V)
+    err = {}
+    for b in ("odd-image", "surface-nodes"):
+        x, u = solve(400, b)
+        err[b] = np.max(np.abs(u - series.displacement(x, np.array(STEPS) * DT))) / PEAK * 100
+    print(f"\nm = 400 error [% of peak]: {err}")
+    assert err["surface-nodes"] > err["odd-image"]
