@@ -4,6 +4,8 @@ METHODS = {
     "none": "uncorrected PD: truncated neighbourhoods, BCs on the nodes nearest the boundary",
     "taylor-fictitious": "seed 000: fictitious layer by nearest-node Taylor extrapolation, "
                          "Dirichlet/Neumann via Lagrange multipliers",
+    "surface-nodes": "seeds 001/002: surface nodes carry the boundary conditions, fictitious layer "
+                     "by Taylor extrapolation about the nearest surface node",
     "fem": "classical-elasticity FEM reference (reference_fem)",
 }
 
