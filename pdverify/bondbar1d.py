@@ -1,7 +1,7 @@
 """1D linearised bond-based PD bar with a constant or triangular micromodulus (seed 004)."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
@@ -110,7 +110,6 @@ class BondBar1D:
     micromodulus: str = "triangular"
     calibration: str = "discrete"
     end_factors: tuple = ()
-    arrays: dict = field(init=False, repr=False, default_factory=dict)
 
     def __post_init__(self):
         if self.end_weight not in END_WEIGHTS:
@@ -148,7 +147,6 @@ class BondBar1D:
         s = (alpha * self.c1 * self.area ** 2 * self.spacing * self.profile[which]
              * self.weight[i] * self.weight[j] / k)
         self.bond_i, self.bond_j, self.bond_k, self.bond_stiffness = i, j, k, s
-        self.bond_factor = alpha
         # K = sum_b s_b (e_i - e_j)(e_i - e_j)^T; duplicates are summed by the COO -> CSR step
         self.K = sp.csr_matrix((np.r_[s, s, -s, -s], (np.r_[i, j, i, j], np.r_[i, j, j, i])),
                                shape=(N, N))

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import numpy as np
+from scipy.optimize import minimize_scalar
 
 
 def max_relative_error_pct(u, u_ref) -> float:
@@ -67,8 +68,6 @@ def fitted_frequency(t, signal, guess: float, *, harmonics=(1, 3, 5, 7), rel_spa
     by 0.04 % over five periods; with 1, 3, 5, 7 the bias is 0.004 %). At most
     ``max_samples`` evenly strided samples are used.
     """
-    from scipy.optimize import minimize_scalar
-
     t = np.asarray(t, dtype=float)
     y = np.asarray(signal, dtype=float)
     stride = max(1, int(np.ceil(t.size / max_samples)))

@@ -112,7 +112,7 @@ def central_difference(stiffness, mass, u0, v0, dt: float, n_steps: int, *, forc
     if not np.all(np.isfinite(u)):
         raise NumericalError(f"{where}: displacements became non-finite by step {n_steps}")
     v = v_half - 0.5 * dt_inv_mass * (f - K @ u)  # back from t_{n+1/2} to t_n
+    omega_max = 2.0 / dt_limit if np.isfinite(dt_limit) else 0.0
     info = {"method": "central-difference", "steps": int(n_steps), "dt": float(dt),
-            "dt_limit": float(dt_limit), "omega_max": float(2.0 / dt_limit)
-            if np.isfinite(dt_limit) else 0.0}
+            "dt_limit": float(dt_limit), "omega_max": float(omega_max)}
     return ExplicitRun(u=u, v=v, times=np.arange(n_steps + 1) * dt, history=history, info=info)

@@ -79,12 +79,14 @@ def test_printed_eq99_indexing_is_reversed(m):
 
 def strain_factor(nodes, ratio, weight="full", method="none", shape="triangular",
                   calibration="discrete"):
+    """f(N) = (u_N - u_1) E / (L sigma) of a bar of length L = 1 (Table 12)."""
+    E, sigma = 2.0, 3.0
     factors = homogenization_factors(float(ratio), weight, shape) if method == "homogenized" else ()
-    bar = BondBar1D(nodes=nodes, spacing=1.0 / (nodes - 1), horizon_ratio=float(ratio), E=2.0,
+    bar = BondBar1D(nodes=nodes, spacing=1.0 / (nodes - 1), horizon_ratio=float(ratio), E=E,
                     end_weight=weight, micromodulus=shape, calibration=calibration,
                     end_factors=factors)
-    u = bar.end_force_displacement(3.0 * bar.area)  # sigma = 3
-    return (u[-1] - u[0]) / 1.0 * 2.0 / 3.0
+    u = bar.end_force_displacement(sigma * bar.area)
+    return (u[-1] - u[0]) * E / sigma
 
 
 CONFIGS = ([(float(m), "half") for m in M_RANGE] + [(float(m), "full") for m in M_RANGE]

@@ -89,7 +89,7 @@ def constraint_figures(scene, results, folder):
     for r in results:
         f = r.fields
         for ax, k in zip(axes[:3], "abc"):
-            ax.plot(f[f"x_{k}"], f[f"u_{k}"], markers.get(r.method, "^") + "-", ms=4, lw=0.8,
+            ax.plot(f[f"x_{k}"], f[f"u_{k}"], markers[r.method] + "-", ms=4, lw=0.8,
                     mfc="none", label=r.method)
         n_a = f["x_a"].size
         half = f["u_a"][n_a // 2:]
@@ -102,8 +102,8 @@ def constraint_figures(scene, results, folder):
     s = results[0].fields["stress_over_E"]
     for ax, k in zip(axes[:3], "abc"):
         x = results[0].fields[f"x_{k}"]
-        ax.plot(x, s * np.where(x >= 0, x, x if k == "a" else 0.0), "k:", lw=1.2,
-                label="classical")
+        held_at_zero = x < 0 if k == "c" else np.zeros(x.size, dtype=bool)  # (c): x < 0 held
+        ax.plot(x, s * np.where(held_at_zero, 0.0, x), "k:", lw=1.2, label="classical")
         ax.set_title(titles[k])
         ax.set_xlabel("x [m]")
         ax.grid(alpha=0.3)
