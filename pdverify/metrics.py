@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import numpy as np
+from scipy.optimize import minimize_scalar
 
 
 def max_relative_error_pct(u, u_ref) -> float:
@@ -39,3 +40,47 @@ def rel_l2_error(u, u_ref) -> float:
     u = np.asarray(u, dtype=float).ravel()
     u_ref = np.asarray(u_ref, dtype=float).ravel()
     return float(np.linalg.norm(u - u_ref) / np.linalg.norm(u_ref))
+
+
+
+def _harmonic_residual(t, y, frequency, harmonics) -> float:
+    """Least-squares residual of y against 1, cos(h w t), sin(h w t) for h in ``harmonics``."""
+    w = 2.0 * np.pi * frequency
+    cols = [np.ones_like(t)]
+    for h in harmonics:
+        cols += [np.cos(h * w * t), np.sin(h * w * t)]
+    A = np.column_stack(cols)
+    coef, *_ = np.linalg.lstsq(A, y, rcond=None)
+    return float(np.sum((A @ coef - y) ** 2))
+
+
+def fitted_frequency(t, signal, guess: float, *, harmonics=(1, 3, 5, 7), rel_span: float = 0.3,
+                     max_samples: int = 4000) -> float:
+    """Fundamental frequency [Hz] of ``signal`` by a least-squares harmonic fit.
+
+    The model is a constant plus cos/sin pairs at the multiples ``harmonics`` of one
+    fundamental f; the linear coefficients are eliminated (variable projection) and
+    the residual is minimised over f in two stages: the fundamental alone on a grid over
+    ``guess`` (1 +- rel_span) (spacing 1/40 of a Fourier bin at five periods), then all
+    harmonics near that minimum (within a seventh of half a bin, the width of the basin
+    of the highest harmonic). Higher harmonics in the model keep the fit from being
+    biased by the signal's own (a triangle wave's third harmonic moves a one-term fit
+    by 0.04 % over five periods; with 1, 3, 5, 7 the bias is 0.004 %). At most
+    ``max_samples`` evenly strided samples are used.
+    """
+    t = np.asarray(t, dtype=float)
+    y = np.asarray(signal, dtype=float)
+    stride = max(1, int(np.ceil(t.size / max_samples)))
+    t, y = t[::stride], y[::stride]
+    grid = guess * np.linspace(1.0 - rel_span, 1.0 + rel_span, int(rel_span * 400) + 1)
+    first = np.array([_harmonic_residual(t, y, f, (1,)) for f in grid])
+    k = int(np.argmin(first))
+    h = grid[1] - grid[0]
+    coarse = minimize_scalar(lambda f: _harmonic_residual(t, y, f, (1,)),
+                             bounds=(grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]),
+                             method="bounded", options={"xatol": 1e-9 * guess}).x
+    half_bin = 0.5 / (t[-1] - t[0])
+    reach = min(h, half_bin / max(harmonics))
+    return float(minimize_scalar(lambda f: _harmonic_residual(t, y, f, harmonics),
+                                 bounds=(coarse - reach, coarse + reach), method="bounded",
+                                 options={"xatol": 1e-10 * guess}).x)

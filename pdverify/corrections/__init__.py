@@ -6,6 +6,8 @@ METHODS = {
                          "Dirichlet/Neumann via Lagrange multipliers",
     "surface-nodes": "seeds 001/002: surface nodes carry the boundary conditions, fictitious layer "
                      "by Taylor extrapolation about the nearest surface node",
+    "homogenized": "seed 004: stiffness factors on the end bonds (1, 1+k), (N, N-k) so that a "
+                   "linear field satisfies every equilibrium equation (1D bond-based)",
     "fem": "classical-elasticity FEM reference (reference_fem)",
 }
 

@@ -1,1 +1,1 @@
-"""Solvers: static (direct, with constraints); later explicit dynamics and contact."""
+"""Solvers: static (direct, with constraints), explicit dynamics, modal; later contact."""

@@ -9,6 +9,7 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import ArpackError, ArpackNoConvergence, eigs
 
 from ..errors import NumericalError
+from .modal import exact_stability_limit
 
 
 @dataclass
@@ -79,18 +80,30 @@ def stability_limit(stiffness, mass=None) -> StabilityLimit:
 
 @dataclass
 class CentralDifferenceResult:
-    """Displacements at the sampled steps plus what the integrator did."""
+    """What :func:`central_difference` returns.
+
+    ``steps``, ``times``, ``u``: the sampled steps, their times and u there (rows);
+    ``history``: u[record] at every step 0..n_steps (rows; ``None`` without ``record``),
+    at ``history_times``; ``u_final``, ``v_final``: the state at the last step (v by the
+    central difference (u_{n+1} - u_{n-1}) / 2 dt); ``limit`` and ``info``: the stability
+    limit used and a summary.
+    """
 
     steps: np.ndarray
     times: np.ndarray
     u: np.ndarray                       # (len(steps), n)
     limit: StabilityLimit
     info: dict = field(default_factory=dict)
+    history: np.ndarray | None = None
+    history_times: np.ndarray | None = None
+    u_final: np.ndarray | None = None
+    v_final: np.ndarray | None = None
 
 
 def central_difference(stiffness, u0, v0, dt: float, n_steps: int, *, mass=None,
                        load: Callable[[float], np.ndarray] | None = None,
-                       sample_steps=(), where: str = "central difference",
+                       sample_steps=(), fixed=(), record=None, dt_limit: float | None = None,
+                       where: str = "central difference",
                        check_every: int = 100) -> CentralDifferenceResult:
     """Integrate M u'' + K u = f(t) by central differences (seed 002 Eqs. 4-7).
 
@@ -98,7 +111,12 @@ def central_difference(stiffness, u0, v0, dt: float, n_steps: int, *, mass=None,
     u_{-1} = u_0 - dt v_0 + dt^2/2 a_0 (Eqs. 6-7). ``stiffness`` is sparse (one product per
     step), ``mass`` a lumped mass vector (default 1: K is then minus the acceleration
     operator), ``load(t)`` an optional force vector. ``sample_steps`` are the step
-    indices n (0..n_steps) whose u_n is returned.
+    indices n (0..n_steps) whose u_n is returned; ``record`` are unknowns whose value is
+    kept at every step (``history``). ``fixed`` unknowns are held at their initial value
+    (no acceleration; the stability limit is then that of the free unknowns).
+    ``dt_limit``, when the caller already knows the sharp limit (e.g. from
+    :func:`pdverify.solvers.modal.exact_stability_limit` for a symmetric K), replaces the
+    estimate below.
 
     Raises :class:`NumericalError` (i) before any step when ``dt`` exceeds the stability
     limit 2 / sqrt(lambda_max(M^-1 K)), naming the limit: for a symmetric K, steps below the
@@ -121,10 +139,24 @@ def central_difference(stiffness, u0, v0, dt: float, n_steps: int, *, mass=None,
     # for sure, so nothing more is computed; above it the limit is sharpened from the
     # extreme eigenvalue before refusing. Non-symmetric K (extrapolated fictitious nodes):
     # the extreme eigenvalue is always computed, to catch complex or negative ones.
-    limit = gershgorin_limit(K, mass)
-    symmetric = abs(K - K.T).max() <= 1e-12 * limit.gershgorin if n else True
-    if dt > limit.dt_limit or not symmetric:
-        limit = stability_limit(K, mass)
+    fixed = np.asarray(fixed, dtype=int)
+    free = np.ones(n, dtype=bool)
+    free[fixed] = False
+    K_free = K[free][:, free] if fixed.size else K
+    m_free = None if mass is None else np.asarray(mass, dtype=float)[free]
+    if dt_limit is not None:
+        limit = StabilityLimit(float(dt_limit), 4.0 / float(dt_limit) ** 2, "given", np.nan)
+    else:
+        limit = gershgorin_limit(K_free, m_free)
+        symmetric = abs(K_free - K_free.T).max() <= 1e-12 * limit.gershgorin if n else True
+        if not symmetric:
+            limit = stability_limit(K_free, m_free)
+        elif dt > limit.dt_limit:
+            # symmetric: the operator's own limit, exact to round-off (modal.py)
+            m_all = np.ones(K_free.shape[0]) if m_free is None else m_free
+            exact = exact_stability_limit(K_free, m_all)
+            limit = StabilityLimit(exact, 4.0 / exact ** 2, "exact (symmetric)", limit.gershgorin,
+                                   0.0, 4.0 / exact ** 2)
     if limit.imag_ratio > 1e-6:
         raise NumericalError(f"{where}: M^-1 K has a complex eigenvalue (|Im|/|lambda| = "
                              f"{limit.imag_ratio:.2g}); central differences are unstable at any dt")
@@ -132,11 +164,16 @@ def central_difference(stiffness, u0, v0, dt: float, n_steps: int, *, mass=None,
         raise NumericalError(f"{where}: M^-1 K has a negative eigenvalue ({limit.real_part:.6g}); "
                              "the semi-discrete system grows exponentially at any dt")
     if dt > limit.dt_limit:
-        raise NumericalError(f"{where}: dt={dt:.6g} s exceeds the central-difference stability "
-                             f"limit 2/sqrt(lambda_max) = {limit.dt_limit:.6g} s "
-                             f"(lambda_max = {limit.lambda_max:.6g} 1/s^2, {limit.estimate})")
+        raise NumericalError(f"{where}: time step dt={dt:.6g} s exceeds the stability limit "
+                             f"2/sqrt(lambda_max) = {limit.dt_limit:.6g} s of central differences "
+                             f"(ratio {dt / limit.dt_limit:.3g} > 1; lambda_max = "
+                             f"{limit.lambda_max:.6g} 1/s^2, {limit.estimate})")
 
     inv_m = np.ones(n) if mass is None else 1.0 / np.asarray(mass, dtype=float)
+    inv_m = np.where(free, inv_m, 0.0)
+    v0 = np.where(free, v0, 0.0)
+    record = None if record is None else np.asarray(record, dtype=int)
+    history = None if record is None else np.empty((n_steps + 1, record.size))
     step_op = (sp.diags(-dt * dt * inv_m) @ K).tocsr()   # dt^2 M^-1 (-K), applied once per step
     dt2_inv_m = dt * dt * inv_m
 
@@ -149,17 +186,19 @@ def central_difference(stiffness, u0, v0, dt: float, n_steps: int, *, mass=None,
     samples = np.empty((sample_steps.size, n))
     next_sample = 0
 
-    def record(step, u):
+    def keep(step, u):
         nonlocal next_sample
         while next_sample < sample_steps.size and sample_steps[next_sample] == step:
             samples[next_sample] = u
             next_sample += 1
+        if history is not None:
+            history[step] = u[record]
 
     step = 0
     with np.errstate(over="raise", invalid="raise"):
         try:
             u = u0.copy()
-            record(0, u)
+            keep(0, u)
             # Eq. (6)-(7): u_{-1} = u_0 - dt v_0 + dt^2 a_0 / 2
             u_prev = u0 - dt * v0 + 0.5 * increment(u0, 0.0)
             for step in range(1, n_steps + 1):
@@ -167,17 +206,22 @@ def central_difference(stiffness, u0, v0, dt: float, n_steps: int, *, mass=None,
                 u_next += 2.0 * u
                 u_next -= u_prev
                 u_prev, u = u, u_next
-                record(step, u)
+                keep(step, u)
                 if step % check_every == 0 and not np.isfinite(u).all():
                     raise FloatingPointError("non-finite displacement")
             if not np.isfinite(u).all():
                 raise FloatingPointError("non-finite displacement")
         except FloatingPointError as exc:
-            raise NumericalError(f"{where}: displacement blew up near step {step} "
+            raise NumericalError(f"{where}: displacements became non-finite: blew up near step {step} "
                                  f"(t = {step * dt:.6g} s): {exc}") from None
+    u_next = increment(u, n_steps * dt) + 2.0 * u - u_prev
+    v_final = (u_next - u_prev) / (2.0 * dt)
     info = {"dt": dt, "n_steps": int(n_steps), "dt_limit": limit.dt_limit,
             "dt_limit_estimate": limit.estimate, "lambda_max": limit.lambda_max,
-            "gershgorin_dt_limit": 2.0 / np.sqrt(limit.gershgorin),
             "dt_over_limit": dt / limit.dt_limit}
+    if np.isfinite(limit.gershgorin) and limit.gershgorin > 0:
+        info["gershgorin_dt_limit"] = 2.0 / np.sqrt(limit.gershgorin)
     return CentralDifferenceResult(steps=sample_steps, times=sample_steps * dt, u=samples,
-                                   limit=limit, info=info)
+                                   limit=limit, info=info, history=history,
+                                   history_times=np.arange(n_steps + 1) * dt,
+                                   u_final=u, v_final=v_final)

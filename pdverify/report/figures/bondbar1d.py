@@ -1,0 +1,152 @@
+"""Figures of the seed-004 bond-based bars: f(N) beside Table 12, Fig. 3 and Figs. 4-5."""
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.lines import Line2D
+
+from . import family, save as _save
+
+def _case(r) -> str:
+    return f"{r.params['horizon_ratio']:g}, {r.params['end_weight']}"
+
+
+def _unique_sweeps(results):
+    """One run per (method, horizon, end weight, shape, calibration): the sweep is the same."""
+    seen, out = set(), []
+    for r in sorted(results, key=lambda r: r.params["nodes"]):
+        key = (r.method, r.params["horizon_ratio"], r.params["end_weight"],
+               r.params["micromodulus"], r.params["calibration"])
+        if key not in seen:
+            seen.add(key)
+            out.append(r)
+    return out
+
+
+@family("bondbar1d-homogenization")
+def homogenization_figures(scene, results, folder):
+    """f(N) of the non-homogenised bars against Table 12, and |f(N) - 1| homogenised."""
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 4.8), layout="constrained")
+    sweeps = _unique_sweeps(results)
+    for r in sweeps:
+        if r.method != "none":
+            continue
+        f = r.fields
+        line, = ax1.semilogx(f["sweep_nodes"], f["sweep_f"], "o-", ms=2.5, lw=1,
+                             label=f"delta/Delta = {_case(r)}")
+        cell = scene.table12.get((r.params["horizon_ratio"], r.params["end_weight"]))
+        if cell is None or r.params["micromodulus"] != "triangular":
+            continue
+        if cell.formula is not None:
+            n = f["sweep_nodes"].astype(float)
+            ax1.semilogx(n, cell.formula(n), "--", color=line.get_color(), lw=1.2)
+        ax1.plot([cell.nodes], [cell.printed], "x" if cell.erratum else "s",
+                 ms=10 if cell.erratum else 7, mfc="none", color=line.get_color(), mew=1.5)
+        if cell.erratum:
+            ax1.annotate(f"Table 12 prints {cell.text} here;\n{cell.erratum}",
+                         (cell.nodes, cell.printed), textcoords="axes fraction",
+                         xytext=(0.32, 0.42), fontsize=8, color=line.get_color(),
+                         arrowprops={"arrowstyle": "->", "color": line.get_color(), "lw": 0.8})
+    handles, _ = ax1.get_legend_handles_labels()
+    handles += [Line2D([], [], color="k", ls="--", label="Table 12 closed / fitted f(N)"),
+                Line2D([], [], color="k", marker="s", mfc="none", ls="none",
+                       label="Table 12 printed f(2m+1)"),
+                Line2D([], [], color="k", marker="x", ls="none", label="printed, erratum")]
+    ax1.legend(handles=handles, fontsize=7, ncol=2)
+    ax1.axhline(1.0, color="k", lw=0.8)
+    ax1.set_xlabel("points N")
+    ax1.set_ylabel("strain factor f(N)")
+    ax1.set_title("non-homogenised (ours: solid)")
+    ax1.grid(True, which="both", alpha=0.3)
+    floor = 1e-17
+    homogenized = [r for r in sweeps if r.method == "homogenized"]
+    colors = plt.cm.tab20(np.linspace(0.0, 1.0, max(len(homogenized), 2)))
+    for r, color in zip(homogenized, colors):
+        f = r.fields
+        ax2.loglog(f["sweep_nodes"], np.maximum(np.abs(f["sweep_f"] - 1.0), floor), "o-", ms=2.5,
+                   lw=0.9, color=color, label=f"delta/Delta = {_case(r)}")
+    ax2.axhline(1e-12, color="r", lw=0.8, ls="--", label="1e-12 (issue's bound)")
+    ax2.set_xlabel("points N")
+    ax2.set_ylabel(f"|f(N) - 1| (exact zeros drawn at {floor:g})")
+    ax2.set_title("homogenised")
+    ax2.grid(True, which="both", alpha=0.3)
+    ax2.legend(fontsize=6.5, ncol=2)
+    name = _save(fig, folder, f"{scene.id}-strain-factor.png")
+    caption = ("Left: strain factor f(N) of the non-homogenised bars (ours, solid) against Table "
+               "12's closed or fitted forms (dashed) and its printed values at N = 2m + 1 "
+               "(squares; the cross is the erratum 1.043, exactly 5/3). Right: |f(N) - 1| of "
+               "the homogenised bars, at round-off for every N.")
+    return [(name, caption)]
+
+
+@family("bondbar1d-constraints")
+def constraint_figures(scene, results, folder):
+    """Fig. 3: the full bar (a), the half bar with its end point held (b) and with m held (c)."""
+    fig, axes = plt.subplots(1, 4, figsize=(17, 4), layout="constrained")
+    titles = {"a": "(a) full bar, midpoint held", "b": "(b) half bar, end point held",
+              "c": "(c) half bar, m end points held"}
+    markers = {"none": "o", "homogenized": "s"}
+    for r in results:
+        f = r.fields
+        for ax, k in zip(axes[:3], "abc"):
+            ax.plot(f[f"x_{k}"], f[f"u_{k}"], markers[r.method] + "-", ms=4, lw=0.8,
+                    mfc="none", label=r.method)
+        n_a = f["x_a"].size
+        half = f["u_a"][n_a // 2:]
+        m = f["x_c"].size - f["x_b"].size + 1
+        scale = np.max(np.abs(f["u_a"]))
+        axes[3].plot(f["x_b"], (f["u_b"] - half) / scale, markers[r.method] + "-", ms=4, lw=0.8,
+                     mfc="none", label=f"{r.method}: (b) - (a)")
+        axes[3].plot(f["x_b"], (f["u_c"][m - 1:] - half) / scale, markers[r.method] + "--", ms=4,
+                     lw=0.8, label=f"{r.method}: (c) - (a)")
+    s = results[0].fields["stress_over_E"]
+    for ax, k in zip(axes[:3], "abc"):
+        x = results[0].fields[f"x_{k}"]
+        held_at_zero = x < 0 if k == "c" else np.zeros(x.size, dtype=bool)  # (c): x < 0 held
+        ax.plot(x, s * np.where(held_at_zero, 0.0, x), "k:", lw=1.2, label="classical")
+        ax.set_title(titles[k])
+        ax.set_xlabel("x [m]")
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("u [m]")
+    axes[0].legend(fontsize=8)
+    axes[3].axhline(0.0, color="k", lw=0.6)
+    axes[3].set_title("difference from the full bar's half")
+    axes[3].set_xlabel("x [m]")
+    axes[3].set_ylabel("(u_half - u_full) / max |u_full|")
+    axes[3].legend(fontsize=7)
+    axes[3].grid(alpha=0.3)
+    name = _save(fig, folder, f"{scene.id}.png")
+    caption = ("Fig. 3 of seed 004: displacements of the full bar (a), the half bar with its end "
+               "point held (b) and with m end points held (c), non-homogenised and homogenised, "
+               "with the classical solution; right: the halves minus the full bar's half. "
+               "Homogenised, (b) coincides with (a); (c) does not.")
+    return [(name, caption)]
+
+
+@family("bondbar1d-vibration")
+def vibration_figures(scene, results, folder):
+    """Figs. 4-5: the point next to the held end and the free end against Rao's series."""
+    ratios = sorted({r.params["horizon_ratio"] for r in results})
+    fig, axes = plt.subplots(2, len(ratios), figsize=(6.5 * len(ratios), 7), squeeze=False,
+                             layout="constrained")
+    for col, ratio in enumerate(ratios):
+        mine = [r for r in results if r.params["horizon_ratio"] == ratio]
+        first = mine[0].fields
+        T = first["period"]
+        for row, (key, what) in enumerate((("next", "point 2 (next to the held end)"),
+                                           ("free", "free end"))):
+            ax = axes[row, col]
+            ax.plot(first["t"] / T, first[f"u_{key}_ref"], "k-", lw=1.4, label="Rao, Eq. (105)")
+            for r in mine:
+                f = r.fields
+                ax.plot(f["t"] / T, f[f"u_{key}"], lw=0.9, label=r.method)
+            ax.set_title(f"delta = {ratio:g} Delta: {what}")
+            ax.set_xlabel("t / (4L/c)")
+            ax.set_ylabel("u [m]")
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=8, loc="lower left")
+    name = _save(fig, folder, f"{scene.id}.png")
+    caption = ("Figs. 4-5 of seed 004 (constraint b): displacement of point 2, next to the held "
+               "end (top), and of the free end (bottom) against Rao's series, for each horizon. "
+               "Time in periods 4L/c of Rao's first mode.")
+    return [(name, caption)]
