@@ -1,0 +1,414 @@
+"""Seed 001: 3D and 2D state-based PD boxes, uncorrected and with the surface node method."""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from manufactured import surface3d as closed
+
+from ..corrections.surface_nodes import MAX_ORDER
+from ..errors import InputError
+from ..params import Param, at_least, open_interval, positive
+from ..solvers.static import solve_constrained
+from ..statebased_nd import StateBasedBox, StateBasedConstants
+from . import MethodSpec, Outcome, Published, Scene, register
+
+NONE = MethodSpec("none")
+
+
+def _order_check(value):
+    return None if 1 <= value <= MAX_ORDER else f"must be 1, 2 or 3 (Taylor orders above {MAX_ORDER} are not supported)"
+
+
+def surface_method(default_order: int) -> MethodSpec:
+    return MethodSpec("surface-nodes", (Param("order", default_order,
+                                              "Taylor truncation order N (displacements N, "
+                                              "dilatations N - 1)", _order_check),))
+
+
+GEOMETRY = Param("geometry", "box", "body shape (only boxes are supported)", choices=("box",))
+
+
+def solve_with_dirichlet(K, rhs, fixed, values, where):
+    """Solve K u = rhs with u[fixed] = values by elimination (their own rows dropped).
+
+    The dropped rows are the equations of the prescribed unknowns (their reactions).
+    Returns the full solution and the solver's diagnostics.
+    """
+    n = K.shape[0]
+    free = np.setdiff1d(np.arange(n), fixed)
+    u = np.zeros(n)
+    u[fixed] = values
+    Kc = K.tocsc()
+    K_free = Kc[:, free].tocsr()[free]
+    r = rhs[free] - (Kc[:, fixed] @ u[fixed])[free] if fixed.size else rhs[free]
+    u_free, _, info = solve_constrained(K_free, r, where=where)
+    u[free] = u_free
+    return u, info
+
+
+def error_metrics(x, u, u_ref, dist, horizon, dim) -> tuple[dict, np.ndarray]:
+    """Eq. (38) (3D) / Eq. (44) (2D) errors in percent, overall and split at delta.
+
+    u_max per component is the largest |u_ref| over the interior nodes. ``boundary_``
+    metrics are over nodes within one horizon of the surface, ``interior_`` over the rest.
+    """
+    scale = np.max(np.abs(u_ref), axis=0)
+    comp = np.abs(u - u_ref) / scale * 100.0        # (n, d) per-component percent
+    mag = np.sqrt(np.sum(comp ** 2, axis=1))         # Eq. (38)
+    near = dist <= horizon
+    out = {}
+
+    def part(prefix, mask):
+        if not np.any(mask):
+            return
+        if dim == 3:
+            out[prefix + "max_error_pct"] = float(mag[mask].max())
+        else:
+            out[prefix + "max_error_pct"] = float(comp[mask].max())
+            out[prefix + "max_error_u_pct"] = float(comp[mask, 0].max())
+            out[prefix + "max_error_v_pct"] = float(comp[mask, 1].max())
+        d = (u - u_ref)[mask]
+        out[prefix + "rel_l2_error"] = float(np.linalg.norm(d) / np.linalg.norm(u_ref[mask]))
+
+    part("", np.ones(x.shape[0], dtype=bool))
+    part("boundary_", near)
+    part("interior_", ~near)
+    return out, (mag if dim == 3 else comp)
+
+
+class SurfaceNodeScene(Scene):
+    """Shared machinery; subclasses define the geometry, loads and constraints."""
+
+    seed = "001"
+    figure = "surface-nodes"
+    kind = "3d"
+
+    # ----------------------------------------------------------------- hooks
+    def box(self, p):
+        raise NotImplementedError
+
+    def exact(self, x, p):
+        raise NotImplementedError
+
+    def body_force(self, x, p, constants, horizon):
+        return np.zeros_like(x)
+
+    def traction(self, x, normal, face, p, constants, horizon):
+        """Applied traction on ``face`` at surface points x (n, d)."""
+        return np.zeros_like(x)
+
+    def surface_dirichlet(self, grid, p):
+        """[(surface-node mask, component)] prescribed on surface nodes (exact values)."""
+        raise NotImplementedError
+
+    def interior_dirichlet(self, grid, p):
+        """[(interior-node mask, component)] for the uncorrected model (exact values)."""
+        raise NotImplementedError
+
+    def loaded_faces(self, p):
+        """Faces whose traction is applied (the others are Dirichlet faces)."""
+        raise NotImplementedError
+
+    # ----------------------------------------------------------------- checks
+    def check(self, method, p):
+        where = f"{self.id} --method {method}"
+        lengths, _ = self.box(p)
+        h = p["spacing"]
+        for name, L in zip("xyz", lengths):
+            n = L / h
+            if abs(n - round(n)) > 1e-9 * max(n, 1.0) or round(n) < 2:
+                raise InputError(f"{where}: spacing={h:g} must divide l_{name}={L:g} into a "
+                                 "whole number (>= 2) of cells")
+        if method == "surface-nodes":
+            m = p["m_ratio"]
+            if abs(m - round(m)) > 1e-12:
+                raise InputError(f"{where}: m_ratio={m:g} must be a whole number for "
+                                 "surface-nodes (the fictitious layer of thickness delta must "
+                                 "be a whole number of cells)")
+            N = p["order"]
+            need = max(N + 1, 2 * ((N + 1) // 2) + 1)
+            for name, L in zip("xyz", lengths):
+                if round(L / h) < need:
+                    raise InputError(f"{where}: l_{name}={L:g} has {round(L / h)} cells; order "
+                                     f"{N} needs at least {need} for the Taylor stencils")
+
+    # ----------------------------------------------------------------- solve
+    def constants(self, p):
+        return StateBasedConstants(self.kind, p["E"], p["nu"])
+
+    def solve(self, method, p, timer):
+        order = p["order"] if method == "surface-nodes" else None
+        with timer.phase("setup"):
+            lengths, origin = self.box(p)
+            c = self.constants(p)
+            model = StateBasedBox(lengths, origin, p["spacing"], p["m_ratio"], c, order=order)
+            g = model.grid
+            d, ni, nu_ = g.dim, g.n_interior, model.n_unknown_nodes
+            K = model.stiffness()
+            x_int = g.x[g.interior_ids]
+            rhs = np.zeros((nu_, d))
+            rhs[:ni] = self.body_force(x_int, p, c, model.horizon) * g.volume
+            fixed, values = [], []
+            if order is None:
+                cells = g.index[g.interior_ids]
+                for face in self.loaded_faces(p):
+                    axis, side, _ = g.faces[face]
+                    on = cells[:, axis] == (0 if side == 0 else g.cells[axis] - 1)
+                    xs = x_int[on].copy()
+                    xs[:, axis] = g.origin[axis] + (0.0 if side == 0 else g.lengths[axis])
+                    nrm = np.zeros_like(xs)
+                    nrm[:, axis] = -1.0 if side == 0 else 1.0
+                    rhs[:ni][on] += self.traction(xs, nrm, face, p, c, model.horizon) * g.face_area
+                u_ref_all = self.exact(x_int, p)
+                for mask, k in self.interior_dirichlet(g, p):
+                    nodes = np.flatnonzero(mask)
+                    fixed.append(k * nu_ + nodes)
+                    values.append(u_ref_all[nodes, k])
+            else:
+                xs, nrm = g.surface_x, g.surface_normal
+                for face in self.loaded_faces(p):
+                    sel = g.surface_face == face
+                    rhs[ni:][sel] = self.traction(xs[sel], nrm[sel], face, p, c,
+                                                  model.horizon) * g.face_area
+                u_ref_s = self.exact(xs, p)
+                for mask, k in self.surface_dirichlet(g, p):
+                    nodes = np.flatnonzero(mask)
+                    fixed.append(k * nu_ + ni + nodes)
+                    values.append(u_ref_s[nodes, k])
+            fixed = np.concatenate(fixed)
+            values = np.concatenate(values)
+            order_idx = np.argsort(fixed)
+            fixed, values = fixed[order_idx], values[order_idx]
+        with timer.phase("solve"):
+            sol, info = solve_with_dirichlet(K, rhs.T.ravel(), fixed, values,
+                                             where=f"{self.id}/{method}")
+        U = sol.reshape(d, nu_).T
+        u = U[:ni]
+        u_ref = self.exact(x_int, p)
+        dist = g.distance_to_surface(x_int)
+        metrics, err = error_metrics(x_int, u, u_ref, dist, model.horizon, d)
+        if order is not None:
+            us_ref = self.exact(g.surface_x, p)
+            scale = np.max(np.abs(u_ref), axis=0)
+            metrics["surface_max_error_pct"] = float(
+                np.max(np.abs(U[ni:] - us_ref) / scale) * 100.0)
+        fields = {"x": x_int, "u": u, "u_ref": u_ref, "error": err, "cells": np.asarray(g.cells),
+                  "lengths": np.asarray(lengths), "origin": np.asarray(origin),
+                  "spacing": p["spacing"], "horizon": model.horizon}
+        size = model.size()
+        size["stiffness_nnz"] = int(K.nnz)
+        return Outcome(metrics=metrics, size=size, fields=fields, diagnostics=info)
+
+
+# =============================================================================== 3D
+BODY_PARAMS = (
+    Param("lx", 1.0, "body length l_x along x [m] (ERRATA seed 001: Table 1 missing)", positive),
+    Param("ly", 0.5, "body size l_y [m], y centred on 0", positive),
+    Param("lz", 0.5, "body size l_z [m], z centred on 0", positive),
+    Param("E", 200e9, "Young's modulus [Pa]", positive),
+    Param("nu", 0.3, "Poisson's ratio", open_interval(-1.0, 0.5)),
+    Param("spacing", 0.05, "grid spacing h [m]", positive),
+    Param("m_ratio", 3.0, "horizon / spacing", at_least(1.0)),
+    GEOMETRY,
+)
+
+
+class Body3D(SurfaceNodeScene):
+    kind = "3d"
+
+    def box(self, p):
+        return (p["lx"], p["ly"], p["lz"]), (0.0, -p["ly"] / 2, -p["lz"] / 2)
+
+
+@register
+class Body3DTraction(Body3D):
+    """Seed 001 §4.1 (Fig. 8): box under the traction p = 10 MPa on x = l_x; Eq. (39).
+
+    Geometry, material and grid (Table 1 is missing; ERRATA seed 001): (l_x, l_y, l_z) =
+    (1.0, 0.5, 0.5) m, x in [0, l_x], y and z centred on 0, E = 200 GPa, nu = 0.3,
+    h = 0.05 m, m-ratio 3 (2000 interior nodes). Gaussian influence (Eq. 7), 3D
+    constants of §2.1, partial volumes = exact cell fractions inside the horizon.
+
+    ``none`` (§4): truncated neighbourhoods; the constraints act on the interior nodes
+    nearest the boundary at the exact displacement there: u on the layer next to x = 0,
+    v on its row next to y = -l_y/2, w on its row next to z = -l_z/2 (Fig. 8); the
+    traction is applied as nodal forces p h^2 on the layer next to x = l_x.
+
+    ``surface-nodes`` (order N): u = 0 on the surface nodes of x = 0; the constraints
+    v(x = 0, y = -l_y/2) = 0 and w(x = 0, z = -l_z/2) = 0 of Fig. 8 lie on body edges,
+    where there are no surface nodes. Our choice: v = 0 on the surface nodes of the face
+    y = -l_y/2 in the cell row next to x = 0 (and w = 0 likewise on z = -l_z/2); Eq. (39)
+    has v = 0 on that whole face, so the constraint is exact and removes the same rigid
+    motions. Every other surface-node equation is the force flux Eq. (36) = p A (zero on
+    the free faces).
+
+    Metrics over the interior nodes: ``max_error_pct`` = max of Eq. (38) with u_max per
+    component over the nodes, ``rel_l2_error``, and both split into ``boundary_`` (nodes
+    within delta of the surface) and ``interior_``; ``surface_max_error_pct`` is the
+    largest component error of the surface nodes (same scale).
+    """
+
+    id = "body3d-traction"
+    title = "3D box under simple traction (surface node method)"
+    seed = "001 §4.1"
+    reference = "analytic"
+    params = BODY_PARAMS + (Param("traction", 10e6, "traction p on x = l_x [Pa]", positive),)
+    methods = (NONE, surface_method(1))
+    published = (
+        Published("max_error_pct", "> 30", "seed 001 §4.1, Fig. 9a", method="none"),
+        Published("max_error_pct", 0.06, "seed 001 §4.1, Fig. 9b", method="surface-nodes",
+                  where={"order": 1}),
+    )
+
+    def exact(self, x, p):
+        return closed.traction_displacement_3d(x, p=p["traction"], E=p["E"], nu=p["nu"],
+                                               ly=p["ly"], lz=p["lz"])
+
+    def loaded_faces(self, p):
+        return (1, 2, 3, 4, 5)
+
+    def traction(self, x, normal, face, p, constants, horizon):
+        t = np.zeros_like(x)
+        if face == 1:
+            t[:, 0] = p["traction"]
+        return t
+
+    def surface_dirichlet(self, g, p):
+        f, cell = g.surface_face, g.surface_cell
+        return [(f == 0, 0), ((f == 2) & (cell[:, 0] == 0), 1), ((f == 4) & (cell[:, 0] == 0), 2)]
+
+    def interior_dirichlet(self, g, p):
+        cell = g.index[g.interior_ids]
+        first = cell[:, 0] == 0
+        return [(first, 0), (first & (cell[:, 1] == 0), 1), (first & (cell[:, 2] == 0), 2)]
+
+    def cases(self, quick=False):
+        return [("none", {}), ("surface-nodes", {"order": 1})]
+
+
+@register
+class Body3DManufactured(Body3D):
+    """Seed 001 §4.2 (Fig. 10): manufactured u = (c_u x y, c_v x^3, c_w x z), Eq. (42).
+
+    Body as in ``body3d-traction`` (ERRATA seed 001). The face x = 0 is clamped (the exact
+    field vanishes there); the body force is Eq. (40) and the other five faces carry the
+    traction tau(x) . n of Eq. (41), both from ``manufactured.surface3d`` (closed forms of
+    the paper's equations, checked in tests against the classical stress and the
+    ERRATA identities). For ``surface-nodes`` the traction is evaluated at the surface
+    nodes (face centres on the surface) and enters Eq. (36) as p A; all three components
+    of the surface nodes of x = 0 are prescribed. For ``none`` the nodes of the layer next
+    to x = 0 are prescribed at the exact displacement there, and each boundary cell face
+    passes its traction tau(x_face) . n h^2 (evaluated at the face centre, on the surface)
+    to the interior node of its cell; the body force is b(x_i) h^3 on every node.
+    Metrics as in ``body3d-traction``.
+    """
+
+    id = "body3d-manufactured"
+    title = "3D box under manufactured loads (surface node method)"
+    seed = "001 §4.2"
+    reference = "manufactured"
+    params = BODY_PARAMS
+    methods = (NONE, surface_method(3))
+    published = (
+        Published("max_error_pct", "> 130", "seed 001 §4.2, Fig. 12a", method="none"),
+        Published("max_error_pct", "< 1", "seed 001 §4.2, Fig. 12b", method="surface-nodes",
+                  where={"order": 1}),
+        Published("max_error_pct", "< 1", "seed 001 §4.2, Fig. 12c", method="surface-nodes",
+                  where={"order": 2}),
+        Published("max_error_pct", 0.4, "seed 001 §4.2, Fig. 12d", method="surface-nodes",
+                  where={"order": 3}),
+    )
+
+    def exact(self, x, p):
+        return closed.manufactured_displacement(x)
+
+    def body_force(self, x, p, c, horizon):
+        return closed.manufactured_body_force(x, k_theta=c.k_theta, k_e=c.k_e)
+
+    def traction(self, x, normal, face, p, c, horizon):
+        return closed.manufactured_traction(x, normal, k_theta=c.k_theta, k_e=c.k_e,
+                                            horizon=horizon)
+
+    def loaded_faces(self, p):
+        return (1, 2, 3, 4, 5)
+
+    def surface_dirichlet(self, g, p):
+        return [(g.surface_face == 0, k) for k in range(3)]
+
+    def interior_dirichlet(self, g, p):
+        first = g.index[g.interior_ids][:, 0] == 0
+        return [(first, k) for k in range(3)]
+
+    def cases(self, quick=False):
+        return [("none", {})] + [("surface-nodes", {"order": n}) for n in (1, 2, 3)]
+
+
+# =============================================================================== 2D
+@register
+class Plate2DPlaneStrain(SurfaceNodeScene):
+    """Seed 001 §5 (Fig. 13): plate under the traction p = 240 MPa on y = l_y; Eq. (43).
+
+    Table 2 and its source [42] are missing; our choice (ERRATA seed 001): 1 x 1 m,
+    E = 200 GPa, nu = 0.3, h = 0.02 m, m-ratio 3, u = 0 on x = 0, v = 0 on y = 0, the
+    other edges free. Plane strain with the constants of §5 (c_theta = 2, Gaussian
+    influence); ``plane=stress`` (our addition) uses the plane-stress constants and
+    u = -nu p x / E, v = p y / E. Per unit thickness: V = h^2, A = h.
+
+    ``none``: u prescribed (exact) on the column of nodes next to x = 0, v on the row next
+    to y = 0, nodal forces p h on the row next to y = l_y. ``surface-nodes``: u = 0 on the
+    surface nodes of x = 0 and v = 0 on those of y = 0 (their other component carries a
+    zero force flux), force flux Eq. (36) = p A on y = l_y and zero on x = l_x.
+    Metrics: ``max_error_u_pct`` and ``max_error_v_pct`` (Eq. 44, largest over the
+    interior nodes), ``max_error_pct`` = the larger of the two, ``rel_l2_error``, and the
+    ``boundary_`` / ``interior_`` split at one horizon from the surface.
+    """
+
+    id = "plate2d-plane-strain"
+    title = "2D plate in plane strain under traction (surface node method)"
+    seed = "001 §5"
+    reference = "analytic"
+    kind = "plane-strain"
+    params = (
+        Param("lx", 1.0, "plate width [m] (ERRATA seed 001: Table 2 missing)", positive),
+        Param("ly", 1.0, "plate height [m]", positive),
+        Param("E", 200e9, "Young's modulus [Pa]", positive),
+        Param("nu", 0.3, "Poisson's ratio", open_interval(-1.0, 0.5)),
+        Param("spacing", 0.02, "grid spacing h [m]", positive),
+        Param("m_ratio", 3.0, "horizon / spacing", at_least(1.0)),
+        Param("traction", 240e6, "traction p on y = l_y [Pa]", positive),
+        Param("plane", "strain", "plane strain (the paper) or plane stress",
+              choices=("strain", "stress")),
+        GEOMETRY,
+    )
+    methods = (NONE, surface_method(1))
+
+    def constants(self, p):
+        return StateBasedConstants("plane-" + p["plane"], p["E"], p["nu"])
+
+    def box(self, p):
+        return (p["lx"], p["ly"]), (0.0, 0.0)
+
+    def exact(self, x, p):
+        return closed.plate_displacement(x, p=p["traction"], E=p["E"], nu=p["nu"],
+                                         plane=p["plane"])
+
+    def loaded_faces(self, p):
+        return (1, 3)
+
+    def traction(self, x, normal, face, p, c, horizon):
+        t = np.zeros_like(x)
+        if face == 3:
+            t[:, 1] = p["traction"]
+        return t
+
+    def surface_dirichlet(self, g, p):
+        f = g.surface_face
+        return [(f == 0, 0), (f == 2, 1)]
+
+    def interior_dirichlet(self, g, p):
+        cell = g.index[g.interior_ids]
+        return [(cell[:, 0] == 0, 0), (cell[:, 1] == 0, 1)]
+
+    def cases(self, quick=False):
+        return [("none", {}), ("surface-nodes", {"order": 1})]
