@@ -13,7 +13,8 @@ from ..solvers.dense import solve_square
 from ..statebased_nd import StateBasedBox, StateBasedConstants
 from . import MethodSpec, Outcome, Published, Scene, register
 
-NONE = MethodSpec("none", (Param(
+NONE = MethodSpec("none")
+NONE_LOAD_POINT = MethodSpec("none", (Param(
     "load_point", "node", "where the uncorrected model evaluates a surface load: at the "
     "node it is applied to (like its constraints) or at the face centre on the surface",
     choices=("node", "surface")),))
@@ -159,7 +160,7 @@ class SurfaceNodeScene(Scene):
                     axis, side, _ = g.faces[face]
                     on = cells[:, axis] == (0 if side == 0 else g.cells[axis] - 1)
                     xs = x_int[on].copy()
-                    if p["load_point"] == "surface":
+                    if p.get("load_point", "surface") == "surface":
                         xs[:, axis] = g.origin[axis] + (0.0 if side == 0 else g.lengths[axis])
                     nrm = np.zeros_like(xs)
                     nrm[:, axis] = -1.0 if side == 0 else 1.0
@@ -288,7 +289,8 @@ class Body3DTraction(Body3D):
         return [(first, 0), (first & (cell[:, 1] == 0), 1), (first & (cell[:, 2] == 0), 2)]
 
     def cases(self, quick=False):
-        return [("none", {}), ("surface-nodes", {"order": 1})]
+        over = {"spacing": 0.1} if quick else {}
+        return [("none", dict(over)), ("surface-nodes", {"order": 1, **over})]
 
 
 @register
@@ -327,7 +329,7 @@ class Body3DManufactured(Body3D):
     seed = "001 §4.2"
     reference = "manufactured"
     params = BODY_PARAMS
-    methods = (NONE, surface_method(3))
+    methods = (NONE_LOAD_POINT, surface_method(3))
     published = (
         Published("max_error_pct", "> 130", "seed 001 §4.2, Fig. 12a", method="none"),
         Published("max_error_pct", "< 1", "seed 001 §4.2, Fig. 12b", method="surface-nodes",
@@ -359,8 +361,9 @@ class Body3DManufactured(Body3D):
         return [(first, k) for k in range(3)]
 
     def cases(self, quick=False):
-        return ([("none", {}), ("none", {"load_point": "surface"})]
-                + [("surface-nodes", {"order": n}) for n in (1, 2, 3)])
+        over = {"spacing": 0.1} if quick else {}
+        return ([("none", dict(over)), ("none", {"load_point": "surface", **over})]
+                + [("surface-nodes", {"order": n, **over}) for n in (1, 2, 3)])
 
 
 # =============================================================================== 2D
@@ -381,6 +384,14 @@ class Plate2DPlaneStrain(SurfaceNodeScene):
     Metrics: ``max_error_u_pct`` and ``max_error_v_pct`` (Eq. 44, largest over the
     interior nodes), ``max_error_pct`` = the larger of the two, ``rel_l2_error``, and the
     ``boundary_`` / ``interior_`` split at one horizon from the surface.
+
+    Finding (not tuned): with surface nodes the plate deforms homogeneously, exactly as
+    the discrete PD material does under sigma = (0, p) (tested to 1e-6), so no boundary
+    error remains; but the discrete 2D material at m = 3 with exact partial areas is
+    itself off the continuum moduli (its stencil's fourth moment is 1 % anisotropic),
+    giving 1.20 % in u and 0.51 % in v against Eq. (43). Issue 7 expects < 0.1 %; the
+    material error falls to 0.25 % at m = 4 and 0.098 % at m = 5 (same h), which the
+    report shows. The 3D stencil at m = 3 is far more isotropic (0.02 %).
     """
 
     id = "plate2d-plane-strain"
@@ -430,4 +441,8 @@ class Plate2DPlaneStrain(SurfaceNodeScene):
         return [(cell[:, 0] == 0, 0), (cell[:, 1] == 0, 1)]
 
     def cases(self, quick=False):
-        return [("none", {}), ("surface-nodes", {"order": 1})]
+        if quick:
+            return [("none", {"spacing": 0.05}), ("surface-nodes", {"order": 1, "spacing": 0.05})]
+        return [("none", {}), ("surface-nodes", {"order": 1}),
+                ("surface-nodes", {"order": 1, "m_ratio": 4.0}),
+                ("surface-nodes", {"order": 1, "m_ratio": 5.0})]

@@ -1,0 +1,92 @@
+"""Figures of seed 001: error maps (Figs. 9, 12, 14, 15) and error against cost."""
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from . import family, label, save as _save
+
+
+def _cells(f):
+    idx = np.rint((f["x"] - f["origin"]) / f["spacing"] - 0.5).astype(int)
+    return idx, tuple(int(n) for n in f["cells"])
+
+
+def _grid_values(f, values):
+    idx, shape = _cells(f)
+    out = np.full(shape, np.nan)
+    out[tuple(idx.T)] = values
+    return out
+
+
+def _maps_2d(scene, results, folder):
+    out = []
+    for r in results:
+        f = r.fields
+        L = f["lengths"]
+        fig, axes = plt.subplots(1, 2, figsize=(10, 4.2))
+        for k, (ax, name) in enumerate(zip(axes, ("u", "v"))):
+            z = _grid_values(f, f["error"][:, k]).T
+            im = ax.imshow(z, origin="lower", extent=(0, L[0], 0, L[1]), cmap="viridis")
+            fig.colorbar(im, ax=ax, label=f"eps_{name} [%] (Eq. 44)")
+            ax.set_title(f"{label(r)}: error in {name}")
+            ax.set_xlabel("x [m]")
+            ax.set_ylabel("y [m]")
+        name = _save(fig, folder, f"{scene.id}-{r.method}-{r.params.get('order', 0)}-"
+                                  f"{len(out)}.png")
+        out.append((name, f"{label(r)}: nodal errors of Eq. (44) in u and v (as Figs. 14-15 "
+                          "of seed 001); each map has its own colour scale."))
+    return out
+
+
+def _maps_3d(scene, results, folder):
+    out = []
+    for r in results:
+        f = r.fields
+        err = _grid_values(f, f["error"])
+        nx, ny, nz = err.shape
+        L, o = f["lengths"], f["origin"]
+        ext_xy = (o[0], o[0] + L[0], o[1], o[1] + L[1])
+        ext_xz = (o[0], o[0] + L[0], o[2], o[2] + L[2])
+        ext_yz = (o[1], o[1] + L[1], o[2], o[2] + L[2])
+        panels = [("top layer z = l_z/2 - h/2", err[:, :, -1].T, ext_xy, ("x", "y")),
+                  ("mid-plane z ~ 0", err[:, :, nz // 2].T, ext_xy, ("x", "y")),
+                  ("side layer y = l_y/2 - h/2", err[:, -1, :].T, ext_xz, ("x", "z")),
+                  ("end layer x = l_x - h/2", err[-1, :, :].T, ext_yz, ("y", "z"))]
+        vmax = np.nanmax(err)
+        fig, axes = plt.subplots(1, 4, figsize=(17, 3.6),
+                                 gridspec_kw={"width_ratios": [2, 2, 2, 1]})
+        for ax, (title, z, ext, (a, b)) in zip(axes, panels):
+            im = ax.imshow(z, origin="lower", extent=ext, cmap="viridis", vmin=0, vmax=vmax)
+            ax.set_title(title, fontsize=9)
+            ax.set_xlabel(f"{a} [m]")
+            ax.set_ylabel(f"{b} [m]")
+        fig.colorbar(im, ax=axes, label="|eps| [%] (Eq. 38)", shrink=0.9)
+        fig.suptitle(f"{scene.id}: {label(r)} (max {vmax:.3g} %)")
+        name = _save(fig, folder, f"{scene.id}-{r.method}-{r.params.get('order', 0)}-"
+                                  f"{len(out)}.png")
+        out.append((name, f"{label(r)}: magnitude of the nodal error of Eq. (38) on four node "
+                          "layers (as Figs. 9 and 12 of seed 001); one colour scale per run."))
+    return out
+
+
+def _cost(scene, results, folder):
+    fig, ax = plt.subplots(figsize=(6.5, 4))
+    for r in results:
+        lab = label(r) + "".join(f", {k}={v}" for k, v in r.params.items() if k == "load_point")
+        ax.loglog(r.timings["total_s"], r.metrics["max_error_pct"], "o", ms=8, label=lab)
+    ax.set_xlabel("total time [s] (setup + solve)")
+    ax.set_ylabel("max_error_pct")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    ax.set_title(f"{scene.id}: error against cost")
+    return [(_save(fig, folder, f"{scene.id}-cost.png"),
+             "Largest nodal error against the run's wall time, one point per method and order "
+             "(the table above lists setup and solve time separately).")]
+
+
+@family("surface-nodes")
+def surface_node_figures(scene, results, folder):
+    dim = results[0].fields["x"].shape[1]
+    maps = _maps_3d(scene, results, folder) if dim == 3 else _maps_2d(scene, results, folder)
+    return maps + _cost(scene, results, folder)
