@@ -55,7 +55,7 @@ def _maps_3d(scene, results, folder):
                   ("end layer x = l_x - h/2", err[-1, :, :].T, ext_yz, ("y", "z"))]
         vmax = np.nanmax(err)
         fig, axes = plt.subplots(1, 4, figsize=(17, 3.6),
-                                 gridspec_kw={"width_ratios": [2, 2, 2, 1]})
+                                 gridspec_kw={"width_ratios": [2, 2, 2, 1], "wspace": 0.35})
         for ax, (title, z, ext, (a, b)) in zip(axes, panels):
             im = ax.imshow(z, origin="lower", extent=ext, cmap="viridis", vmin=0, vmax=vmax)
             ax.set_title(title, fontsize=9)
