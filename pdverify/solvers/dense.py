@@ -7,7 +7,7 @@ import scipy.sparse as sp
 from scipy.linalg import lapack
 
 from ..errors import NumericalError
-from .static import CONDITION_LIMIT, solve_constrained
+from .static import CONDITION_LIMIT, equilibrate, solve_constrained
 
 #: Above this fill (nnz / n^2) a dense LAPACK LU beats SuperLU: in 3D state-based PD every
 #: node couples to all nodes within two horizons, i.e. to a large part of a small body.
@@ -31,16 +31,8 @@ def solve_square(K, f, *, where: str = "static solve"):
     f = np.asarray(f, dtype=float)
     if not np.all(np.isfinite(K.data)) or not np.all(np.isfinite(f)):
         raise NumericalError(f"{where}: the system has non-finite entries")
-    row_max = abs(K).max(axis=1).toarray().ravel()
-    if np.any(row_max == 0):
-        raise NumericalError(f"{where}: singular system (equation {int(np.argmin(row_max))} "
-                             "has no entries)")
-    A = (sp.diags(1.0 / row_max) @ K).toarray()
-    col_max = np.abs(A).max(axis=0)
-    if np.any(col_max == 0):
-        raise NumericalError(f"{where}: singular system (unknown {int(np.argmin(col_max))} "
-                             "appears in no equation)")
-    A /= col_max
+    A_s, row_max, col_max = equilibrate(K, where)
+    A = A_s.toarray()
     anorm = float(np.abs(A).sum(axis=0).max())
     lu, piv, info_ = lapack.dgetrf(A, overwrite_a=True)
     if info_ > 0:

@@ -31,19 +31,8 @@ def solve_constrained(K, f, B=None, c=None, *, where: str = "static solve"):
         rhs = np.asarray(f, dtype=float)
     if not np.all(np.isfinite(A.data)) or not np.all(np.isfinite(rhs)):
         raise NumericalError(f"{where}: the system has non-finite entries")
-    # Row then column equilibration: the constraint rows (dimensionless Dirichlet rows,
-    # force-flux rows) and the stiffness rows differ by many orders of magnitude, which
-    # would inflate the condition estimate without any loss of accuracy.
-    row_max = abs(A).max(axis=1).toarray().ravel()
-    if np.any(row_max == 0):
-        raise NumericalError(f"{where}: singular system (equation {int(np.argmin(row_max))} "
-                             "has no entries)")
-    A_r = sp.diags(1.0 / row_max) @ A
-    col_max = abs(A_r).max(axis=0).toarray().ravel()
-    if np.any(col_max == 0):
-        raise NumericalError(f"{where}: singular system (unknown {int(np.argmin(col_max))} "
-                             "appears in no equation)")
-    A_s = (A_r @ sp.diags(1.0 / col_max)).tocsc()
+    A_s, row_max, col_max = equilibrate(A, where)
+    A_s = A_s.tocsc()
     try:
         lu = spla.splu(A_s)
     except RuntimeError as exc:  # "Factor is exactly singular"
@@ -60,6 +49,27 @@ def solve_constrained(K, f, B=None, c=None, *, where: str = "static solve"):
     info = {"unknowns": int(A.shape[0]), "relative_residual": float(np.linalg.norm(res) / scale),
             "condition_estimate": float(cond)}  # of the equilibrated system
     return sol[:n], sol[n:], info
+
+
+def equilibrate(A, where: str):
+    """Row then column max-scaling of a sparse matrix: ``(A_scaled, row_max, col_max)``.
+
+    Constraint rows (dimensionless Dirichlet rows, force-flux rows) and stiffness rows
+    differ by many orders of magnitude, which would inflate a condition estimate without
+    any loss of accuracy. An empty row or column is a singular system (NumericalError).
+    Solve A x = b as A_scaled y = b / row_max, x = y / col_max.
+    """
+    A = sp.csr_matrix(A)
+    row_max = abs(A).max(axis=1).toarray().ravel()
+    if np.any(row_max == 0):
+        raise NumericalError(f"{where}: singular system (equation {int(np.argmin(row_max))} "
+                             "has no entries)")
+    A_r = sp.diags(1.0 / row_max) @ A
+    col_max = abs(A_r).max(axis=0).toarray().ravel()
+    if np.any(col_max == 0):
+        raise NumericalError(f"{where}: singular system (unknown {int(np.argmin(col_max))} "
+                             "appears in no equation)")
+    return (A_r @ sp.diags(1.0 / col_max)).tocsr(), row_max, col_max
 
 
 def _condition_estimate(A, lu) -> float:
