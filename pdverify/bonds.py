@@ -3,6 +3,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .bonds_nd import bond_pairs
+
 
 def partial_volumes_1d(m_ratio: float) -> tuple[np.ndarray, np.ndarray]:
     """Offsets k >= 1 and cell fractions beta_k inside the horizon, nodes at cell centres.
@@ -24,21 +26,13 @@ def partial_volumes_1d(m_ratio: float) -> tuple[np.ndarray, np.ndarray]:
 def bond_family_1d(n_nodes: int, offsets: np.ndarray, keep=None):
     """All pairs (i, i + k) for the stencil ``offsets`` on a line of ``n_nodes`` nodes.
 
-    Built by array slicing, one block per offset (no per-bond loop). Returns the arrays
-    ``i``, ``j`` (i < j) and ``which`` (index into ``offsets``). ``keep(i, j)`` may
-    return a boolean mask to drop bonds.
+    Built by array slicing, one block per offset (no per-bond loop), by the same routine
+    as the 2D/3D grids (:func:`pdverify.bonds_nd.bond_pairs`). Returns the arrays ``i``,
+    ``j`` (i < j) and ``which`` (index into ``offsets``). ``keep(i, j)`` may return a
+    boolean mask to drop bonds.
     """
-    i_parts, j_parts, w_parts = [], [], []
-    for idx, k in enumerate(offsets):
-        i = np.arange(0, n_nodes - int(k))
-        j = i + int(k)
-        if keep is not None:
-            mask = keep(i, j)
-            i, j = i[mask], j[mask]
-        i_parts.append(i)
-        j_parts.append(j)
-        w_parts.append(np.full(i.shape, idx))
-    if not i_parts:
-        empty = np.zeros(0, dtype=int)
-        return empty, empty, empty
-    return np.concatenate(i_parts), np.concatenate(j_parts), np.concatenate(w_parts)
+    i, j, which = bond_pairs((n_nodes,), np.asarray(offsets, dtype=int).reshape(-1, 1))
+    if keep is not None:
+        mask = keep(i, j)
+        i, j, which = i[mask], j[mask], which[mask]
+    return i, j, which

@@ -4,7 +4,6 @@ from __future__ import annotations
 import json
 import os
 import platform
-import sys
 import tempfile
 import time
 from contextlib import contextmanager
@@ -154,6 +153,3 @@ def load_results(path) -> dict:
         raise ValueError(f"{path}: 'runs' must be a list")
     return doc
 
-
-def python_executable() -> str:
-    return sys.executable

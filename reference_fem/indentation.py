@@ -185,7 +185,6 @@ def solve_level(p: IndentationParams, level: int, check_steps: bool = False) -> 
     X0 = model.dof_coords[0, cx]
     if not np.allclose(X0, model.dof_coords[0, cy]):
         raise RuntimeError("top-edge x and y DOFs do not pair up")
-    nc = X0.size
     cand_rows = row_of[np.concatenate([cx, cy])]   # candidate DOF order: all u_x, then all u_y
     t_setup = time.perf_counter() - t0
 
