@@ -6,12 +6,14 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from .bonds_nd import bond_pairs, half_stencil, partial_volumes, stencil_offsets
+from .bonds_nd import (bond_pairs, half_stencil, moment_corrected_volumes, partial_volumes,
+                       stencil_offsets)
 from .corrections.surface_nodes import (dilatation_extrapolation, displacement_extrapolation,
                                         face_crossings)
 from .grid import BoxGrid
 
 KINDS = ("3d", "plane-strain", "plane-stress")
+QUADRATURES = ("partial-volume", "moment-corrected")
 
 
 @dataclass(frozen=True)
@@ -83,6 +85,12 @@ class StateBasedBox:
     N - 1 about the nearest interior node (steps 1-6), m = m of a complete neighbourhood
     everywhere (§3.2), one force-flux equation per surface node (Eq. 36).
 
+    ``quadrature``: the weights beta of Eqs. (22)-(24): ``partial-volume`` = the exact
+    fraction of each cell inside the horizon (§3.1, ref. [6]); ``moment-corrected`` (our
+    addition) = those fractions minimally adjusted so the stencil's fourth moment is
+    isotropic, which makes the discrete bulk moduli equal the continuum ones
+    (``bonds_nd.moment_corrected_volumes``).
+
     Unknowns ``u~`` (component-major): the interior nodes, then the surface nodes.
     Operators (sparse; names follow seed 000 App. D):
       U = (I_d kron A_U) u~        all node displacements (extrapolation on fictitious)
@@ -102,8 +110,11 @@ class StateBasedBox:
     """
 
     def __init__(self, lengths, origin, spacing, m_ratio, constants: StateBasedConstants,
-                 order: int | None = None):
+                 order: int | None = None, quadrature: str = "partial-volume"):
+        if quadrature not in QUADRATURES:
+            raise ValueError(f"quadrature={quadrature!r}; allowed: {', '.join(QUADRATURES)}")
         self.constants = constants
+        self.quadrature = quadrature
         self.order = order
         self.spacing = h = float(spacing)
         self.m_ratio = float(m_ratio)
@@ -111,11 +122,13 @@ class StateBasedBox:
         dim = len(lengths)
         offsets = stencil_offsets(dim, self.m_ratio)
         beta = partial_volumes(offsets, self.m_ratio)
+        r_k = np.linalg.norm(offsets, axis=1) * h
+        if quadrature == "moment-corrected":
+            beta = moment_corrected_volumes(offsets, beta, gaussian_influence(r_k, delta) * r_k ** 2)
         self.offsets, self.beta_k = offsets, beta
         layers = int(np.abs(offsets).max()) if order is not None else 0
         self.grid = g = BoxGrid(lengths, origin, h, layers)
         V = g.volume
-        r_k = np.linalg.norm(offsets, axis=1) * h
         self.m_inf = float(np.sum(gaussian_influence(r_k, delta) * r_k ** 2 * beta) * V)
 
         half = half_stencil(offsets)

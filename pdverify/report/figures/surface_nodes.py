@@ -7,6 +7,14 @@ import numpy as np
 from . import family, label, save as _save
 
 
+def _label(r) -> str:
+    """Method and order, plus the parameters the seed-001 cases vary."""
+    extra = [f"{k}={v}" for k, v in r.params.items()
+             if (k == "quadrature" and v != "partial-volume") or (k == "m_ratio" and v != 3.0)
+             or k == "load_point"]
+    return label(r) + "".join(", " + e for e in extra)
+
+
 def _cells(f):
     idx = np.rint((f["x"] - f["origin"]) / f["spacing"] - 0.5).astype(int)
     return idx, tuple(int(n) for n in f["cells"])
@@ -29,12 +37,12 @@ def _maps_2d(scene, results, folder):
             z = _grid_values(f, f["error"][:, k]).T
             im = ax.imshow(z, origin="lower", extent=(0, L[0], 0, L[1]), cmap="viridis")
             fig.colorbar(im, ax=ax, label=f"eps_{name} [%] (Eq. 44)")
-            ax.set_title(f"{label(r)}: error in {name}")
+            ax.set_title(f"{_label(r)}: error in {name}", fontsize=9)
             ax.set_xlabel("x [m]")
             ax.set_ylabel("y [m]")
         name = _save(fig, folder, f"{scene.id}-{r.method}-{r.params.get('order', 0)}-"
                                   f"{len(out)}.png")
-        out.append((name, f"{label(r)}: nodal errors of Eq. (44) in u and v (as Figs. 14-15 "
+        out.append((name, f"{_label(r)}: nodal errors of Eq. (44) in u and v (as Figs. 14-15 "
                           "of seed 001); each map has its own colour scale."))
     return out
 
@@ -62,10 +70,10 @@ def _maps_3d(scene, results, folder):
             ax.set_xlabel(f"{a} [m]")
             ax.set_ylabel(f"{b} [m]")
         fig.colorbar(im, ax=axes, label="|eps| [%] (Eq. 38)", shrink=0.9)
-        fig.suptitle(f"{scene.id}: {label(r)} (max {vmax:.3g} %)")
+        fig.suptitle(f"{scene.id}: {_label(r)} (max {vmax:.3g} %)")
         name = _save(fig, folder, f"{scene.id}-{r.method}-{r.params.get('order', 0)}-"
                                   f"{len(out)}.png")
-        out.append((name, f"{label(r)}: magnitude of the nodal error of Eq. (38) on four node "
+        out.append((name, f"{_label(r)}: magnitude of the nodal error of Eq. (38) on four node "
                           "layers (as Figs. 9 and 12 of seed 001); one colour scale per run."))
     return out
 
@@ -73,8 +81,7 @@ def _maps_3d(scene, results, folder):
 def _cost(scene, results, folder):
     fig, ax = plt.subplots(figsize=(6.5, 4))
     for r in results:
-        lab = label(r) + "".join(f", {k}={v}" for k, v in r.params.items() if k == "load_point")
-        ax.loglog(r.timings["total_s"], r.metrics["max_error_pct"], "o", ms=8, label=lab)
+        ax.loglog(r.timings["total_s"], r.metrics["max_error_pct"], "o", ms=8, label=_label(r))
     ax.set_xlabel("total time [s] (setup + solve)")
     ax.set_ylabel("max_error_pct")
     ax.grid(True, which="both", alpha=0.3)
