@@ -25,6 +25,8 @@ def _cli(*args, timeout=120):
                              "lz=0.2"], "l_z"),
     ("plate2d-plane-strain", ["--set", "plane=axisymmetric"], "plane"),
     ("body3d-manufactured", ["--method", "none", "--set", "load_point=edge"], "load_point"),
+    ("plate2d-plane-strain", ["--set", "quadrature=exact"], "quadrature"),
+    ("body3d-manufactured", ["--set", "surface_load=edge"], "surface_load"),
 ])
 def test_unsupported_input_exits_2_with_one_line(scene, args, needle):
     r = _cli("run", scene, *args)
