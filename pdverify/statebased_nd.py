@@ -123,13 +123,14 @@ class StateBasedBox:
         offsets = stencil_offsets(dim, self.m_ratio)
         beta = partial_volumes(offsets, self.m_ratio)
         r_k = np.linalg.norm(offsets, axis=1) * h
+        w_k = gaussian_influence(r_k, delta) * r_k ** 2  # weight of m per unit beta V
         if quadrature == "moment-corrected":
-            beta = moment_corrected_volumes(offsets, beta, gaussian_influence(r_k, delta) * r_k ** 2)
+            beta = moment_corrected_volumes(offsets, beta, w_k)
         self.offsets, self.beta_k = offsets, beta
         layers = int(np.abs(offsets).max()) if order is not None else 0
         self.grid = g = BoxGrid(lengths, origin, h, layers)
         V = g.volume
-        self.m_inf = float(np.sum(gaussian_influence(r_k, delta) * r_k ** 2 * beta) * V)
+        self.m_inf = float(np.sum(w_k * beta) * V)
 
         half = half_stencil(offsets)
         a, b, which = bond_pairs(g.ext_shape, offsets[half])

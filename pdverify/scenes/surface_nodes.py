@@ -166,9 +166,16 @@ class SurfaceNodeScene(Scene):
     def body_force(self, x, p, constants, horizon):
         return np.zeros_like(x)
 
+    #: (face, component) that carries the uniform traction p["traction"]; None: unloaded
+    uniform_load = None
+
     def traction(self, x, normal, face, p, constants, horizon):
-        """Applied traction on ``face`` at surface points x (n, d)."""
-        return np.zeros_like(x)
+        """Applied traction on ``face`` at surface points x (n, d): the uniform
+        p["traction"] on ``uniform_load``'s face and component, zero elsewhere."""
+        t = np.zeros_like(x)
+        if self.uniform_load is not None and face == self.uniform_load[0]:
+            t[:, self.uniform_load[1]] = p["traction"]
+        return t
 
     def surface_dirichlet(self, grid, p):
         """[(surface-node mask, component)] prescribed on surface nodes (exact values)."""
@@ -182,15 +189,14 @@ class SurfaceNodeScene(Scene):
         """Faces whose traction is applied (the others are Dirichlet faces)."""
         raise NotImplementedError
 
-    def _face_load(self, face, centres, normals, p, c, horizon):
+    def _face_load(self, face, centres, normals, p, c, horizon, grid):
         """Force on each cell face of ``face``: the traction's resultant over the face
         (default) or, with ``surface_load=centre``, its value at the centre times A."""
         def traction(x, n):
             return self.traction(x, n, face, p, c, horizon)
-        area = p["spacing"] ** (centres.shape[1] - 1)
         if p.get("surface_load", "face-mean") == "centre":
-            return traction(centres, normals) * area
-        return face_resultant(traction, centres, normals, p["spacing"]) * area
+            return traction(centres, normals) * grid.face_area
+        return face_resultant(traction, centres, normals, grid.spacing) * grid.face_area
 
     # ----------------------------------------------------------------- checks
     def check(self, method, p):
@@ -243,7 +249,7 @@ class SurfaceNodeScene(Scene):
                         xs[:, axis] = g.origin[axis] + (0.0 if side == 0 else g.lengths[axis])
                     nrm = np.zeros_like(xs)
                     nrm[:, axis] = -1.0 if side == 0 else 1.0
-                    rhs[:ni][on] += self._face_load(face, xs, nrm, p, c, model.horizon)
+                    rhs[:ni][on] += self._face_load(face, xs, nrm, p, c, model.horizon, g)
                 u_ref_all = self.exact(x_int, p)
                 for mask, k in self.interior_dirichlet(g, p):
                     nodes = np.flatnonzero(mask)
@@ -254,7 +260,7 @@ class SurfaceNodeScene(Scene):
                 for face in self.loaded_faces(p):
                     sel = g.surface_face == face
                     rhs[ni:][sel] = self._face_load(face, xs[sel], nrm[sel], p, c,
-                                                    model.horizon)
+                                                    model.horizon, g)
                 u_ref_s = self.exact(xs, p)
                 for mask, k in self.surface_dirichlet(g, p):
                     nodes = np.flatnonzero(mask)
@@ -345,6 +351,7 @@ class Body3DTraction(Body3D):
     reference = "analytic"
     params = BODY_PARAMS + (Param("traction", 10e6, "traction p on x = l_x [Pa]", positive),)
     methods = (NONE, surface_method(1))
+    uniform_load = (1, 0)  # p along x on x = l_x
     published = (
         Published("max_error_pct", "> 30", "seed 001 §4.1, Fig. 9a", method="none",
                   where=PAPER_QUADRATURE),
@@ -359,11 +366,6 @@ class Body3DTraction(Body3D):
     def loaded_faces(self, p):
         return (1, 2, 3, 4, 5)
 
-    def traction(self, x, normal, face, p, constants, horizon):
-        t = np.zeros_like(x)
-        if face == 1:
-            t[:, 0] = p["traction"]
-        return t
 
     def surface_dirichlet(self, g, p):
         f, cell = g.surface_face, g.surface_cell
@@ -518,6 +520,7 @@ class Plate2DPlaneStrain(SurfaceNodeScene):
         GEOMETRY,
     )
     methods = (NONE, surface_method(1))
+    uniform_load = (3, 1)  # p along y on y = l_y
 
     def constants(self, p):
         return StateBasedConstants("plane-" + p["plane"], p["E"], p["nu"])
@@ -532,11 +535,6 @@ class Plate2DPlaneStrain(SurfaceNodeScene):
     def loaded_faces(self, p):
         return (1, 3)
 
-    def traction(self, x, normal, face, p, c, horizon):
-        t = np.zeros_like(x)
-        if face == 3:
-            t[:, 1] = p["traction"]
-        return t
 
     def surface_dirichlet(self, g, p):
         f = g.surface_face

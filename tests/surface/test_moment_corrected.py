@@ -48,8 +48,9 @@ def _discrete_moduli(kind, quadrature, m_ratio=3.0):
     model = StateBasedBox(L, (0.0,) * dim, h, m_ratio, c, order=1, quadrature=quadrature)
     g = model.grid
     out = []
-    for eps in (np.diag([1.0] + [0.0] * (dim - 1)),
-                np.eye(dim)[[1, 0] + list(range(2, dim))] * 0.5):  # uniaxial; shear 1-2
+    shear = np.zeros((dim, dim))
+    shear[0, 1] = shear[1, 0] = 0.5                # engineering shear strain 1 in 1-2
+    for eps in (np.diag([1.0] + [0.0] * (dim - 1)), shear):
         def u(x, eps=eps):
             return x @ eps.T
         rows = model.rows_of_state(u(g.x), model.dilatation_of_field(u, g.x))

@@ -15,6 +15,10 @@ def _label(r) -> str:
     return label(r) + "".join(", " + e for e in extra)
 
 
+def _map_name(scene, r, i) -> str:
+    return f"{scene.id}-{r.method}-{r.params.get('order', 0)}-{i}.png"
+
+
 def _cells(f):
     idx = np.rint((f["x"] - f["origin"]) / f["spacing"] - 0.5).astype(int)
     return idx, tuple(int(n) for n in f["cells"])
@@ -40,8 +44,7 @@ def _maps_2d(scene, results, folder):
             ax.set_title(f"{_label(r)}: error in {name}", fontsize=9)
             ax.set_xlabel("x [m]")
             ax.set_ylabel("y [m]")
-        name = _save(fig, folder, f"{scene.id}-{r.method}-{r.params.get('order', 0)}-"
-                                  f"{len(out)}.png")
+        name = _save(fig, folder, _map_name(scene, r, len(out)))
         out.append((name, f"{_label(r)}: nodal errors of Eq. (44) in u and v (as Figs. 14-15 "
                           "of seed 001); each map has its own colour scale."))
     return out
@@ -71,8 +74,7 @@ def _maps_3d(scene, results, folder):
             ax.set_ylabel(f"{b} [m]")
         fig.colorbar(im, ax=axes, label="|eps| [%] (Eq. 38)", shrink=0.9)
         fig.suptitle(f"{scene.id}: {_label(r)} (max {vmax:.3g} %)")
-        name = _save(fig, folder, f"{scene.id}-{r.method}-{r.params.get('order', 0)}-"
-                                  f"{len(out)}.png")
+        name = _save(fig, folder, _map_name(scene, r, len(out)))
         out.append((name, f"{_label(r)}: magnitude of the nodal error of Eq. (38) on four node "
                           "layers (as Figs. 9 and 12 of seed 001); one colour scale per run."))
     return out
