@@ -1,12 +1,131 @@
-"""End-bond homogenisation of 1D bond-based bars (seed 004 §3-5): the factor computation."""
+"""End-bond homogenisation of 1D bond-based bars (seed 004 §3-5): the bar and its factors."""
 from __future__ import annotations
 
 from functools import lru_cache
 
 import numpy as np
 
-from ..bondbar1d import BondBar1D, bond_profile, split_horizon_ratio
 from ..errors import InputError
+from ..pd import BondBasedModel, BoxGrid, Closure, bond_micromodulus, build_stencil, get_influence
+
+MICROMODULI = ("triangular", "constant")
+END_WEIGHTS = ("full", "half")
+CALIBRATIONS = ("discrete", "continuum")
+
+
+def split_horizon_ratio(horizon_ratio: float) -> tuple[int, float]:
+    """(m, beta) with delta = (m + beta) Delta and beta in {0, 1/2} (seed 004 Eq. 7, Fig. 2).
+
+    beta = 0: the horizon runs through the middle of element m ("through an element");
+    beta = 1/2: it falls on the border between elements m and m + 1 ("between elements").
+    Raises ``ValueError`` for any other ratio.
+    """
+    twice = 2.0 * float(horizon_ratio)
+    if not np.isfinite(twice) or abs(twice - round(twice)) > 1e-12 or round(twice) < 2:
+        raise ValueError(f"horizon_ratio={horizon_ratio!r} must be a whole or half-whole number "
+                         ">= 1 (delta = m Delta or (m + 1/2) Delta)")
+    twice_int = int(round(twice))
+    return twice_int // 2, 0.5 * (twice_int % 2)
+
+
+def _check_micromodulus(micromodulus: str) -> None:
+    if micromodulus not in MICROMODULI:
+        raise ValueError(f"micromodulus={micromodulus!r}; allowed: {', '.join(MICROMODULI)}")
+
+
+def bond_profile(horizon_ratio: float, micromodulus: str = "triangular"):
+    """Offsets k >= 1 and the per-offset weights c(k Delta)/c1 * v_k of the discrete bar.
+
+    c(xi)/c1 is 1 (constant) or 1 - xi/delta (triangular, Eq. 6; the engine's ``conical``
+    influence); v_k is the fraction of element k inside the horizon (1/2 for the element
+    the horizon cuts in two, 1 otherwise: the 1D partial volume of the engine's stencil),
+    which is the m(1/2 + beta) term of Eq. (9). Offsets whose weight vanishes (the
+    triangle's tip at k = m when beta = 0) are dropped.
+    """
+    _check_micromodulus(micromodulus)
+    split_horizon_ratio(horizon_ratio)
+    stencil = build_stencil(1, float(horizon_ratio))
+    k = stencil.half_offsets[:, 0]
+    weight = get_influence(micromodulus).omega(k, float(horizon_ratio)) * stencil.half_beta
+    keep = weight > 0
+    return k[keep], weight[keep]
+
+
+def micromodulus_c1(horizon_ratio: float, *, E: float, area: float, spacing: float,
+                    micromodulus: str = "triangular", calibration: str = "discrete") -> float:
+    """The micromodulus constant c1 of Eq. (6) (c = c1 for the constant micromodulus).
+
+    ``discrete``: equate the strain energy density of the discrete horizon to E eps^2 / 2,
+    W_m = (c1 s^2 A / 2) sum_k c_k/c1 v_k k Delta^2 (Eqs. 9, 18), which gives Eq. (14)
+    (beta = 0, = Eq. 26) and Eq. (22) (beta = 1/2, = Eq. 30) for the triangular
+    micromodulus. ``continuum``: c_inf = 6E/(A delta^2) (triangular) or 2E/(A delta^2)
+    (constant), exact only for infinitely many points in the horizon. Both are the
+    engine's :func:`pdverify.pd.bond_micromodulus` in 1D.
+    """
+    if calibration not in CALIBRATIONS:
+        raise ValueError(f"calibration={calibration!r}; allowed: {', '.join(CALIBRATIONS)}")
+    _check_micromodulus(micromodulus)
+    split_horizon_ratio(horizon_ratio)
+    return bond_micromodulus(micromodulus, 1, E, horizon_ratio * spacing, area=area,
+                             calibration=calibration, spacing=spacing,
+                             stencil=build_stencil(1, float(horizon_ratio)))
+
+
+def micromodulus_factor(horizon_ratio: float, micromodulus: str = "triangular") -> float:
+    """c1(m) / c_inf, the function f_1(m) of Eqs. (27) and (31) (Tables 1 and 2)."""
+    args = dict(E=1.0, area=1.0, spacing=1.0, micromodulus=micromodulus)
+    return (micromodulus_c1(horizon_ratio, calibration="discrete", **args)
+            / micromodulus_c1(horizon_ratio, calibration="continuum", **args))
+
+
+def end_bond_closure(nodes: int, end_factors) -> Closure:
+    """The ``homogenized`` closure: factor ``end_factors[k - 1]`` on the bonds (1, 1 + k) and
+    (N, N - k) of an N-point bar (seed 004 §3.1), 1 on every other bond."""
+    factors = np.asarray(end_factors, dtype=float)
+
+    def bond_factor(a, b, _n):
+        alpha = np.ones(a.size)
+        for k, f in enumerate(factors, start=1):  # at most m - 1 offsets, not a loop over bonds
+            alpha[(a == 0) & (b == k)] = f
+            alpha[(b == nodes - 1) & (a == nodes - 1 - k)] = f
+        return alpha
+
+    return Closure(bond_factor=bond_factor if factors.size else None)
+
+
+def bond_bar(*, nodes: int, spacing: float, horizon_ratio: float, E: float, area: float = 1.0,
+             end_weight: str = "full", micromodulus: str = "triangular",
+             calibration: str = "discrete", end_factors=()) -> BondBasedModel:
+    """The bar of seed 004 as an engine model: N points x_i = (i - 1) Delta on the surface
+    (``on-surface`` grid), linearised bond-based PD (Eq. 33).
+
+    Each point carries the element volume A Delta, or A Delta / 2 at both ends with
+    ``end_weight="half"`` (Fig. 1 shows full weight). A bond of length k Delta has the
+    spring stiffness alpha c1 (c(k Delta)/c1) v_k V_i V_j / (k Delta) (the engine's
+    :class:`~pdverify.pd.BondBasedModel`), so that the force on i is Eq. (33) times the
+    volume V_i of the subject point; alpha is the end-bond factor of
+    :func:`end_bond_closure` (``end_factors``; ``()`` = the uncorrected bar).
+    """
+    if end_weight not in END_WEIGHTS:
+        raise ValueError(f"end_weight={end_weight!r}; allowed: {', '.join(END_WEIGHTS)}")
+    m, _ = split_horizon_ratio(horizon_ratio)
+    offsets, _ = bond_profile(horizon_ratio, micromodulus)
+    if offsets.size == 0:
+        raise ValueError(f"horizon_ratio={horizon_ratio}: no bond has a non-zero "
+                         f"{micromodulus} micromodulus")
+    if nodes < 2 * m + 1:
+        raise ValueError(f"nodes={nodes} must be >= 2m + 1 = {2 * m + 1}")
+    factors = np.asarray(end_factors, dtype=float)
+    if factors.size and not (factors.size <= offsets.max() and np.all(factors > 0)):
+        raise ValueError(f"end_factors={end_factors!r}: at most {offsets.max()} positive factors")
+    grid = BoxGrid(((nodes - 1) * spacing,), (0.0,), spacing, placement="on-surface",
+                   boundary_volume="partial" if end_weight == "half" else "full")
+    stencil = build_stencil(1, float(horizon_ratio))
+    c1 = micromodulus_c1(horizon_ratio, E=E, area=area, spacing=spacing,
+                         micromodulus=micromodulus, calibration=calibration)
+    return BondBasedModel(grid, stencil, c1, get_influence(micromodulus),
+                          end_bond_closure(nodes, factors), thickness=area)
+
 
 #: A consistent system is solved to round-off (relative residual ~1e-16, the equations
 #: are O(1) sums of at most 2m + 2 terms); an inconsistent one leaves an O(1/m) residual
@@ -44,10 +163,11 @@ def homogenization_factors(horizon_ratio: float, end_weight: str = "full",
                          "needs m >= 2 (seed 004 §3.1: m - 1 end bonds are adjusted)")
     reach = int(bond_profile(horizon_ratio, micromodulus)[0].max())
     n = 4 * reach + 3
-    bar = BondBar1D(nodes=n, spacing=1.0, horizon_ratio=horizon_ratio, E=1.0,
-                    end_weight=end_weight, micromodulus=micromodulus)
-    u = bar.x - bar.x[n // 2]  # integers: every bond extension u_j - u_i is exact
-    i, j, s = bar.bond_i, bar.bond_j, bar.bond_stiffness
+    bar = bond_bar(nodes=n, spacing=1.0, horizon_ratio=horizon_ratio, E=1.0,
+                   end_weight=end_weight, micromodulus=micromodulus)
+    x = bar.grid.x[:, 0]
+    u = x - x[n // 2]  # integers: every bond extension u_j - u_i is exact
+    i, j, s = bar.bond_a, bar.bond_b, bar.bond_stiffness
     tension = s * (u[j] - u[i])
     # internal force of every point under the linear field, summed bond by bond (not K @ u,
     # whose diagonal term cancels large products and loses ~m^2 ulps)

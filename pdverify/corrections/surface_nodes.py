@@ -1,55 +1,17 @@
-"""Surface node method (seed 001 §3): Taylor extrapolation in 2D/3D and face-crossing bonds."""
+"""Surface node method (seeds 001 §3, 002): surface-node unknowns, Taylor-extrapolated
+fictitious layer about the nearest surface node, force-flux rows of face-crossing bonds."""
 from __future__ import annotations
 
 from itertools import product
-from math import factorial
 
 import numpy as np
 import scipy.sparse as sp
 
+from ..pd.bonds import bond_pairs
+from ..pd.closure import Closure, real_identity, with_rows
+from .taylor import extrapolation_rows, taylor_weights, window_start
+
 MAX_ORDER = 3
-
-
-# --------------------------------------------------------------------------- Taylor
-def monomial_exponents(dim: int, order: int) -> np.ndarray:
-    """Exponents (n_1, ..., n_d) with 1 <= n_1 + ... + n_d <= order (Eqs. 13, 25, 29)."""
-    out = [e for n in range(1, order + 1)
-           for e in product(range(n + 1), repeat=dim) if sum(e) == n]
-    return np.asarray(out, dtype=int).reshape(-1, dim)
-
-
-def taylor_monomials(r, exponents) -> np.ndarray:
-    """Taylor factors prod_a r_a^n_a / n_a! of offsets ``r`` (..., dim) -> (..., n_mono)."""
-    r = np.asarray(r, dtype=float)
-    fact = np.array([[factorial(int(n)) for n in e] for e in exponents], dtype=float)
-    powers = r[..., None, :] ** exponents  # (..., n_mono, dim)
-    return np.prod(powers / fact, axis=-1)
-
-
-def taylor_weights(src_rel, tgt_rel, group, order):
-    """Weights of a Taylor series centred on a node, derivatives fitted on source nodes.
-
-    For each target t (offset ``tgt_rel[t]`` from its centre node, scaled by the spacing)
-    in ``group[t]``, returns w (n_targets, n_src) with
-    u(target) = u(centre) + sum_q w_q (u(source_q) - u(centre)) (Eqs. 25-28 / 29-32: the
-    series of order ``order`` about the centre, its derivatives from the expansions of
-    the sources, Eqs. 26/30). ``src_rel`` (n_groups, n_src, dim) are source offsets from
-    the centre; when there are more sources than derivatives the system of Eq. (26)/(30)
-    is solved in the least-squares sense. Either way the weights reproduce every
-    polynomial of degree <= order exactly (its Taylor series is exact and the fit
-    recovers its derivatives when the sources are unisolvent).
-    """
-    dim = src_rel.shape[-1]
-    exps = monomial_exponents(dim, order)
-    M = taylor_monomials(src_rel, exps)          # (G, S, n_mono)
-    G = np.linalg.pinv(M)                        # (G, n_mono, S)
-    T = taylor_monomials(tgt_rel, exps)          # (n_targets, n_mono)
-    return np.einsum("tm,tms->ts", T, G[group])
-
-
-def _window(centre, width, n):
-    """Start of a window of ``width`` cells nearest to ``centre`` inside [0, n)."""
-    return np.clip(centre - width // 2, 0, n - width)
 
 
 def displacement_stencils(grid, order: int):
@@ -69,9 +31,13 @@ def displacement_stencils(grid, order: int):
         lo, hi = grid.face_start[face], grid.face_start[face + 1]
         cells = grid.surface_cell[lo:hi]
         tang = grid.tangential_axes(axis)
-        win = np.indices((width,) * (d - 1)).reshape(d - 1, -1).T  # (w^(d-1), d-1)
-        start = np.stack([_window(cells[:, t], width, grid.cells[t]) for t in tang], axis=1)
-        tcells = start[:, None, :] + win[None, :, :]                # (n, W, d-1)
+        if d == 1:  # no tangential axes: one source per level
+            tcells = np.zeros((cells.shape[0], 1, 0), dtype=int)
+        else:
+            win = np.indices((width,) * (d - 1)).reshape(d - 1, -1).T  # (w^(d-1), d-1)
+            start = np.stack([window_start(cells[:, t], width, grid.cells[t]) for t in tang],
+                             axis=1)
+            tcells = start[:, None, :] + win[None, :, :]            # (n, W, d-1)
         n, W = tcells.shape[:2]
         levels = []
         for level in range(order + 1):
@@ -123,7 +89,7 @@ def displacement_extrapolation(grid, order: int, fict_ids) -> sp.csr_matrix:
     tgt_rel = (grid.x[fict_ids] - grid.surface_x[s]) / grid.spacing
     W = taylor_weights(src_rel, tgt_rel, s, order)  # per-surface-node fit, gathered
     centre = grid.n_interior + s
-    return _assemble(fict_ids.size, n_unk, W, src_ids[s], centre)
+    return extrapolation_rows(fict_ids.size, n_unk, W, src_ids[s], centre)
 
 
 def dilatation_extrapolation(grid, order: int, fict_ids) -> sp.csr_matrix:
@@ -140,24 +106,14 @@ def dilatation_extrapolation(grid, order: int, fict_ids) -> sp.csr_matrix:
     ub, first = np.unique(b, return_index=True)
     bidx = b_idx[first]
     win = np.indices((width,) * grid.dim).reshape(grid.dim, -1).T
-    start = _window(bidx, width, cells)
+    start = window_start(bidx, width, cells)
     c = start[:, None, :] + win[None, :, :]
     src_ids = grid.interior_number[grid.ext_id(c)]
     src_rel = (c - bidx[:, None, :]).astype(float)
     group = np.searchsorted(ub, b)
     tgt_rel = (grid.index[fict_ids] - b_idx).astype(float)
     W = taylor_weights(src_rel, tgt_rel, group, deg)
-    return _assemble(fict_ids.size, n_int, W, src_ids[group], b)
-
-
-def _assemble(n_rows, n_cols, W, src, centre):
-    rows = np.repeat(np.arange(n_rows), W.shape[1])
-    vals = np.concatenate([W.ravel(), 1.0 - W.sum(axis=1)])
-    rows = np.concatenate([rows, np.arange(n_rows)])
-    cols = np.concatenate([src.ravel(), centre])
-    out = sp.csr_matrix((vals, (rows, cols)), shape=(n_rows, n_cols))
-    out.sum_duplicates()
-    return out
+    return extrapolation_rows(fict_ids.size, n_int, W, src_ids[group], b)
 
 
 # --------------------------------------------------------------------------- force flux
@@ -223,3 +179,56 @@ def face_crossings(grid, a, b):
         return z.astype(int), z.astype(int), z, z
     return (np.concatenate(out_s), np.concatenate(out_b), np.concatenate(out_alpha),
             np.concatenate(out_sign))
+
+
+# --------------------------------------------------------------------------- the closure
+def surface_node_closure(grid, stencil, order: int, *, dilatations: bool = True):
+    """The surface node method's :class:`~pdverify.pd.closure.Closure` and its flux data.
+
+    Unknowns: the interior nodes, then one surface node per boundary cell face. The grid
+    must carry a fictitious layer of ``stencil.reach`` nodes. Fictitious displacements by
+    order-N Taylor extrapolation about the nearest surface node (seed 001 steps 7-12;
+    seed 002 Eqs. 8-9 in 1D), dilatations (``dilatations=True``, state-based) by order
+    N - 1 about the nearest interior node (steps 1-6), m of a complete neighbourhood at
+    every node (§3.2). Bonds: every stencil pair with an interior end, plus the
+    fictitious-fictitious pairs that cross a surface node's face (they enter Eq. 36).
+
+    Returns ``(closure, flux)`` with ``flux = (surface node, bond, alpha, sign)`` in the
+    model's bond numbering (see :func:`face_crossings`); :func:`flux_rows` turns it into
+    the force-flux equations of Eq. (36).
+    """
+    a, b, _ = bond_pairs(grid.ext_shape, stencil.half_offsets)
+    ia, ib = grid.is_interior[a], grid.is_interior[b]
+    keep = ia | ib
+    cand = np.flatnonzero(~(ia & ib))
+    s, bond, alpha, sign = face_crossings(grid, a[cand], b[cand])
+    keep[cand[bond]] = True
+    new_index = np.cumsum(keep) - 1
+    flux = (s, new_index[cand[bond]], alpha, sign)
+
+    fict = np.flatnonzero(~grid.is_interior)
+    A_Theta = real_identity(grid)
+    if fict.size and dilatations:
+        A_Theta = with_rows(A_Theta, fict, dilatation_extrapolation(grid, order, fict))
+    closure = Closure(keep=keep, weighted_volume="complete",
+                      displacement_map=surface_node_displacement_map(grid, order),
+                      dilatation_map=A_Theta, n_unknown_nodes=grid.n_interior + grid.n_surface)
+    return closure, flux
+
+
+def surface_node_displacement_map(grid, order: int) -> sp.csr_matrix:
+    """All node displacements from [interior nodes, surface nodes]: identity on the interior,
+    order-N Taylor extrapolation about the nearest surface node on the fictitious layer."""
+    A_U = real_identity(grid, grid.n_interior + grid.n_surface)
+    fict = np.flatnonzero(~grid.is_interior)
+    if fict.size:
+        A_U = with_rows(A_U, fict, displacement_extrapolation(grid, order, fict))
+    return A_U
+
+
+def flux_rows(model, flux) -> sp.csr_matrix:
+    """The force-flux equations (Eq. 36) of every surface node, as rows over bond forces:
+    sum over crossing bonds of alpha f_b (m . n) with m the bond direction from the inner
+    end (``sign``), placed after the interior equations of each component."""
+    s, bond, alpha, sign = flux
+    return model.bond_force_rows(model.grid.n_interior + s, bond, alpha * sign)

@@ -8,9 +8,12 @@ import numpy as np
 
 from manufactured import vibration1d as rao
 
-from ..bondbar1d import BondBar1D, micromodulus_factor, split_horizon_ratio
-from ..corrections.homogenized import homogenization_factors
-from ..errors import InputError
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ..corrections.homogenized import (bond_bar, homogenization_factors, micromodulus_factor,
+                                       split_horizon_ratio)
+from ..errors import InputError, NumericalError
 from ..metrics import fitted_frequency, max_error_of_peak_pct, rel_l2_error
 from ..params import Param, at_least, positive
 from ..solvers.explicit import central_difference
@@ -55,6 +58,73 @@ def bar_params(horizon_ratio=4.0, E=1.0):
     )
 
 
+class BondBar:
+    """A seed-004 bar: the engine's bond-based model (built by
+    :func:`pdverify.corrections.homogenized.bond_bar`) and the analyses the scenes need.
+
+    ``K`` is the symmetric stiffness (K u = external nodal forces). The paper's
+    non-symmetric matrix S of Su = -b (force per unit volume, App. 2) is -diag(1/V) K;
+    :meth:`equation_rows` returns it divided by c1 A, the scaling of the printed
+    equations (34)-(98).
+    """
+
+    def __init__(self, *, nodes, spacing, horizon_ratio, E, area=1.0, end_weight="full",
+                 micromodulus="triangular", calibration="discrete", end_factors=()):
+        self.model = bond_bar(nodes=nodes, spacing=spacing, horizon_ratio=horizon_ratio, E=E,
+                              area=area, end_weight=end_weight, micromodulus=micromodulus,
+                              calibration=calibration, end_factors=end_factors)
+        self.nodes, self.spacing, self.E, self.area = nodes, spacing, E, area
+        self.m, self.beta = split_horizon_ratio(horizon_ratio)
+        self.end_factors = tuple(float(a) for a in end_factors)
+        self.c1 = self.model.c
+        self.K = self.model.K
+        self.x = self.model.grid.x[:, 0]
+        self.volume = self.model.node_volume
+
+    def equation_rows(self) -> np.ndarray:
+        """Dense S / (c1 A): row i is the left-hand side of Eq. (33) / (c1 A) for point i."""
+        return -(self.K.toarray() / self.volume[:, None]) / (self.c1 * self.area)
+
+    def lumped_mass(self, density: float) -> np.ndarray:
+        """Nodal masses rho V_i (half at both ends for half-weight end elements)."""
+        return self.model.lumped_mass(density)
+
+    def cut_stiffness(self) -> sp.csr_matrix:
+        """F with F d = the force through every cut, d_c = u_{c+1} - u_c (c = 1..N-1).
+
+        A bond i-j crosses the cuts i..j-1 and its extension is the sum of their gaps
+        (G d); the force through cut c is the summed force of the bonds crossing it,
+        so F = G^T diag(s) G, banded (half-width = the bond reach) and SPD.
+        """
+        i, j, s = self.model.bond_a, self.model.bond_b, self.model.bond_stiffness
+        span = j - i
+        rows = np.repeat(np.arange(i.size), span)
+        start = np.repeat(np.cumsum(span) - span, span)
+        cols = np.repeat(i, span) + (np.arange(rows.size) - start)
+        G = sp.csr_matrix((np.ones(rows.size), (rows, cols)), shape=(i.size, self.nodes - 1))
+        return (G.T @ sp.diags(s) @ G).tocsr()
+
+    def end_force_displacement(self, force: float) -> np.ndarray:
+        """Displacements under -force at point 1 and +force at point N, centre at rest.
+
+        Node i's equation is flux(i-1) - flux(i) + f_i = 0, so end forces +-F put the force
+        F through every cut: N - 1 equations F d = F 1 for the N - 1 gaps. This statically
+        determinate form is solved instead of K u = f with a pinned node because its
+        condition number stays bounded as N grows (K's grows like N^2, which costs about
+        1e-12 of f(N) at N = 1001), and the strain factor needs round-off accuracy there.
+        """
+        F = self.cut_stiffness().tocsc()
+        gaps = spla.spsolve(F, np.full(self.nodes - 1, float(force)))
+        if not np.all(np.isfinite(gaps)):
+            raise NumericalError("end-loaded bar: the cut system gave non-finite gaps")
+        u = np.concatenate([[0.0], np.cumsum(gaps)])
+        N = self.nodes
+        return u - 0.5 * (u[(N - 1) // 2] + u[N // 2])
+
+    def size(self) -> dict:
+        return {"nodes": int(self.nodes), "dofs": int(self.nodes), "bonds": self.model.n_bonds()}
+
+
 class BondBarScene(Scene):
     """Shared checks and bar construction of the seed-004 scenes."""
 
@@ -84,11 +154,11 @@ class BondBarScene(Scene):
         return homogenization_factors(float(p["horizon_ratio"]), p["end_weight"],
                                       p["micromodulus"])
 
-    def bar(self, method, p, nodes, spacing) -> BondBar1D:
-        return BondBar1D(nodes=nodes, spacing=spacing, horizon_ratio=float(p["horizon_ratio"]),
-                         E=p["E"], area=AREA, end_weight=p["end_weight"],
-                         micromodulus=p["micromodulus"], calibration=p["calibration"],
-                         end_factors=self.factors(method, p))
+    def bar(self, method, p, nodes, spacing) -> "BondBar":
+        return BondBar(nodes=nodes, spacing=spacing, horizon_ratio=float(p["horizon_ratio"]),
+                       E=p["E"], area=AREA, end_weight=p["end_weight"],
+                       micromodulus=p["micromodulus"], calibration=p["calibration"],
+                       end_factors=self.factors(method, p))
 
 
 # --------------------------------------------------------------------------- Sec. 6.1
@@ -215,7 +285,7 @@ class Homogenization(BondBarScene):
                 out.append((HOMOGENIZED.name, {"horizon_ratio": ratio, "nodes": 1001}))
         return out
 
-    def strain_factor(self, bar: BondBar1D, stress: float) -> tuple[float, np.ndarray]:
+    def strain_factor(self, bar: BondBar, stress: float) -> tuple[float, np.ndarray]:
         u = bar.end_force_displacement(stress * bar.area)
         length = (bar.nodes - 1) * bar.spacing
         return float((u[-1] - u[0]) / length * bar.E / stress), u
@@ -334,7 +404,7 @@ class Constraints(BondBarScene):
         }
         fields = {f"{name}_{k}": d[k] for k in specs for name, d in (("x", x), ("u", u))}
         fields["stress_over_E"] = p["stress"] / p["E"]
-        size = {"nodes": n_a + n_b + n_c, "bonds": sum(b.bond_i.size for b in bars.values())}
+        size = {"nodes": n_a + n_b + n_c, "bonds": sum(b.model.n_bonds() for b in bars.values())}
         diagnostics = {f"bar_{k}_{key}": info[k][key] for k in info
                        for key in ("relative_residual", "condition_estimate")}
         return Outcome(metrics=metrics, size=size, fields=fields, diagnostics=diagnostics)

@@ -5,10 +5,9 @@ import numpy as np
 
 from manufactured import bar1d as closed
 
-from ..operators import Bar1D
 from ..params import Param, positive
 from . import Outcome, Published, Scene, register
-from .bar1d import BAR_PARAMS, NONE, TAYLOR, check_bar_grid
+from .bar1d import BAR_PARAMS, NONE, TAYLOR, StateBar, check_bar_grid
 
 _FEATURES = closed.flux_features()  # (1.26285..., 0.77160..., 0.39403...)
 
@@ -62,14 +61,13 @@ class ForceFlux(Scene):
     def solve(self, method, p, timer):
         with timer.phase("setup"):
             order = p.get("order") if method == TAYLOR.name else None
-            bar = Bar1D(p["length"], p["area"], p["E"], p["nu"], p["spacing"], p["m_ratio"],
-                        taylor_order=order)
+            bar = StateBar(p, order)
         with timer.phase("solve"):
             eps, delta, L = p["strain"], bar.horizon, p["length"]
             x = bar.x_real
             u = eps * x
             tau_inf = p["E"] * eps
-            faces = np.arange(bar.n_real + 1) * p["spacing"]
+            faces = np.arange(bar.grid.n_interior + 1) * p["spacing"]
             flux = (bar.flux_rows(faces) @ u) / p["area"] / tau_inf
             if order is None:
                 flux_ref = closed.force_flux_ratio(faces, horizon=delta, length=L)
@@ -78,7 +76,8 @@ class ForceFlux(Scene):
             V = p["area"] * p["spacing"]
             body = (bar.K @ u) / V / (tau_inf / delta)  # b_i = -(internal force)/V, Eq. (54)
             body_ref = closed.body_force_ratio(x, horizon=delta, length=L)
-            m_ratio = bar.m[bar.real] / bar.m_inf
+            model = bar.model
+            m_ratio = model.m[model.grid.interior_ids] / model.m_inf
             m_ref = closed.weighted_volume_ratio(x, horizon=delta, length=L)
         metrics = {"flux_max_ratio": float(flux.max()),
                    "flux_table_error": float(np.max(np.abs(flux - flux_ref)))}

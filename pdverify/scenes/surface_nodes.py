@@ -5,12 +5,74 @@ import numpy as np
 
 from manufactured import surface3d as closed
 
-from ..corrections.surface_nodes import MAX_ORDER
+from ..corrections.surface_nodes import MAX_ORDER, flux_rows, surface_node_closure
 from ..errors import InputError
 from ..params import Param, at_least, open_interval, positive
+from ..pd import (QUADRATURES, BoxGrid, StateBasedConstants, StateBasedModel, build_stencil,
+                  get_influence)
 from ..solvers.dense import solve_square
-from ..statebased_nd import QUADRATURES, StateBasedBox, StateBasedConstants
 from . import MethodSpec, Outcome, Published, Scene, register
+
+
+class StateBox:
+    """A seed-001 box on the engine: the state-based model, uncorrected or with surface nodes.
+
+    ``order=None``: the uncorrected model (seed 001 §4, 'without the fictitious and
+    surface nodes'): bonds only between interior nodes, m_i and theta_i over the
+    truncated neighbourhoods (Eqs. 22-23). ``order=N``: the surface node method's closure
+    (``pdverify.corrections.surface_nodes.surface_node_closure``): a fictitious layer of
+    thickness delta, one surface node per boundary cell face, order-N displacement and
+    order N - 1 dilatation extrapolation, m of a complete neighbourhood, and one
+    force-flux equation per surface node (Eq. 36) below the interior equations in P.
+    ``quadrature``: the weights beta of Eqs. (22)-(24) (``pdverify.pd.bonds``); the
+    moment correction uses the state-based weight omega |xi|^2.
+    """
+
+    def __init__(self, lengths, origin, spacing, m_ratio, constants: StateBasedConstants,
+                 order: int | None = None, quadrature: str = "partial-volume",
+                 influence: str = "gaussian"):
+        inf = get_influence(influence)
+        h, delta = float(spacing), float(m_ratio) * float(spacing)
+
+        def moment_weight(offsets):
+            r = np.linalg.norm(offsets, axis=1) * h
+            return inf.omega(r, delta) * r ** 2
+
+        stencil = build_stencil(len(lengths), float(m_ratio), quadrature=quadrature,
+                                moment_weight=moment_weight)
+        self.order = order
+        self.grid = BoxGrid(lengths, origin, h, stencil.reach if order is not None else 0)
+        closure, flux = (surface_node_closure(self.grid, stencil, order) if order is not None
+                         else (None, None))
+        self.model = model = StateBasedModel(self.grid, stencil, constants, inf, closure)
+        self.P = model.equilibrium_rows()
+        if flux is not None:
+            self.P = (self.P + flux_rows(model, flux)).tocsr()
+        self.horizon = model.horizon
+        self.n_unknown_nodes = model.n_unknown_nodes
+        self.A_U_full = model.A_U_full
+
+    @property
+    def dim(self) -> int:
+        return self.grid.dim
+
+    def stiffness(self):
+        return self.model.stiffness(self.P)
+
+    def rows_of_state(self, U_ext, Theta_ext):
+        return self.model.rows_of_state(U_ext, Theta_ext, self.P)
+
+    def dilatation_of_field(self, u_fn, points):
+        return self.model.dilatation_of_field(u_fn, points)
+
+    def size(self) -> dict:
+        g = self.grid
+        out = {"interior_nodes": int(g.n_interior), "bonds": int(self.model.bond_a.size),
+               "dofs": int(self.dim * self.n_unknown_nodes)}
+        if self.order is not None:
+            out["surface_nodes"] = int(g.n_surface)
+            out["fictitious_nodes"] = int(g.n_ext - g.n_interior)
+        return out
 
 NONE = MethodSpec("none")
 NONE_LOAD_POINT = MethodSpec("none", (Param(
@@ -230,8 +292,8 @@ class SurfaceNodeScene(Scene):
         with timer.phase("setup"):
             lengths, origin = self.box(p)
             c = self.constants(p)
-            model = StateBasedBox(lengths, origin, p["spacing"], p["m_ratio"], c, order=order,
-                                  quadrature=p["quadrature"])
+            model = StateBox(lengths, origin, p["spacing"], p["m_ratio"], c, order=order,
+                             quadrature=p["quadrature"], influence=p.get("influence", "gaussian"))
             g = model.grid
             d, ni, nu_ = g.dim, g.n_interior, model.n_unknown_nodes
             K = model.stiffness()

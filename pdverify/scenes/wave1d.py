@@ -5,10 +5,14 @@ import numpy as np
 
 from manufactured import wave1d as analytic
 
+import scipy.sparse as sp
+
+from ..corrections.surface_nodes import surface_node_displacement_map
 from ..errors import InputError
 from ..metrics import max_error_of_peak_pct, rel_l2_error
-from ..micromodulus1d import WaveBar1D
 from ..params import Param, at_least, positive
+from ..pd import BondBasedModel, BoxGrid, Closure, bond_micromodulus, build_stencil, get_influence
+from ..pd.closure import real_identity, with_rows
 from ..solvers.explicit import central_difference
 from . import MethodSpec, Outcome, Published, Scene, register
 
@@ -19,6 +23,135 @@ SURFACE_NODES = MethodSpec("surface-nodes", (
     Param("order", 1, "Taylor order of the fictitious-node extrapolation (1 = Eqs. 8-9)",
           at_least(1)),))
 NONE = MethodSpec("none")
+
+BOUNDARIES = ("surface-nodes", "none", "odd-image")
+
+
+def lattice_symbol(k, *, horizon: float, m_ratio: float):
+    """psi_h(k): the discrete operator of Eq. (3) on an unbounded grid maps sin(kx) to -v^2 psi_h sin(kx).
+
+    psi_h = 2/delta sum_j beta_j Delta (1 - cos(k xi_j)) / xi_j^2, the one-point quadrature of
+    psi (Eq. 12). The quadrature omits the node's own cell, where the integrand of Eq. (12)
+    is k^2/2, so psi - psi_h = k^2 / (2 m) + O(m^-2) at fixed delta: first-order
+    m-convergence.
+    """
+    stencil = build_stencil(1, m_ratio)
+    spacing = horizon / m_ratio
+    xi = stencil.half_offsets[:, 0] * spacing
+    c = stencil.half_beta * spacing / (horizon * xi ** 2)
+    k = np.asarray(k, dtype=float)
+    return np.sum(2.0 * c * (1.0 - np.cos(np.multiply.outer(k, xi))), axis=-1)
+
+
+class WaveBar:
+    """A bar [0, l] of 1D bond-based PD (seed 002 Eq. 3) with one of three boundary treatments.
+
+    The engine's bond-based model with the hyperbolic influence delta/|xi| and the
+    micromodulus c = v^2 / delta^2 of energy equivalence (rho = 1, unit area), so that
+    -(K u)_i / V_i = sum_j v^2 beta_j Delta (u_j - u_i) / (delta xi^2) is Eq. (3). Real
+    nodes sit at the cell centres x_i = (i - 1/2) Delta, i = 1..N, Delta = delta / m
+    (Fig. 2; N = 100, 250, 1000 for m = 10, 25, 100).
+
+    ``boundary="surface-nodes"`` (seed 002 Figs. 3-4): surface nodes at x = 0 and x = l carry
+    the Dirichlet values and have no bonds; a fictitious layer of m cells beyond each end
+    completes the neighbourhoods, its displacements extrapolated about the nearest surface
+    node by a Taylor series of order ``taylor_order`` through the surface node and the
+    ``taylor_order`` nearest real nodes (order 1 = Eqs. 8-9; the surface node method's
+    displacement map, ``pdverify.corrections.surface_nodes``). All N real nodes are unknowns.
+
+    ``boundary="none"``: no fictitious nodes, neighbourhoods truncated at the ends, and the
+    end nodes (the first and last real node, Delta/2 inside the bar) held at the Dirichlet
+    value; the N - 2 others are unknowns.
+
+    ``boundary="odd-image"`` (a reference model, not a method of the paper): like
+    surface nodes, but the fictitious layer is the odd image about the surface value,
+    u(x_s - xi) = 2 u_s - u(x_s + xi). This is the extension the sine series of Eq. (11)
+    implies, so it isolates the quadrature error from the extrapolation's model error.
+
+    In every case the free accelerations are ``a = A u_free + A_bc u_bc`` with
+    ``A = -diag(1/V) K_real @ map`` multiplied out once (N x N, a banded matrix plus the
+    few columns the extrapolation adds): one sparse product per time step.
+    """
+
+    def __init__(self, length, horizon, m_ratio, wave_speed, boundary="surface-nodes",
+                 taylor_order=1):
+        if boundary not in BOUNDARIES:
+            raise ValueError(f"boundary={boundary!r}; allowed: {', '.join(BOUNDARIES)}")
+        self.length, self.horizon, self.boundary = length, horizon, boundary
+        self.spacing = horizon / m_ratio
+        n = length / self.spacing
+        if abs(n - round(n)) > 1e-9 * n:
+            raise ValueError(f"spacing {self.spacing} does not divide length {length}")
+        self.n_real = nr = int(round(n))
+        surface = boundary != "none"
+        if surface and nr < taylor_order + 1:
+            raise ValueError(f"order {taylor_order} needs at least {taylor_order + 1} "
+                             f"real nodes, got {nr}")
+        stencil = build_stencil(1, m_ratio)
+        grid = BoxGrid((length,), (0.0,), self.spacing, stencil.reach if surface else 0)
+        if boundary == "surface-nodes":
+            closure = Closure(displacement_map=surface_node_displacement_map(grid, taylor_order),
+                              n_unknown_nodes=nr + 2)
+        elif boundary == "odd-image":
+            closure = Closure(displacement_map=self._odd_image(grid), n_unknown_nodes=nr + 2)
+        else:
+            closure = None
+        c = bond_micromodulus("hyperbolic", 1, wave_speed ** 2, horizon)
+        self.model = BondBasedModel(grid, stencil, c, get_influence("hyperbolic"), closure)
+        self.x_lattice = grid.x[:, 0]
+        self.n_fict = grid.layers
+        full = (sp.diags(-1.0 / self.model.node_volume[grid.interior_ids])
+                @ self.model.reduced()).tocsc()
+        if surface:
+            self.free = np.arange(nr)
+            self.x_bc = np.array([0.0, length])
+            self.A, self.A_bc = full[:, :nr].tocsr(), full[:, nr:].tocsr()
+        else:
+            self.free = np.arange(1, nr - 1)
+            fixed = np.array([0, nr - 1])
+            self.x_bc = self.x_real[fixed]
+            rows = full.tocsr()[self.free].tocsc()
+            self.A, self.A_bc = rows[:, self.free].tocsr(), rows[:, fixed].tocsr()
+        self.A.sort_indices()
+
+    @staticmethod
+    def _odd_image(grid):
+        """Fictitious node at -(j + 1/2) Delta (and its mirror at the right end) from
+        2 u_s - u_j, unknowns [real u (N), surface values (2)]."""
+        nr, nf = grid.n_interior, grid.layers
+        j = np.arange(nf)
+        left = np.flatnonzero(grid.index[:, 0] < 0)[::-1]      # -(j + 1/2) Delta, j = 0..
+        right = np.flatnonzero(grid.index[:, 0] >= nr)          # l + (j + 1/2) Delta
+        rows = np.r_[left, left, right, right]
+        cols = np.r_[j, np.full(nf, nr), nr - 1 - j, np.full(nf, nr + 1)]
+        vals = np.r_[-np.ones(nf), np.full(nf, 2.0), -np.ones(nf), np.full(nf, 2.0)]
+        block = sp.csr_matrix((vals, (np.arange(rows.size), cols)), shape=(rows.size, nr + 2))
+        return with_rows(real_identity(grid, nr + 2), rows, block)
+
+    @property
+    def x_real(self) -> np.ndarray:
+        return self.x_lattice[self.n_fict:self.n_fict + self.n_real]
+
+    @property
+    def x_free(self) -> np.ndarray:
+        return self.x_real[self.free]
+
+    def real_displacements(self, u_free, u_bc=(0.0, 0.0)) -> np.ndarray:
+        """All real nodes' displacements from the free ones (``none``: the end nodes get ``u_bc``)."""
+        u_free = np.asarray(u_free, dtype=float)
+        if self.boundary != "none":
+            return u_free
+        out = np.empty(u_free.shape[:-1] + (self.n_real,))
+        out[..., self.free] = u_free
+        out[..., 0], out[..., -1] = u_bc[0], u_bc[1]
+        return out
+
+    def size(self) -> dict:
+        surface = 2 if self.boundary != "none" else 0
+        return {"nodes": int(self.n_real + 2 * self.n_fict + surface),
+                "real_nodes": int(self.n_real), "fictitious_nodes": int(2 * self.n_fict),
+                "dofs": int(self.free.size), "bonds": self.model.n_bonds(),
+                "operator_nnz": int(self.A.nnz)}
 
 
 @register
@@ -54,8 +187,8 @@ class Wave1DSurfaceNodes(Scene):
 
     Findings: the error falls at first order in 1/m because the one-point quadrature of
     Eq. (3) leaves out the node's own cell (psi - psi_h = k^2 / (2m), see
-    ``micromodulus1d.lattice_symbol``). Order-1 extrapolation is not the odd extension the
-    analytic series implies (``WaveBar1D(boundary="odd-image")``): the two discrete solutions
+    ``lattice_symbol``). Order-1 extrapolation is not the odd extension the
+    analytic series implies (``WaveBar(boundary="odd-image")``): the two discrete solutions
     differ by about 0.27-0.28 % of the peak at m = 25 and 100 alike (order 2: 0.11-0.09 %).
     That gap is below the quadrature error for m <= 100, so the paper's convergence shows,
     but it bounds it beyond a few hundred (at m = 400 the order-1 error, 0.33 %, already
@@ -113,8 +246,8 @@ class Wave1DSurfaceNodes(Scene):
         length, horizon = p["length"], p["horizon"]
         wave_speed = float(np.sqrt(p["E"] / p["rho"]))
         with timer.phase("setup"):
-            bar = WaveBar1D(length, horizon, float(p["m_ratio"]), wave_speed,
-                            boundary=method, taylor_order=p.get("order", 1))
+            bar = WaveBar(length, horizon, float(p["m_ratio"]), wave_speed,
+                          boundary=method, taylor_order=p.get("order", 1))
             u0 = analytic.gaussian_pulse(bar.x_free, length=length)
             steps = [int(round(t / p["dt"])) for t in SAMPLE_TIMES]
         with timer.phase("solve"):

@@ -2,8 +2,9 @@
 import numpy as np
 import pytest
 
-from pdverify.bondbar1d import (BondBar1D, bond_profile, micromodulus_c1, micromodulus_factor,
-                                split_horizon_ratio)
+from pdverify.corrections.homogenized import (bond_profile, micromodulus_c1, micromodulus_factor,
+                                             split_horizon_ratio)
+from pdverify.scenes.bar1d_bondbased import BondBar
 
 EPS = np.finfo(float).eps
 #: c1 is E over a sum of at most 2m positive O(m^2) terms: a few ulps, at m <= 40 below 1e-14.
@@ -89,7 +90,7 @@ def test_constant_micromodulus_through_an_element_needs_no_discrete_correction(m
 def test_table14_end_equation_coefficient(ratio, weight, C):
     # App. 1, Eq. (A1.7): b_1/(c1 A) = C sigma Delta / E, with b_1 = sigma A / V_1.
     E, sigma, spacing = 7.0, 3.0, 0.25
-    bar = BondBar1D(nodes=21, spacing=spacing, horizon_ratio=ratio, E=E, area=0.3,
+    bar = BondBar(nodes=21, spacing=spacing, horizon_ratio=ratio, E=E, area=0.3,
                     end_weight=weight)
     b1 = sigma * bar.area / bar.volume[0]
     np.testing.assert_allclose(b1 / (bar.c1 * bar.area) / (sigma * spacing / E), C,

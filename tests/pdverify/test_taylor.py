@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from pdverify.corrections.taylor import taylor_extrapolation_weights
-from pdverify.operators import Bar1D
+from pdverify.scenes.bar1d import StateBar
 
 EPS = np.finfo(float).eps
 
@@ -13,36 +13,36 @@ def test_fictitious_displacements_reproduce_polynomials(order, rng):
     # seed 000 §3: a Taylor series of order n is exact for degree <= n. Tolerance:
     # eps times the extrapolation amplification ||W||_inf (sum of |weights|) times the
     # size of the field, the round-off of evaluating W @ u.
-    bar = Bar1D(1.0, 0.01, 1e9, 0.3, 0.05, 3.0, taylor_order=order)
-    A_U = bar.A_U.toarray()
+    bar = StateBar(dict(length=1.0, area=0.01, E=1e9, nu=0.3, spacing=0.05, m_ratio=3.0), order)
+    A_U = bar.model.A_U.toarray()
     amp = np.abs(A_U).sum(axis=1).max()
     for _ in range(3):
         for degree in range(order + 1):
             coef = rng.normal(size=degree + 1)
-            u_all = np.polyval(coef, bar.x)
-            got = A_U @ u_all[bar.real]
+            u_all = np.polyval(coef, bar.grid.x[:, 0])
+            got = A_U @ u_all[bar.grid.interior_ids]
             np.testing.assert_allclose(got, u_all, rtol=0,
                                        atol=50 * EPS * amp * np.abs(u_all).max())
     # and not beyond its order: degree n + 1 is not reproduced
-    u_all = bar.x ** (order + 1)
-    assert np.abs(A_U @ u_all[bar.real] - u_all).max() > 1e-8 * np.abs(u_all).max()
+    u_all = bar.grid.x[:, 0] ** (order + 1)
+    assert np.abs(A_U @ u_all[bar.grid.interior_ids] - u_all).max() > 1e-8 * np.abs(u_all).max()
 
 
 @pytest.mark.parametrize("order", [1, 2, 3, 4, 5])
 def test_fictitious_dilatations_reproduce_degree_n_minus_1(order, rng):
     # seed 000 Eq. (47): dilatations are extrapolated with order n - 1.
-    bar = Bar1D(1.0, 0.01, 1e9, 0.3, 0.05, 3.0, taylor_order=order)
-    A = bar.A_Theta.toarray()
+    bar = StateBar(dict(length=1.0, area=0.01, E=1e9, nu=0.3, spacing=0.05, m_ratio=3.0), order)
+    A = bar.model.A_Theta.toarray()
     amp = np.abs(A).sum(axis=1).max()
     coef = rng.normal(size=order)
-    th = np.polyval(coef, bar.x)
-    np.testing.assert_allclose(A @ th[bar.real], th, rtol=0, atol=50 * EPS * amp * np.abs(th).max())
+    th = np.polyval(coef, bar.grid.x[:, 0])
+    np.testing.assert_allclose(A @ th[bar.grid.interior_ids], th, rtol=0, atol=50 * EPS * amp * np.abs(th).max())
 
 
 @pytest.mark.parametrize("order", [1, 3, 5])
 def test_boundary_value_row_is_exact(order, rng):
     # seed 000 Eq. (58): the Dirichlet row extrapolates u to x = 0 exactly for degree <= n.
-    bar = Bar1D(1.0, 0.01, 1e9, 0.3, 0.05, 3.0, taylor_order=order)
+    bar = StateBar(dict(length=1.0, area=0.01, E=1e9, nu=0.3, spacing=0.05, m_ratio=3.0), order)
     coef = rng.normal(size=order + 1)
     for side, point in (("left", 0.0), ("right", 1.0)):
         row = bar.boundary_value_row(side)

@@ -2,10 +2,11 @@
 import numpy as np
 import pytest
 
-from pdverify.bonds_nd import (fourth_moment_anisotropy, moment_corrected_volumes,
+from pdverify.pd.bonds import (fourth_moment_anisotropy, moment_corrected_volumes,
                                partial_volumes, stencil_offsets)
 from pdverify.scenes.surface_nodes import face_resultant
-from pdverify.statebased_nd import StateBasedBox, StateBasedConstants
+from pdverify.pd import StateBasedConstants
+from pdverify.scenes.surface_nodes import StateBox
 
 # Sums of a few hundred terms of size <= 1: 1e-13 is ~500 eps of summation round-off.
 SUM_ATOL = 1e-13
@@ -45,7 +46,7 @@ def _discrete_moduli(kind, quadrature, m_ratio=3.0):
     dim = 3 if kind == "3d" else 2
     h = 0.02
     L = (h * 8,) * dim
-    model = StateBasedBox(L, (0.0,) * dim, h, m_ratio, c, order=1, quadrature=quadrature)
+    model = StateBox(L, (0.0,) * dim, h, m_ratio, c, order=1, quadrature=quadrature)
     g = model.grid
     out = []
     shear = np.zeros((dim, dim))

@@ -3,9 +3,9 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from pdverify.bonds_nd import (bond_pairs, half_stencil, partial_volumes, rectangle_disk_area,
+from pdverify.pd.bonds import (bond_pairs, half_stencil, partial_volumes, rectangle_disk_area,
                                stencil_offsets)
-from pdverify.statebased_nd import gaussian_weighted_volume
+from pdverify.pd import get_influence
 
 # Closed-form sums are exact up to round-off of ~500 terms of size <= 1:
 # 1e-12 relative is ~5000 eps, a generous bound on summation error.
@@ -71,7 +71,7 @@ def test_weighted_volume_converges_to_the_analytic_value(dim):
         h = delta / m
         r = np.linalg.norm(k, axis=1) * h
         m_h = np.sum(np.exp(-(r / delta) ** 2) * r ** 2 * beta) * h ** dim
-        errs.append(abs(m_h / gaussian_weighted_volume(dim, delta) - 1.0))
+        errs.append(abs(m_h / get_influence("gaussian").weighted_volume(dim, delta) - 1.0))
     slope = np.polyfit(np.log(1.0 / ms), np.log(errs), 1)[0]
     # mid-point quadrature with exact cell fractions: second order in h (margin 0.2)
     assert slope > 1.8, (slope, errs)
@@ -81,7 +81,7 @@ def test_weighted_volume_converges_to_the_analytic_value(dim):
 
 def test_weighted_volume_3d_is_4_pi_delta_1():
     # ERRATA seed 001: Delta_1 / delta^5 = 0.1002687981 (10 digits quoted)
-    np.testing.assert_allclose(gaussian_weighted_volume(3, 1.0), 4 * np.pi * 0.1002687981,
+    np.testing.assert_allclose(get_influence("gaussian").weighted_volume(3, 1.0), 4 * np.pi * 0.1002687981,
                                rtol=1e-9)
 
 

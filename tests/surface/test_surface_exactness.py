@@ -10,9 +10,10 @@ from itertools import product
 import numpy as np
 import pytest
 
-from pdverify.corrections.surface_nodes import monomial_exponents
+from pdverify.corrections.taylor import monomial_exponents
 from pdverify.scenes.surface_nodes import solve_with_dirichlet
-from pdverify.statebased_nd import StateBasedBox, StateBasedConstants
+from pdverify.pd import StateBasedConstants
+from pdverify.scenes.surface_nodes import StateBox
 
 EPS = np.finfo(float).eps
 
@@ -36,7 +37,7 @@ CASES = [("plane-strain", (0.4, 0.3), (0.0, 0.0), 0.05, n) for n in (1, 2, 3)] +
 @pytest.mark.parametrize("kind,lengths,origin,h,order", CASES)
 def test_polynomial_field_recovered_to_round_off(rng, kind, lengths, origin, h, order):
     c = StateBasedConstants(kind, 200e9, 0.3)
-    model = StateBasedBox(lengths, origin, h, 3.0, c, order=order)
+    model = StateBox(lengths, origin, h, 3.0, c, order=order)
     g = model.grid
     d, ni, nu_ = g.dim, g.n_interior, model.n_unknown_nodes
     u = _poly_field(rng, d, order, 1e-3)
@@ -60,7 +61,7 @@ def test_extrapolation_is_exact_for_degree_n_only(rng):
     """Order N reproduces degree N in the fictitious layer, not degree N + 1."""
     c = StateBasedConstants("plane-strain", 200e9, 0.3)
     for order in (1, 2, 3):
-        model = StateBasedBox((0.4, 0.3), (0.0, 0.0), 0.05, 3.0, c, order=order)
+        model = StateBox((0.4, 0.3), (0.0, 0.0), 0.05, 3.0, c, order=order)
         g = model.grid
         fict = ~g.is_interior
         for degree, exact in ((order, True), (order + 1, False)):
@@ -79,7 +80,7 @@ def test_face_crossing_weights_give_the_discrete_stress(rng):
     so a homogeneous strain gives the same flux on every node of a face, corners included.
     """
     c = StateBasedConstants("3d", 200e9, 0.3)
-    model = StateBasedBox((0.3, 0.25, 0.3), (0.0, 0.0, 0.0), 0.05, 3.0, c, order=1)
+    model = StateBox((0.3, 0.25, 0.3), (0.0, 0.0, 0.0), 0.05, 3.0, c, order=1)
     g = model.grid
     eps = rng.uniform(-1, 1, (3, 3)) * 1e-3
     eps = eps + eps.T

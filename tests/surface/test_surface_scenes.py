@@ -3,7 +3,8 @@ import numpy as np
 import pytest
 
 from pdverify.scenes import get_scene
-from pdverify.statebased_nd import StateBasedBox, StateBasedConstants
+from pdverify.pd import StateBasedConstants
+from pdverify.scenes.surface_nodes import StateBox
 
 
 def _run(scene, method, **over):
@@ -23,7 +24,7 @@ def _discrete_plate_strain_error(p, m_ratio):
     force flux of a unit strain, and sigma = (0, p) gives the homogeneous strains.
     """
     c = StateBasedConstants("plane-strain", p["E"], p["nu"])
-    model = StateBasedBox((0.3, 0.3), (0.0, 0.0), 0.02, m_ratio, c, order=1)
+    model = StateBox((0.3, 0.3), (0.0, 0.0), 0.02, m_ratio, c, order=1)
     g = model.grid
     eps = np.diag([1.0, 0.0])
 

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from manufactured.wave1d import gaussian_pulse, wave_series
-from pdverify.micromodulus1d import WaveBar1D
+from pdverify.scenes.wave1d import WaveBar
 from pdverify.scenes.wave1d import SAMPLE_TIMES
 from pdverify.solvers.explicit import central_difference
 
@@ -12,7 +12,7 @@ STEPS = [int(round(t / DT)) for t in SAMPLE_TIMES]
 
 
 def solve(m, boundary, order=1):
-    bar = WaveBar1D(1.0, DELTA, m, V, boundary=boundary, taylor_order=order)
+    bar = WaveBar(1.0, DELTA, m, V, boundary=boundary, taylor_order=order)
     run = central_difference(-bar.A, gaussian_pulse(bar.x_free), 0.0, DT, STEPS[-1],
                              sample_steps=STEPS)
     return bar.x_real, bar.real_displacements(run.u)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from pdverify.micromodulus1d import WaveBar1D
+from pdverify.scenes.wave1d import WaveBar
 from pdverify.report.figures import draw
 from pdverify.scenes import get_scene
 
@@ -75,7 +75,7 @@ def test_step_above_the_stability_limit_fails_the_run_naming_the_limit():
     # m = 10: the sharp limit 2/sqrt(lambda_max) from LAPACK's eigenvalues of the operator;
     # a step 2 % above it is refused through the CLI (exit 1, failed run), one 2 % below
     # it (but above the Gershgorin bound) runs.
-    bar = WaveBar1D(1.0, 0.1, 10, 5000.0)
+    bar = WaveBar(1.0, 0.1, 10, 5000.0)
     limit = 2 / np.sqrt(np.max(np.abs(np.linalg.eigvals(-bar.A.toarray()))))
     proc = cli("run", SCENE, "--set", "m_ratio=10", "--set", f"dt={1.02 * limit:.6e}")
     assert proc.returncode == 1, proc.stdout + proc.stderr

@@ -1,5 +1,7 @@
-"""2D/3D bond families from one stencil of integer offsets, and exact partial volumes beta."""
+"""Bond families from one stencil of integer offsets (any dimension) and partial volumes beta."""
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -57,7 +59,8 @@ def partial_volumes(offsets: np.ndarray, m_ratio: float) -> np.ndarray:
     """Fraction beta of each neighbour cell inside the horizon (nodes at cell centres).
 
     Units of the spacing: the cell at offset k is [k - 1/2, k + 1/2]^d and the horizon a
-    ball of radius ``m_ratio`` centred on the node. 2D: the exact area of a square inside
+    ball of radius ``m_ratio`` centred on the node. 1D: the length of the cell inside the
+    interval (beta = 1/2 for the node at |xi| = delta at integer m_ratio). 2D: the exact area of a square inside
     a disk (closed form). 3D: beta = int A(x) dx with A the exact area of the cell's
     cross-section inside the disk of radius sqrt(R^2 - x^2); the x-range is split where
     that disk radius passes the cross-section's edge and corner distances, and each
@@ -68,11 +71,16 @@ def partial_volumes(offsets: np.ndarray, m_ratio: float) -> np.ndarray:
     offsets = np.atleast_2d(np.asarray(offsets, dtype=float))
     dim = offsets.shape[1]
     R = float(m_ratio)
+    if dim == 1:
+        # the interval [|k| - 1/2, |k| + 1/2] inside [-R, R]; at integer m_ratio the node
+        # at |xi| = delta gets beta = 1/2 (ERRATA, seeds 000 and 002), which makes the
+        # discrete weighted volume of a complete neighbourhood exact (seed 000, Eq. 25)
+        return np.clip(R - np.abs(offsets[:, 0]) + 0.5, 0.0, 1.0)
     lo, hi = offsets - 0.5, offsets + 0.5
     if dim == 2:
         return np.clip(rectangle_disk_area(lo[:, 0], hi[:, 0], lo[:, 1], hi[:, 1], R), 0.0, 1.0)
     if dim != 3:
-        raise ValueError(f"partial volumes for dim={dim} are not implemented here")
+        raise ValueError(f"partial volumes need dim 1, 2 or 3, got {dim}")
     y0, y1, z0, z1 = lo[:, 1], hi[:, 1], lo[:, 2], hi[:, 2]
     dists = np.stack([np.abs(y0), np.abs(y1), np.abs(z0), np.abs(z1),
                       np.hypot(y0, z0), np.hypot(y0, z1), np.hypot(y1, z0), np.hypot(y1, z1)],
@@ -165,3 +173,63 @@ def bond_pairs(ext_shape, offsets: np.ndarray):
         empty = np.zeros(0, dtype=int)
         return empty, empty, empty
     return np.concatenate(a_parts), np.concatenate(b_parts), np.concatenate(w_parts)
+
+
+#: Weights beta of the one-point quadrature over a neighbourhood: ``partial-volume`` = the
+#: exact fraction of each cell inside the horizon (seed 001 §3.1; in 1D the seed-000 rule),
+#: ``moment-corrected`` (our addition) = those fractions minimally adjusted so that the
+#: stencil's fourth moment is isotropic (2D and 3D; :func:`moment_corrected_volumes`).
+QUADRATURES = ("partial-volume", "moment-corrected")
+
+
+@dataclass(frozen=True)
+class Stencil:
+    """The integer offsets of one neighbourhood and their quadrature weights beta.
+
+    ``offsets`` (n, dim) are every non-zero offset whose cell meets the horizon (both
+    signs), ``beta`` their weights; ``half`` masks one offset of each pair +-k, the one
+    bonds are built from (a bond a -> a + k for every half offset k).
+    """
+
+    dim: int
+    m_ratio: float
+    quadrature: str
+    offsets: np.ndarray
+    beta: np.ndarray
+
+    @property
+    def half(self) -> np.ndarray:
+        return half_stencil(self.offsets)
+
+    @property
+    def half_offsets(self) -> np.ndarray:
+        return self.offsets[self.half]
+
+    @property
+    def half_beta(self) -> np.ndarray:
+        return self.beta[self.half]
+
+    @property
+    def reach(self) -> int:
+        """Largest offset along an axis: the fictitious layer that completes a neighbourhood."""
+        return int(np.abs(self.offsets).max()) if self.offsets.size else 0
+
+
+def build_stencil(dim: int, m_ratio: float, *, quadrature: str = "partial-volume",
+                  moment_weight=None) -> Stencil:
+    """The stencil of horizon ``m_ratio`` spacings with the weights of ``quadrature``.
+
+    ``moment_weight(offsets) -> (n,)`` is the per-offset weight of the fourth moment that
+    ``moment-corrected`` makes isotropic (state-based: omega |xi|^2; bond-based:
+    omega |xi|); it is required for that quadrature only.
+    """
+    if quadrature not in QUADRATURES:
+        raise ValueError(f"quadrature={quadrature!r}; allowed: {', '.join(QUADRATURES)}")
+    offsets = stencil_offsets(dim, m_ratio)
+    beta = partial_volumes(offsets, m_ratio)
+    if quadrature == "moment-corrected":
+        if dim < 2:
+            raise ValueError("quadrature='moment-corrected' needs dim 2 or 3 (a 1D stencil "
+                             "has no fourth-moment anisotropy)")
+        beta = moment_corrected_volumes(offsets, beta, moment_weight(offsets))
+    return Stencil(dim, float(m_ratio), quadrature, offsets, beta)

@@ -1,47 +1,82 @@
-"""Uniform 2D/3D cell grids on boxes: interior and fictitious nodes, faces and surface nodes."""
+"""Uniform box grids in 1, 2 and 3 dimensions: node placement, node kinds, faces, surface nodes."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
 import numpy as np
 
+#: Where the nodes of a box sit. ``cell-centred``: one node at the centre of every cell of
+#: side ``spacing`` (seeds 000, 001, 002). ``on-surface``: nodes on the cell vertices, so
+#: the outermost nodes lie on the surface (seeds 003, 004).
+PLACEMENTS = ("cell-centred", "on-surface")
+
+#: Volume of a node on the surface of an ``on-surface`` grid: ``partial`` = the part of
+#: its cell inside the body (1/2 per axis on which it lies on the surface: half on edges,
+#: a quarter at 2D corners, seed 003 / ERRATA; half-weight end elements, seed 004),
+#: ``full`` = a whole cell (seed 004, Fig. 1).
+BOUNDARY_VOLUMES = ("partial", "full")
+
+KIND_INTERIOR, KIND_FICTITIOUS = 0, 1
+
 
 @dataclass
 class BoxGrid:
-    """Cells of side ``spacing`` on the box ``origin + [0, lengths]``, nodes at cell centres.
+    """Nodes of the box ``origin + [0, lengths]`` on a uniform grid of side ``spacing``.
 
-    The grid is extended by ``layers`` cells on every side (the fictitious layer, edge and
-    corner regions included). Every node of the extended grid carries its integer cell
-    index (interior cells have 0 <= index < cells along every axis) and its position.
+    The grid is extended by ``layers`` nodes on every side (the fictitious layer, edge and
+    corner regions included). Every node of the extended grid carries its integer index
+    (real nodes have 0 <= index < nodes along every axis), its position ``x``, its kind
+    (``is_interior`` = a real node of the body, otherwise fictitious) and its volume.
+    "Interior" means "inside the body", as opposed to fictitious; it includes the nodes
+    on the surface of an ``on-surface`` grid.
 
     Faces are numbered ``2 * axis + side`` (side 0 at the lower end of the axis, 1 at the
-    upper end). A surface node sits at the centre of every boundary cell face (seed 001
-    §3, Fig. 5); it is identified by its face and the index of the boundary cell it
-    belongs to.
+    upper end). On a cell-centred grid a *surface node* sits at the centre of every
+    boundary cell face (seed 001 §3, Fig. 5; seed 002 in 1D); it is identified by its face
+    and the index of the boundary cell it belongs to. Surface nodes are extra nodes, not
+    part of the extended grid.
     """
 
     lengths: tuple
     origin: tuple
     spacing: float
     layers: int = 0
+    placement: str = "cell-centred"
+    boundary_volume: str = "partial"
     arrays: dict = field(init=False, repr=False, default_factory=dict)
 
     def __post_init__(self):
+        if self.placement not in PLACEMENTS:
+            raise ValueError(f"placement={self.placement!r}; allowed: {', '.join(PLACEMENTS)}")
+        if self.boundary_volume not in BOUNDARY_VOLUMES:
+            raise ValueError(f"boundary_volume={self.boundary_volume!r}; allowed: "
+                             f"{', '.join(BOUNDARY_VOLUMES)}")
         self.lengths = tuple(float(v) for v in self.lengths)
         self.origin = tuple(float(v) for v in self.origin)
         self.dim = len(self.lengths)
+        if not 1 <= self.dim <= 3:
+            raise ValueError(f"a box grid has 1, 2 or 3 dimensions, got {self.dim}")
         h = self.spacing
         self.cells = tuple(int(round(L / h)) for L in self.lengths)
-        self.ext_shape = tuple(n + 2 * self.layers for n in self.cells)
+        centred = self.placement == "cell-centred"
+        self.nodes_per_axis = tuple(n if centred else n + 1 for n in self.cells)
+        self.ext_shape = tuple(n + 2 * self.layers for n in self.nodes_per_axis)
         idx = np.indices(self.ext_shape).reshape(self.dim, -1).T - self.layers
         self.index = idx
-        self.x = np.asarray(self.origin) + (idx + 0.5) * h
-        cells = np.asarray(self.cells)
-        self.is_interior = np.all((idx >= 0) & (idx < cells), axis=1)
+        self.x = np.asarray(self.origin) + (idx + (0.5 if centred else 0.0)) * h
+        n_axis = np.asarray(self.nodes_per_axis)
+        self.is_interior = np.all((idx >= 0) & (idx < n_axis), axis=1)
+        self.kind = np.where(self.is_interior, KIND_INTERIOR, KIND_FICTITIOUS)
         self.interior_ids = np.flatnonzero(self.is_interior)
         self.interior_number = np.full(idx.shape[0], -1)
         self.interior_number[self.interior_ids] = np.arange(self.interior_ids.size)
-        self._build_surface()
+        weight = np.ones(idx.shape[0])
+        if not centred and self.boundary_volume == "partial":
+            on_surface = self.is_interior[:, None] & ((idx == 0) | (idx == n_axis - 1))
+            weight = np.prod(np.where(on_surface, 0.5, 1.0), axis=1)
+        self.node_volume = weight * self.volume
+        if centred:
+            self._build_surface()
 
     # ------------------------------------------------------------------ ids
     @property
@@ -54,23 +89,23 @@ class BoxGrid:
 
     @property
     def volume(self) -> float:
-        """Cell volume h^d (2D: per unit thickness)."""
+        """Cell volume h^d (2D: per unit thickness; 1D: per unit cross-section)."""
         return self.spacing ** self.dim
 
     @property
     def face_area(self) -> float:
-        """Cell face area h^(d-1) (2D: a cell edge of unit thickness)."""
+        """Cell face area h^(d-1) (2D: a cell edge of unit thickness; 1D: 1)."""
         return self.spacing ** (self.dim - 1)
 
     def ext_id(self, index) -> np.ndarray:
-        """Extended-grid node id of integer cell indices (..., dim)."""
+        """Extended-grid node id of integer node indices (..., dim)."""
         index = np.asarray(index) + self.layers
         return np.ravel_multi_index(tuple(np.moveaxis(index, -1, 0)), self.ext_shape)
 
     def tangential_axes(self, axis: int) -> tuple:
         return tuple(a for a in range(self.dim) if a != axis)
 
-    # ------------------------------------------------------------------ surface
+    # ------------------------------------------------------------------ surface nodes
     def _build_surface(self):
         h = self.spacing
         faces, starts, cell_idx, pos, normal, face_of = [], [], [], [], [], []
@@ -79,7 +114,7 @@ class BoxGrid:
             for side in (0, 1):
                 tang = self.tangential_axes(axis)
                 shape = tuple(self.cells[t] for t in tang)
-                t_idx = np.indices(shape).reshape(len(tang), -1).T
+                t_idx = np.indices(shape).reshape(len(tang), -1).T if tang else np.zeros((1, 0), int)
                 n = t_idx.shape[0]
                 cidx = np.zeros((n, self.dim), dtype=int)
                 cidx[:, list(tang)] = t_idx
@@ -109,8 +144,10 @@ class BoxGrid:
     def surface_id(self, face: int, cell_index) -> np.ndarray:
         """Surface-node id on ``face`` for boundary-cell indices (..., dim)."""
         axis, _, shape = self.faces[face]
-        tang = self.tangential_axes(axis)
         cell_index = np.asarray(cell_index)
+        if not shape:  # 1D: one surface node per face
+            return np.full(cell_index.shape[:-1], self.face_start[face], dtype=int)
+        tang = self.tangential_axes(axis)
         t = tuple(cell_index[..., a] for a in tang)
         return self.face_start[face] + np.ravel_multi_index(t, shape)
 

@@ -1,0 +1,113 @@
+"""Linear bond-based PD on box grids of any dimension: bond stiffnesses and the sparse stiffness."""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from .bonds import Stencil, bond_pairs
+from .closure import Closure, real_identity
+from .grid import BoxGrid
+from .influence import Influence
+
+
+class BondBasedModel:
+    """Linearised bond-based PD: pairwise forces along the reference bond direction.
+
+    Bond a-b (a -> a + k for every half-stencil offset k the closure keeps) has the
+    micromodulus c omega(|xi|); linearised, its force on a is s_b (n . (u_b - u_a)) n with
+    the spring stiffness
+
+        s_b = alpha_b c omega(|xi|) beta_k V_a V_b / |xi|,
+
+    so that the force density on a is c omega (e / |xi|) V_b (seed 004, Eq. 33, times V_a;
+    seed 002, Eq. 3 with c omega / |xi| = v^2 rho / (delta xi^2); seed 003, Eq. 1).
+    ``alpha_b`` is the closure's bond factor (1 by default), ``beta_k`` the stencil's
+    partial volume and V the node volumes (grid volumes times ``thickness``: the
+    cross-section A in 1D, the thickness in 2D). Offsets whose weight omega beta is zero
+    (the tip of a conical micromodulus at integer m) carry no bond.
+
+    ``K`` (d * n_ext square, component-major) is the symmetric stiffness of all grid nodes,
+    K u = external nodal forces, assembled from the bond arrays in one sparse call:
+    K = sum_b s_b (n n^T) kron (e_a - e_b)(e_a - e_b)^T. :meth:`reduced` restricts it to
+    the closure's unknowns (displacement map) and to the real nodes' equations.
+    """
+
+    def __init__(self, grid: BoxGrid, stencil: Stencil, micromodulus: float,
+                 influence: Influence, closure: Closure | None = None, *,
+                 thickness: float = 1.0):
+        if grid.dim != stencil.dim:
+            raise ValueError(f"dimensions differ: grid {grid.dim}, stencil {stencil.dim}")
+        self.grid, self.stencil, self.influence = grid, stencil, influence
+        self.closure = closure = closure or Closure()
+        self.c = float(micromodulus)
+        self.spacing = h = grid.spacing
+        self.m_ratio = stencil.m_ratio
+        self.horizon = delta = stencil.m_ratio * h
+        self.thickness = float(thickness)
+        self.node_volume = grid.node_volume * self.thickness
+
+        offsets, beta = stencil.half_offsets, stencil.half_beta
+        r = np.linalg.norm(offsets, axis=1) * h
+        live = influence.omega(r, delta) * beta > 0
+        self.offsets, self.beta_k = offsets[live], beta[live]
+        a, b, which = bond_pairs(grid.ext_shape, offsets)
+        keep = closure.bond_mask(grid, a, b) & live[which]
+        a, b, which = a[keep], b[keep], which[keep]
+        xi = (grid.index[b] - grid.index[a]) * h
+        x = np.linalg.norm(xi, axis=1)
+        self.bond_a, self.bond_b, self.bond_which = a, b, which
+        self.bond_x, self.bond_n = x, xi / x[:, None]
+        self.bond_factor = (closure.bond_factor(a, b, self.bond_n)
+                            if closure.bond_factor is not None else np.ones(a.size))
+        self.bond_stiffness = (self.bond_factor * self.c * influence.omega(x, delta) * beta[which]
+                               * self.node_volume[a] * self.node_volume[b] / x)
+        self.n_unknown_nodes = (closure.n_unknown_nodes if closure.n_unknown_nodes is not None
+                                else grid.n_interior)
+        self.K = self._assemble()
+
+    @property
+    def dim(self) -> int:
+        return self.grid.dim
+
+    def _assemble(self) -> sp.csr_matrix:
+        d, ne = self.dim, self.grid.n_ext
+        a, b, s, n = self.bond_a, self.bond_b, self.bond_stiffness, self.bond_n
+        rows, cols, vals = [], [], []
+        for p in range(d):          # d^2 blocks, each vectorised over bonds
+            for q in range(d):
+                w = s * n[:, p] * n[:, q]
+                ra, rb, ca, cb = p * ne + a, p * ne + b, q * ne + a, q * ne + b
+                rows += [ra, rb, ra, rb]
+                cols += [ca, cb, cb, ca]
+                vals += [w, w, -w, -w]
+        # duplicates (a node's many bonds) are summed by the COO -> CSR step
+        return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                             shape=(d * ne, d * ne))
+
+    def displacement_map(self) -> sp.csr_matrix:
+        """The closure's all-node map (I_d kron A_U), identity on real nodes by default."""
+        cl, g = self.closure, self.grid
+        A_U = cl.displacement_map if cl.displacement_map is not None else real_identity(g)
+        return sp.kron(sp.identity(self.dim, format="csr"), A_U, format="csr")
+
+    def real_rows(self) -> np.ndarray:
+        """Row indices of K that are the real nodes' equations (component-major)."""
+        ne = self.grid.n_ext
+        return np.concatenate([k * ne + self.grid.interior_ids for k in range(self.dim)])
+
+    def reduced(self) -> sp.csr_matrix:
+        """The real nodes' equations in terms of the unknowns: K[real rows] @ (I kron A_U)."""
+        return (self.K[self.real_rows()] @ self.displacement_map()).tocsr()
+
+    def bond_forces(self, u) -> np.ndarray:
+        """Scalar bond forces s_b n . (u_b - u_a) (tension positive) of the unknowns ``u``."""
+        U = (self.displacement_map() @ np.asarray(u, dtype=float)).reshape(self.dim, -1)
+        du = U[:, self.bond_b] - U[:, self.bond_a]
+        return self.bond_stiffness * np.einsum("kb,bk->b", du, self.bond_n)
+
+    def lumped_mass(self, density: float) -> np.ndarray:
+        """Nodal masses rho V_i of the real nodes (component-major, repeated per component)."""
+        return np.tile(density * self.node_volume[self.grid.interior_ids], self.dim)
+
+    def n_bonds(self) -> int:
+        return int(self.bond_a.size)

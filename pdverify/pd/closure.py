@@ -1,0 +1,77 @@
+"""The engine's side of the correction contract: what a boundary treatment hands a model."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+import scipy.sparse as sp
+
+#: How the weighted volume m of a node is computed: ``truncated`` = over the bonds the
+#: node has (seed 000, Eq. 50; seed 001, Eq. 22), ``complete`` = m of a complete
+#: neighbourhood at every node (the fictitious layer completes it; seed 000 §4,
+#: seed 001 §3.2).
+WEIGHTED_VOLUMES = ("truncated", "complete")
+
+
+@dataclass
+class Closure:
+    """How a boundary treatment closes the PD equations near the surface.
+
+    Every field has the default of the uncorrected model, so ``Closure()`` is the method
+    ``none`` (truncated neighbourhoods, no extra nodes or rows). A correction in
+    ``pdverify.corrections`` fills in what it changes:
+
+    - ``keep``: which stencil pairs of the (extended) grid are bonds, as a mask over
+      ``bond_pairs(grid.ext_shape, stencil.half_offsets)`` or a function ``keep(a, b)``
+      returning one; default: pairs with at least one real node.
+    - ``weighted_volume``: ``truncated`` or ``complete`` (see :data:`WEIGHTED_VOLUMES`).
+    - ``displacement_map`` (n_ext x n_unknown_nodes): all node displacements from the
+      unknowns, per component (identity on real nodes, extrapolation rows on fictitious
+      or mirror nodes, columns for extra unknowns such as surface nodes);
+      ``n_unknown_nodes`` its column count. Default: the real nodes are the unknowns.
+    - ``dilatation_map`` (n_ext x n_real): all node dilatations from the real ones
+      (state-based only). Default: zero on fictitious nodes.
+    - ``bond_factor(a, b, n) -> factor``: a stiffness factor per bond (end-bond, energy,
+      volume or directional corrections); ``n`` the unit bond vectors. Default: 1.
+
+    Flux and constraint rows are built by the correction from the model's bonds after
+    construction (e.g. :meth:`StateBasedModel.bond_force_rows`).
+    """
+
+    keep: np.ndarray | Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
+    weighted_volume: str = "truncated"
+    displacement_map: sp.spmatrix | None = None
+    dilatation_map: sp.spmatrix | None = None
+    n_unknown_nodes: int | None = None
+    bond_factor: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray] | None = None
+
+    def __post_init__(self):
+        if self.weighted_volume not in WEIGHTED_VOLUMES:
+            raise ValueError(f"weighted_volume={self.weighted_volume!r}; allowed: "
+                             f"{', '.join(WEIGHTED_VOLUMES)}")
+
+    def bond_mask(self, grid, a, b) -> np.ndarray:
+        """Which of the candidate pairs a-b are bonds (see ``keep``)."""
+        if self.keep is None:
+            return grid.is_interior[a] | grid.is_interior[b]
+        mask = self.keep(a, b) if callable(self.keep) else np.asarray(self.keep, dtype=bool)
+        if mask.shape != a.shape:
+            raise ValueError(f"keep: {mask.shape[0]} flags for {a.size} candidate pairs")
+        return mask
+
+
+def real_identity(grid, n_cols: int | None = None) -> sp.csr_matrix:
+    """n_ext x n_cols map that copies the real (interior) nodes and is zero elsewhere."""
+    ni = grid.n_interior
+    n_cols = ni if n_cols is None else n_cols
+    return sp.csr_matrix((np.ones(ni), (grid.interior_ids, np.arange(ni))),
+                         shape=(grid.n_ext, n_cols))
+
+
+def with_rows(base: sp.csr_matrix, rows: np.ndarray, block: sp.spmatrix) -> sp.csr_matrix:
+    """``base`` plus ``block`` placed on the node rows ``rows`` (extrapolation rows)."""
+    block = sp.coo_matrix(block)
+    extra = sp.csr_matrix((block.data, (np.asarray(rows)[block.row], block.col)),
+                          shape=base.shape)
+    return (base + extra).tocsr()

@@ -1,0 +1,211 @@
+"""Linear ordinary state-based PD on box grids of any dimension, as sparse operator products."""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from .bonds import Stencil, bond_pairs
+from .closure import Closure, real_identity
+from .grid import BoxGrid
+from .influence import Influence, StateBasedConstants
+
+
+class StateBasedModel:
+    """Linearised ordinary state-based PD (seed 000 §4.2 and App. D; seed 001 §2-3).
+
+    Built from a grid, a stencil (offsets and weights beta), the constants, an influence
+    function and a :class:`~pdverify.pd.closure.Closure` from the boundary treatment.
+    Bonds are the stencil pairs (a, a + k), one per half-stencil offset, that the closure
+    keeps. ``thickness`` scales every node volume: the cross-section A in 1D, the plate
+    thickness in 2D (1 = per unit thickness), unused in 3D.
+
+    Unknowns (component-major, ``d * n_unknown_nodes``): the closure's unknown nodes,
+    by default the real nodes. Operators (sparse; names follow seed 000 App. D):
+      U = (I_d kron A_U) u~         all node displacements (closure's displacement map)
+      e = A_e U                     bond extensions n . (U_b - U_a), Eq. (21) of seed 001
+      theta = A_theta e             real-node dilatations, Eq. (23) of seed 001 / (51) of 000
+      Theta = A_Theta theta         all node dilatations (closure's dilatation map)
+      f = K_e e + K_theta Theta     scalar bond forces times beta V_a V_b, Eq. (24) / (53)
+      rows = P f                    equations: minus the internal nodal force of every real
+                                    node (:meth:`equilibrium_rows`), plus a correction's
+                                    flux rows (:meth:`bond_force_rows`)
+    so K = P K_b with K_b = K_e A_e A_U + K_theta A_Theta A_theta A_e A_U.
+    Where things are multiplied out: K_b is never formed in 2D/3D (each of its rows would
+    couple ~1000 dofs in 3D); :meth:`stiffness` multiplies out the two terms
+    (P K_e) B + (P K_theta A_Theta)(A_theta B) with B = A_e A_U, each a product of sparse
+    factors. :meth:`bond_force_matrix` does form K_b, for 1D bars, where it is banded and
+    both the stiffness and the section-force rows (seed 000, Eq. 60) need it.
+    :meth:`rows_of_state` applies the factors to a given state without multiplying
+    anything out.
+    """
+
+    def __init__(self, grid: BoxGrid, stencil: Stencil, constants: StateBasedConstants,
+                 influence: Influence, closure: Closure | None = None, *,
+                 thickness: float = 1.0):
+        if grid.dim != stencil.dim or grid.dim != constants.dim:
+            raise ValueError(f"dimensions differ: grid {grid.dim}, stencil {stencil.dim}, "
+                             f"constants {constants.kind}")
+        self.grid, self.stencil, self.constants = grid, stencil, constants
+        self.influence = influence
+        self.closure = closure = closure or Closure()
+        self.spacing = h = grid.spacing
+        self.m_ratio = stencil.m_ratio
+        self.horizon = delta = stencil.m_ratio * h
+        self.thickness = float(thickness)
+        self.node_volume = grid.node_volume * self.thickness
+        V = grid.volume * self.thickness
+
+        r_k = np.linalg.norm(stencil.offsets, axis=1) * h
+        #: m of a complete neighbourhood (the discrete Eq. 25 of seed 000 / 22 of seed 001)
+        self.m_inf = float(np.sum(influence.omega(r_k, delta) * r_k ** 2 * stencil.beta) * V)
+
+        half = stencil.half
+        a, b, which = bond_pairs(grid.ext_shape, stencil.offsets[half])
+        beta_h = stencil.beta[half]
+        keep = closure.bond_mask(grid, a, b)
+        a, b, which = a[keep], b[keep], which[keep]
+        self.bond_a, self.bond_b = a, b
+        xi = (grid.index[b] - grid.index[a]) * h
+        x = np.linalg.norm(xi, axis=1)
+        self.bond_n = xi / x[:, None]
+        self.bond_x = x
+        self.bond_omega = influence.omega(x, delta)
+        self.bond_beta = beta_h[which]
+        if closure.bond_factor is not None:
+            self.bond_beta = self.bond_beta * closure.bond_factor(a, b, self.bond_n)
+        Va, Vb = self.node_volume[a], self.node_volume[b]
+        if closure.weighted_volume == "complete":
+            self.m = np.full(grid.n_ext, self.m_inf)
+        else:  # Eq. (50) of seed 000 / (22) of seed 001 over the bonds each node has
+            w = self.bond_omega * x ** 2 * self.bond_beta
+            self.m = np.bincount(a, w * Vb, grid.n_ext) + np.bincount(b, w * Va, grid.n_ext)
+        self.n_unknown_nodes = (closure.n_unknown_nodes if closure.n_unknown_nodes is not None
+                                else grid.n_interior)
+        self._build_operators(Va, Vb)
+
+    # ------------------------------------------------------------------ assembly
+    @property
+    def dim(self) -> int:
+        return self.grid.dim
+
+    def _build_operators(self, Va, Vb):
+        g, c, cl = self.grid, self.constants, self.closure
+        d = g.dim
+        a, b = self.bond_a, self.bond_b
+        nb, ne, ni = a.size, g.n_ext, g.n_interior
+        nu_ = self.n_unknown_nodes
+        rows = np.arange(nb)
+        om, x, be, n = self.bond_omega, self.bond_x, self.bond_beta, self.bond_n
+        m = self.m
+
+        self.A_U = (cl.displacement_map if cl.displacement_map is not None
+                    else real_identity(g, nu_)).tocsr()
+        self.A_Theta = (cl.dilatation_map if cl.dilatation_map is not None
+                        else real_identity(g)).tocsr()
+        # bond extension from all-node displacements (component-major columns)
+        self.A_e = sp.hstack([sp.csr_matrix((np.r_[-n[:, k], n[:, k]],
+                                             (np.r_[rows, rows], np.r_[a, b])), shape=(nb, ne))
+                              for k in range(d)]).tocsr()
+        # real-node dilatations: every bond counts at each real end, with the other end's V
+        coef = c.c_theta * om * x * be
+        ia, ib = g.is_interior[a], g.is_interior[b]
+        self.A_theta = sp.csr_matrix(
+            (np.r_[coef[ia] * Vb[ia] / m[a[ia]], coef[ib] * Va[ib] / m[b[ib]]],
+             (np.r_[g.interior_number[a[ia]], g.interior_number[b[ib]]],
+              np.r_[rows[ia], rows[ib]])), shape=(ni, nb))
+        # bond forces times beta V_a V_b
+        VV = Va * Vb
+        self.K_e = sp.diags(c.k_e * om * be * VV * (1.0 / m[a] + 1.0 / m[b]))
+        kt = c.k_theta * om * x * be * VV
+        self.K_theta = sp.csr_matrix((np.r_[kt / m[a], kt / m[b]], (np.r_[rows, rows], np.r_[a, b])),
+                                     shape=(nb, ne))
+        self.A_U_full = sp.kron(sp.identity(d, format="csr"), self.A_U, format="csr")
+
+    def bond_force_rows(self, node_rows, bonds, weights) -> sp.csr_matrix:
+        """Rows r (d * n_unknown_nodes x bonds) with r @ f = sum weights f_b n_b per node.
+
+        Equation ``node_rows[i]`` (an unknown-node number, per component) collects
+        ``weights[i]`` times bond ``bonds[i]``'s force along its direction a -> b.
+        """
+        d, nu_ = self.dim, self.n_unknown_nodes
+        node_rows, bonds = np.asarray(node_rows), np.asarray(bonds)
+        weights = np.broadcast_to(np.asarray(weights, dtype=float), bonds.shape)
+        rows = np.concatenate([k * nu_ + node_rows for k in range(d)])
+        cols = np.tile(bonds, d)
+        vals = np.concatenate([weights * self.bond_n[bonds, k] for k in range(d)])
+        return sp.csr_matrix((vals, (rows, cols)), shape=(d * nu_, self.bond_a.size))
+
+    def equilibrium_rows(self) -> sp.csr_matrix:
+        """Minus the internal force of every real node (f_b along a -> b pulls a towards b)."""
+        g, a, b = self.grid, self.bond_a, self.bond_b
+        ia, ib = g.is_interior[a], g.is_interior[b]
+        bonds = np.arange(a.size)
+        return self.bond_force_rows(
+            np.r_[g.interior_number[a[ia]], g.interior_number[b[ib]]],
+            np.r_[bonds[ia], bonds[ib]], np.r_[-np.ones(ia.sum()), np.ones(ib.sum())])
+
+    def stiffness(self, P=None) -> sp.csr_matrix:
+        """K = P K_b, multiplied out as (P K_e) B + (P K_theta A_Theta)(A_theta B).
+
+        ``P`` defaults to :meth:`equilibrium_rows` (K u = external nodal forces).
+        """
+        P = self.equilibrium_rows() if P is None else P
+        B = (self.A_e @ self.A_U_full).tocsr()             # extensions from unknowns
+        bond_part = (P @ self.K_e) @ B                      # 'bond-based' part, ~stencil-sparse
+        coupling = (P @ self.K_theta) @ self.A_Theta        # nodes <- real dilatations
+        theta_of_u = (self.A_theta @ B).tocsr()             # real dilatations <- unknowns
+        return (bond_part + coupling @ theta_of_u).tocsr()
+
+    def bond_force_matrix(self) -> sp.csr_matrix:
+        """K_b: scalar bond forces (times beta V_a V_b) from the unknowns, multiplied out."""
+        B = (self.A_e @ self.A_U_full).tocsr()
+        return (self.K_e @ B + self.K_theta @ (self.A_Theta @ (self.A_theta @ B))).tocsr()
+
+    def bond_forces(self, u) -> np.ndarray:
+        """Scalar bond forces f (times beta V_a V_b, along a -> b) of the unknowns ``u``."""
+        e = self.A_e @ (self.A_U_full @ np.asarray(u, dtype=float))
+        return self.K_e @ e + self.K_theta @ (self.A_Theta @ (self.A_theta @ e))
+
+    def crossing_selector(self, planes, axis: int = 0) -> sp.csr_matrix:
+        """Rows s (one per plane) with s @ f = the summed force of the bonds crossing it.
+
+        A bond a-b crosses the plane x[axis] = p when its ends lie on opposite sides; the
+        force counts with the sign of n_b[axis], so that dividing by the section area gives
+        the force flux tau(x_p, +e_axis) of seed 000 Eq. (21) (tension positive).
+        """
+        planes = np.atleast_1d(np.asarray(planes, dtype=float))
+        xa = self.grid.x[self.bond_a, axis]
+        xb = self.grid.x[self.bond_b, axis]
+        lo, hi = np.minimum(xa, xb), np.maximum(xa, xb)
+        hit = (lo[None, :] < planes[:, None]) & (planes[:, None] < hi[None, :])
+        return sp.csr_matrix(hit * np.sign(self.bond_n[:, axis])[None, :])
+
+    # ------------------------------------------------------------------ fields
+    def dilatation_of_field(self, u_fn, points) -> np.ndarray:
+        """Discrete dilatation of a field at ``points`` over complete neighbourhoods.
+
+        ``u_fn(x) -> (n, d)``; used to apply the discrete operator to an exact field.
+        """
+        h, V, c = self.spacing, self.grid.volume * self.thickness, self.constants
+        xi = self.stencil.offsets * h
+        r = np.linalg.norm(xi, axis=1)
+        n = xi / r[:, None]
+        w = c.c_theta * self.influence.omega(r, self.horizon) * r * self.stencil.beta * V / self.m_inf
+        points = np.asarray(points, dtype=float)
+        u0 = u_fn(points)
+        out = np.zeros(points.shape[0])
+        for k in range(xi.shape[0]):  # loop over stencil offsets
+            du = u_fn(points + xi[k]) - u0
+            out += w[k] * (du @ n[k])
+        return out
+
+    def rows_of_state(self, U_ext, Theta_ext, P=None) -> np.ndarray:
+        """P f for given displacements (n_ext, d) and dilatations (n_ext,) at every node.
+
+        Kept as a product (factor by factor, never forming K): the discrete operator
+        applied to an exact field gives discrete manufactured loads.
+        """
+        P = self.equilibrium_rows() if P is None else P
+        U = np.asarray(U_ext, dtype=float).T.ravel()
+        f = self.K_e @ (self.A_e @ U) + self.K_theta @ np.asarray(Theta_ext, dtype=float)
+        return P @ f
