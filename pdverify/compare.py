@@ -50,14 +50,39 @@ class Change:
         return self.verdict == "regression"
 
 
-def compare_docs(base: dict, new: dict, *, rtol=None, atol=None) -> list[Change]:
-    """All differences between two pdverify.results/1 documents that exceed the thresholds."""
+def current_defaults(scene: str, method: str) -> dict:
+    """Every parameter of (scene, method) at its current default; {} if either is gone."""
+    from .scenes import get_scene
+    try:
+        return get_scene(scene).resolve(method, {})
+    except InputError:
+        return {}
+
+
+def compare_docs(base: dict, new: dict, *, rtol=None, atol=None, defaults=current_defaults,
+                 matched: list | None = None) -> list[Change]:
+    """All differences between two pdverify.results/1 documents that exceed the thresholds.
+
+    A baseline run with no exact match is matched to the new run whose params are the
+    baseline's plus parameters added since, each at its current default (``defaults``):
+    adding a parameter that keeps the old behaviour as its default does not lose the
+    baseline. Such matches are appended to ``matched`` as (scene, method, added keys).
+    """
     old_runs = {run_key(r["scene"], r["method"], r["params"]): r for r in base["runs"]}
     new_runs = {run_key(r["scene"], r["method"], r["params"]): r for r in new["runs"]}
     out: list[Change] = []
+    used = set()
     for key, old in old_runs.items():
         scene, method, params = key
         cur = new_runs.get(key)
+        if cur is None:
+            added = {k: v for k, v in defaults(scene, method).items() if k not in old["params"]}
+            wider = run_key(scene, method, {**old["params"], **added}) if added else None
+            if wider in new_runs and wider not in old_runs:
+                cur = new_runs[wider]
+                used.add(wider)
+                if matched is not None:
+                    matched.append((scene, method, tuple(sorted(added))))
         if cur is None:
             out.append(Change(scene, method, params, "(run)", "present", "missing", "regression"))
             continue
@@ -84,7 +109,7 @@ def compare_docs(base: dict, new: dict, *, rtol=None, atol=None) -> list[Change]
             else:
                 verdict = "regression"
             out.append(Change(scene, method, params, name, ov, nv, verdict))
-    for key in new_runs.keys() - old_runs.keys():
+    for key in new_runs.keys() - old_runs.keys() - used:
         scene, method, params = key
         out.append(Change(scene, method, params, "(run)", "absent", "new", "new"))
     return out
@@ -122,8 +147,13 @@ def compare_files(baseline: str, new: str, *, rtol=None, atol=None, stream=None)
             raise InputError(f"results file {path!r} does not exist") from None
         except ValueError as exc:
             raise InputError(str(exc)) from None
-    changes = compare_docs(docs[0], docs[1], rtol=rtol, atol=atol)
+    matched: list = []
+    changes = compare_docs(docs[0], docs[1], rtol=rtol, atol=atol, matched=matched)
     print(format_changes(changes), file=stream)
+    if matched:
+        keys = sorted({k for *_, added in matched for k in added})
+        print(f"compare: {len(matched)} baseline run(s) matched with parameters added since, "
+              f"at their defaults: {', '.join(keys)}", file=stream)
     n_reg = sum(c.is_regression for c in changes)
     print(f"compare: {n_reg} regression(s), {len(changes) - n_reg} other change(s)", file=stream)
     return 1 if n_reg else 0

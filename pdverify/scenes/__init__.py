@@ -5,7 +5,7 @@ import importlib
 import pkgutil
 
 from ..errors import InputError
-from .base import MethodSpec, Outcome, Published, Scene
+from .base import MethodSpec, Outcome, Published, Scene, influence_param, require_influence
 
 _REGISTRY: dict[str, Scene] = {}
 _LOADED = False
@@ -44,4 +44,5 @@ def get_scene(scene_id: str) -> Scene:
         raise InputError(f"unknown scene {scene_id!r}; allowed: {allowed}") from None
 
 
-__all__ = ["MethodSpec", "Outcome", "Published", "Scene", "register", "all_scenes", "get_scene"]
+__all__ = ["MethodSpec", "Outcome", "Published", "Scene", "influence_param", "register",
+           "require_influence", "all_scenes", "get_scene"]

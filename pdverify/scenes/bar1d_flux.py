@@ -6,7 +6,7 @@ import numpy as np
 from manufactured import bar1d as closed
 
 from ..params import Param, positive
-from . import Outcome, Published, Scene, register
+from . import Outcome, Published, Scene, register, require_influence
 from .bar1d import BAR_PARAMS, NONE, TAYLOR, StateBar, check_bar_grid
 
 _FEATURES = closed.flux_features()  # (1.26285..., 0.77160..., 0.39403...)
@@ -52,6 +52,9 @@ class ForceFlux(Scene):
 
     def check(self, method, p):
         check_bar_grid(self.id, method, p, min_horizons=4.0)
+        if method == NONE.name:
+            require_influence(self.id, method, p, "hyperbolic", "the closed forms of Tables 1, 2 "
+                              "and B1 are derived for seed 000's delta / |xi|")
 
     def cases(self, quick=False):
         ratios = self.report_m_ratios[:3] if quick else self.report_m_ratios

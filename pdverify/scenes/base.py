@@ -9,6 +9,7 @@ import numpy as np
 
 from ..errors import InputError, NumericalError
 from ..params import Param, resolve
+from ..pd.influence import INFLUENCES
 from ..results import RunResult, Timer
 
 
@@ -18,6 +19,21 @@ class MethodSpec:
 
     name: str
     params: tuple[Param, ...] = ()
+
+
+def influence_param(default: str, source: str) -> Param:
+    """The ``influence`` parameter of a state-based scene: any registered influence function
+    (``pdverify.pd.influence``), the paper's as the default."""
+    return Param("influence", default, f"influence function omega ({source}); any registered: "
+                 + ", ".join(f"{k} = {v.description}" for k, v in sorted(INFLUENCES.items())),
+                 choices=tuple(sorted(INFLUENCES)))
+
+
+def require_influence(scene_id: str, method: str, p: dict, allowed: str, why: str) -> None:
+    """Refuse (one line, exit 2) an ``influence`` the scene's reference is not derived for."""
+    if p.get("influence", allowed) != allowed:
+        raise InputError(f"{scene_id} --method {method}: influence={p['influence']} is not "
+                         f"supported here; allowed: {allowed} ({why})")
 
 
 @dataclass

@@ -71,3 +71,27 @@ def test_bad_files_exit_2(tmp_path, capsys):
     junk.write_text("{\"schema\": \"other\"}")
     assert main(["compare", str(junk), str(junk)]) == 2
     assert "schema" in capsys.readouterr().err
+
+
+def test_a_parameter_added_at_its_default_keeps_the_baseline(tmp_path, baseline, capsys):
+    # a baseline written before a scene gained a parameter: the new runs carry it at its
+    # default (the old behaviour), so they still match, and the match is reported
+    old = copy.deepcopy(baseline)
+    for run in old["runs"]:
+        assert run["params"].pop("influence") == "hyperbolic"
+    assert main(["compare", write(tmp_path, "a.json", old), write(tmp_path, "b.json", baseline)]) == 0
+    out = capsys.readouterr().out
+    assert "0 regression(s), 0 other change(s)" in out
+    assert f"{len(old['runs'])} baseline run(s) matched with parameters added since" in out
+    assert "influence" in out
+
+
+def test_a_parameter_added_off_its_default_does_not_match(tmp_path, baseline, capsys):
+    old = copy.deepcopy(baseline)
+    new = copy.deepcopy(baseline)
+    for run in old["runs"]:
+        run["params"].pop("influence")
+    new["runs"][0]["params"]["influence"] = "gaussian"   # not the old behaviour
+    assert main(["compare", write(tmp_path, "a.json", old), write(tmp_path, "b.json", new)]) == 1
+    out = capsys.readouterr().out
+    assert "missing" in out and "1 regression(s)" in out
