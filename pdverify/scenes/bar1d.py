@@ -41,6 +41,7 @@ class StateBar:
     """
 
     def __init__(self, p: dict, order: int | None = None):
+        p = {**{q.name: q.default for q in BAR_PARAMS}, **p}  # unset keys: the paper's values
         stencil = build_stencil(1, p["m_ratio"])
         layers = stencil.reach if order else 0
         self.grid = g = BoxGrid((p["length"],), (0.0,), p["spacing"], layers)
