@@ -8,6 +8,11 @@ METHODS = {
                      "by Taylor extrapolation about the nearest surface node",
     "homogenized": "seed 004: stiffness factors on the end bonds (1, 1+k), (N, N-k) so that a "
                    "linear field satisfies every equilibrium equation (1D bond-based)",
+    "energy-directional": "seed 003: bond stiffness times (phi(x, e) + phi(x', -e))/2, phi the "
+                          "Eq. (14) ratio of the horizon's radial integral to its truncated part "
+                          "along the bond direction (bond-based)",
+    "virtual-nodes": "seed 003 §4.1.2: buffer layers of thickness delta outside the clamped edges, "
+                     "displaced rigidly (bond-based)",
     "fem": "classical-elasticity FEM reference (reference_fem)",
 }
 

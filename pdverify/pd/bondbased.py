@@ -105,6 +105,15 @@ class BondBasedModel:
         du = U[:, self.bond_b] - U[:, self.bond_a]
         return self.bond_stiffness * np.einsum("kb,bk->b", du, self.bond_n)
 
+    def strain_energy_density(self, u) -> np.ndarray:
+        """W_i = 1 / (2 V_i) sum_(bonds at i) s_b e_b^2 / 2 at every grid node: half of each
+        bond's energy s e^2 / 2 goes to each end (seed 003, Eq. 5 discretised)."""
+        U = (self.displacement_map() @ np.asarray(u, dtype=float)).reshape(self.dim, -1)
+        e = np.einsum("kb,bk->b", U[:, self.bond_b] - U[:, self.bond_a], self.bond_n)
+        half = 0.25 * self.bond_stiffness * e * e
+        n = self.grid.n_ext
+        return (np.bincount(self.bond_a, half, n) + np.bincount(self.bond_b, half, n)) / self.node_volume
+
     def lumped_mass(self, density: float) -> np.ndarray:
         """Nodal masses rho V_i of the real nodes (component-major, repeated per component)."""
         return np.tile(density * self.node_volume[self.grid.interior_ids], self.dim)

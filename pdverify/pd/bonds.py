@@ -178,8 +178,11 @@ def bond_pairs(ext_shape, offsets: np.ndarray):
 #: Weights beta of the one-point quadrature over a neighbourhood: ``partial-volume`` = the
 #: exact fraction of each cell inside the horizon (seed 001 §3.1; in 1D the seed-000 rule),
 #: ``moment-corrected`` (our addition) = those fractions minimally adjusted so that the
-#: stencil's fourth moment is isotropic (2D and 3D; :func:`moment_corrected_volumes`).
-QUADRATURES = ("partial-volume", "moment-corrected")
+#: stencil's fourth moment is isotropic (2D and 3D; :func:`moment_corrected_volumes`),
+#: ``full-cells`` = the whole cell of every neighbour whose node lies in the closed horizon
+#: |xi| <= delta, none of the others (no partial volumes, as in Peridigm by default; it
+#: reproduces seed 003's Tables 1 and 2).
+QUADRATURES = ("partial-volume", "moment-corrected", "full-cells")
 
 
 @dataclass(frozen=True)
@@ -227,6 +230,9 @@ def build_stencil(dim: int, m_ratio: float, *, quadrature: str = "partial-volume
         raise ValueError(f"quadrature={quadrature!r}; allowed: {', '.join(QUADRATURES)}")
     offsets = stencil_offsets(dim, m_ratio)
     beta = partial_volumes(offsets, m_ratio)
+    if quadrature == "full-cells":
+        inside = np.linalg.norm(offsets, axis=1) <= m_ratio * (1.0 + 1e-12)
+        offsets, beta = offsets[inside], np.ones(int(inside.sum()))
     if quadrature == "moment-corrected":
         if dim < 2:
             raise ValueError("quadrature='moment-corrected' needs dim 2 or 3 (a 1D stencil "

@@ -45,7 +45,16 @@ class Influence:
     description: str
     source: str
     shape: Callable[[np.ndarray], np.ndarray]      # omega as a function of t = |xi| / delta
-    unit_moment: Callable[[int], float]            # int_0^1 omega(t) t^k dt
+    partial_moment: Callable[[int, np.ndarray], np.ndarray]  # int_0^s omega(t) t^k dt
+
+    def unit_moment(self, k: int) -> float:
+        """int_0^1 omega(t) t^k dt."""
+        return float(self.partial_moment(k, np.float64(1.0)))
+
+    def radial_ratio(self, dim: int, reach, horizon: float) -> np.ndarray:
+        """int_0^delta omega xi^D dxi / int_0^reach omega xi^D dxi (seed 003, Eq. 14)."""
+        s = np.asarray(reach, dtype=float) / horizon
+        return self.unit_moment(dim) / self.partial_moment(dim, s)
 
     def omega(self, length, horizon) -> np.ndarray:
         return self.shape(np.asarray(length, dtype=float) / horizon)
@@ -70,20 +79,31 @@ def register_influence(influence: Influence) -> Influence:
     return influence
 
 
+def _gaussian_partial(k, s):
+    """int_0^s exp(-t^2) t^k dt = gamma((k + 1)/2, s^2) / 2 (s = 1: exact recursion)."""
+    if np.ndim(s) == 0 and s == 1.0:
+        return 0.5 * _lower_gamma_at_one(k + 1)
+    from scipy.special import gamma, gammainc
+    a = 0.5 * (k + 1)
+    return 0.5 * gamma(a) * gammainc(a, np.asarray(s, dtype=float) ** 2)
+
+
 register_influence(Influence(
     "gaussian", "exp(-|xi|^2 / delta^2)", "seed 001, Eq. (7)",
-    lambda t: np.exp(-t * t), lambda k: 0.5 * _lower_gamma_at_one(k + 1)))
+    lambda t: np.exp(-t * t), _gaussian_partial))
 register_influence(Influence(
     "hyperbolic", "delta / |xi|", "seed 000, Eq. (23); seed 002, Eq. (3) as c v^2 / xi^2",
-    lambda t: 1.0 / t, lambda k: 1.0 / k))
+    lambda t: 1.0 / t, lambda k, s: np.asarray(s, dtype=float) ** k / k))
 register_influence(Influence(
     "constant", "1", "seed 003 (constant micromodulus); seed 004, constant c",
-    lambda t: np.ones_like(t), lambda k: 1.0 / (k + 1)))
+    lambda t: np.ones_like(t), lambda k, s: np.asarray(s, dtype=float) ** (k + 1) / (k + 1)))
 register_influence(Influence(
     "conical", "max(1 - |xi| / delta, 0)",
     "seed 004, Eq. (6) (triangular micromodulus); Le and Bobaru",
     # zero, not negative, at the centres of partial cells beyond delta (2D/3D stencils)
-    lambda t: np.maximum(1.0 - t, 0.0), lambda k: 1.0 / (k + 1) - 1.0 / (k + 2)))
+    lambda t: np.maximum(1.0 - t, 0.0),
+    lambda k, s: (np.asarray(s, dtype=float) ** (k + 1) / (k + 1)
+                  - np.asarray(s, dtype=float) ** (k + 2) / (k + 2))))
 
 #: Seed 004 calls the conical micromodulus "triangular".
 ALIASES = {"triangular": "conical"}

@@ -1,4 +1,5 @@
-"""FEM references of seeds 000 §6.2 and 003 §4 as scenes with method ``fem`` (issue #5)."""
+"""FEM references of seeds 000 §6.2 and 003 §4.2 as scenes with method ``fem`` (issue #5);
+the seed-003 sheets (FEM and PD) are in ``sheets``."""
 from __future__ import annotations
 
 import dataclasses
@@ -79,35 +80,6 @@ class ClampedPlateFem(FemReference):
     title = "Clamped plate under body load in x (FEM reference)"
     seed = "000 §6.2"
     params_class, function = "PlateParams", "clamped_plate"
-
-
-@register
-class TensionSheetFem(FemReference):
-    """Seed 003 §4.1.1 sheet: 50 x 100 mm, 1 MPa on the ends, plane stress, nu = 1/3
-    (ERRATA), unit thickness; supports that the uniaxial closed form satisfies exactly.
-    ``max_error_pct`` (largest |u - u_closed| over max |u_closed|, %) checks the FEM
-    against the closed form (Q2 contains the linear field: round-off, issue #5: 1e-10).
-    """
-
-    id = "sheet2d-tension"
-    title = "Sheet under uniaxial tension (FEM vs closed form)"
-    seed = "003 §4.1.1"
-    params_class, function = "TensionSheetParams", "tension_sheet"
-
-
-@register
-class ClampedSheetFem(FemReference):
-    """Seed 003 §4.1.2 clamped sheet: square of side 4 delta (delta = 5 mm), top and bottom
-    edges clamped and displaced +-2 delta/100 (ERRATA: the paper swaps the edges), sides
-    free, plane stress, E = 1 GPa, nu = 1/3. ``tensile_stress_mpa`` = top reaction /
-    width / thickness; meshes graded toward the clamped corners (singular there).
-    """
-
-    id = "sheet2d-clamped"
-    title = "Clamped square sheet, 1 % strain (FEM reference)"
-    seed = "003 §4.1.2"
-    params_class, function = "ClampedSheetParams", "clamped_sheet"
-    published = (Published("tensile_stress_mpa", 10.32, "seed 003 Table 2 (FEM)"),)
 
 
 @register

@@ -10,7 +10,7 @@ from ..errors import InputError
 from ..params import Param, at_least, open_interval, positive
 from ..pd import (QUADRATURES, BoxGrid, StateBasedConstants, StateBasedModel, build_stencil,
                   get_influence)
-from ..solvers.dense import solve_square
+from ..solvers.dense import solve_with_dirichlet
 from . import MethodSpec, Outcome, Published, Scene, influence_param, register, require_influence
 
 
@@ -130,24 +130,6 @@ def face_resultant(traction, centres, normals, spacing):
             weight *= w[q]
         out += weight * traction(x, normals)
     return out
-
-
-def solve_with_dirichlet(K, rhs, fixed, values, where):
-    """Solve K u = rhs with u[fixed] = values by elimination (their own rows dropped).
-
-    The dropped rows are the equations of the prescribed unknowns (their reactions).
-    Returns the full solution and the solver's diagnostics.
-    """
-    n = K.shape[0]
-    free = np.setdiff1d(np.arange(n), fixed)
-    u = np.zeros(n)
-    u[fixed] = values
-    Kc = K.tocsc()
-    K_free = Kc[:, free].tocsr()[free]
-    r = rhs[free] - (Kc[:, fixed] @ u[fixed])[free] if fixed.size else rhs[free]
-    u_free, info = solve_square(K_free, r, where=where)
-    u[free] = u_free
-    return u, info
 
 
 def error_metrics(x, u, u_ref, dist, horizon, dim) -> tuple[dict, np.ndarray]:

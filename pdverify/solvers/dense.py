@@ -14,7 +14,7 @@ from .static import CONDITION_LIMIT, equilibrate, solve_constrained
 DENSE_FILL = 0.1
 
 
-def solve_square(K, f, *, where: str = "static solve"):
+def solve_square(K, f, *, where: str = "static solve", spd: bool = False):
     """Solve the square system K u = f; dense LAPACK LU when K is full enough, else sparse.
 
     Same contract as :func:`pdverify.solvers.static.solve_constrained` without constraints:
@@ -25,8 +25,8 @@ def solve_square(K, f, *, where: str = "static solve"):
     K = sp.csr_matrix(K)
     n = K.shape[0]
     if n < 2000 or K.nnz < DENSE_FILL * n * n:
-        u, _, info = solve_constrained(K, f, where=where)
-        info["solver"] = "sparse LU (SuperLU)"
+        u, _, info = solve_constrained(K, f, where=where, spd=spd)
+        info["solver"] = "sparse LU (SuperLU" + (", symmetric mode)" if spd else ")")
         return u, info
     f = np.asarray(f, dtype=float)
     if not np.all(np.isfinite(K.data)) or not np.all(np.isfinite(f)):
@@ -49,3 +49,21 @@ def solve_square(K, f, *, where: str = "static solve"):
     scale = max(np.linalg.norm(f), abs(K).max() * np.linalg.norm(u), 1e-300)
     return u, {"unknowns": int(n), "relative_residual": float(np.linalg.norm(res) / scale),
                "condition_estimate": float(cond), "solver": "dense LU (LAPACK)"}
+
+
+def solve_with_dirichlet(K, rhs, fixed, values, where, spd: bool = False):
+    """Solve K u = rhs with u[fixed] = values by elimination (their own rows dropped).
+
+    The dropped rows are the equations of the prescribed unknowns (their reactions).
+    Returns the full solution and the solver's diagnostics.
+    """
+    n = K.shape[0]
+    free = np.setdiff1d(np.arange(n), fixed)
+    u = np.zeros(n)
+    u[fixed] = values
+    Kc = K.tocsc()
+    K_free = Kc[:, free].tocsr()[free]
+    r = rhs[free] - (Kc[:, fixed] @ u[fixed])[free] if fixed.size else rhs[free]
+    u_free, info = solve_square(K_free, r, where=where, spd=spd)
+    u[free] = u_free
+    return u, info
