@@ -182,7 +182,9 @@ class TensionSheet(SheetScene):
         Published("max_error_uy_pct", 3.2, "seed 003 Table 1", method="energy-directional",
                   where=PAPER),
     )
-    m_sweep = (0.0025, 0.00125, 0.001, 0.000625)   # m = 2, 4, 5, 8 at delta = 5 mm
+    # m = 2, 4, 5 at delta = 5 mm (spacing must divide both sides evenly); m = 8 (0.625 mm)
+    # takes ~20 s per run with today's direct solve and waits for the solver layer
+    m_sweep = (0.0025, 0.00125, 0.001)
 
     def check_pd(self, where, method, p):
         _grid_check(where, (("width", p["width"]), ("length", p["length"])), p["spacing"],
