@@ -63,7 +63,14 @@ class BondBasedModel:
                                * self.node_volume[a] * self.node_volume[b] / x)
         self.n_unknown_nodes = (closure.n_unknown_nodes if closure.n_unknown_nodes is not None
                                 else grid.n_interior)
-        self.K = self._assemble()
+        self._K = None
+
+    @property
+    def K(self) -> sp.csr_matrix:
+        """The stiffness, assembled on first use (energy and force queries do not need it)."""
+        if self._K is None:
+            self._K = self._assemble()
+        return self._K
 
     @property
     def dim(self) -> int:
