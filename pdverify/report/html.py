@@ -23,7 +23,12 @@ def _num(v) -> str:
 
 
 def _params(result, scene) -> str:
-    defaults = {p.name: p.default for p in scene.params}
+    """The run's params that differ from the scene's and its method's defaults."""
+    try:
+        method_params = scene.method(result.method).params
+    except Exception:  # a method the scene no longer offers: show everything
+        method_params = ()
+    defaults = {p.name: p.default for p in tuple(scene.params) + tuple(method_params)}
     shown = {k: v for k, v in result.params.items() if defaults.get(k, object()) != v}
     return ", ".join(f"{k}={_num(v)}" for k, v in shown.items()) or "defaults"
 
