@@ -64,8 +64,7 @@ def own_factor_energy_density(model, u, lower, upper, horizon, axes=None) -> np.
     g, inf = model.grid, model.influence
     lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
     a, b, n = model.bond_a, model.bond_b, model.bond_n
-    U = (model.displacement_map() @ np.asarray(u, dtype=float)).reshape(model.dim, -1)
-    e = np.einsum("kb,bk->b", U[:, b] - U[:, a], n)
+    e = model.bond_extensions(u)
     base = model.bond_stiffness / model.bond_factor * e * e / 4.0  # c_b omega beta V_a V_b e^2/(4|xi|)
     fa = directional_factor(g.x[a], n, lower, upper, horizon, inf, g.dim, axes)
     fb = directional_factor(g.x[b], -n, lower, upper, horizon, inf, g.dim, axes)

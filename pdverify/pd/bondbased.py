@@ -106,17 +106,19 @@ class BondBasedModel:
         """The real nodes' equations in terms of the unknowns: K[real rows] @ (I kron A_U)."""
         return (self.K[self.real_rows()] @ self.displacement_map()).tocsr()
 
-    def bond_forces(self, u) -> np.ndarray:
-        """Scalar bond forces s_b n . (u_b - u_a) (tension positive) of the unknowns ``u``."""
+    def bond_extensions(self, u) -> np.ndarray:
+        """Linearised bond extensions e_b = n_b . (u_b - u_a) of the unknowns ``u``."""
         U = (self.displacement_map() @ np.asarray(u, dtype=float)).reshape(self.dim, -1)
-        du = U[:, self.bond_b] - U[:, self.bond_a]
-        return self.bond_stiffness * np.einsum("kb,bk->b", du, self.bond_n)
+        return np.einsum("kb,bk->b", U[:, self.bond_b] - U[:, self.bond_a], self.bond_n)
+
+    def bond_forces(self, u) -> np.ndarray:
+        """Scalar bond forces s_b e_b (tension positive) of the unknowns ``u``."""
+        return self.bond_stiffness * self.bond_extensions(u)
 
     def strain_energy_density(self, u) -> np.ndarray:
         """W_i = 1 / (2 V_i) sum_(bonds at i) s_b e_b^2 / 2 at every grid node: half of each
         bond's energy s e^2 / 2 goes to each end (seed 003, Eq. 5 discretised)."""
-        U = (self.displacement_map() @ np.asarray(u, dtype=float)).reshape(self.dim, -1)
-        e = np.einsum("kb,bk->b", U[:, self.bond_b] - U[:, self.bond_a], self.bond_n)
+        e = self.bond_extensions(u)
         half = 0.25 * self.bond_stiffness * e * e
         n = self.grid.n_ext
         return (np.bincount(self.bond_a, half, n) + np.bincount(self.bond_b, half, n)) / self.node_volume

@@ -4,6 +4,7 @@ from __future__ import annotations
 import html
 
 from ..corrections import describe
+from ..errors import InputError
 
 CSS = """
 body{font-family:system-ui,sans-serif;margin:2em auto;max-width:1250px;color:#222}
@@ -26,7 +27,7 @@ def _params(result, scene) -> str:
     """The run's params that differ from the scene's and its method's defaults."""
     try:
         method_params = scene.method(result.method).params
-    except Exception:  # a method the scene no longer offers: show everything
+    except InputError:  # a method the scene no longer offers: show everything
         method_params = ()
     defaults = {p.name: p.default for p in tuple(scene.params) + tuple(method_params)}
     shown = {k: v for k, v in result.params.items() if defaults.get(k, object()) != v}

@@ -12,7 +12,7 @@ from ..pd import BondBasedModel, BoxGrid, Closure, bond_micromodulus, build_sten
 from ..pd.influence import bond_based_nu
 from ..solvers.dense import solve_with_dirichlet
 from . import MethodSpec, Outcome, Published, register
-from .fem_references import FEM, FemReference
+from .fem_references import FEM, FemReference, _reference_module
 
 MICROMODULI = ("constant", "conical")
 #: seed 003's node volumes (ERRATA) and the horizon quadrature that reproduces Tables 1-2
@@ -74,10 +74,7 @@ class SheetScene(FemReference):
 
     def fem_reference(self, p):
         """The converged FEM reference at this scene's shared params (cached on disk)."""
-        rf = self._cls()
-        fem_defaults = {f.name: f.default for f in dataclasses.fields(rf)
-                        if f.name not in self.shared}
-        from .fem_references import _reference_module
+        fem_defaults = {q.name: q.default for q in self.method(FEM.name).params}
         return getattr(_reference_module(), self.function)(
             **fem_defaults, **{k: p[k] for k in self.shared})
 

@@ -113,6 +113,8 @@ def test_state_based_moduli_are_the_lattice_moduli(kind, influence):
     k_dev = c.k_e / (d * (d + 2))
     dev = np.array([3 * k_dev * eta * (d - 1), -3 * k_dev * 3 * eta, -3 * k_dev * 3 * eta]) \
         / (d + 2 + 3 * eta) * np.array([1, 1 / 3, 1 / 3])
+    # got - want is a difference of O(1e11) moduli giving O(1e9): RTOL_SUM of the moduli
+    # becomes ~1e-8 of the difference, hence rtol 1e-8 here
     np.testing.assert_allclose(got - want, dev, rtol=1e-8, atol=RTOL_SUM * want.max())
 
 
@@ -158,7 +160,9 @@ def test_bond_based_moduli_are_the_lattice_moduli(kind, influence):
     np.testing.assert_allclose(got, lattice, rtol=RTOL_SUM)
     rel = got / _bond_continuum(kind) - 1
     print(f"{kind} {influence}: continuum-calibrated bond-based moduli error {rel}")
-    assert np.abs(rel).max() < 0.25  # a one-point quadrature of the horizon at m = 3
+    # a ceiling, not the claim (that is the lattice equality above): measured <= 17 % at
+    # m = 3 (1D conical; the same effect as seed 004's f_1(m), Tables 1-2)
+    assert np.abs(rel).max() < 0.25
 
 
 @pytest.mark.parametrize("influence", sorted(INFLUENCES))
