@@ -5,7 +5,7 @@ import numpy as np
 
 from manufactured import bar1d as closed
 
-from ..corrections.taylor_fictitious import boundary_value_row, fictitious_closure
+from ..corrections.taylor_fictitious import boundary_value_rows, fictitious_closure
 from ..errors import InputError
 from ..metrics import max_relative_error_pct, nodal_relative_error_pct, rel_l2_error
 from ..params import Param, at_least, open_interval, positive
@@ -58,8 +58,8 @@ class StateBar:
 
     def boundary_value_row(self, side: str) -> np.ndarray:
         """Row r with r @ u = u at the end ``side`` by Taylor extrapolation (Eq. 58)."""
-        point = 0.0 if side == "left" else self.length
-        return boundary_value_row(self.grid, self.order, side, point)
+        face = 0 if side == "left" else 1
+        return boundary_value_rows(self.grid, self.order, face)[0].toarray()[0]
 
     def flux_rows(self, planes):
         """Rows r with r @ u = A * tau(x_p, +1) at each plane (force through the section,

@@ -1,5 +1,6 @@
-"""FEM references of seeds 000 §6.2 and 003 §4.2 as scenes with method ``fem`` (issue #5);
-the seed-003 sheets (FEM and PD) are in ``sheets``."""
+"""FEM references as scenes with method ``fem`` (issue #5), and the base of the scenes that
+run PD methods beside their FEM reference (``FemAndPD``: the seed-000 plate in ``plate2d``,
+the seed-003 sheets in ``sheets``)."""
 from __future__ import annotations
 
 import dataclasses
@@ -8,7 +9,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..params import Param
-from . import MethodSpec, Outcome, Published, Scene, register
+from . import MethodSpec, Outcome, Scene, register
 
 FEM = MethodSpec("fem")
 
@@ -67,19 +68,55 @@ class FemReference(Scene):
         return fields
 
 
-@register
-class ClampedPlateFem(FemReference):
-    """Seed 000 §6.2 plate (Table 4): 3 x 2 m, all edges clamped, plane stress, E = 1 GPa,
-    nu = 0.2, thickness 0.05 m, uniform body load in x (ERRATA: 1e6 N/m^3; errors are
-    normalised by Eq. 70). Q2 elements on uniform meshes halved per level.
-    Metric ``max_displacement`` (max |u| over the plate) and ``refinement_change_pct``
-    (issue #5 asks < 0.1 %). The PD methods of this scene come with the 2D Taylor method.
+class FemAndPD(FemReference):
+    """A scene whose FEM reference (method ``fem``) and PD methods share one id.
+
+    Scene params are the ones both sides share (``shared``, names of the reference's
+    dataclass fields); the FEM study's own params belong to ``fem``, the discretisation's
+    (``pd_params``) to the PD methods, listed in ``pd_methods`` as (name, extra params).
+    Subclasses implement ``check_pd`` and ``solve_pd``.
     """
 
-    id = "plate2d-clamped"
-    title = "Clamped plate under body load in x (FEM reference)"
-    seed = "000 §6.2"
-    params_class, function = "PlateParams", "clamped_plate"
+    shared: tuple = ()
+    pd_params: tuple = ()
+    pd_methods: tuple = ()
+
+    def _fields(self):
+        return {f.name: f for f in dataclasses.fields(self._cls())}
+
+    @property
+    def params(self):
+        return tuple(Param(n, f.default, "") for n, f in self._fields().items() if n in self.shared)
+
+    @property
+    def methods(self):
+        fem = MethodSpec(FEM.name, tuple(Param(n, f.default, "")
+                                         for n, f in self._fields().items()
+                                         if n not in self.shared))
+        return (fem,) + tuple(MethodSpec(name, self.pd_params + extra)
+                              for name, extra in self.pd_methods)
+
+    def check(self, method, p):
+        if method == FEM.name:
+            return super().check(method, p)
+        self.check_pd(f"{self.id} --method {method}", method, p)
+
+    def check_pd(self, where, method, p):
+        raise NotImplementedError
+
+    def solve(self, method, p, timer):
+        if method == FEM.name:
+            return super().solve(method, p, timer)
+        return self.solve_pd(method, p, timer)
+
+    def solve_pd(self, method, p, timer):
+        raise NotImplementedError
+
+    def fem_reference(self, p):
+        """The converged FEM reference at this scene's shared params (cached on disk)."""
+        fem_defaults = {q.name: q.default for q in self.method(FEM.name).params}
+        return getattr(_reference_module(), self.function)(
+            **fem_defaults, **{k: p[k] for k in self.shared})
 
 
 @register

@@ -1,8 +1,6 @@
 """Seed 003 §4.1: 2D bond-based sheets, directional energy correction, virtual nodes, FEM."""
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 
 from ..corrections.energy_directional import directional_closure
@@ -11,8 +9,8 @@ from ..params import Param, at_least, positive
 from ..pd import BondBasedModel, BoxGrid, Closure, bond_micromodulus, build_stencil, get_influence
 from ..pd.influence import bond_based_nu
 from ..solvers.dense import solve_with_dirichlet
-from . import MethodSpec, Outcome, Published, register
-from .fem_references import FEM, FemReference, _reference_module
+from . import Outcome, Published, register
+from .fem_references import FemAndPD
 
 MICROMODULI = ("constant", "conical")
 #: seed 003's node volumes (ERRATA) and the horizon quadrature that reproduces Tables 1-2
@@ -26,35 +24,13 @@ PD_COMMON = (
 PAPER = {"micromodulus": "constant", "quadrature": "full-cells"}
 
 
-class SheetScene(FemReference):
+class SheetScene(FemAndPD):
     """Shared machinery of the seed-003 sheets: the FEM reference (method ``fem``) and the
-    bond-based PD runs of one scene. Scene params are the ones both sides share; the FEM
-    study's own params belong to ``fem``, the discretisation's to the PD methods."""
+    bond-based PD runs of one scene (see :class:`FemAndPD` for the params' split)."""
 
     figure = "sheets"
-    shared: tuple = ()
-    pd_params: tuple = ()
-    pd_methods: tuple = ()
 
-    def _fields(self):
-        return {f.name: f for f in dataclasses.fields(self._cls())}
-
-    @property
-    def params(self):
-        return tuple(Param(n, f.default, "") for n, f in self._fields().items() if n in self.shared)
-
-    @property
-    def methods(self):
-        fem = MethodSpec(FEM.name, tuple(Param(n, f.default, "")
-                                         for n, f in self._fields().items()
-                                         if n not in self.shared))
-        return (fem,) + tuple(MethodSpec(name, self.pd_params + extra)
-                              for name, extra in self.pd_methods)
-
-    def check(self, method, p):
-        if method == FEM.name:
-            return super().check(method, p)
-        where = f"{self.id} --method {method}"
+    def check_pd(self, where, method, p):
         nu = bond_based_nu(2, "stress")
         if abs(p["nu"] - nu) > 1e-12:
             raise InputError(f"{where}: nu={p['nu']:g} is not allowed; bond-based PD in plane "
@@ -62,21 +38,10 @@ class SheetScene(FemReference):
         for name in ("E", "thickness"):
             if not (p[name] > 0 and np.isfinite(p[name])):
                 raise InputError(f"{where}: {name}={p[name]!r} must be a finite number > 0")
-        self.check_pd(where, method, p)
+        self.check_sheet(where, method, p)
 
-    def check_pd(self, where, method, p):
+    def check_sheet(self, where, method, p):
         raise NotImplementedError
-
-    def solve(self, method, p, timer):
-        if method == FEM.name:
-            return super().solve(method, p, timer)
-        return self.solve_pd(method, p, timer)
-
-    def fem_reference(self, p):
-        """The converged FEM reference at this scene's shared params (cached on disk)."""
-        fem_defaults = {q.name: q.default for q in self.method(FEM.name).params}
-        return getattr(_reference_module(), self.function)(
-            **fem_defaults, **{k: p[k] for k in self.shared})
 
     # ----------------------------------------------------------------- PD helpers
     @staticmethod
@@ -183,7 +148,7 @@ class TensionSheet(SheetScene):
     # takes ~20 s per run with today's direct solve and waits for the solver layer
     m_sweep = (0.0025, 0.00125, 0.001)
 
-    def check_pd(self, where, method, p):
+    def check_sheet(self, where, method, p):
         _grid_check(where, (("width", p["width"]), ("length", p["length"])), p["spacing"],
                     p["horizon"], "spacing")
         for name in ("width", "length"):
@@ -325,7 +290,7 @@ class ClampedSheet(SheetScene):
                   where={**PAPER, "correct_sides": True}),
     )
 
-    def check_pd(self, where, method, p):
+    def check_sheet(self, where, method, p):
         delta = p["horizon"]
         if p["m_ratio"] < 2:
             raise InputError(f"{where}: m_ratio={p['m_ratio']:g} must be >= 2 (the paper uses 6)")

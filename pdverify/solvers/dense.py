@@ -14,19 +14,19 @@ from .static import CONDITION_LIMIT, equilibrate, solve_constrained
 DENSE_FILL = 0.1
 
 
-def solve_square(K, f, *, where: str = "static solve", spd: bool = False):
+def solve_square(K, f, *, where: str = "static solve", spd: bool = False,
+                 ordering: str = "COLAMD"):
     """Solve the square system K u = f; dense LAPACK LU when K is full enough, else sparse.
 
     Same contract as :func:`pdverify.solvers.static.solve_constrained` without constraints:
     row then column equilibration, a 1-norm condition estimate of the equilibrated
     matrix (LAPACK gecon), :class:`NumericalError` on singular or near-singular systems.
-    Returns ``(u, info)``.
+    ``ordering``: SuperLU's column ordering on the sparse path. Returns ``(u, info)``.
     """
     K = sp.csr_matrix(K)
     n = K.shape[0]
     if n < 2000 or K.nnz < DENSE_FILL * n * n:
-        u, _, info = solve_constrained(K, f, where=where, spd=spd)
-        info["solver"] = "sparse LU (SuperLU" + (", symmetric mode)" if spd else ")")
+        u, _, info = solve_constrained(K, f, where=where, spd=spd, ordering=ordering)
         return u, info
     f = np.asarray(f, dtype=float)
     if not np.all(np.isfinite(K.data)) or not np.all(np.isfinite(f)):
@@ -51,7 +51,8 @@ def solve_square(K, f, *, where: str = "static solve", spd: bool = False):
                "condition_estimate": float(cond), "solver": "dense LU (LAPACK)"}
 
 
-def solve_with_dirichlet(K, rhs, fixed, values, where, spd: bool = False):
+def solve_with_dirichlet(K, rhs, fixed, values, where, spd: bool = False,
+                         ordering: str = "COLAMD"):
     """Solve K u = rhs with u[fixed] = values by elimination (their own rows dropped).
 
     The dropped rows are the equations of the prescribed unknowns (their reactions).
@@ -64,6 +65,6 @@ def solve_with_dirichlet(K, rhs, fixed, values, where, spd: bool = False):
     Kc = K.tocsc()
     K_free = Kc[:, free].tocsr()[free]
     r = rhs[free] - (Kc[:, fixed] @ u[fixed])[free] if fixed.size else rhs[free]
-    u_free, info = solve_square(K_free, r, where=where, spd=spd)
+    u_free, info = solve_square(K_free, r, where=where, spd=spd, ordering=ordering)
     u[free] = u_free
     return u, info

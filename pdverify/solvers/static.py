@@ -19,13 +19,21 @@ CONDITION_LIMIT = 1e14
 SPD_OPTIONS = dict(permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
                    options=dict(SymmetricMode=True))
 
+#: Column orderings SuperLU offers (``ordering`` of :func:`solve_constrained`). Measured,
+#: not assumed (benchmarks/plate_solvers.py): minimum degree on A + A^T is ~3x faster than
+#: the default COLAMD on the seed-000 plate's Lagrange system, but ~1.6x slower on the
+#: seed-001 surface-node plate, so each scene states its choice.
+ORDERINGS = ("COLAMD", "MMD_AT_PLUS_A", "MMD_ATA", "NATURAL")
 
-def solve_constrained(K, f, B=None, c=None, *, where: str = "static solve", spd: bool = False):
+
+def solve_constrained(K, f, B=None, c=None, *, where: str = "static solve", spd: bool = False,
+                      ordering: str = "COLAMD"):
     """Solve [[K, B^T], [B, 0]] [u; lam] = [f; c] with a sparse LU factorisation.
 
     ``spd=True`` (only without constraints) declares K symmetric positive definite and
     factors it in SuperLU's symmetric mode (:data:`SPD_OPTIONS`); the residual and
-    condition checks below guard the claim.
+    condition checks below guard the claim. Otherwise ``ordering`` is SuperLU's column
+    ordering (:data:`ORDERINGS`), with partial pivoting.
 
     Returns ``(u, lam, info)``; ``info`` holds the system size, the relative residual
     and a 1-norm condition estimate. Singular or near-singular systems, and non-finite
@@ -46,7 +54,7 @@ def solve_constrained(K, f, B=None, c=None, *, where: str = "static solve", spd:
     A_s, row_max, col_max = equilibrate(A, where)
     A_s = A_s.tocsc()
     try:
-        lu = spla.splu(A_s, **(SPD_OPTIONS if spd and B is None else {}))
+        lu = spla.splu(A_s, **(SPD_OPTIONS if spd and B is None else {"permc_spec": ordering}))
     except RuntimeError as exc:  # "Factor is exactly singular"
         raise NumericalError(f"{where}: singular system of size {A.shape[0]} ({exc})") from None
     sol = lu.solve(rhs / row_max) / col_max
@@ -59,7 +67,9 @@ def solve_constrained(K, f, B=None, c=None, *, where: str = "static solve", spd:
     res = A @ sol - rhs
     scale = max(np.linalg.norm(rhs), abs(A).max() * np.linalg.norm(sol), 1e-300)
     info = {"unknowns": int(A.shape[0]), "relative_residual": float(np.linalg.norm(res) / scale),
-            "condition_estimate": float(cond)}  # of the equilibrated system
+            "condition_estimate": float(cond),  # of the equilibrated system
+            "solver": "sparse LU (SuperLU, " + ("symmetric mode)" if spd and B is None
+                                                else f"{ordering} ordering)")}
     return sol[:n], sol[n:], info
 
 

@@ -1,0 +1,83 @@
+"""Time the seed-000 clamped plate: SuperLU orderings on its Lagrange system, and whole runs.
+
+Plain script (no test runner): python benchmarks/plate_solvers.py [--repeat N] [--json FILE]
+1. The Lagrange system [[K, B^T], [B, 0]] of ``taylor-fictitious`` (order 2, m = 3) at
+   spacing 0.05 m and 0.025 m (the issue's "4x finer grid", 9,600 real nodes), equilibrated
+   as ``solve_constrained`` does, factored with each ordering: median of N alternating
+   runs, ratio to SuperLU's default COLAMD. Supports ``pdverify.scenes.plate2d.ORDERING``.
+2. Whole runs (``Scene.run``: setup, solve, errors; FEM reference from the cache) at
+   Table 4's size (600 real nodes) and 4x finer, against the budgets of 1 s and 10 s.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import time
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from pdverify.pd import StateBasedConstants
+from pdverify.scenes import get_scene
+from pdverify.scenes.plate2d import StatePlate
+from pdverify.solvers.static import equilibrate
+
+ORDERINGS = ("COLAMD", "MMD_AT_PLUS_A", "MMD_ATA")
+
+
+def lagrange_system(spacing, order=2):
+    c = StateBasedConstants("plane-stress", 1e9, 0.2)
+    plate = StatePlate((3.0, 2.0), spacing, 3.0, c, "hyperbolic", order, thickness=0.05)
+    A = sp.bmat([[plate.K, plate.B.T], [plate.B, None]], format="csr")
+    A_s, _, _ = equilibrate(A, "benchmark")
+    return A_s.tocsc()
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--json", default=None, help="write the medians to this file")
+    args = ap.parse_args(argv)
+    out = {"orderings": {}, "runs": {}}
+    for h in (0.05, 0.025):
+        A = lagrange_system(h)
+        b = np.random.default_rng(0).normal(size=A.shape[0])
+        times = {k: [] for k in ORDERINGS}
+        for _ in range(args.repeat):        # alternate, so drift hits every alternative alike
+            for name in ORDERINGS:
+                t0 = time.perf_counter()
+                x = spla.splu(A, permc_spec=name).solve(b)
+                times[name].append(time.perf_counter() - t0)
+                res = np.linalg.norm(A @ x - b) / np.linalg.norm(b)
+                assert res < 1e-8, (name, res)
+        base = np.median(times["COLAMD"])
+        print(f"spacing {h} m: {A.shape[0]} unknowns, {A.nnz} non-zeros; median of {args.repeat}")
+        for name, ts in times.items():
+            med = float(np.median(ts))
+            print(f"  splu {name:15s} {med:7.2f} s   speed-up vs COLAMD {base / med:5.2f}x")
+            out["orderings"][f"{h}/{name}"] = med
+    scene = get_scene("plate2d-clamped")
+    cases = [("Table 4 (600 real nodes)", 0.1, 1.0), ("4x finer (9,600 real nodes)", 0.025, 10.0)]
+    for label, h, budget in cases:
+        for method, extra in (("none", {}), ("taylor-fictitious", {"order": 1}),
+                              ("taylor-fictitious", {"order": 3})):
+            walls = []
+            for _ in range(args.repeat):
+                t0 = time.perf_counter()
+                r = scene.run(method, {"spacing": h, **extra})
+                walls.append(time.perf_counter() - t0)
+                assert r.status == "ok", r.message
+            med = float(np.median(walls))
+            tag = f"{method} {extra.get('order', '')}".strip()
+            print(f"{label:28s} {tag:20s} run {med:6.2f} s (budget {budget:g} s: "
+                  f"{'met' if med < budget else 'MISSED'}); setup {r.timings['setup_s']:.2f} s, "
+                  f"solve {r.timings['solve_s']:.2f} s")
+            out["runs"][f"{h}/{tag}"] = med
+    if args.json:
+        with open(args.json, "w") as fh:
+            json.dump(out, fh, indent=1)
+
+
+if __name__ == "__main__":
+    main()
