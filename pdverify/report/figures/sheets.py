@@ -5,7 +5,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import LogNorm
 
-from . import FAMILIES, family, save
+from . import FAMILIES, family, node_image, save
 
 PAPER = {"micromodulus": "constant", "quadrature": "full-cells"}
 
@@ -19,14 +19,8 @@ def _is_default(r, **extra):
 
 
 def _grid(r, values):
-    """Values at the run's nodes as an image (rows: y), with the extent of the nodes."""
-    x, h = r.fields["x"], r.fields["spacing"]
-    i = np.rint((x[:, 0] - x[:, 0].min()) / h).astype(int)
-    j = np.rint((x[:, 1] - x[:, 1].min()) / h).astype(int)
-    img = np.full((j.max() + 1, i.max() + 1), np.nan)
-    img[j, i] = values
-    ext = (x[:, 0].min() * 1e3, x[:, 0].max() * 1e3, x[:, 1].min() * 1e3, x[:, 1].max() * 1e3)
-    return img, ext
+    """Values at the run's nodes as an image (rows: y), extent in mm."""
+    return node_image(r.fields["x"], r.fields["spacing"], values, unit=1e3)
 
 
 def _tension(scene, runs, folder):
