@@ -2,8 +2,9 @@
 
 METHODS = {
     "none": "uncorrected PD: truncated neighbourhoods, BCs on the nodes nearest the boundary",
-    "taylor-fictitious": "seed 000: fictitious layer by nearest-node Taylor extrapolation, "
-                         "Dirichlet/Neumann via Lagrange multipliers",
+    "taylor-fictitious": "seed 000: fictitious layer by nearest-node Taylor extrapolation (1D "
+                         "series along the normal; 2D corners by Eq. 69), Dirichlet/Neumann "
+                         "via Lagrange multipliers",
     "surface-nodes": "seeds 001/002: surface nodes carry the boundary conditions, fictitious layer "
                      "by Taylor extrapolation about the nearest surface node",
     "homogenized": "seed 004: stiffness factors on the end bonds (1, 1+k), (N, N-k) so that a "
