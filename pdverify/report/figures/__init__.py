@@ -37,6 +37,14 @@ def draw(scene, results, folder) -> list[tuple[str, str]]:
     return fn(scene, ok, folder)
 
 
+def fem_then_pd(scene, results, folder):
+    """For scenes that run PD beside their FEM reference: the FEM figures, the FEM runs and
+    the PD runs, as ``(figures, fem_runs, pd_runs)``."""
+    fem = [r for r in results if r.method == "fem"]
+    pd_runs = [r for r in results if r.method != "fem"]
+    return (FAMILIES["fem-reference"](scene, fem, folder) if fem else []), fem, pd_runs
+
+
 def label(result) -> str:
     extra = ", ".join(f"{k}={v}" for k, v in result.params.items() if k in ("order",))
     return result.method + (f" ({extra})" if extra else "")

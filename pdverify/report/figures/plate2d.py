@@ -5,7 +5,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from ...scenes.plate2d import TABLE4 as PAPER
-from . import FAMILIES, family, node_image, save
+from . import family, fem_then_pd, node_image, save
 
 #: the params of Table 4's runs (the maps); the sweeps vary spacing, m_ratio, quadrature
 TABLE4 = {**PAPER, "ring_value": "reference"}
@@ -123,9 +123,7 @@ def _convergence(scene, runs, folder):
 
 @family("plate2d")
 def plate_figures(scene, results, folder):
-    fem = [r for r in results if r.method == "fem"]
-    runs = [r for r in results if r.method != "fem"]
-    out = FAMILIES["fem-reference"](scene, fem, folder) if fem else []
+    out, fem, runs = fem_then_pd(scene, results, folder)
     if fem and "grid" in fem[0].fields:
         out.append(_fig28(scene, fem[0], folder))
     out += _error_maps(scene, runs, folder)

@@ -5,7 +5,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import LogNorm
 
-from . import FAMILIES, family, node_image, save
+from . import family, fem_then_pd, node_image, save
 
 PAPER = {"micromodulus": "constant", "quadrature": "full-cells"}
 
@@ -100,9 +100,7 @@ def _clamped(scene, runs, folder):
 
 @family("sheets")
 def sheet_figures(scene, results, folder):
-    fem = [r for r in results if r.method == "fem"]
-    pd_runs = [r for r in results if r.method != "fem"]
-    out = FAMILIES["fem-reference"](scene, fem, folder) if fem else []
+    out, _, pd_runs = fem_then_pd(scene, results, folder)
     if scene.id == "sheet2d-tension":
         out += _tension(scene, pd_runs, folder)
     else:
