@@ -25,7 +25,7 @@ C_THETA, K_THETA, K_E, C_BOND = sp.symbols("c_theta k_theta k_e c_bond")
 RESERVED = ("x", "y", "z", "delta", "c_theta", "k_theta", "k_e", "c_bond")
 
 CACHE_ENV = "PDVERIFY_CACHE_DIR"
-_CACHE_FORMAT = 1
+_CACHE_FORMAT = 2  # 2: entries carry a SHA-256 of their content
 # Working precision (decimal digits) of the numeric coefficients handed to lambdify; well
 # beyond double precision so that every coefficient is correctly rounded.
 _DPS = 30
@@ -380,12 +380,21 @@ def _from_json(data):
     return sp.sympify(data["sympy"])
 
 
+def _digest(payload) -> str:
+    return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()
+
+
 def _cache_load(key):
+    """The cached entry, or None for a miss: missing, unreadable, or content that does not
+    match its checksum (checked before any expression is parsed)."""
     path = cache_dir() / "manufactured" / f"{key}.json"
     try:
-        return _from_json(json.loads(path.read_text()))
-    except (OSError, ValueError, TypeError, KeyError, AttributeError, sp.SympifyError, SyntaxError):
-        return None  # missing or unreadable: derive again
+        doc = json.loads(path.read_text())
+        if not isinstance(doc, dict) or doc.get("sha256") != _digest(doc.get("entry")):
+            return None
+        return _from_json(doc["entry"])
+    except Exception:  # noqa: BLE001 - any unreadable entry is a miss: derive again
+        return None
 
 
 def _cache_store(key, entry):
@@ -393,9 +402,14 @@ def _cache_store(key, entry):
     try:
         folder.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
-        with os.fdopen(fd, "w") as fh:
-            json.dump(_to_json(entry), fh)
-        os.replace(tmp, folder / f"{key}.json")
+        payload = _to_json(entry)
+        try:
+            with os.fdopen(fd, "w") as fh:
+                json.dump({"sha256": _digest(payload), "entry": payload}, fh)
+            os.replace(tmp, folder / f"{key}.json")
+        finally:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
     except OSError:
         pass  # a read-only or full cache only costs time
 

@@ -4,7 +4,7 @@ usage:
   python -m pdverify list                                   scenes and their methods
   python -m pdverify run SCENE [--method M] [--set KEY=VALUE ...] [--json FILE]
   python -m pdverify report [--out DIR] [--quick] [--only SCENE ...] [--jobs N]
-  python -m pdverify compare BASELINE.json NEW.json [--rtol R] [--atol A]
+  python -m pdverify compare BASELINE.json NEW.json [--rtol R] [--atol A] [--summary FILE]
 
 Exit codes: 0 success; 1 a run failed numerically or a regression was found;
 2 bad input (one line naming the input and what is allowed).
@@ -42,6 +42,8 @@ def build_parser() -> argparse.ArgumentParser:
     cmp_.add_argument("new")
     cmp_.add_argument("--rtol", type=float, default=None)
     cmp_.add_argument("--atol", type=float, default=None)
+    cmp_.add_argument("--summary", default=None, metavar="FILE",
+                      help="also write the changes as JSON (FILE.json) or Markdown (else)")
     return parser
 
 
@@ -65,15 +67,24 @@ def _dispatch(args) -> int:
         from .listing import format_listing
         print(format_listing())
         return 0
+    from . import validate
     if args.command == "run":
         from .params import parse_assignments
         from .runner import run_one
+        json_path = validate.output_file(args.json) if args.json is not None else None
         return run_one(args.scene, method=args.method, overrides=parse_assignments(args.set),
-                       json_path=args.json)
+                       json_path=json_path)
     if args.command == "report":
-        from .report import build_report
-        return build_report(out=args.out, quick=args.quick, only=args.only, jobs=args.jobs)
+        from .report import DEFAULT_OUT, build_report
+        out = validate.output_dir(DEFAULT_OUT if args.out is None else args.out)
+        return build_report(out=out, quick=args.quick, only=validate.only(args.only),
+                            jobs=validate.jobs(args.jobs))
     if args.command == "compare":
         from .compare import compare_files
-        return compare_files(args.baseline, args.new, rtol=args.rtol, atol=args.atol)
+        for path, what in ((args.baseline, "baseline"), (args.new, "new results")):
+            validate.input_file(path, what)
+        summary = (validate.output_file(args.summary, "--summary") if args.summary is not None
+                   else None)
+        return compare_files(args.baseline, args.new, rtol=args.rtol, atol=args.atol,
+                             summary=summary)
     raise InputError(f"unknown command {args.command!r}")

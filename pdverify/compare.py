@@ -1,6 +1,8 @@
 """Baseline versus new results.json: per-run metric changes, regressions and the exit code."""
 from __future__ import annotations
 
+import json
+import math
 import sys
 from dataclasses import dataclass
 
@@ -97,6 +99,8 @@ def compare_docs(base: dict, new: dict, *, rtol=None, atol=None, defaults=curren
             if nv is None:
                 out.append(Change(scene, method, params, name, ov, "missing", "regression"))
                 continue
+            if _is_nan(ov) and _is_nan(nv):
+                continue  # NaN against NaN is no change (JSON stores it as "nan" or NaN)
             if not isinstance(ov, (int, float)) or not isinstance(nv, (int, float)):
                 if ov != nv:
                     out.append(Change(scene, method, params, name, ov, nv, "regression"))
@@ -115,8 +119,13 @@ def compare_docs(base: dict, new: dict, *, rtol=None, atol=None, defaults=curren
     return out
 
 
+def _is_nan(v) -> bool:
+    if isinstance(v, str):
+        return v.strip().lower() == "nan"
+    return isinstance(v, float) and math.isnan(v)
+
+
 def _short_params(params_json: str) -> str:
-    import json
     params = json.loads(params_json)
     return ",".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in params.items())
 
@@ -133,18 +142,48 @@ def format_changes(changes: list[Change]) -> str:
     return "\n".join("  ".join(cell[:90].ljust(w) for cell, w in zip(row, widths)) for row in rows)
 
 
-def compare_files(baseline: str, new: str, *, rtol=None, atol=None, stream=None) -> int:
-    """``pdverify compare``: print the table of changes; 1 on any regression, else 0."""
+def summary_text(changes: list[Change], path: str, baseline: str, new: str) -> str:
+    """The changes as JSON (``path`` ending in .json) or a Markdown table (else), for CI."""
+    n_reg = sum(c.is_regression for c in changes)
+    if path.endswith(".json"):
+        return json.dumps({"baseline": baseline, "new": new, "regressions": n_reg,
+                           "changes": [{"verdict": c.verdict, "scene": c.scene,
+                                        "method": c.method, "params": json.loads(c.params),
+                                        "metric": c.metric, "baseline": c.old, "new": c.new}
+                                       for c in changes]}, indent=1, default=str) + "\n"
+    lines = [f"# pdverify compare: {n_reg} regression(s), {len(changes) - n_reg} other change(s)",
+             "", f"baseline `{baseline}`, new `{new}`", ""]
+    if changes:
+        lines += ["| verdict | scene | method | params | metric | baseline | new |",
+                  "|---|---|---|---|---|---|---|"]
+        for c in changes:
+            fmt = (lambda v: f"{v:.6g}" if isinstance(v, float) else str(v))
+            lines.append(f"| {c.verdict} | {c.scene} | {c.method} | {_short_params(c.params)} "
+                         f"| {c.metric} | {fmt(c.old)} | {fmt(c.new)} |")
+    return "\n".join(lines) + "\n"
+
+
+def compare_files(baseline: str, new: str, *, rtol=None, atol=None, stream=None,
+                  summary: str | None = None) -> int:
+    """``pdverify compare``: print the table of changes; 1 on any regression, else 0.
+
+    Both files are checked against the schema first (exit 2 naming the file and the
+    first bad field); ``summary`` also writes the changes as JSON or Markdown.
+    """
     stream = stream or sys.stdout
     for value, flag in ((rtol, "--rtol"), (atol, "--atol")):
-        if value is not None and not value >= 0:
-            raise InputError(f"{flag}={value} must be >= 0")
+        if value is not None and not (value >= 0 and math.isfinite(value)):
+            raise InputError(f"{flag}={value} must be a finite number >= 0")
     docs = []
     for path in (baseline, new):
         try:
             docs.append(load_results(path))
         except FileNotFoundError:
             raise InputError(f"results file {path!r} does not exist") from None
+        except IsADirectoryError:
+            raise InputError(f"results file {path!r} is a folder") from None
+        except PermissionError:
+            raise InputError(f"results file {path!r} cannot be read (permission denied)") from None
         except ValueError as exc:
             raise InputError(str(exc)) from None
     matched: list = []
@@ -156,4 +195,7 @@ def compare_files(baseline: str, new: str, *, rtol=None, atol=None, stream=None)
               f"at their defaults: {', '.join(keys)}", file=stream)
     n_reg = sum(c.is_regression for c in changes)
     print(f"compare: {n_reg} regression(s), {len(changes) - n_reg} other change(s)", file=stream)
+    if summary is not None:
+        from .results import atomic_write_text
+        atomic_write_text(summary, summary_text(changes, summary, baseline, new))
     return 1 if n_reg else 0

@@ -1,6 +1,7 @@
 """Typed, range-checked parameters for scenes and methods (the --set KEY=VALUE layer)."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any, Callable, Mapping
 
@@ -29,6 +30,11 @@ class Param:
 
     def convert(self, raw: Any, where: str) -> Any:
         kind = self.kind
+        if isinstance(raw, str) and kind is not str and not raw.isascii():
+            # float() accepts full-width and other Unicode digits ('０.３'): refuse them, a
+            # value must read the same to the user and to the program
+            raise InputError(f"{where}: {self.name}={raw!r} must be written with ASCII "
+                             f"characters (a {kind.__name__})")
         try:
             if isinstance(raw, str):
                 if kind is bool:
@@ -51,10 +57,11 @@ class Param:
                 value = raw
             if not isinstance(value, kind):
                 raise ValueError(raw)
-        except (TypeError, ValueError):
-            raise InputError(f"{where}: {self.name}={raw!r} is not a valid {kind.__name__}") from None
-        if kind is float and value != value:  # NaN
-            raise InputError(f"{where}: {self.name}={raw!r} is not a number")
+        except (TypeError, ValueError, OverflowError):
+            raise InputError(f"{where}: {self.name}={raw!r} is not a valid {kind.__name__}"
+                             + (" (out of range)" if kind is int else "")) from None
+        if kind is float and not math.isfinite(value):  # NaN, inf, and overflow such as 1e400
+            raise InputError(f"{where}: {self.name}={raw!r} must be a finite number")
         if self.choices is not None and value not in self.choices:
             allowed = ", ".join(str(c) for c in self.choices)
             raise InputError(f"{where}: {self.name}={raw!r} is not allowed; allowed: {allowed}")

@@ -139,17 +139,48 @@ def write_results(path, runs: list[RunResult]) -> dict:
     return doc
 
 
-def load_results(path) -> dict:
-    """Read a results file and check its schema; raises ValueError with the reason."""
-    with open(path, encoding="utf-8") as fh:
-        try:
-            doc = json.load(fh)
-        except json.JSONDecodeError as exc:
-            raise ValueError(f"{path}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
+#: What a run of pdverify.results/1 must hold: key -> (allowed types, description).
+_RUN_FIELDS = {"scene": (str,), "method": (str,), "params": (dict,), "status": (str,),
+               "metrics": (dict,)}
+_OPTIONAL_RUN_FIELDS = {"reference": (str,), "message": (str,), "timings": (dict,),
+                        "size": (dict,), "diagnostics": (dict,)}
+_TYPE_NAMES = {str: "a string", dict: "an object"}
+
+
+def check_schema(doc, path) -> None:
+    """Raise ValueError naming ``path`` and the first field that breaks pdverify.results/1."""
     if not isinstance(doc, dict) or doc.get("schema") != SCHEMA:
         raise ValueError(f"{path}: schema is {doc.get('schema') if isinstance(doc, dict) else None!r}, "
                          f"expected {SCHEMA!r}")
     if not isinstance(doc.get("runs"), list):
         raise ValueError(f"{path}: 'runs' must be a list")
-    return doc
+    for k, run in enumerate(doc["runs"]):
+        if not isinstance(run, dict):
+            raise ValueError(f"{path}: runs[{k}] must be an object, got {type(run).__name__}")
+        for name, types in _RUN_FIELDS.items():
+            if name not in run:
+                raise ValueError(f"{path}: runs[{k}] has no {name!r}")
+        for name, types in {**_RUN_FIELDS, **_OPTIONAL_RUN_FIELDS}.items():
+            if name in run and not isinstance(run[name], types):
+                raise ValueError(f"{path}: runs[{k}].{name} must be {_TYPE_NAMES[types[0]]}, "
+                                 f"got {type(run[name]).__name__}")
+        if run["status"] not in ("ok", "failed"):
+            raise ValueError(f"{path}: runs[{k}].status must be 'ok' or 'failed', "
+                             f"got {run['status']!r}")
+        for name, v in run["metrics"].items():
+            if isinstance(v, bool) or not isinstance(v, (int, float, str)):
+                raise ValueError(f"{path}: runs[{k}].metrics.{name} must be a number or a "
+                                 f"string, got {type(v).__name__}")
 
+
+def load_results(path) -> dict:
+    """Read a results file and check its schema; raises ValueError with the reason."""
+    try:
+        with open(path, encoding="utf-8") as fh:
+            doc = json.load(fh)
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{path}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
+    except UnicodeDecodeError:
+        raise ValueError(f"{path}: not a text (UTF-8) file") from None
+    check_schema(doc, path)
+    return doc

@@ -53,7 +53,8 @@ def cached(reference: str, params: dict, compute: Callable[[], results.Reference
     """Return the cached result for (reference, params) or compute, store and return it.
 
     The file is written to a temporary name and renamed, so parallel runs never read a
-    partial file. An unreadable cache file is treated as a miss and overwritten.
+    partial file. Any entry that cannot be read back whole (truncated, empty, corrupted,
+    or content that no longer matches its checksum) is a miss: recomputed and replaced.
     """
     key = cache_key(reference, params)
     path = cache_dir() / f"{reference}-{key[:24]}.npz"
@@ -62,7 +63,7 @@ def cached(reference: str, params: dict, compute: Callable[[], results.Reference
             res = results.from_npz(path, classes)
             if res.cache_key == key:
                 return dataclasses.replace(res, from_cache=True)
-        except (OSError, ValueError, KeyError, TypeError):
+        except Exception:  # noqa: BLE001 - any unreadable entry is a miss (BadZipFile, EOFError, ...)
             pass
     res = dataclasses.replace(compute(), cache_key=key, from_cache=False)
     if use_cache:

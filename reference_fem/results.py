@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -141,24 +142,42 @@ def to_npz(result: ReferenceResult, path: Path) -> None:
         else:
             meta[f.name] = v
     arrays["__meta__"] = np.array(json.dumps(meta, allow_nan=True))
+    arrays["__checksum__"] = np.array(content_digest(arrays))
     np.savez(path, **arrays)
+
+
+def content_digest(arrays: dict) -> str:
+    """SHA-256 over every entry's name, dtype, shape and bytes (sorted by name), so that a
+    cache file whose content was altered in any way no longer matches its checksum."""
+    h = hashlib.sha256()
+    for name in sorted(k for k in arrays if k != "__checksum__"):
+        a = np.ascontiguousarray(arrays[name])
+        h.update(name.encode())
+        h.update(str(a.dtype).encode())
+        h.update(str(a.shape).encode())
+        h.update(a.tobytes())
+    return h.hexdigest()
 
 
 def from_npz(path: Path, classes: dict) -> ReferenceResult:
     """Read a result written by :func:`to_npz`; ``classes`` maps class names to types."""
     with np.load(path, allow_pickle=False) as z:
-        meta = json.loads(str(z["__meta__"]))
-        cls = classes[meta.pop("class")]
-        kwargs = {}
-        for name, v in meta.items():
-            if isinstance(v, dict) and "__field__" in v:
-                coords = tuple(z[f"{name}.coord{k}"] for k in range(v["__field__"]))
-                kwargs[name] = FieldSolution(coords=coords, values=z[f"{name}.values"],
-                                             lam=v["lam"], mu=v["mu"])
-            elif isinstance(v, dict) and "__array__" in v:
-                kwargs[name] = z[name]
-            elif name in _ROW_TUPLES:
-                kwargs[name] = tuple(RefinementRow(**r) for r in v)
-            else:
-                kwargs[name] = v
+        arrays = {k: z[k] for k in z.files}
+    if "__checksum__" not in arrays or str(arrays["__checksum__"]) != content_digest(arrays):
+        raise ValueError(f"{path}: checksum does not match the content")
+    z = arrays
+    meta = json.loads(str(z["__meta__"]))
+    cls = classes[meta.pop("class")]
+    kwargs = {}
+    for name, v in meta.items():
+        if isinstance(v, dict) and "__field__" in v:
+            coords = tuple(z[f"{name}.coord{k}"] for k in range(v["__field__"]))
+            kwargs[name] = FieldSolution(coords=coords, values=z[f"{name}.values"],
+                                         lam=v["lam"], mu=v["mu"])
+        elif isinstance(v, dict) and "__array__" in v:
+            kwargs[name] = z[name]
+        elif name in _ROW_TUPLES:
+            kwargs[name] = tuple(RefinementRow(**r) for r in v)
+        else:
+            kwargs[name] = v
     return cls(**kwargs)

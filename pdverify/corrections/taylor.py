@@ -7,6 +7,12 @@ from math import factorial
 import numpy as np
 import scipy.sparse as sp
 
+from ..errors import NumericalError
+
+#: Above this condition number of the (column-scaled) Taylor fit its weights lose more than
+#: 12 of double precision's ~16 digits: the fit is refused as numerically singular.
+FIT_CONDITION_LIMIT = 1e12
+
 
 def monomial_exponents(dim: int, order: int) -> np.ndarray:
     """Exponents (n_1, ..., n_d) with 1 <= n_1 + ... + n_d <= order (seed 001 Eqs. 13, 25, 29)."""
@@ -36,10 +42,36 @@ def taylor_weights(src_rel, tgt_rel, group, order):
     the weights reproduce every polynomial of degree <= order exactly (its Taylor series
     is exact and the fit recovers its derivatives when the sources are unisolvent).
     """
+    src_rel = np.asarray(src_rel, dtype=float)
+    tgt_rel = np.asarray(tgt_rel, dtype=float)
     dim = src_rel.shape[-1]
+    group = np.asarray(group)
+    if dim == 1 and src_rel.shape[1] == order:
+        # a square 1D fit is interpolation: the weights are the Lagrange polynomials of the
+        # nodes {0} + sources at the target, evaluated as products (stable at any order,
+        # where the monomial fit below loses every digit from order ~20 on)
+        nodes = src_rel[group, :, 0]                              # (T, S)
+        t = tgt_rel[:, 0][:, None]
+        all_nodes = np.concatenate([np.zeros((nodes.shape[0], 1)), nodes], axis=1)
+        W = np.ones_like(nodes)
+        for k in range(order + 1):
+            other = all_nodes[:, k][:, None]
+            factor = np.where(np.arange(1, order + 1)[None, :] == k, 1.0,
+                              (t - other) / np.where(nodes == other, 1.0, nodes - other))
+            W *= factor
+        return W
     exps = monomial_exponents(dim, order)
     M = taylor_monomials(src_rel, exps)          # (G, S, n_mono)
-    G = np.linalg.pinv(M)                        # (G, n_mono, S)
+    scale = np.abs(M).max(axis=1, keepdims=True)  # column scaling: monomials differ by k!
+    scale[scale == 0] = 1.0
+    sv = np.linalg.svd(M / scale, compute_uv=False)
+    worst = float(np.max(sv[:, 0] / np.maximum(sv[:, -1], 1e-300)))
+    if worst > FIT_CONDITION_LIMIT:
+        raise NumericalError(f"Taylor fit of order {order} in {dim}D on {src_rel.shape[1]} "
+                             f"nodes is numerically singular (condition {worst:.1e} > "
+                             f"{FIT_CONDITION_LIMIT:.0e}): its weights would not extrapolate "
+                             "polynomials of that degree; use a lower order")
+    G = np.linalg.pinv(M / scale) / np.swapaxes(scale, 1, 2)   # (G, n_mono, S)
     T = taylor_monomials(tgt_rel, exps)          # (n_targets, n_mono)
     return np.einsum("tm,tms->ts", T, G[group])
 

@@ -195,17 +195,30 @@ def test_cache_written_read_and_keyed(tmp_path, monkeypatch):
     assert second.stress_expr == first.stress_expr
     solution(SEED001_FIELD, **{**kw, "nu": 0.25})  # another input, another entry
     assert len(list((tmp_path / "c1" / "manufactured").glob("*.json"))) == 2
-    # a cached entry is really used: tamper with it and read it back
-    entry = engine._from_json(json.loads(files[0].read_text()))
+    def stored(path):
+        return engine._from_json(json.loads(path.read_text())["entry"])
+
+    def store(path, entry, checksum=True):
+        payload = engine._to_json(entry)
+        digest = engine._digest(payload) if checksum else "0" * 64
+        path.write_text(json.dumps({"sha256": digest, "entry": payload}))
+
+    # a cached entry is really used: change it (with a matching checksum) and read it back
+    entry = stored(files[0])
     entry["numeric"]["dilatation"] = sp.Integer(7)
-    files[0].write_text(json.dumps(engine._to_json(entry)))
+    store(files[0], entry)
     assert solution(SEED001_FIELD, **kw).dilatation_expr == 7
-    # a structurally damaged entry is derived again and overwritten
-    entry = engine._from_json(json.loads(files[0].read_text()))
-    del entry["symbolic"]
-    files[0].write_text(json.dumps(engine._to_json(entry)))
+    # an edited entry whose checksum no longer matches is a miss: derived again, replaced
+    entry["numeric"]["dilatation"] = sp.Integer(9)
+    store(files[0], entry, checksum=False)
     assert solution(SEED001_FIELD, **kw).dilatation_expr == first.dilatation_expr
-    assert "symbolic" in engine._from_json(json.loads(files[0].read_text()))
+    assert stored(files[0])["numeric"]["dilatation"] == first.dilatation_expr
+    # a structurally damaged entry is derived again and overwritten
+    entry = stored(files[0])
+    del entry["symbolic"]
+    store(files[0], entry)
+    assert solution(SEED001_FIELD, **kw).dilatation_expr == first.dilatation_expr
+    assert "symbolic" in stored(files[0])
     # a corrupt entry is ignored and rewritten
     files[0].write_text("{not json")
     assert solution(SEED001_FIELD, **kw).dilatation_expr == first.dilatation_expr

@@ -1,0 +1,94 @@
+"""Checks of the command line's paths and flags, before any work (bad input: exit 2).
+
+Parameters are checked by ``pdverify.params`` and each scene's ``check``; this module
+covers what is not a parameter: output paths, ``--jobs`` and ``--only``.
+"""
+from __future__ import annotations
+
+import os
+import tempfile
+
+from .errors import InputError
+
+
+def _probe_folder(folder: str, flag: str, shown: str) -> None:
+    """Prove that ``folder`` could be created (if missing) and take a file, without leaving
+    anything behind: its nearest existing ancestor must be a folder that takes a file."""
+    probe = folder
+    while not os.path.exists(probe):
+        parent = os.path.dirname(probe)
+        if parent == probe:
+            break
+        probe = parent
+    if not os.path.isdir(probe):
+        raise InputError(f"{flag} {shown!r}: {probe!r} is a file, not a folder")
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=".probe-", dir=probe)
+        os.close(fd)
+        os.unlink(tmp)
+    except OSError as exc:
+        reason = exc.strerror or type(exc).__name__
+        raise InputError(f"{flag} {shown!r}: cannot write there ({reason})") from None
+
+
+def output_dir(path, flag: str = "--out") -> str:
+    """A report folder: a non-empty path that is not a file, whose ``results.json`` and
+    ``index.html`` are not folders and whose ``figures`` is not a file, in a writable
+    parent. Returns the absolute path."""
+    if path is None:
+        raise InputError(f"{flag}: a folder is required")
+    if not str(path).strip():
+        raise InputError(f"{flag} {path!r}: empty path; give a folder")
+    full = os.path.abspath(os.path.expanduser(str(path)))
+    if os.path.exists(full) and not os.path.isdir(full):
+        raise InputError(f"{flag} {path!r} is a file; give a folder")
+    for name, want_dir in (("results.json", False), ("index.html", False), ("figures", True)):
+        p = os.path.join(full, name)
+        if os.path.exists(p) and os.path.isdir(p) != want_dir:
+            kind = "a folder" if not want_dir else "a file"
+            raise InputError(f"{flag} {path!r}: {name} there is {kind}; remove it or choose "
+                             "another folder")
+    _probe_folder(os.path.dirname(full), flag, str(path))
+    return full
+
+
+def output_file(path, flag: str = "--json") -> str:
+    """A file to write: non-empty, not a folder, in a writable folder. Returns it absolute."""
+    if not str(path).strip():
+        raise InputError(f"{flag} {path!r}: empty path; give a file name")
+    full = os.path.abspath(os.path.expanduser(str(path)))
+    if os.path.isdir(full) or str(path).endswith(os.sep):
+        raise InputError(f"{flag} {path!r} is a folder; give a file name")
+    _probe_folder(os.path.dirname(full), flag, str(path))
+    return full
+
+
+def input_file(path, what: str) -> str:
+    """A file to read: exists and is a regular file."""
+    if not str(path).strip():
+        raise InputError(f"{what} {path!r}: empty path")
+    if os.path.isdir(path):
+        raise InputError(f"{what} {path!r} is a folder, not a results file")
+    if not os.path.isfile(path):
+        raise InputError(f"{what} {path!r} does not exist")
+    return path
+
+
+def jobs(value: int) -> int:
+    """``--jobs``: 1 .. the number of CPUs."""
+    cpus = os.cpu_count() or 1
+    if not 1 <= value <= cpus:
+        raise InputError(f"--jobs={value} must be between 1 and {cpus} (the CPUs of this machine)")
+    return value
+
+
+def only(scenes) -> list | None:
+    """``--only``: every scene at most once."""
+    if scenes is None:
+        return None
+    seen = set()
+    for s in scenes:
+        if s in seen:
+            raise InputError(f"--only: scene {s!r} is given twice")
+        seen.add(s)
+    return list(scenes)
