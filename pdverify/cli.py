@@ -47,7 +47,16 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _terminate(signum, frame):  # SIGTERM: unwind like Ctrl-C, so cleanups run
+    raise KeyboardInterrupt
+
+
 def main(argv=None) -> int:
+    import signal
+    try:
+        signal.signal(signal.SIGTERM, _terminate)
+    except ValueError:  # not in the main thread (e.g. called from a test's worker thread)
+        pass
     try:
         args = build_parser().parse_args(argv)
         if args.command is None:

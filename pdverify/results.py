@@ -115,8 +115,17 @@ def document(runs: list[RunResult]) -> dict:
     }
 
 
+def umask_mode(mode: int) -> int:
+    """``mode`` under the process umask (what ``open`` would give a new file or folder)."""
+    current = os.umask(0)
+    os.umask(current)
+    return mode & ~current
+
+
 def atomic_write_text(path: str | os.PathLike, text: str) -> None:
-    """Write ``text`` to ``path`` so that a reader sees the old file or the new, never half."""
+    """Write ``text`` to ``path`` so that a reader sees the old file or the new, never half.
+
+    The file gets the usual permissions (0666 under the umask), not mkstemp's 0600."""
     path = os.fspath(path)
     folder = os.path.dirname(os.path.abspath(path))
     os.makedirs(folder, exist_ok=True)
@@ -126,6 +135,7 @@ def atomic_write_text(path: str | os.PathLike, text: str) -> None:
             fh.write(text)
             fh.flush()
             os.fsync(fh.fileno())
+        os.chmod(tmp, umask_mode(0o666))
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):

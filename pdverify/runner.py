@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import sys
-from concurrent.futures import ProcessPoolExecutor
 
 from .errors import InputError
 from .results import RunResult, write_results
@@ -51,30 +50,124 @@ def plan(only=None, quick=False) -> list[tuple[str, str, dict]]:
     return cases
 
 
+def _worker(conn) -> None:
+    """Worker process: run the cases it receives, send back each result; None ends it."""
+    while True:
+        try:
+            case = conn.recv()
+        except EOFError:
+            return
+        if case is None:
+            return
+        conn.send(_run_case(case))
+
+
+def _died(case, exitcode) -> RunResult:
+    """The failed record of a case whose worker process died in native code."""
+    import signal
+    scene_id, method, overrides = case
+    if exitcode is not None and exitcode < 0:
+        try:
+            how = f"signal {signal.Signals(-exitcode).name}"
+        except ValueError:
+            how = f"signal {-exitcode}"
+    else:
+        how = f"exit code {exitcode}"
+    scene = get_scene(scene_id)
+    try:
+        params = scene.resolve(method, overrides)
+    except InputError:
+        params = dict(overrides)
+    return RunResult(scene=scene_id, method=method, params=params, reference=scene.reference,
+                     status="failed",
+                     message=f"the run's process died ({how}) in native code (e.g. a crash in "
+                             "a linear-algebra library, or killed for lack of memory)",
+                     timings={"setup_s": 0.0, "solve_s": 0.0, "total_s": 0.0})
+
+
 def run_cases(cases, *, jobs: int = 1, progress=None) -> list[RunResult]:
-    """Run ``cases`` in order (or over ``jobs`` processes); one progress line per run."""
+    """Run ``cases`` in ``jobs`` supervised worker processes; one progress line per run.
+
+    Every case runs in a worker process, so a run that dies in native code (segfault,
+    abort, out-of-memory kill) becomes a failed run naming the signal, a new worker takes
+    over, and the other runs go on. Results come back in the order of ``cases``.
+    """
+    import multiprocessing as mp
+    from multiprocessing.connection import wait
+
     if jobs < 1:
         raise InputError(f"--jobs={jobs} must be >= 1")
     total = len(cases)
-    results: list[RunResult] = []
+    results: list[RunResult | None] = [None] * total
+    done = 0
 
     def note(k, res):
         if progress is not None:
             params = " ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}"
                               for k, v in sorted(cases[k][2].items()))
             status = res.status if res.status == "ok" else f"FAILED: {res.message}"
-            print(f"[{k + 1}/{total}] {res.scene} {res.method} {params} ... {status} "
+            print(f"[{done}/{total}] {res.scene} {res.method} {params} ... {status} "
                   f"({res.timings.get('total_s', 0):.2f} s) {format_metrics(res.metrics, 2)}",
                   file=progress, flush=True)
 
-    if jobs == 1 or total <= 1:
-        for k, case in enumerate(cases):
-            res = _run_case(case)
-            note(k, res)
-            results.append(res)
-        return results
-    with ProcessPoolExecutor(max_workers=jobs) as pool:
-        for k, res in enumerate(pool.map(_run_case, cases)):
-            note(k, res)
-            results.append(res)
+    ctx = mp.get_context("fork")
+    workers = {}          # connection -> (process, index of the case it runs or None)
+    pending = list(range(total))
+
+    def start():
+        parent, child = ctx.Pipe()
+        proc = ctx.Process(target=_worker, args=(child,), daemon=True)
+        proc.start()
+        child.close()
+        workers[parent] = [proc, None]
+
+    def give(conn):
+        if pending:
+            k = pending.pop(0)
+            workers[conn][1] = k
+            conn.send(cases[k])
+        else:
+            workers[conn][1] = None
+
+    try:
+        for _ in range(min(jobs, total)):
+            start()
+        for conn in list(workers):
+            give(conn)
+        while done < total:
+            busy = {c: w for c, w in workers.items() if w[1] is not None}
+            ready = wait(list(busy) + [w[0].sentinel for w in busy.values()])
+            for conn, (proc, k) in list(busy.items()):
+                res = None
+                if conn in ready or proc.sentinel in ready:
+                    try:
+                        if conn.poll():
+                            res = conn.recv()
+                    except (EOFError, OSError):
+                        res = None
+                    if res is None and proc.is_alive():
+                        continue
+                    if res is None:           # the worker died: record it, replace it
+                        proc.join()
+                        res = _died(cases[k], proc.exitcode)
+                        conn.close()
+                        del workers[conn]
+                        start()
+                        conn = list(workers)[-1]
+                    results[k] = res
+                    done += 1
+                    note(k, res)
+                    give(conn)
+    finally:
+        for conn, (proc, _) in workers.items():
+            try:
+                conn.send(None)
+            except (OSError, BrokenPipeError):
+                pass
+            conn.close()
+        for conn, (proc, _) in workers.items():
+            proc.join(timeout=1)
+            if proc.is_alive():
+                proc.kill()
+                proc.join()
     return results

@@ -1,22 +1,101 @@
 """The main job: run every scene and method, write results.json, figures and index.html."""
 from __future__ import annotations
 
+import fcntl
 import os
+import shutil
 import sys
+import tempfile
 import time
+from contextlib import contextmanager
 
-from ..results import atomic_write_text, write_results
+from ..errors import InputError
+from ..results import atomic_write_text, umask_mode, write_results
 from ..runner import plan, run_cases
 from ..scenes import get_scene
 
 DEFAULT_OUT = os.path.join("reports", "latest")
 
 
+@contextmanager
+def output_lock(out: str):
+    """Hold ``<parent>/.<name>.lock`` for the whole report: a second report into the same
+    folder exits 2 naming the holder instead of interleaving with this one."""
+    parent, name = os.path.split(os.path.abspath(out))
+    os.makedirs(parent, exist_ok=True)
+    path = os.path.join(parent, f".{name}.lock")
+    fh = open(path, "a+")
+    try:
+        fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        fh.seek(0)
+        holder = fh.read().strip() or "another process"
+        fh.close()
+        raise InputError(f"--out {out!r} is being written by {holder}; wait for it or "
+                         "choose another folder") from None
+    fh.seek(0)
+    fh.truncate()
+    fh.write(f"pdverify report (pid {os.getpid()})")
+    fh.flush()
+    try:
+        yield
+    finally:
+        fh.close()  # releases the lock; the empty lock file may stay
+
+
+def _clean_stale(parent: str, name: str) -> None:
+    """Remove staging folders that earlier, killed reports into ``name`` left behind (only
+    while holding the lock, so none of them belongs to a live report)."""
+    for entry in os.listdir(parent):
+        if entry.startswith(f".{name}.staging-") or entry.startswith(f".{name}.old-"):
+            shutil.rmtree(os.path.join(parent, entry), ignore_errors=True)
+
+
+def _swap_in(staging: str, out: str) -> None:
+    """Replace ``out`` by ``staging`` as a whole: the old folder is renamed aside, the new
+    one renamed in, the old one deleted. A reader sees the old report or the new one."""
+    parent, name = os.path.split(out)
+    old = None
+    if os.path.exists(out):
+        old = tempfile.mkdtemp(prefix=f".{name}.old-", dir=parent)
+        os.rmdir(old)
+        os.rename(out, old)
+    try:
+        os.rename(staging, out)
+    except BaseException:
+        if old is not None:
+            os.rename(old, out)
+        raise
+    if old is not None:
+        shutil.rmtree(old, ignore_errors=True)
+
+
 def build_report(*, out=None, quick=False, only=None, jobs=1, progress=None) -> int:
-    """Run the report; returns 0, or 1 if any run failed. Bad input raises before work."""
+    """Run the report; returns 0, or 1 if any run failed. Bad input raises before work.
+
+    Figures, results.json and index.html are written into a staging folder next to
+    ``out`` and swapped in as a whole at the end, under a lock on ``out``: a report that
+    is killed or fails leaves the previous one intact (its staging folder is removed now,
+    or by the next report into the same folder if the process was killed outright).
+    """
     progress = progress or sys.stderr
-    out = out or DEFAULT_OUT
+    out = os.path.abspath(out or DEFAULT_OUT)
     cases = plan(only=only, quick=quick)  # raises InputError on unknown scenes
+    parent, name = os.path.split(out)
+    with output_lock(out):
+        _clean_stale(parent, name)
+        staging = tempfile.mkdtemp(prefix=f".{name}.staging-", dir=parent)
+        os.chmod(staging, umask_mode(0o777))  # mkdtemp gives 0700
+        try:
+            code = _build(cases, staging, out, jobs, progress)
+            _swap_in(staging, out)
+        finally:
+            if os.path.exists(staging):
+                shutil.rmtree(staging, ignore_errors=True)
+    return code
+
+
+def _build(cases, out, final, jobs, progress) -> int:
     t0 = time.perf_counter()
     results = run_cases(cases, jobs=jobs, progress=progress)
     figdir = os.path.join(out, "figures")
@@ -41,7 +120,8 @@ def build_report(*, out=None, quick=False, only=None, jobs=1, progress=None) -> 
                       html.page(doc, sections, time.perf_counter() - t0))
     failed = sum(r.status != "ok" for r in results)
     print(f"report: {len(results)} runs, {failed} failed, "
-          f"{time.perf_counter() - t0:.1f} s -> {os.path.join(out, 'index.html')}", file=progress)
+          f"{time.perf_counter() - t0:.1f} s -> {os.path.join(final, 'index.html')}",
+          file=progress)
     return 1 if failed else 0
 
 
