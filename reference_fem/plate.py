@@ -116,7 +116,8 @@ def compute(p: PlateParams) -> PlateResult:
         sample = fld.evaluate(pts)
         extra = {}
         if prev_sample is not None:
-            scale = np.max(np.linalg.norm(sample, axis=1))
+            peak = np.max(np.abs(sample))          # scale-free: normalise before squaring
+            scale = peak * np.max(np.linalg.norm(sample / peak, axis=1))
             extra["field_change_pct"] = float(100 * np.max(np.abs(sample - prev_sample)) / scale)
         rows.append(RefinementRow(level=level, dofs=int(model.basis.N),
                                   h_min=p.spacing / 2 ** level, quantity=q,

@@ -127,7 +127,10 @@ class Scene:
             result.metrics, result.size = out.metrics, out.size
             result.fields, result.diagnostics = out.fields, out.diagnostics
         except NumericalError as exc:
-            result.status, result.message = "failed", str(exc)
+            where = f"{self.id}/{method}"
+            msg = str(exc)
+            result.status = "failed"
+            result.message = msg if msg.startswith(where) else f"{where}: {msg}"
         except (FloatingPointError, ArithmeticError, np.linalg.LinAlgError) as exc:
             result.status = "failed"
             result.message = f"numerical error: {type(exc).__name__}: {exc}"

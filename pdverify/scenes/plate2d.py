@@ -7,6 +7,7 @@ import numpy as np
 from ..corrections.taylor_fictitious import (CORNER_RULES, clamped_rows, fictitious_closure,
                                              needed_nodes)
 from ..errors import InputError
+from ..metrics import rel_l2_error
 from ..params import Param, at_least, positive
 from ..pd import (QUADRATURES, BoxGrid, StateBasedConstants, StateBasedModel, build_stencil,
                   get_influence)
@@ -123,7 +124,7 @@ def plate_errors(x, u, u_ref, lengths, horizon) -> tuple[dict, np.ndarray]:
             continue
         out[prefix + "max_error_u_pct"] = float(err[mask, 0].max())
         out[prefix + "max_error_v_pct"] = float(err[mask, 1].max())
-    out["rel_l2_error"] = float(np.linalg.norm(u - u_ref) / np.linalg.norm(u_ref))
+    out["rel_l2_error"] = rel_l2_error(u, u_ref)
     return out, err
 
 

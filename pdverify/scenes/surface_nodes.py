@@ -7,6 +7,7 @@ from manufactured import surface3d as closed
 
 from ..corrections.surface_nodes import MAX_ORDER, flux_rows, surface_node_closure
 from ..errors import InputError
+from ..metrics import rel_l2_error
 from ..params import Param, at_least, open_interval, positive
 from ..pd import (QUADRATURES, BoxGrid, StateBasedConstants, StateBasedModel, build_stencil,
                   get_influence)
@@ -153,8 +154,7 @@ def error_metrics(x, u, u_ref, dist, horizon, dim) -> tuple[dict, np.ndarray]:
             out[prefix + "max_error_pct"] = float(comp[mask].max())
             out[prefix + "max_error_u_pct"] = float(comp[mask, 0].max())
             out[prefix + "max_error_v_pct"] = float(comp[mask, 1].max())
-        d = (u - u_ref)[mask]
-        out[prefix + "rel_l2_error"] = float(np.linalg.norm(d) / np.linalg.norm(u_ref[mask]))
+        out[prefix + "rel_l2_error"] = rel_l2_error(u[mask], u_ref[mask])
 
     part("", np.ones(x.shape[0], dtype=bool))
     part("boundary_", near)

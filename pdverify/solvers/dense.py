@@ -7,7 +7,7 @@ import scipy.sparse as sp
 from scipy.linalg import lapack
 
 from ..errors import NumericalError
-from .static import CONDITION_LIMIT, equilibrate, solve_constrained
+from .static import CONDITION_LIMIT, equilibrate, relative_residual, solve_constrained
 
 #: Above this fill (nnz / n^2) a dense LAPACK LU beats SuperLU: in 3D state-based PD every
 #: node couples to all nodes within two horizons, i.e. to a large part of a small body.
@@ -45,9 +45,7 @@ def solve_square(K, f, *, where: str = "static solve", spd: bool = False,
     u = sl.lu_solve((lu, piv), f / row_max, check_finite=False) / col_max
     if not np.all(np.isfinite(u)):
         raise NumericalError(f"{where}: solution has non-finite values (singular system)")
-    res = K @ u - f
-    scale = max(np.linalg.norm(f), abs(K).max() * np.linalg.norm(u), 1e-300)
-    return u, {"unknowns": int(n), "relative_residual": float(np.linalg.norm(res) / scale),
+    return u, {"unknowns": int(n), "relative_residual": relative_residual(K, u, f),
                "condition_estimate": float(cond), "solver": "dense LU (LAPACK)"}
 
 

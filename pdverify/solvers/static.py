@@ -64,13 +64,28 @@ def solve_constrained(K, f, B=None, c=None, *, where: str = "static solve", spd:
     if cond > CONDITION_LIMIT:
         raise NumericalError(f"{where}: near-singular system (condition estimate {cond:.2e} "
                              f"> {CONDITION_LIMIT:.0e} after equilibration)")
-    res = A @ sol - rhs
-    scale = max(np.linalg.norm(rhs), abs(A).max() * np.linalg.norm(sol), 1e-300)
-    info = {"unknowns": int(A.shape[0]), "relative_residual": float(np.linalg.norm(res) / scale),
+    info = {"unknowns": int(A.shape[0]), "relative_residual": relative_residual(A, sol, rhs),
             "condition_estimate": float(cond),  # of the equilibrated system
             "solver": "sparse LU (SuperLU, " + ("symmetric mode)" if spd and B is None
                                                 else f"{ordering} ordering)")}
     return sol[:n], sol[n:], info
+
+
+def relative_residual(A, x, b) -> float:
+    """||A x - b|| / max(||b||, max|A| ||x||), computed scale-free: x and b are divided by
+    max |x| first, so solutions of 1e+-300 neither overflow nor underflow the norms."""
+    s = float(np.max(np.abs(x))) if np.size(x) else 0.0
+    if s == 0.0 or not np.isfinite(s):
+        return 0.0 if s == 0.0 and not np.any(b) else float("inf")
+    xs, bs = x / s, np.asarray(b, dtype=float) / s
+    r = A @ xs - bs
+    denom = max(_norm(bs), float(abs(A).max()) * _norm(xs), 1e-300)
+    return float(_norm(r) / denom)
+
+
+def _norm(v) -> float:
+    m = float(np.max(np.abs(v))) if np.size(v) else 0.0
+    return 0.0 if m == 0.0 else m * float(np.linalg.norm(v / m))
 
 
 def equilibrate(A, where: str):

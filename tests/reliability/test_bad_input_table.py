@@ -1,0 +1,185 @@
+"""Bad input, table-driven (issue 18): exit 2, one line naming the input, no traceback,
+nothing written, before any work."""
+import json
+import os
+
+import pytest
+
+from pdverify.cli import main
+
+GOOD_RUN = {"scene": "bar1d-traction", "method": "none", "params": {}, "reference": "analytic",
+            "status": "ok", "message": "", "metrics": {"max_error_pct": 1.0}}
+
+
+def _doc(runs, schema="pdverify.results/1"):
+    return {"schema": schema, "runs": runs}
+
+
+#: (id, argv, files to create first {name: content or None for a folder}, text expected)
+CASES = [
+    # ---------------------------------------------------------------- run: scene, method
+    ("unknown-scene", ["run", "no-such-scene"], {}, "unknown scene"),
+    ("unknown-method", ["run", "bar1d-traction", "--method", "nope"], {}, "unknown method"),
+    ("unknown-command", ["frobnicate"], {}, "invalid choice"),
+    ("unknown-flag", ["run", "bar1d-traction", "--fast"], {}, "unrecognized"),
+    # ---------------------------------------------------------------- run: --set syntax
+    ("set-no-equals", ["run", "bar1d-traction", "--set", "force"], {}, "expected KEY=VALUE"),
+    ("set-empty-key", ["run", "bar1d-traction", "--set", "=3"], {}, "expected KEY=VALUE"),
+    ("set-twice", ["run", "bar1d-traction", "--set", "force=1", "--set", "force=2"], {},
+     "given twice"),
+    ("set-unknown-key", ["run", "bar1d-traction", "--set", "colour=1"], {}, "unknown key"),
+    # ---------------------------------------------------------------- run: values
+    ("int-overflow", ["run", "bar1d-traction", "--method", "taylor-fictitious", "--set",
+                      "order=1e400"], {}, "order='1e400'"),
+    ("int-fraction", ["run", "bar1d-traction", "--method", "taylor-fictitious", "--set",
+                      "order=2.5"], {}, "order='2.5'"),
+    ("int-zero", ["run", "bar1d-traction", "--method", "taylor-fictitious", "--set", "order=0"],
+     {}, "order='0'"),
+    ("int-text", ["run", "bar1d-traction", "--method", "taylor-fictitious", "--set",
+                  "order=two"], {}, "order='two'"),
+    ("load-inf", ["run", "bar1d-traction", "--set", "force=inf"], {}, "force='inf'"),
+    ("load-nan", ["run", "bar1d-traction", "--set", "force=nan"], {}, "force='nan'"),
+    ("load-overflow", ["run", "bar1d-traction", "--set", "force=1e999"], {}, "force='1e999'"),
+    ("load-zero", ["run", "bar1d-traction", "--set", "force=0"], {}, "force=0"),
+    ("full-width-digits", ["run", "bar1d-traction", "--set", "nu=０.３"], {}, "ASCII"),
+    ("negative-spacing", ["run", "bar1d-traction", "--set", "spacing=-1"], {}, "spacing='-1'"),
+    ("zero-spacing", ["run", "bar1d-traction", "--set", "spacing=0"], {}, "spacing='0'"),
+    ("text-spacing", ["run", "bar1d-traction", "--set", "spacing=abc"], {}, "spacing='abc'"),
+    ("spacing-not-dividing", ["run", "bar1d-traction", "--set", "spacing=0.07"], {},
+     "must divide"),
+    ("nu-half", ["run", "bar1d-traction", "--set", "nu=0.5"], {}, "nu='0.5'"),
+    ("nu-below", ["run", "bar1d-traction", "--set", "nu=-1"], {}, "nu='-1'"),
+    ("m-ratio-small", ["run", "bar1d-traction", "--set", "m_ratio=0.5"], {}, "m_ratio='0.5'"),
+    ("length-inf", ["run", "bar1d-traction", "--set", "length=inf"], {}, "length='inf'"),
+    ("area-negative", ["run", "bar1d-traction", "--set", "area=-0.01"], {}, "area='-0.01'"),
+    ("E-zero", ["run", "bar1d-traction", "--set", "E=0"], {}, "E='0'"),
+    ("influence-unknown", ["run", "bar1d-traction", "--set", "influence=nope"], {},
+     "influence='nope'"),
+    ("order-too-large-1d", ["run", "bar1d-sine-load", "--method", "taylor-fictitious",
+                            "--set", "order=10"], {}, "order=10 is too large"),
+    ("plate-order-too-large", ["run", "plate2d-clamped", "--method", "taylor-fictitious",
+                               "--set", "order=20"], {}, "order=20 needs 21"),
+    ("plate-spacing", ["run", "plate2d-clamped", "--method", "none", "--set",
+                       "spacing=0.07"], {}, "spacing=0.07 must divide"),
+    ("plate-corners", ["run", "plate2d-clamped", "--method", "taylor-fictitious", "--set",
+                       "corners=diagonal"], {}, "corners='diagonal'"),
+    ("plate-body-force", ["run", "plate2d-clamped", "--method", "none", "--set",
+                          "body_force=0"], {}, "body_force=0"),
+    ("plate-ring-value", ["run", "plate2d-clamped", "--method", "none", "--set",
+                          "ring_value=maybe"], {}, "ring_value='maybe'"),
+    ("fem-levels", ["run", "plate2d-clamped", "--set", "levels=1"], {}, "levels"),
+    ("sheet-nu", ["run", "sheet2d-tension", "--method", "none", "--set", "nu=0.3"], {},
+     "nu=0.3 is not allowed"),
+    ("sheet-m-ratio", ["run", "sheet2d-clamped", "--method", "none", "--set",
+                       "m_ratio=1.5"], {}, "m_ratio=1.5"),
+    ("sheet-virtual-m", ["run", "sheet2d-clamped", "--method", "virtual-nodes", "--set",
+                         "m_ratio=6.3"], {}, "m_ratio"),
+    ("box-spacing", ["run", "body3d-traction", "--method", "none", "--set", "spacing=0.07"],
+     {}, "must divide"),
+    ("box-order", ["run", "body3d-traction", "--method", "surface-nodes", "--set", "order=4"],
+     {}, "order='4'"),
+    ("manufactured-influence", ["run", "body3d-manufactured", "--method", "none", "--set",
+                                "influence=hyperbolic"], {}, "influence=hyperbolic"),
+    ("bool-text", ["run", "sheet2d-clamped", "--method", "virtual-nodes", "--set",
+                   "correct_sides=perhaps"], {}, "correct_sides='perhaps'"),
+    # ---------------------------------------------------------------- run: --json
+    ("json-empty", ["run", "bar1d-traction", "--json", ""], {}, "--json ''"),
+    ("json-folder", ["run", "bar1d-traction", "--json", "adir"], {"adir": None}, "is a folder"),
+    ("json-trailing-slash", ["run", "bar1d-traction", "--json", "new/"], {}, "is a folder"),
+    ("json-proc", ["run", "bar1d-traction", "--json", "/proc/nope/x.json"], {},
+     "cannot write there"),
+    ("json-under-file", ["run", "bar1d-traction", "--json", "afile/x.json"],
+     {"afile": "x"}, "is a file"),
+    # ---------------------------------------------------------------- report
+    ("out-empty", ["report", "--out", ""], {}, "--out ''"),
+    ("out-file", ["report", "--out", "afile"], {"afile": "x"}, "is a file"),
+    ("out-proc", ["report", "--out", "/proc/nope"], {}, "cannot write there"),
+    ("out-results-folder", ["report", "--out", "r"], {"r": None, "r/results.json": None},
+     "results.json there is a folder"),
+    ("out-index-folder", ["report", "--out", "r"], {"r": None, "r/index.html": None},
+     "index.html there is a folder"),
+    ("out-figures-file", ["report", "--out", "r"], {"r": None, "r/figures": "x"},
+     "figures there is a file"),
+    ("jobs-zero", ["report", "--jobs", "0"], {}, "--jobs=0"),
+    ("jobs-negative", ["report", "--jobs", "-1"], {}, "--jobs=-1"),
+    ("jobs-huge", ["report", "--jobs", "1000"], {}, "--jobs=1000"),
+    ("jobs-text", ["report", "--jobs", "many"], {}, "--jobs"),
+    ("only-unknown", ["report", "--only", "no-such"], {}, "unknown scene"),
+    ("only-twice", ["report", "--only", "bar1d-traction", "bar1d-traction"], {}, "given twice"),
+    ("only-empty", ["report", "--only"], {}, "--only"),
+    # ---------------------------------------------------------------- compare
+    ("cmp-missing", ["compare", "missing.json", "b.json"], {"b.json": json.dumps(_doc([]))},
+     "does not exist"),
+    ("cmp-folder", ["compare", "adir", "b.json"], {"adir": None, "b.json": json.dumps(_doc([]))},
+     "is a folder"),
+    ("cmp-not-json", ["compare", "a.json", "b.json"],
+     {"a.json": "{not json", "b.json": json.dumps(_doc([]))}, "not valid JSON"),
+    ("cmp-binary", ["compare", "a.json", "b.json"],
+     {"a.json": b"\xff\xfe\x00", "b.json": json.dumps(_doc([]))}, "a.json"),
+    ("cmp-schema", ["compare", "a.json", "b.json"],
+     {"a.json": json.dumps(_doc([], "other/1")), "b.json": json.dumps(_doc([]))}, "schema"),
+    ("cmp-runs-not-list", ["compare", "a.json", "b.json"],
+     {"a.json": json.dumps({"schema": "pdverify.results/1", "runs": {}}),
+      "b.json": json.dumps(_doc([]))}, "'runs' must be a list"),
+    ("cmp-run-string", ["compare", "a.json", "b.json"],
+     {"a.json": json.dumps(_doc(["run"])), "b.json": json.dumps(_doc([]))},
+     "runs[0] must be an object"),
+    ("cmp-metrics-null", ["compare", "a.json", "b.json"],
+     {"a.json": json.dumps(_doc([{**GOOD_RUN, "metrics": None}])),
+      "b.json": json.dumps(_doc([]))}, "runs[0].metrics must be an object"),
+    ("cmp-missing-scene", ["compare", "a.json", "b.json"],
+     {"a.json": json.dumps(_doc([{k: v for k, v in GOOD_RUN.items() if k != "scene"}])),
+      "b.json": json.dumps(_doc([]))}, "has no 'scene'"),
+    ("cmp-bad-status", ["compare", "a.json", "b.json"],
+     {"a.json": json.dumps(_doc([{**GOOD_RUN, "status": "fine"}])),
+      "b.json": json.dumps(_doc([]))}, "status must be"),
+    ("cmp-metric-list", ["compare", "a.json", "b.json"],
+     {"a.json": json.dumps(_doc([GOOD_RUN])),
+      "b.json": json.dumps(_doc([{**GOOD_RUN, "metrics": {"max_error_pct": [1]}}]))},
+     "b.json: runs[0].metrics.max_error_pct"),
+    ("cmp-rtol-negative", ["compare", "a.json", "a.json", "--rtol", "-1"],
+     {"a.json": json.dumps(_doc([GOOD_RUN]))}, "--rtol=-1"),
+    ("cmp-rtol-nan", ["compare", "a.json", "a.json", "--rtol", "nan"],
+     {"a.json": json.dumps(_doc([GOOD_RUN]))}, "--rtol=nan"),
+    ("cmp-atol-inf", ["compare", "a.json", "a.json", "--atol", "inf"],
+     {"a.json": json.dumps(_doc([GOOD_RUN]))}, "--atol=inf"),
+    ("cmp-summary-empty", ["compare", "a.json", "a.json", "--summary", ""],
+     {"a.json": json.dumps(_doc([GOOD_RUN]))}, "--summary ''"),
+    ("cmp-summary-folder", ["compare", "a.json", "a.json", "--summary", "adir"],
+     {"a.json": json.dumps(_doc([GOOD_RUN])), "adir": None}, "is a folder"),
+]
+
+
+def _snapshot(root):
+    out = {}
+    for dirpath, dirnames, filenames in os.walk(root):
+        for n in dirnames + filenames:
+            p = os.path.join(dirpath, n)
+            out[os.path.relpath(p, root)] = os.path.getsize(p) if os.path.isfile(p) else None
+    return out
+
+
+def test_at_least_60_distinct_cases():
+    assert len({c[0] for c in CASES}) == len(CASES) >= 60
+
+
+@pytest.mark.parametrize("name, argv, files, needle", CASES, ids=[c[0] for c in CASES])
+def test_bad_input(name, argv, files, needle, tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("PDVERIFY_CACHE_DIR", str(tmp_path / ".cache-unused"))
+    for rel, content in files.items():
+        p = tmp_path / rel
+        if content is None:
+            p.mkdir(parents=True, exist_ok=True)
+        elif isinstance(content, bytes):
+            p.write_bytes(content)
+        else:
+            p.write_text(content)
+    before = _snapshot(tmp_path)
+    code = main(argv)
+    err = capsys.readouterr().err
+    assert code == 2
+    assert err.count("\n") == 1 and err.startswith("pdverify: error: "), err
+    assert "Traceback" not in err
+    assert needle in err, err
+    assert _snapshot(tmp_path) == before          # nothing written, nothing created
