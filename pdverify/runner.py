@@ -1,6 +1,7 @@
 """Running scenes: one run for the CLI, and a batch (optionally in parallel) for the report."""
 from __future__ import annotations
 
+import os
 import sys
 
 from .errors import InputError
@@ -50,8 +51,29 @@ def plan(only=None, quick=False) -> list[tuple[str, str, dict]]:
     return cases
 
 
-def _worker(conn) -> None:
-    """Worker process: run the cases it receives, send back each result; None ends it."""
+def _die_with_parent(parent_pid: int) -> None:
+    """Linux: have the kernel kill this worker when the report process dies (SIGKILL
+    included), so no orphan keeps computing, or holds the output lock and pipes."""
+    import ctypes
+    import signal
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(1, int(signal.SIGKILL))           # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):                # not Linux: orphans end at EOF instead
+        pass
+    if os.getppid() != parent_pid:                   # the parent died before prctl
+        os._exit(1)
+
+
+def _worker(conn, inherited, parent_pid) -> None:
+    """Worker process: run the cases it receives, send back each result; None ends it.
+
+    ``inherited``: the supervisor's ends of the pipes, copied by fork; closed at once so
+    that each pipe reaches EOF when the supervisor's own end closes.
+    """
+    _die_with_parent(parent_pid)
+    for c in inherited:
+        c.close()
     while True:
         try:
             case = conn.recv()
@@ -116,7 +138,8 @@ def run_cases(cases, *, jobs: int = 1, progress=None) -> list[RunResult]:
 
     def start():
         parent, child = ctx.Pipe()
-        proc = ctx.Process(target=_worker, args=(child,), daemon=True)
+        proc = ctx.Process(target=_worker, args=(child, [parent, *workers], os.getpid()),
+                           daemon=True)
         proc.start()
         child.close()
         workers[parent] = [proc, None]

@@ -25,8 +25,9 @@ class FemReference(Scene):
     The run calls the converged, cached reference of ``reference_fem`` (a refinement
     study; see its docstring for meshes, elements and every choice) and records its
     metrics, including ``refinement_change_pct`` (change of the compared quantity over
-    the last refinement). Timings are this run's wall time (near zero on a cache hit);
-    the study's own cost per level is in the refinement table of the report.
+    the last refinement). Timings are this run's wall time (near zero on a cache hit)
+    plus ``reference_study_s`` (the whole study as first computed) and the converged
+    level's setup and solve; the cost per level is in the refinement table of the report.
     """
 
     reference = "fem"
@@ -58,9 +59,12 @@ class FemReference(Scene):
         size = {"dofs": int(last.dofs), "levels": len(res.refinement)}
         fields = {"refinement": res.refinement_table(), "quantity_name": res.quantity_name,
                   "grid": res.sample_grid((121, 121))}
-        diagnostics = {"from_cache": bool(res.from_cache), "study_s": float(res.study_s),
-                       "converged_setup_s": float(res.setup_s),
-                       "converged_solve_s": float(res.solve_s)}
+        # the study's own cost (as first computed, also on a cache hit) sits with the
+        # timings, so that everything outside "timings" is reproducible bit for bit
+        timer.phases.update(reference_study=float(res.study_s),
+                            reference_converged_setup=float(res.setup_s),
+                            reference_converged_solve=float(res.solve_s))
+        diagnostics = {"from_cache": bool(res.from_cache)}
         return Outcome(metrics=metrics, size=size, fields=self.extra_fields(res, fields),
                        diagnostics=diagnostics)
 

@@ -1,0 +1,104 @@
+"""The report folder is swapped in whole (kills leave the previous report intact), and
+results are reproducible bit for bit (issue 18)."""
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+SCENES = ["bar1d-traction", "bar1d-uniform-load", "plate2d-clamped", "sheet2d-tension"]
+
+
+def _report(out, *extra, env=None):
+    return subprocess.Popen([sys.executable, "-m", "pdverify", "report", "--quick", "--out",
+                             str(out), "--only", *SCENES, *extra],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+
+
+def _strip(doc):
+    doc = dict(doc)
+    for key in ("created", "machine"):
+        doc.pop(key)
+    doc["runs"] = [{k: v for k, v in r.items() if k != "timings"} for r in doc["runs"]]
+    return doc
+
+
+@pytest.fixture(scope="module")
+def env(tmp_path_factory):
+    e = dict(os.environ, PDVERIFY_CACHE_DIR=str(tmp_path_factory.mktemp("cache")))
+    return e
+
+
+def test_results_are_bitwise_reproducible_across_runs_and_jobs(tmp_path, env):
+    docs = []
+    for k, jobs in enumerate((1, 1, 2)):
+        p = _report(tmp_path / f"r{k}", "--jobs", str(jobs), env=env)
+        p.communicate()
+        assert p.returncode == 0
+        docs.append(json.loads((tmp_path / f"r{k}" / "results.json").read_text()))
+    # the first run computed the FEM references, the others read them from the cache
+    for d in docs[1:]:
+        for r in d["runs"]:
+            r["diagnostics"].pop("from_cache", None)
+    for r in docs[0]["runs"]:
+        r["diagnostics"].pop("from_cache", None)
+    assert json.dumps(_strip(docs[0])) == json.dumps(_strip(docs[1])) == json.dumps(_strip(docs[2]))
+
+
+def _leftovers(parent, name):
+    return [e for e in os.listdir(parent) if e.startswith(f".{name}.staging-")
+            or e.startswith(f".{name}.old-") or e.startswith(".tmp-")]
+
+
+def test_killed_reports_leave_the_previous_one_intact(tmp_path, env):
+    out = tmp_path / "rep"
+    for _ in range(2):              # the second run is timed: FEM references cached
+        t0 = time.perf_counter()
+        p = _report(out, env=env)
+        p.communicate()
+        duration = time.perf_counter() - t0
+        assert p.returncode == 0
+    before = {n: (out / n).read_bytes() for n in ("results.json", "index.html")}
+    figures = sorted(os.listdir(out / "figures"))
+    in_figure_phase = 0
+    points = [0.1, 0.25, 0.4, 0.55, 0.7, 0.8, 0.86, 0.9, 0.94, 0.97, 0.99, 1.02]
+    for k, frac in enumerate(points):
+        sig = signal.SIGKILL if k % 2 else signal.SIGTERM
+        p = _report(out, env=env)
+        time.sleep(frac * duration)
+        p.send_signal(sig)
+        _, err = p.communicate()
+        if "[" in err and "report:" not in err:
+            done = [line for line in err.splitlines() if line.startswith("[")]
+            if done:
+                k_done, total = done[-1][1:].split("]")[0].split("/")
+                in_figure_phase += k_done == total
+        if "report:" in err:        # it finished before the signal: a new, whole report
+            before = {n: (out / n).read_bytes() for n in ("results.json", "index.html")}
+            continue
+        # killed: the previous report is untouched
+        assert {n: (out / n).read_bytes() for n in before} == before
+        assert sorted(os.listdir(out / "figures")) == figures
+        if sig == signal.SIGTERM:   # unwinds: its staging folder is gone at once
+            assert _leftovers(tmp_path, "rep") == []
+    assert in_figure_phase >= 1, "no kill landed after the last run (figure phase)"
+    # a SIGKILL cannot clean up; the next report into the folder removes what it left
+    p = _report(out, env=env)
+    p.communicate()
+    assert p.returncode == 0
+    assert _leftovers(tmp_path, "rep") == []
+
+
+def test_second_report_into_the_same_folder_is_refused(tmp_path, env):
+    out = tmp_path / "rep"
+    first = _report(out, env=env)
+    time.sleep(1.5)
+    second = _report(out, env=env)
+    _, err = second.communicate()
+    first.communicate()
+    assert second.returncode == 2
+    assert "is being written by pdverify report (pid" in err and err.count("\n") == 1
+    assert first.returncode == 0
