@@ -48,6 +48,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _terminate(signum, frame):  # SIGTERM: unwind like Ctrl-C, so cleanups run
+    from .errors import STOP_REQUESTED
+    STOP_REQUESTED["flag"] = True
     raise KeyboardInterrupt
 
 

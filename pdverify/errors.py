@@ -15,3 +15,8 @@ class NumericalError(RuntimeError):
     The message says what happened and where; the run is recorded as failed and
     never aborts a report.
     """
+
+
+#: Set when the process was asked to stop (SIGTERM, Ctrl-C): a step that finishes after a
+#: library swallowed the interrupt checks it before publishing anything.
+STOP_REQUESTED = {"flag": False}

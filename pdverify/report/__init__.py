@@ -9,7 +9,7 @@ import tempfile
 import time
 from contextlib import contextmanager
 
-from ..errors import InputError
+from ..errors import STOP_REQUESTED, InputError
 from ..results import atomic_write_text, umask_mode, write_results
 from ..runner import plan, run_cases
 from ..scenes import get_scene
@@ -88,6 +88,8 @@ def build_report(*, out=None, quick=False, only=None, jobs=1, progress=None) -> 
         os.chmod(staging, umask_mode(0o777))  # mkdtemp gives 0700
         try:
             code = _build(cases, staging, out, jobs, progress)
+            if STOP_REQUESTED["flag"]:  # an interrupt some library swallowed: publish nothing
+                raise KeyboardInterrupt
             _swap_in(staging, out)
         finally:
             if os.path.exists(staging):
