@@ -16,8 +16,8 @@ import time
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
+from _splu_timing import time_splu
 from pdverify.pd import StateBasedConstants
 from pdverify.scenes import get_scene
 from pdverify.scenes.plate2d import StatePlate
@@ -42,19 +42,10 @@ def main(argv=None):
     out = {"orderings": {}, "runs": {}}
     for h in (0.05, 0.025):
         A = lagrange_system(h)
-        b = np.random.default_rng(0).normal(size=A.shape[0])
-        times = {k: [] for k in ORDERINGS}
-        for _ in range(args.repeat):        # alternate, so drift hits every alternative alike
-            for name in ORDERINGS:
-                t0 = time.perf_counter()
-                x = spla.splu(A, permc_spec=name).solve(b)
-                times[name].append(time.perf_counter() - t0)
-                res = np.linalg.norm(A @ x - b) / np.linalg.norm(b)
-                assert res < 1e-8, (name, res)
-        base = np.median(times["COLAMD"])
+        medians = time_splu(A, {name: {"permc_spec": name} for name in ORDERINGS}, args.repeat)
+        base = medians["COLAMD"]
         print(f"spacing {h} m: {A.shape[0]} unknowns, {A.nnz} non-zeros; median of {args.repeat}")
-        for name, ts in times.items():
-            med = float(np.median(ts))
+        for name, med in medians.items():
             print(f"  splu {name:15s} {med:7.2f} s   speed-up vs COLAMD {base / med:5.2f}x")
             out["orderings"][f"{h}/{name}"] = med
     scene = get_scene("plate2d-clamped")

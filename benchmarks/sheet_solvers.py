@@ -7,11 +7,10 @@ default (COLAMD) ordering; the choice it supports is ``pdverify.solvers.static.S
 from __future__ import annotations
 
 import argparse
-import time
 
 import numpy as np
-import scipy.sparse.linalg as spla
 
+from _splu_timing import time_splu
 from pdverify.scenes import get_scene
 from pdverify.solvers.static import SPD_OPTIONS
 
@@ -40,24 +39,15 @@ def main(argv=None):
     ap.add_argument("--repeat", type=int, default=5)
     args = ap.parse_args(argv)
     K = sheet_matrix()
-    b = np.random.default_rng(0).normal(size=K.shape[0])
     alternatives = {
         "splu COLAMD (default)": {},
         "splu MMD_AT_PLUS_A": dict(permc_spec="MMD_AT_PLUS_A"),
         "splu SPD_OPTIONS (symmetric mode)": SPD_OPTIONS,
     }
-    times = {k: [] for k in alternatives}
-    for _ in range(args.repeat):            # alternate, so drift hits every alternative alike
-        for name, opts in alternatives.items():
-            t0 = time.perf_counter()
-            x = spla.splu(K, **opts).solve(b)
-            times[name].append(time.perf_counter() - t0)
-            res = np.linalg.norm(K @ x - b) / np.linalg.norm(b)
-            assert res < 1e-8, (name, res)
-    base = np.median(times["splu COLAMD (default)"])
+    medians = time_splu(K, alternatives, args.repeat)
+    base = medians["splu COLAMD (default)"]
     print(f"matrix: {K.shape[0]} unknowns, {K.nnz} non-zeros; median of {args.repeat}")
-    for name, ts in times.items():
-        med = np.median(ts)
+    for name, med in medians.items():
         print(f"  {name:36s} {med:7.3f} s   ratio to default {med / base:5.2f}")
 
 

@@ -35,18 +35,21 @@ def max_error_of_peak_pct(u, u_ref, peak: float | None = None) -> float:
     return float(np.max(np.abs(u - u_ref)) / scale * 100.0)
 
 
-def rel_l2_error(u, u_ref) -> float:
-    """||u - u_ref||_2 / ||u_ref||_2 over the given (real) nodes (DESIGN.md).
+def scaled_norm(v) -> float:
+    """||v||_2 computed as m ||v / m|| with m = max |v|: no square under- or overflows, so
+    values of 1e+-300 give the same relative measures as values of 1."""
+    v = np.asarray(v, dtype=float).ravel()
+    m = float(np.max(np.abs(v))) if v.size else 0.0
+    return 0.0 if m == 0.0 or not np.isfinite(m) else m * float(np.linalg.norm(v / m))
 
-    Scale-free: both are divided by max |u_ref| before any square is formed, so loads of
-    1e-300 or moduli of 1e300 neither underflow nor overflow the norms."""
+
+def rel_l2_error(u, u_ref) -> float:
+    """||u - u_ref||_2 / ||u_ref||_2 over the given (real) nodes (DESIGN.md), scale-free
+    (:func:`scaled_norm`); NaN when the reference is zero."""
     u = np.asarray(u, dtype=float).ravel()
     u_ref = np.asarray(u_ref, dtype=float).ravel()
-    scale = float(np.max(np.abs(u_ref))) if u_ref.size else 0.0
-    if scale == 0.0 or not np.isfinite(scale):
-        return float("nan")
-    return float(np.linalg.norm(u / scale - u_ref / scale) / np.linalg.norm(u_ref / scale))
-
+    ref = scaled_norm(u_ref)
+    return float(scaled_norm(u - u_ref) / ref) if ref > 0 else float("nan")
 
 
 def _harmonic_residual(t, y, frequency, harmonics) -> float:

@@ -149,7 +149,7 @@ def write_results(path, runs: list[RunResult]) -> dict:
     return doc
 
 
-#: What a run of pdverify.results/1 must hold: key -> (allowed types, description).
+#: What a run of pdverify.results/1 must hold (key -> allowed types), and may hold.
 _RUN_FIELDS = {"scene": (str,), "method": (str,), "params": (dict,), "status": (str,),
                "metrics": (dict,)}
 _OPTIONAL_RUN_FIELDS = {"reference": (str,), "message": (str,), "timings": (dict,),
@@ -167,7 +167,7 @@ def check_schema(doc, path) -> None:
     for k, run in enumerate(doc["runs"]):
         if not isinstance(run, dict):
             raise ValueError(f"{path}: runs[{k}] must be an object, got {type(run).__name__}")
-        for name, types in _RUN_FIELDS.items():
+        for name in _RUN_FIELDS:
             if name not in run:
                 raise ValueError(f"{path}: runs[{k}] has no {name!r}")
         for name, types in {**_RUN_FIELDS, **_OPTIONAL_RUN_FIELDS}.items():

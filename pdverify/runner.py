@@ -133,7 +133,7 @@ def run_cases(cases, *, jobs: int = 1, progress=None) -> list[RunResult]:
                   file=progress, flush=True)
 
     ctx = mp.get_context("fork")
-    workers = {}          # connection -> (process, index of the case it runs or None)
+    workers = {}          # connection -> [process, index of the case it runs or None]
     pending = list(range(total))
 
     def start():
@@ -143,6 +143,7 @@ def run_cases(cases, *, jobs: int = 1, progress=None) -> list[RunResult]:
         proc.start()
         child.close()
         workers[parent] = [proc, None]
+        return parent
 
     def give(conn):
         if pending:
@@ -175,8 +176,7 @@ def run_cases(cases, *, jobs: int = 1, progress=None) -> list[RunResult]:
                         res = _died(cases[k], proc.exitcode)
                         conn.close()
                         del workers[conn]
-                        start()
-                        conn = list(workers)[-1]
+                        conn = start()
                     results[k] = res
                     done += 1
                     note(k, res)
@@ -185,7 +185,7 @@ def run_cases(cases, *, jobs: int = 1, progress=None) -> list[RunResult]:
         for conn, (proc, _) in workers.items():
             try:
                 conn.send(None)
-            except (OSError, BrokenPipeError):
+            except OSError:  # the worker is gone (BrokenPipeError)
                 pass
             conn.close()
         for conn, (proc, _) in workers.items():

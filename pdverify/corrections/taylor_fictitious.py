@@ -88,9 +88,8 @@ def fictitious_closure(grid, order: int) -> Closure:
 def boundary_lines(grid, face: int) -> np.ndarray:
     """Integer indices (n_lines, dim) of the real nodes nearest ``face`` (= 2 axis + side):
     the anchor of each line perpendicular to that face."""
-    axis, side = divmod(face, 2)
     real = grid.index[grid.interior_ids]
-    return real[real[:, axis] == (0 if side == 0 else grid.nodes_per_axis[axis] - 1)]
+    return real[real[:, face // 2] == grid.boundary_layer(face)]
 
 
 def boundary_value_rows(grid, order: int, face: int) -> tuple[sp.csr_matrix, np.ndarray]:
@@ -102,11 +101,10 @@ def boundary_value_rows(grid, order: int, face: int) -> tuple[sp.csr_matrix, np.
     axis, side = divmod(face, 2)
     anchors = boundary_lines(grid, face)
     inward = 1 if side == 0 else -1
-    face_x = grid.origin[axis] + (0.0 if side == 0 else grid.lengths[axis])
     x_anchor = grid.x[grid.ext_id(anchors[:1]), axis][0]
+    target = (grid.face_coordinate(face) - x_anchor) / grid.spacing   # in spacings
     s = np.arange(order + 1)
-    w = taylor_extrapolation_weights(s * inward, [(face_x - x_anchor) / grid.spacing], order,
-                                     anchor=0.0, scale=1.0)[0]
+    w = taylor_extrapolation_weights(s * inward, [target], order, anchor=0.0, scale=1.0)[0]
     nodes = anchors[:, None, :] + np.outer(s * inward, np.eye(grid.dim, dtype=int)[axis])[None]
     cols = grid.interior_number[grid.ext_id(nodes)]
     rows = np.repeat(np.arange(anchors.shape[0]), s.size)
@@ -136,15 +134,14 @@ def clamped_rows(grid, order: int, faces, corners: str = "normal-only"):
     n, d = grid.n_interior, grid.dim
     blocks, points, comps = [], [], []
     for face in faces:
-        axis, side = divmod(face, 2)
+        axis = face // 2
         R, anchors = boundary_value_rows(grid, order, face)
         at_corner = np.zeros(anchors.shape[0], dtype=bool)
         for other in faces:
-            t, t_side = divmod(other, 2)
-            if t != axis:
-                at_corner |= anchors[:, t] == (0 if t_side == 0 else grid.nodes_per_axis[t] - 1)
+            if other // 2 != axis:
+                at_corner |= anchors[:, other // 2] == grid.boundary_layer(other)
         x = grid.x[grid.ext_id(anchors)]
-        x[:, axis] = grid.origin[axis] + (0.0 if side == 0 else grid.lengths[axis])
+        x[:, axis] = grid.face_coordinate(face)
         for k in range(d):
             keep = np.flatnonzero(np.ones_like(at_corner) if (corners == "both" or k == axis)
                                   else ~at_corner)

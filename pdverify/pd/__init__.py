@@ -10,8 +10,8 @@ from .closure import Closure
 from .grid import BoxGrid
 from .influence import (INFLUENCES, StateBasedConstants, bond_micromodulus, get_influence,
                         material_kind)
-from .statebased import StateBasedModel
+from .statebased import StateBasedModel, state_based_stencil
 
 __all__ = ["BondBasedModel", "BoxGrid", "Closure", "INFLUENCES", "QUADRATURES", "StateBasedConstants",
-           "StateBasedModel", "Stencil", "bond_micromodulus", "bond_pairs", "build_stencil",
+           "StateBasedModel", "state_based_stencil", "Stencil", "bond_micromodulus", "bond_pairs", "build_stencil",
            "get_influence", "material_kind", "partial_volumes", "stencil_offsets"]

@@ -102,6 +102,16 @@ class BoxGrid:
         index = np.asarray(index) + self.layers
         return np.ravel_multi_index(tuple(np.moveaxis(index, -1, 0)), self.ext_shape)
 
+    def face_coordinate(self, face: int) -> float:
+        """Coordinate of ``face`` (= 2 axis + side) along its axis."""
+        axis, side = divmod(face, 2)
+        return self.origin[axis] + (0.0 if side == 0 else self.lengths[axis])
+
+    def boundary_layer(self, face: int) -> int:
+        """Index, along the face's axis, of the layer of real nodes nearest ``face``."""
+        axis, side = divmod(face, 2)
+        return 0 if side == 0 else self.nodes_per_axis[axis] - 1
+
     def tangential_axes(self, axis: int) -> tuple:
         return tuple(a for a in range(self.dim) if a != axis)
 
@@ -120,7 +130,7 @@ class BoxGrid:
                 cidx[:, list(tang)] = t_idx
                 cidx[:, axis] = 0 if side == 0 else self.cells[axis] - 1
                 x = np.asarray(self.origin) + (cidx + 0.5) * h
-                x[:, axis] = self.origin[axis] + (0.0 if side == 0 else self.lengths[axis])
+                x[:, axis] = self.face_coordinate(2 * axis + side)
                 nrm = np.zeros((n, self.dim))
                 nrm[:, axis] = -1.0 if side == 0 else 1.0
                 faces.append((axis, side, shape))

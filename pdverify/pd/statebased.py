@@ -4,10 +4,24 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from .bonds import Stencil, bond_pairs
+from .bonds import Stencil, bond_pairs, build_stencil
 from .closure import Closure, real_identity
 from .grid import BoxGrid
 from .influence import Influence, StateBasedConstants
+
+
+def state_based_stencil(dim: int, m_ratio: float, spacing: float, influence: Influence,
+                        quadrature: str = "partial-volume") -> Stencil:
+    """:func:`~pdverify.pd.bonds.build_stencil` for a state-based model: with
+    ``moment-corrected`` the fourth moment made isotropic is the one of the state-based
+    weight omega |xi|^2 (the discrete bulk then has the continuum moduli)."""
+    h, delta = float(spacing), float(m_ratio) * float(spacing)
+
+    def moment_weight(offsets):
+        r = np.linalg.norm(offsets, axis=1) * h
+        return influence.omega(r, delta) * r ** 2
+
+    return build_stencil(dim, float(m_ratio), quadrature=quadrature, moment_weight=moment_weight)
 
 
 class StateBasedModel:

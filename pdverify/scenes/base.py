@@ -36,6 +36,19 @@ def require_influence(scene_id: str, method: str, p: dict, allowed: str, why: st
                          f"supported here; allowed: {allowed} ({why})")
 
 
+def whole_cells(where: str, spacing: float, lengths, label: str = "spacing") -> list[int]:
+    """Cells along each of ``lengths`` ((name, L) pairs); refuse (one line, exit 2) a
+    ``spacing`` that does not divide every L into a whole number (>= 2) of cells."""
+    counts = []
+    for name, L in lengths:
+        n = L / spacing
+        if abs(n - round(n)) > 1e-9 * max(n, 1.0) or round(n) < 2:
+            raise InputError(f"{where}: {label}={spacing:g} must divide {name}={L:g} into a "
+                             "whole number (>= 2) of cells")
+        counts.append(int(round(n)))
+    return counts
+
+
 @dataclass
 class Outcome:
     """What a scene's ``solve`` returns: numbers for JSON and arrays for figures."""

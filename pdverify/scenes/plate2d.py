@@ -9,11 +9,11 @@ from ..corrections.taylor_fictitious import (CORNER_RULES, clamped_rows, fictiti
 from ..errors import InputError
 from ..metrics import rel_l2_error
 from ..params import Param, at_least, positive
-from ..pd import (QUADRATURES, BoxGrid, StateBasedConstants, StateBasedModel, build_stencil,
-                  get_influence)
+from ..pd import (QUADRATURES, BoxGrid, StateBasedConstants, StateBasedModel, get_influence,
+                  state_based_stencil)
 from ..solvers.dense import solve_with_dirichlet
 from ..solvers.static import solve_constrained
-from . import Outcome, Published, influence_param, register
+from . import Outcome, Published, influence_param, register, whole_cells
 from .fem_references import FemAndPD
 
 #: SuperLU ordering of both PD solves here: minimum degree on A + A^T, 2.9x faster than
@@ -43,16 +43,9 @@ class StatePlate:
                  order=None, quadrature="partial-volume", thickness=1.0,
                  corners="normal-only"):
         inf = get_influence(influence)
-        h, delta = float(spacing), float(m_ratio) * float(spacing)
-
-        def moment_weight(offsets):
-            r = np.linalg.norm(offsets, axis=1) * h
-            return inf.omega(r, delta) * r ** 2
-
-        stencil = build_stencil(2, float(m_ratio), quadrature=quadrature,
-                                moment_weight=moment_weight)
+        stencil = state_based_stencil(2, m_ratio, spacing, inf, quadrature)
         self.order = order
-        self.grid = g = BoxGrid(tuple(lengths), (0.0, 0.0), h,
+        self.grid = g = BoxGrid(tuple(lengths), (0.0, 0.0), float(spacing),
                                 stencil.reach if order is not None else 0)
         closure = fictitious_closure(g, order) if order is not None else None
         self.model = StateBasedModel(g, stencil, constants, inf, closure, thickness=thickness)
@@ -223,14 +216,7 @@ class ClampedPlate(FemAndPD):
     m_sweep_horizon = 0.2
 
     def check_pd(self, where, method, p):
-        h = p["spacing"]
-        n_axis = []
-        for name in ("length", "width"):
-            n = p[name] / h
-            if not np.isfinite(n) or abs(n - round(n)) > 1e-9 * max(n, 1.0) or round(n) < 2:
-                raise InputError(f"{where}: spacing={h:g} must divide {name}={p[name]:g} into "
-                                 "a whole number (>= 2) of cells")
-            n_axis.append(int(round(n)))
+        n_axis = whole_cells(where, p["spacing"], [(k, p[k]) for k in ("length", "width")])
         if method == "taylor-fictitious":
             need = needed_nodes(p["order"])
             if min(n_axis) < need:

@@ -10,7 +10,7 @@ from ..params import Param, at_least, positive
 from ..pd import BondBasedModel, BoxGrid, Closure, bond_micromodulus, build_stencil, get_influence
 from ..pd.influence import bond_based_nu
 from ..solvers.dense import solve_with_dirichlet
-from . import Outcome, Published, register
+from . import Outcome, Published, register, whole_cells
 from .fem_references import FemAndPD
 
 MICROMODULI = ("constant", "conical")
@@ -66,11 +66,7 @@ class SheetScene(FemAndPD):
 
 
 def _grid_check(where, lengths, spacing, horizon, label):
-    for name, L in lengths:
-        n = L / spacing
-        if abs(n - round(n)) > 1e-9 * max(n, 1.0) or round(n) < 2:
-            raise InputError(f"{where}: {label}={spacing:g} must divide {name}={L:g} into a "
-                             "whole number (>= 2) of cells")
+    whole_cells(where, spacing, lengths, label)
     m = horizon / spacing
     if m < 2 - 1e-12:
         raise InputError(f"{where}: horizon / spacing = {m:g} must be >= 2 (m = delta / Delta; "

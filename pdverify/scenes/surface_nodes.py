@@ -9,10 +9,11 @@ from ..corrections.surface_nodes import MAX_ORDER, flux_rows, surface_node_closu
 from ..errors import InputError
 from ..metrics import rel_l2_error
 from ..params import Param, at_least, open_interval, positive
-from ..pd import (QUADRATURES, BoxGrid, StateBasedConstants, StateBasedModel, build_stencil,
-                  get_influence)
+from ..pd import (QUADRATURES, BoxGrid, StateBasedConstants, StateBasedModel, get_influence,
+                  state_based_stencil)
 from ..solvers.dense import solve_with_dirichlet
-from . import MethodSpec, Outcome, Published, Scene, influence_param, register, require_influence
+from . import (MethodSpec, Outcome, Published, Scene, influence_param, register,
+               require_influence, whole_cells)
 
 
 class StateBox:
@@ -33,16 +34,10 @@ class StateBox:
                  order: int | None = None, quadrature: str = "partial-volume",
                  influence: str = "gaussian"):
         inf = get_influence(influence)
-        h, delta = float(spacing), float(m_ratio) * float(spacing)
-
-        def moment_weight(offsets):
-            r = np.linalg.norm(offsets, axis=1) * h
-            return inf.omega(r, delta) * r ** 2
-
-        stencil = build_stencil(len(lengths), float(m_ratio), quadrature=quadrature,
-                                moment_weight=moment_weight)
+        stencil = state_based_stencil(len(lengths), m_ratio, spacing, inf, quadrature)
         self.order = order
-        self.grid = BoxGrid(lengths, origin, h, stencil.reach if order is not None else 0)
+        self.grid = BoxGrid(lengths, origin, float(spacing),
+                            stencil.reach if order is not None else 0)
         closure, flux = (surface_node_closure(self.grid, stencil, order) if order is not None
                          else (None, None))
         self.model = model = StateBasedModel(self.grid, stencil, constants, inf, closure)
@@ -252,11 +247,7 @@ class SurfaceNodeScene(Scene):
         where = f"{self.id} --method {method}"
         lengths, _ = self.box(p)
         h = p["spacing"]
-        for name, L in zip("xyz", lengths):
-            n = L / h
-            if abs(n - round(n)) > 1e-9 * max(n, 1.0) or round(n) < 2:
-                raise InputError(f"{where}: spacing={h:g} must divide l_{name}={L:g} into a "
-                                 "whole number (>= 2) of cells")
+        whole_cells(where, h, [(f"l_{name}", L) for name, L in zip("xyz", lengths)])
         if method == "surface-nodes":
             m = p["m_ratio"]
             if abs(m - round(m)) > 1e-12:
@@ -292,10 +283,10 @@ class SurfaceNodeScene(Scene):
                 cells = g.index[g.interior_ids]
                 for face in self.loaded_faces(p):
                     axis, side, _ = g.faces[face]
-                    on = cells[:, axis] == (0 if side == 0 else g.cells[axis] - 1)
+                    on = cells[:, axis] == g.boundary_layer(face)
                     xs = x_int[on].copy()
                     if p.get("load_point", "surface") == "surface":
-                        xs[:, axis] = g.origin[axis] + (0.0 if side == 0 else g.lengths[axis])
+                        xs[:, axis] = g.face_coordinate(face)
                     nrm = np.zeros_like(xs)
                     nrm[:, axis] = -1.0 if side == 0 else 1.0
                     rhs[:ni][on] += self._face_load(face, xs, nrm, p, c, model.horizon, g)

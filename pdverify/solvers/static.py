@@ -6,6 +6,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..errors import NumericalError
+from ..metrics import scaled_norm
 
 #: Above this 1-norm condition estimate the solution has lost (almost) every digit of
 #: double precision (eps ~ 2.2e-16), so the run is refused as near-singular.
@@ -19,11 +20,10 @@ CONDITION_LIMIT = 1e14
 SPD_OPTIONS = dict(permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
                    options=dict(SymmetricMode=True))
 
-#: Column orderings SuperLU offers (``ordering`` of :func:`solve_constrained`). Measured,
-#: not assumed (benchmarks/plate_solvers.py): minimum degree on A + A^T is ~3x faster than
-#: the default COLAMD on the seed-000 plate's Lagrange system, but ~1.6x slower on the
-#: seed-001 surface-node plate, so each scene states its choice.
-ORDERINGS = ("COLAMD", "MMD_AT_PLUS_A", "MMD_ATA", "NATURAL")
+# ``ordering`` of solve_constrained is SuperLU's permc_spec (COLAMD, MMD_AT_PLUS_A,
+# MMD_ATA, NATURAL). Measured, not assumed (benchmarks/plate_solvers.py): minimum degree
+# on A + A^T is ~3x faster than the default COLAMD on the seed-000 plate's Lagrange system,
+# but ~1.6x slower on the seed-001 surface-node plate, so each scene states its choice.
 
 
 def solve_constrained(K, f, B=None, c=None, *, where: str = "static solve", spd: bool = False,
@@ -33,7 +33,7 @@ def solve_constrained(K, f, B=None, c=None, *, where: str = "static solve", spd:
     ``spd=True`` (only without constraints) declares K symmetric positive definite and
     factors it in SuperLU's symmetric mode (:data:`SPD_OPTIONS`); the residual and
     condition checks below guard the claim. Otherwise ``ordering`` is SuperLU's column
-    ordering (:data:`ORDERINGS`), with partial pivoting.
+    ordering (``permc_spec``), with partial pivoting.
 
     Returns ``(u, lam, info)``; ``info`` holds the system size, the relative residual
     and a 1-norm condition estimate. Singular or near-singular systems, and non-finite
@@ -72,20 +72,15 @@ def solve_constrained(K, f, B=None, c=None, *, where: str = "static solve", spd:
 
 
 def relative_residual(A, x, b) -> float:
-    """||A x - b|| / max(||b||, max|A| ||x||), computed scale-free: x and b are divided by
-    max |x| first, so solutions of 1e+-300 neither overflow nor underflow the norms."""
+    """||A x - b|| / max(||b||, max|A| ||x||), scale-free: x and b are divided by max |x|
+    first (and the norms are :func:`~pdverify.metrics.scaled_norm`), so solutions of
+    1e+-300 neither overflow nor underflow."""
     s = float(np.max(np.abs(x))) if np.size(x) else 0.0
     if s == 0.0 or not np.isfinite(s):
         return 0.0 if s == 0.0 and not np.any(b) else float("inf")
     xs, bs = x / s, np.asarray(b, dtype=float) / s
-    r = A @ xs - bs
-    denom = max(_norm(bs), float(abs(A).max()) * _norm(xs), 1e-300)
-    return float(_norm(r) / denom)
-
-
-def _norm(v) -> float:
-    m = float(np.max(np.abs(v))) if np.size(v) else 0.0
-    return 0.0 if m == 0.0 else m * float(np.linalg.norm(v / m))
+    denom = max(scaled_norm(bs), float(abs(A).max()) * scaled_norm(xs), 1e-300)
+    return float(scaled_norm(A @ xs - bs) / denom)
 
 
 def equilibrate(A, where: str):

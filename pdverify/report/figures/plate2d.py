@@ -11,9 +11,10 @@ from . import family, fem_then_pd, node_image, save
 TABLE4 = {**PAPER, "ring_value": "reference"}
 
 
-def _matches(r, **want):
+def _matches(r, ignore=()):
+    """Whether run ``r`` has Table 4's params, apart from those in ``ignore``."""
     return all(abs(r.params.get(k, v) - v) < 1e-12 if isinstance(v, float)
-               else r.params.get(k, v) == v for k, v in {**TABLE4, **want}.items())
+               else r.params.get(k, v) == v for k, v in TABLE4.items() if k not in ignore)
 
 
 def _label(r):
@@ -96,19 +97,16 @@ def _sweep(ax, runs, x_of, xlabel, title):
 
 
 def _convergence(scene, runs, folder):
-    fixed_m = [r for r in runs if abs(r.params["m_ratio"] - 3.0) < 1e-12
-               and r.params.get("ring_value", "reference") == "reference"
-               and r.params.get("corners", "normal-only") == "normal-only"
-               and r.params["influence"] == "hyperbolic"]
-    fixed_d = [r for r in runs if abs(r.params["spacing"] * r.params["m_ratio"] - 0.2) < 1e-9
-               and r.params["quadrature"] == "partial-volume"
-               and r.params.get("ring_value", "reference") == "reference"
-               and r.params["influence"] == "hyperbolic"]
+    delta = scene.m_sweep_horizon
+    fixed_m = [r for r in runs if _matches(r, ignore=("spacing", "quadrature"))]
+    fixed_d = [r for r in runs if _matches(r, ignore=("spacing", "m_ratio"))
+               and abs(r.params["spacing"] * r.params["m_ratio"] - delta) < 1e-9]
+    m = TABLE4["m_ratio"]
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 4.4), layout="constrained")
     ok1 = _sweep(a1, fixed_m, lambda r: r.params["spacing"] * r.params["m_ratio"],
-                 "horizon delta [m] (m = 3 fixed)", "delta-refinement at fixed m = 3")
+                 f"horizon delta [m] (m = {m:g} fixed)", f"delta-refinement at fixed m = {m:g}")
     ok2 = _sweep(a2, fixed_d, lambda r: r.params["m_ratio"],
-                 "m = delta / Delta (delta = 0.2 m fixed)", "m-refinement at fixed delta")
+                 f"m = delta / Delta (delta = {delta:g} m fixed)", "m-refinement at fixed delta")
     if not (ok1 or ok2):
         plt.close(fig)
         return []
