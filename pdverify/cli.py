@@ -12,9 +12,10 @@ Exit codes: 0 success; 1 a run failed numerically or a regression was found;
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 
-from .errors import InputError
+from .errors import STOP_REQUESTED, InputError
 
 
 class _Parser(argparse.ArgumentParser):
@@ -47,18 +48,51 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _terminate(signum, frame):  # SIGTERM: unwind like Ctrl-C, so cleanups run
-    from .errors import STOP_REQUESTED
+_RETRY_S = 0.02  # a stop that landed inside an import is raised this much later
+
+
+def _inside_import_or_exec(frame) -> bool:
+    """True while the main thread runs an import or a string given to ``exec``.
+
+    A KeyboardInterrupt raised there escapes badly: an extension module's init turns it
+    into ``ImportError: initialization failed``, and one raised inside ``exec`` (which
+    dataclasses use to build their methods) makes CPython 3.11 end the process by SIGINT
+    even after the CLI has caught it. Only frames above ``main`` count (``python -c``
+    itself runs from a string).
+    """
+    while frame is not None and frame.f_code is not main.__code__:
+        name = frame.f_code.co_filename
+        if name == "<string>" or name.startswith("<frozen importlib"):
+            return True
+        frame = frame.f_back
+    return False
+
+
+def _terminate(signum, frame):
+    """SIGTERM: unwind like Ctrl-C, so cleanups run. Inside an import or ``exec`` the
+    interrupt waits (SIGALRM re-checks every 20 ms) until that code has returned."""
     STOP_REQUESTED["flag"] = True
+    if _inside_import_or_exec(frame):
+        signal.setitimer(signal.ITIMER_REAL, _RETRY_S)
+        return
     raise KeyboardInterrupt
 
 
-def main(argv=None) -> int:
-    import signal
+def _retry(signum, frame):
+    if STOP_REQUESTED["flag"]:
+        _terminate(signum, frame)
+
+
+def _install_stop_handlers() -> None:
     try:
         signal.signal(signal.SIGTERM, _terminate)
+        signal.signal(signal.SIGALRM, _retry)
     except ValueError:  # not in the main thread (e.g. called from a test's worker thread)
         pass
+
+
+def main(argv=None) -> int:
+    _install_stop_handlers()
     try:
         args = build_parser().parse_args(argv)
         if args.command is None:

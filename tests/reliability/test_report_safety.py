@@ -115,3 +115,21 @@ def test_second_report_into_the_same_folder_is_refused(tmp_path, env):
     assert second.returncode == 2
     assert "is being written by pdverify report (pid" in err and err.count("\n") == 1
     assert first.returncode == 0
+
+
+def test_a_stop_inside_exec_or_import_waits_until_it_has_returned(monkeypatch):
+    """A KeyboardInterrupt raised inside ``exec`` (dataclasses build their methods so) makes
+    CPython 3.11 exit by SIGINT after the CLI caught it, and one raised inside an extension
+    module's init becomes an ImportError: the SIGTERM handler defers it there."""
+    from pdverify import cli
+    from pdverify.errors import STOP_REQUESTED
+    monkeypatch.setitem(STOP_REQUESTED, "flag", False)
+    timers = []
+    monkeypatch.setattr(cli.signal, "setitimer", lambda which, seconds: timers.append(seconds))
+    exec("cli._terminate(signal.SIGTERM, sys._getframe())",
+         {"cli": cli, "signal": signal, "sys": sys})
+    assert STOP_REQUESTED["flag"] and timers == [cli._RETRY_S]
+    with pytest.raises(KeyboardInterrupt):      # the retry, back outside: the stop lands
+        cli._retry(signal.SIGALRM, sys._getframe())
+    STOP_REQUESTED["flag"] = False
+    cli._retry(signal.SIGALRM, sys._getframe())  # no stop pending: an alarm does nothing
