@@ -3,11 +3,14 @@
 usage:
   python -m pdverify list                                   scenes and their methods
   python -m pdverify run SCENE [--method M] [--set KEY=VALUE ...] [--json FILE]
+                          [--max-memory SIZE]
   python -m pdverify report [--out DIR] [--quick] [--only SCENE ...] [--jobs N]
+                          [--max-memory SIZE]
   python -m pdverify compare BASELINE.json NEW.json [--rtol R] [--atol A] [--summary FILE]
 
 Exit codes: 0 success; 1 a run failed numerically or a regression was found;
-2 bad input (one line naming the input and what is allowed).
+2 bad input (one line naming the input and what is allowed), a run above the memory
+budget (its estimate and the limit) included; 130 interrupted.
 """
 from __future__ import annotations
 
@@ -16,6 +19,10 @@ import signal
 import sys
 
 from .errors import STOP_REQUESTED, InputError
+
+
+MAX_MEMORY_HELP = ("refuse (exit 2) any run whose memory estimate exceeds SIZE, e.g. 4G, "
+                   "512M (default: $PDVERIFY_MAX_MEMORY, else half the available memory)")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -33,11 +40,13 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--method", default=None)
     run.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     run.add_argument("--json", default=None, metavar="FILE")
+    run.add_argument("--max-memory", default=None, metavar="SIZE", help=MAX_MEMORY_HELP)
     rep = sub.add_parser("report", help="run every scene and method, write the HTML report")
     rep.add_argument("--out", default=None, metavar="DIR")
     rep.add_argument("--quick", action="store_true")
     rep.add_argument("--only", nargs="+", default=None, metavar="SCENE")
     rep.add_argument("--jobs", type=int, default=1)
+    rep.add_argument("--max-memory", default=None, metavar="SIZE", help=MAX_MEMORY_HELP)
     cmp_ = sub.add_parser("compare", help="compare a results file against a baseline")
     cmp_.add_argument("baseline")
     cmp_.add_argument("new")
@@ -105,6 +114,9 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("pdverify: interrupted", file=sys.stderr)
         return 130
+    finally:
+        from . import budget
+        budget.set_limit(None)  # --max-memory holds for this command only
 
 
 def _dispatch(args) -> int:
@@ -112,7 +124,9 @@ def _dispatch(args) -> int:
         from .listing import format_listing
         print(format_listing())
         return 0
-    from . import validate
+    from . import budget, validate
+    if args.command in ("run", "report"):
+        budget.set_limit(args.max_memory)
     if args.command == "run":
         from .params import parse_assignments
         from .runner import run_one

@@ -30,6 +30,7 @@ class RunResult:
     timings: dict = field(default_factory=dict)
     size: dict = field(default_factory=dict)
     diagnostics: dict = field(default_factory=dict)
+    warnings: list = field(default_factory=list)
     fields: dict = field(default_factory=dict, repr=False)
 
     @property
@@ -48,6 +49,7 @@ class RunResult:
             "timings": _plain(self.timings),
             "size": _plain(self.size),
             "diagnostics": _plain(self.diagnostics),
+            "warnings": list(self.warnings),
         }
 
 
@@ -153,8 +155,8 @@ def write_results(path, runs: list[RunResult]) -> dict:
 _RUN_FIELDS = {"scene": (str,), "method": (str,), "params": (dict,), "status": (str,),
                "metrics": (dict,)}
 _OPTIONAL_RUN_FIELDS = {"reference": (str,), "message": (str,), "timings": (dict,),
-                        "size": (dict,), "diagnostics": (dict,)}
-_TYPE_NAMES = {str: "a string", dict: "an object"}
+                        "size": (dict,), "diagnostics": (dict,), "warnings": (list,)}
+_TYPE_NAMES = {str: "a string", dict: "an object", list: "a list"}
 
 
 def check_schema(doc, path) -> None:

@@ -26,6 +26,8 @@ def run_one(scene_id: str, *, method=None, overrides=None, json_path=None, strea
     for key, value in result.metrics.items():
         print(f"  {key:24s} {value:.10g}" if isinstance(value, float) else f"  {key:24s} {value}",
               file=stream)
+    for text in result.warnings:
+        print(f"  warning: {text}", file=stream)
     t = result.timings
     print(f"  time: setup {t['setup_s']:.4f} s, solve {t['solve_s']:.4f} s, "
           f"total {t['total_s']:.4f} s; size {result.size}", file=stream)
@@ -128,6 +130,8 @@ def run_cases(cases, *, jobs: int = 1, progress=None) -> list[RunResult]:
             params = " ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}"
                               for k, v in sorted(cases[k][2].items()))
             status = res.status if res.status == "ok" else f"FAILED: {res.message}"
+            if res.warnings:
+                status += f" ({len(res.warnings)} warning)"
             print(f"[{done}/{total}] {res.scene} {res.method} {params} ... {status} "
                   f"({res.timings.get('total_s', 0):.2f} s) {format_metrics(res.metrics, 2)}",
                   file=progress, flush=True)

@@ -66,6 +66,11 @@ class ClampedSheetParams:
                    f"elements must be even and >= 2, got {self.elements}")
         _p.require(2 <= self.levels <= 6, REFERENCE, f"levels must be 2..6, got {self.levels}")
 
+    def finest_cells(self) -> tuple[int, int]:
+        """Elements per side of the finest level (for a resource estimate)."""
+        n = self.elements * 2 ** (self.levels - 1)
+        return n, n
+
     @property
     def side(self) -> float:
         return self.side_factor * self.horizon

@@ -53,6 +53,7 @@ curve) is recorded.
 """
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 
@@ -103,6 +104,24 @@ class IndentationParams:
         _p.require(1.0 <= self.grading_ratio <= 2.0, REFERENCE,
                    f"grading_ratio must lie in [1, 2], got {self.grading_ratio}")
         _p.require(2 <= self.levels <= 5, REFERENCE, f"levels must be 2..5, got {self.levels}")
+
+    def finest_cells(self) -> tuple[int, int]:
+        """Elements along x and y of the finest level, counted without building the mesh
+        (for a resource estimate): the fine zone at ``spacing``, then elements growing by
+        ``grading_ratio`` up to each outer edge, then ``levels - 1`` bisections."""
+        def cells(fine: float, outside: tuple[float, ...]) -> int:
+            n = max(1, round(fine / self.spacing))
+            h, r = fine / n, self.grading_ratio
+            for rest in outside:
+                if rest > 0:
+                    n += (math.ceil(rest / (h * r)) if r == 1.0 else
+                          max(1, math.ceil(math.log1p(rest * (r - 1) / (h * r)) / math.log(r))))
+            return n
+        half = min(self.fine_half_width, self.width / 2)
+        fine_y = min(self.fine_depth, self.height)
+        k = 2 ** (self.levels - 1)
+        return (cells(2 * half, (self.width / 2 - half,) * 2) * k,
+                cells(fine_y, (self.height - fine_y,)) * k)
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)

@@ -58,6 +58,11 @@ class PlateParams:
             _p.require(abs(n - round(n)) < 1e-9 * n and round(n) >= 1, REFERENCE,
                        f"spacing {self.spacing} must divide {name} {L}")
 
+    def finest_cells(self) -> tuple[int, int]:
+        """Elements along x and y of the finest level (for a resource estimate)."""
+        h = self.spacing / 2 ** (self.levels - 1)
+        return round(self.length / h), round(self.width / h)
+
 
 @dataclass(frozen=True, eq=False, kw_only=True)
 class PlateResult(ReferenceResult):

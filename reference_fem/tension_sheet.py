@@ -66,6 +66,11 @@ class TensionSheetParams:
             _p.require(abs(n - round(n)) < 1e-9 * n and round(n) % 2 == 0, REFERENCE,
                        f"{name} {L} must be an even multiple of spacing {self.spacing}")
 
+    def finest_cells(self) -> tuple[int, int]:
+        """Elements along x and y of the finest level (for a resource estimate)."""
+        h = self.spacing / 2 ** (self.levels - 1)
+        return round(self.width / h), round(self.length / h)
+
 
 @dataclass(frozen=True, eq=False, kw_only=True)
 class TensionSheetResult(ReferenceResult):

@@ -11,7 +11,7 @@ body{font-family:system-ui,sans-serif;margin:2em auto;max-width:1250px;color:#22
 table{border-collapse:collapse;margin:.6em 0;font-size:13px}
 th,td{border:1px solid #ccc;padding:3px 7px;text-align:right;vertical-align:top}
 th{background:#f2f2f2} td.l,th.l{text-align:left}
-.failed{background:#fde2e2} .doc{white-space:pre-wrap;font-size:12px;color:#444;
+.failed{background:#fde2e2} .warning{color:#8a5a00} .doc{white-space:pre-wrap;font-size:12px;color:#444;
 background:#fafafa;border-left:3px solid #ddd;padding:.4em .8em}
 figure{margin:1em 0} figcaption{font-size:12px;color:#555} code{font-size:12px}
 """
@@ -58,6 +58,8 @@ def scene_section(scene, results, figures) -> str:
                 cell += f'<br><small title="{html.escape(paper[m].source)}">paper: {_num(paper[m].value)}</small>'
             cells.append(f"<td>{cell}</td>")
         status = r.status if r.status == "ok" else f"failed: {html.escape(r.message)}"
+        status += "".join(f'<br><small class="warning">warning: {html.escape(w)}</small>'
+                          for w in r.warnings)
         cls = "" if r.status == "ok" else ' class="failed"'
         size = ", ".join(f"{k} {v}" for k, v in r.size.items())
         t = r.timings
@@ -99,6 +101,7 @@ def refinement_table(result) -> str:
 def page(doc: dict, sections: list[tuple], total_time: float) -> str:
     runs = doc["runs"]
     failed = [r for r in runs if r["status"] != "ok"]
+    warned = sum(1 for r in runs if r.get("warnings"))
     methods = sorted({r["method"] for r in runs})
     toc = "".join(f'<li><a href="#{s.id}">{html.escape(s.id)}</a> — {html.escape(s.title)}</li>'
                   for s, _ in sections)
@@ -110,7 +113,7 @@ def page(doc: dict, sections: list[tuple], total_time: float) -> str:
 <h1>pdverify report</h1>
 <p>pdverify {html.escape(doc['pdverify_version'])}, created {html.escape(doc['created'])},
 Python {html.escape(str(doc['machine']['python']))} on {doc['machine']['cpus']} CPUs.
-{len(runs)} runs, {len(failed)} failed, {total_time:.1f} s in all. Machine-readable:
+{len(runs)} runs, {len(failed)} failed, {warned} ok with a warning, {total_time:.1f} s in all. Machine-readable:
 <a href="results.json">results.json</a> (schema <code>{html.escape(doc['schema'])}</code>).</p>
 <p>Each table lists one run per row: the method, the parameters that differ from the scene's
 defaults (the paper's values), the metrics with the paper's number beneath where the paper

@@ -5,6 +5,7 @@ import numpy as np
 
 from manufactured import bar1d as closed
 
+from .. import budget
 from ..corrections.taylor_fictitious import boundary_value_rows, fictitious_closure
 from ..errors import InputError
 from ..metrics import max_relative_error_pct, nodal_relative_error_pct, rel_l2_error
@@ -88,6 +89,13 @@ def check_bar_grid(scene_id: str, method: str, p: dict, min_horizons: float = 0.
     return n
 
 
+def bar_estimate(p) -> budget.Estimate:
+    """State-based bar: n + 1 nodes and m fictitious ones at each end; the dilatation
+    couples nodes two horizons (2m spacings) apart."""
+    m = p["m_ratio"]
+    return budget.linear_system(p["length"] / p["spacing"] + 1 + 2 * m, 1, 1, 2 * m)
+
+
 class StaticBar(Scene):
     """Shared machinery of the four bars of seed 000 §5 (clamped at x = 0).
 
@@ -134,6 +142,9 @@ class StaticBar(Scene):
     # -------------------------------------------------------------------------------
     def check(self, method, p):
         check_bar_grid(self.id, method, p, min_horizons=2.0)
+
+    def estimate(self, method, p):
+        return bar_estimate(p)
 
     def cases(self, quick=False):
         return [("none", {})] + [(TAYLOR.name, {"order": n}) for n in self.paper_orders]

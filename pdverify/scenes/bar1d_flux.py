@@ -7,7 +7,7 @@ from manufactured import bar1d as closed
 
 from ..params import Param, positive
 from . import Outcome, Published, Scene, register, require_influence
-from .bar1d import BAR_PARAMS, NONE, TAYLOR, StateBar, check_bar_grid
+from .bar1d import BAR_PARAMS, NONE, TAYLOR, StateBar, bar_estimate, check_bar_grid
 
 _FEATURES = closed.flux_features()  # (1.26285..., 0.77160..., 0.39403...)
 
@@ -55,6 +55,9 @@ class ForceFlux(Scene):
         if method == NONE.name:
             require_influence(self.id, method, p, "hyperbolic", "the closed forms of Tables 1, 2 "
                               "and B1 are derived for seed 000's delta / |xi|")
+
+    def estimate(self, method, p):
+        return bar_estimate(p)
 
     def cases(self, quick=False):
         ratios = self.report_m_ratios[:3] if quick else self.report_m_ratios

@@ -7,10 +7,32 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from .. import budget
 from ..errors import InputError, NumericalError
 from ..params import Param, resolve
 from ..pd.influence import INFLUENCES
 from ..results import RunResult, Timer
+
+
+def conditioning_warnings(diagnostics: Mapping) -> list[str]:
+    """One warning for the worst ``*condition_estimate`` in ``diagnostics`` (nested
+    included) above :data:`~pdverify.solvers.static.WARN_CONDITION`."""
+    from ..solvers.static import WARN_CONDITION
+
+    def walk(d, path):
+        for k, v in d.items():
+            if isinstance(v, Mapping):
+                yield from walk(v, path + (k,))
+            elif k.endswith("condition_estimate") and isinstance(v, (int, float)):
+                yield float(v), ".".join(path + (k,))
+
+    worst = max(walk(diagnostics, ()), default=(0.0, ""))
+    if worst[0] <= WARN_CONDITION:
+        return []
+    eps = float(np.finfo(float).eps)
+    return [f"ill-conditioned: {worst[1]} = {worst[0]:.2e}, so the solution is trustworthy "
+            f"only to ~{worst[0] * eps:.0e} relative (condition x machine epsilon); errors "
+            "below that are round-off, not the method"]
 
 
 @dataclass(frozen=True)
@@ -111,10 +133,16 @@ class Scene:
         where = f"{self.id} --method {method}"
         values = resolve(self.params + spec.params, dict(overrides or {}), where)
         self.check(method, values)
+        budget.check(where, self.estimate(method, values))
         return values
 
     def check(self, method: str, params: dict) -> None:
         """Cross-parameter checks; raise :class:`InputError` with a one-line message."""
+
+    def estimate(self, method: str, params: dict) -> budget.Estimate | None:
+        """What the run will need, from its checked params alone (:mod:`pdverify.budget`);
+        cheap: no assembly, no import of a heavy library."""
+        return None
 
     # -- running ----------------------------------------------------------------------
     def solve(self, method: str, params: dict, timer: Timer) -> Outcome:
@@ -139,6 +167,7 @@ class Scene:
                 raise NumericalError(f"metric {bad[0]} is not finite ({out.metrics[bad[0]]})")
             result.metrics, result.size = out.metrics, out.size
             result.fields, result.diagnostics = out.fields, out.diagnostics
+            result.warnings = conditioning_warnings(out.diagnostics)
         except NumericalError as exc:
             where = f"{self.id}/{method}"
             msg = str(exc)

@@ -7,6 +7,7 @@ import dataclasses
 
 import numpy as np
 
+from .. import budget
 from ..errors import InputError
 from ..params import Param
 from . import MethodSpec, Outcome, Scene, register
@@ -49,6 +50,9 @@ class FemReference(Scene):
             self._cls()(**p)
         except (TypeError, ValueError) as exc:
             raise InputError(f"{self.id} --method {method}: {exc}".replace("\n", " ")) from None
+
+    def estimate(self, method, p):
+        return budget.quadratic_elements(self._cls()(**p).finest_cells())
 
     def solve(self, method, p, timer):
         rf = _reference_module()
@@ -106,6 +110,18 @@ class FemAndPD(FemReference):
         self.check_pd(f"{self.id} --method {method}", method, p)
 
     def check_pd(self, where, method, p):
+        raise NotImplementedError
+
+    def estimate(self, method, p):
+        if method == FEM.name:
+            return super().estimate(method, p)
+        # the FEM reference (at the fem method's defaults) runs first unless cached
+        fem_defaults = {q.name: q.default for q in self.method(FEM.name).params}
+        fem = super().estimate(FEM.name, {**fem_defaults, **{k: p[k] for k in self.shared}})
+        return budget.larger(self.estimate_pd(method, p), fem)
+
+    def estimate_pd(self, method, p):
+        """The PD run's own needs."""
         raise NotImplementedError
 
     def solve(self, method, p, timer):

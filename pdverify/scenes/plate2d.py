@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import budget
 from ..corrections.taylor_fictitious import (CORNER_RULES, clamped_rows, fictitious_closure,
                                              needed_nodes)
 from ..errors import InputError
@@ -214,6 +215,13 @@ class ClampedPlate(FemAndPD):
     #: ~5 s a run with the direct solver)
     m_sweep = (2, 3, 4)
     m_sweep_horizon = 0.2
+
+    def estimate_pd(self, method, p):
+        """Cell-centred real nodes and the fictitious ring m deep; the dilatation couples
+        nodes 2m spacings apart."""
+        h, m = p["spacing"], p["m_ratio"]
+        nodes = (p["length"] / h + 2 * m) * (p["width"] / h + 2 * m)
+        return budget.linear_system(nodes, 2, 2, 2 * m, dense_allowed=method == "none")
 
     def check_pd(self, where, method, p):
         n_axis = whole_cells(where, p["spacing"], [(k, p[k]) for k in ("length", "width")])

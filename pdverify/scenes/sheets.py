@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import budget
 from ..corrections.energy_directional import directional_closure
 from ..errors import InputError
 from ..metrics import rel_l2_error
@@ -145,6 +146,11 @@ class TensionSheet(SheetScene):
     # takes ~20 s per run with today's direct solve and waits for the solver layer
     m_sweep = (0.0025, 0.00125, 0.001)
 
+    def estimate_pd(self, method, p):
+        h = p["spacing"]
+        return budget.linear_system((p["width"] / h + 1) * (p["length"] / h + 1), 2, 2,
+                                    p["horizon"] / h, dense_allowed=True)
+
     def check_sheet(self, where, method, p):
         _grid_check(where, (("width", p["width"]), ("length", p["length"])), p["spacing"],
                     p["horizon"], "spacing")
@@ -286,6 +292,12 @@ class ClampedSheet(SheetScene):
         Published("tensile_stress_mpa", 8.64, "seed 003 Table 2, row 5", method="virtual-nodes",
                   where={**PAPER, "correct_sides": True}),
     )
+
+    def estimate_pd(self, method, p):
+        m = p["m_ratio"]
+        n = p["side_factor"] * m + 1                  # nodes along a side
+        rows = n + 2 * m if method == "virtual-nodes" else n
+        return budget.linear_system(n * rows, 2, 2, m, dense_allowed=True)
 
     def check_sheet(self, where, method, p):
         delta = p["horizon"]

@@ -1,10 +1,13 @@
 """Seed 001: 3D and 2D state-based PD boxes, uncorrected and with the surface node method."""
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from manufactured import surface3d as closed
 
+from .. import budget
 from ..corrections.surface_nodes import MAX_ORDER, flux_rows, surface_node_closure
 from ..errors import InputError
 from ..metrics import rel_l2_error
@@ -241,6 +244,20 @@ class SurfaceNodeScene(Scene):
         if p.get("surface_load", "face-mean") == "centre":
             return traction(centres, normals) * grid.face_area
         return face_resultant(traction, centres, normals, grid.spacing) * grid.face_area
+
+    def estimate(self, method, p):
+        """Unknowns on the cell-centred nodes and (surface-nodes) one surface node per
+        boundary cell face; the dilatation couples nodes 2m spacings apart. The fictitious
+        layer (m deep) folds into the unknowns through its Taylor rows, which are stored."""
+        lengths, _ = self.box(p)
+        m, d = p["m_ratio"], len(lengths)
+        cells = [L / p["spacing"] for L in lengths]
+        nodes, rows = math.prod(cells), 0.0
+        if method == "surface-nodes":
+            nodes += 2 * sum(nodes / c for c in cells)
+            fictitious = math.prod(c + 2 * m for c in cells) - math.prod(cells)
+            rows = budget.BYTES_PER_NONZERO * fictitious * d * d * budget.lattice_neighbours(d, m)
+        return budget.linear_system(nodes, d, d, 2 * m, dense_allowed=True, extra_bytes=rows)
 
     # ----------------------------------------------------------------- checks
     def check(self, method, p):

@@ -1,12 +1,15 @@
 """Seed 002: a Gaussian pulse in a fixed-fixed PD bar, surface nodes against the analytic PD series."""
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from manufactured import wave1d as analytic
 
 import scipy.sparse as sp
 
+from .. import budget
 from ..corrections.surface_nodes import surface_node_displacement_map
 from ..errors import InputError
 from ..metrics import max_error_of_peak_pct, rel_l2_error
@@ -215,6 +218,14 @@ class Wave1DSurfaceNodes(Scene):
         Published("max_error_pct", "decreases with m, no number printed", "seed 002 Fig. 5",
                   method="surface-nodes"),
     )
+
+    def estimate(self, method, p):
+        m = p["m_ratio"]
+        nodes = p["length"] * m / p["horizon"] + 1 + 2 * m
+        steps = math.ceil(SAMPLE_TIMES[-1] / p["dt"])
+        series = 8.0 * p["n_terms"] * nodes * (len(SAMPLE_TIMES) + 1)
+        return budget.linear_system(nodes, 1, 1, m, extra_bytes=series) + budget.Estimate(
+            0.0, f"{steps:.3g} time steps, {p['n_terms']} series terms", steps)
 
     def check(self, method, p):
         where = f"{self.id} --method {method}"

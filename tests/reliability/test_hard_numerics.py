@@ -78,3 +78,20 @@ def test_same_case_same_verdict_every_time():
     verdicts = {(_run("bar1d-sine-load", "taylor-fictitious", {"order": o, "spacing": 0.01})
                  .diagnostics.get("condition_estimate")) for o in (20,) for _ in range(4)}
     assert len(verdicts) == 1
+
+
+def test_ok_but_ill_conditioned_runs_carry_a_warning_in_json_and_report():
+    """Order 20 at 100 cells: condition estimate 2.3e12, so kappa * eps = 5e-4 relative,
+    above the 1e-6 of WARN_CONDITION; order 10 (2.3e8, 5e-8) stays clean."""
+    from pdverify.report.html import scene_section
+    from pdverify.solvers.static import WARN_CONDITION
+    scene = get_scene("bar1d-traction")
+    warned = scene.run("taylor-fictitious", {"order": 20, "spacing": 0.01})
+    clean = scene.run("taylor-fictitious", {"order": 10, "spacing": 0.01})
+    assert warned.status == clean.status == "ok"
+    assert warned.diagnostics["condition_estimate"] > WARN_CONDITION
+    assert clean.diagnostics["condition_estimate"] < WARN_CONDITION and clean.warnings == []
+    (text,) = warned.warnings
+    assert text.startswith("ill-conditioned: condition_estimate = 2.26e+12") and "5e-04" in text
+    assert warned.to_json()["warnings"] == [text]
+    assert "warning: ill-conditioned" in scene_section(scene, [warned, clean], [])

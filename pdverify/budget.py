@@ -1,0 +1,193 @@
+"""Resource budget: every run's memory and time-step estimate, from its params alone,
+checked against a limit before any allocation (issue 18).
+
+A run above the limit is bad input: exit 2 with one line that names the run, the
+estimate, what it is made of and the limit. The limit is ``--max-memory`` (``run`` and
+``report``), else the environment variable ``PDVERIFY_MAX_MEMORY``, else half of the
+memory available when the command starts. Time-stepping runs are also held to
+:data:`MAX_TIME_STEPS`.
+
+The memory model (:func:`linear_system`) counts what dominates a static PD or FEM solve:
+
+- the assembled matrix and its assembly arrays, :data:`BYTES_PER_NONZERO` per stored
+  non-zero, with nonzeros = unknowns x (unknowns per row: d x nodes within the stencil's
+  reach r, counted on the lattice);
+- the factor: a dense LU keeps two n x n copies (equilibrated matrix and LU), a sparse
+  LU's fill follows nested dissection: the top separator of a D-dimensional body n nodes
+  across is r layers thick, so the factor holds ~ d^2 max(N r, (r N^((D-1)/D))^2)
+  entries, at :data:`BYTES_PER_FACTOR_ENTRY` each.
+
+The two constants were measured (``benchmarks/budget_calibration.py`` prints estimate
+against peak resident memory for every scene family at two sizes); the estimate is
+meant to be an upper bound within a factor of about 3 of the measured peak above the
+interpreter's own footprint (measured: 1.05x to 2.3x over 18 runs of all families above
+a few MB; FEM 1.05-1.15x, 3D dense 1.1-1.6x, 2D sparse 1.1-2.0x, 1D 2.3x).
+"""
+from __future__ import annotations
+
+import math
+import os
+import re
+from dataclasses import dataclass
+
+from .errors import InputError
+
+MEMORY_ENV = "PDVERIFY_MAX_MEMORY"
+#: share of the available memory one run may plan to use when no limit is given
+DEFAULT_FRACTION = 0.5
+#: ceiling on explicit time steps of one run (~ minutes of 1D stepping on this machine)
+MAX_TIME_STEPS = 20_000_000
+#: matrix and assembly arrays per stored non-zero: measured 61 B on the 3D boxes (dense
+#: path: 6000 unknowns, 13.1 M non-zeros, 1.37 GB; 9000 unknowns, 24.0 M, 2.75 GB)
+BYTES_PER_NONZERO = 64.0
+#: SuperLU factor per nested-dissection entry: measured 352-671 B on the 2D plates and
+#: sheets (plate2d 0.025 m: 475 B; sheet2d 0.0005 m: 477 B; plane-strain 0.01 m, COLAMD:
+#: 671 B); the same count with reach 2 bounds the Q2 FEM solves (1.05-1.15x)
+BYTES_PER_FACTOR_ENTRY = 700.0
+#: the dense path of :func:`pdverify.solvers.dense.solve_square`: above 2000 unknowns and
+#: 10 % fill, two n x n float64 copies
+DENSE_MIN_UNKNOWNS, DENSE_FILL = 2000, 0.1
+
+_UNITS = {"": 1, "b": 1, "k": 2 ** 10, "kb": 10 ** 3, "kib": 2 ** 10, "m": 2 ** 20,
+          "mb": 10 ** 6, "mib": 2 ** 20, "g": 2 ** 30, "gb": 10 ** 9, "gib": 2 ** 30,
+          "t": 2 ** 40, "tb": 10 ** 12, "tib": 2 ** 40}
+_limit_override: int | None = None
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """What one run will need: ``memory`` bytes above the interpreter's own footprint,
+    ``time_steps`` explicit steps, and ``detail``, the sizes they come from."""
+
+    memory: float
+    detail: str
+    time_steps: int = 0
+
+    def __add__(self, other: "Estimate") -> "Estimate":
+        return Estimate(self.memory + other.memory, f"{self.detail}; {other.detail}",
+                        self.time_steps + other.time_steps)
+
+
+def larger(first: Estimate, then: Estimate) -> Estimate:
+    """Two phases run one after the other: the peak is the larger of the two."""
+    big = first if first.memory >= then.memory else then
+    return Estimate(big.memory, f"{big.detail} (the larger phase)",
+                    max(first.time_steps, then.time_steps))
+
+
+def parse_size(text: str, what: str) -> int:
+    """Bytes from '4G', '512M', '1.5GB', '2GiB', '3e9'; k/M/G/T alone are binary."""
+    m = re.fullmatch(r"\s*([0-9]*\.?[0-9]+(?:[eE][+-]?[0-9]+)?)\s*([A-Za-z]*)\s*", str(text))
+    unit = m.group(2).lower() if m else None
+    if m is None or unit not in _UNITS:
+        raise InputError(f"{what}={text!r} must be a size such as 4G, 512M, 1.5GB or a "
+                         "number of bytes")
+    value = float(m.group(1)) * _UNITS[unit]
+    if not (math.isfinite(value) and value >= 2 ** 20):
+        raise InputError(f"{what}={text!r} must be at least 1M")
+    return int(value)
+
+
+def set_limit(text: str | None) -> None:
+    """``--max-memory``: overrides the environment and the default for this process."""
+    global _limit_override
+    _limit_override = None if text is None else parse_size(text, "--max-memory")
+
+
+def available_memory() -> int:
+    """MemAvailable of /proc/meminfo (Linux); else physical pages x page size."""
+    try:
+        with open("/proc/meminfo") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+
+
+def memory_limit() -> tuple[int, str]:
+    """The limit in bytes and where it comes from."""
+    if _limit_override is not None:
+        return _limit_override, "--max-memory"
+    env = os.environ.get(MEMORY_ENV)
+    if env:
+        return parse_size(env, MEMORY_ENV), MEMORY_ENV
+    return int(DEFAULT_FRACTION * available_memory()), (
+        f"default: {DEFAULT_FRACTION:.0%} of available memory; change with --max-memory "
+        f"or {MEMORY_ENV}")
+
+
+def format_bytes(n: float) -> str:
+    for unit, size in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if n >= size:
+            return f"{n / size:.3g} {unit}"
+    return f"{n:.0f} B"
+
+
+def check(where: str, estimate: Estimate | None) -> None:
+    """Raise :class:`InputError` when ``estimate`` exceeds the memory limit or the step
+    ceiling; one line with the estimate, its sizes and the limit."""
+    if estimate is None:
+        return
+    if estimate.time_steps > MAX_TIME_STEPS:
+        raise InputError(f"{where}: needs ~{estimate.time_steps:.3g} time steps "
+                         f"({estimate.detail}), above the ceiling of {MAX_TIME_STEPS:.3g}")
+    limit, source = memory_limit()
+    if estimate.memory > limit:
+        raise InputError(f"{where}: needs ~{format_bytes(estimate.memory)} of memory "
+                         f"({estimate.detail}), above the limit of {format_bytes(limit)} "
+                         f"({source})")
+
+
+_PEAK_WRAPPER = ("import resource, subprocess, sys; "
+                 "code = subprocess.run(sys.argv[1:], stdout=subprocess.DEVNULL, "
+                 "stderr=subprocess.DEVNULL).returncode; "
+                 "print(code, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)")
+
+
+def measured_peak(args, env=None) -> float:
+    """Peak resident memory (bytes) of the command ``args``, for calibrating and testing
+    the estimates. A small wrapper process starts it: a child's peak counts the memory
+    of whatever forked it, so timing it straight from a large process (a test session)
+    would measure that process instead. Raises RuntimeError if the command fails."""
+    import subprocess
+    import sys
+    out = subprocess.run([sys.executable, "-c", _PEAK_WRAPPER, *args], env=env,
+                         capture_output=True, text=True, check=True).stdout.split()
+    if out[0] != "0":
+        raise RuntimeError(f"{' '.join(args)} exited with {out[0]}")
+    return float(out[1]) * 1024.0
+
+
+def lattice_neighbours(dim: int, reach: float) -> float:
+    """Lattice points within ``reach`` spacings of a node (itself included), ~ the ball."""
+    r = float(reach)
+    return {1: 2 * math.floor(r) + 1, 2: math.pi * r * r + 1,
+            3: 4.0 / 3.0 * math.pi * r ** 3 + 1}[dim]
+
+
+def linear_system(nodes: float, dim: int, dofs_per_node: int, reach: float,
+                  dense_allowed: bool = False, extra_bytes: float = 0.0) -> Estimate:
+    """Memory of assembling and factoring a static system on ``nodes`` lattice nodes in
+    ``dim`` dimensions whose stencil reaches ``reach`` node spacings (see the module
+    docstring); ``dense_allowed``: the solver switches to dense LU when it is full."""
+    n = float(nodes) * dofs_per_node
+    nnz = min(n * dofs_per_node * lattice_neighbours(dim, reach), n * n)
+    sep = reach * float(nodes) ** ((dim - 1) / dim)
+    factor = dofs_per_node ** 2 * max(float(nodes) * reach, sep * sep)
+    dense = dense_allowed and n >= DENSE_MIN_UNKNOWNS and nnz >= DENSE_FILL * n * n
+    memory = BYTES_PER_NONZERO * nnz + extra_bytes + (
+        2 * 8.0 * n * n if dense else min(BYTES_PER_FACTOR_ENTRY * factor, 24.0 * n * n))
+    how = "dense LU" if dense else "sparse LU"
+    return Estimate(memory, f"{nodes:.4g} nodes, {n:.4g} unknowns, ~{nnz:.3g} non-zeros, "
+                            f"{how}")
+
+
+def quadratic_elements(cells) -> Estimate:
+    """A Q2 (9- or 27-node) vector FEM solve on a tensor mesh with ``cells`` elements per
+    axis: (2 n + 1) nodes per axis, one element spans two node spacings."""
+    nodes = math.prod(2 * int(n) + 1 for n in cells)
+    est = linear_system(nodes, len(cells), len(cells), 2)
+    return Estimate(est.memory, f"FEM {' x '.join(str(int(n)) for n in cells)} Q2 elements, "
+                                + est.detail)
