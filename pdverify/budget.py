@@ -20,8 +20,8 @@ The memory model (:func:`linear_system`) counts what dominates a static PD or FE
 The two constants were measured (``benchmarks/budget_calibration.py`` prints estimate
 against peak resident memory for every scene family at two sizes); the estimate is
 meant to be an upper bound within a factor of about 3 of the measured peak above the
-interpreter's own footprint (measured: 1.05x to 2.3x over 18 runs of all families above
-a few MB; FEM 1.05-1.15x, 3D dense 1.1-1.6x, 2D sparse 1.1-2.0x, 1D 2.3x).
+interpreter's own footprint (measured: 1.03x to 2.3x over 18 runs of all families above
+a few MB; FEM 1.03-1.15x, 3D dense 1.1-1.6x, 2D sparse 1.1-2.0x, 1D 2.3x).
 """
 from __future__ import annotations
 
@@ -42,7 +42,7 @@ MAX_TIME_STEPS = 20_000_000
 BYTES_PER_NONZERO = 64.0
 #: SuperLU factor per nested-dissection entry: measured 352-671 B on the 2D plates and
 #: sheets (plate2d 0.025 m: 475 B; sheet2d 0.0005 m: 477 B; plane-strain 0.01 m, COLAMD:
-#: 671 B); the same count with reach 2 bounds the Q2 FEM solves (1.05-1.15x)
+#: 671 B); the same count with reach 2 bounds the Q2 FEM solves (1.03-1.15x)
 BYTES_PER_FACTOR_ENTRY = 700.0
 #: the dense path of :func:`pdverify.solvers.dense.solve_square`: above 2000 unknowns and
 #: 10 % fill, two n x n float64 copies
