@@ -18,6 +18,7 @@ import argparse
 import signal
 import sys
 
+from . import __version__
 from .errors import STOP_REQUESTED, InputError
 
 
@@ -33,25 +34,35 @@ class _Parser(argparse.ArgumentParser):
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="pdverify", description=__doc__,
                      formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--version", action="version", version=f"pdverify {__version__}")
     sub = parser.add_subparsers(dest="command", parser_class=_Parser)
     sub.add_parser("list", help="list scenes, methods and parameters")
     run = sub.add_parser("run", help="run one scene with one method")
-    run.add_argument("scene")
-    run.add_argument("--method", default=None)
-    run.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
-    run.add_argument("--json", default=None, metavar="FILE")
+    run.add_argument("scene", help="scene id (see: python -m pdverify list)")
+    run.add_argument("--method", default=None,
+                     help="boundary treatment (default: the scene's first method)")
+    run.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                     help="override a scene or method parameter; repeat for several")
+    run.add_argument("--json", default=None, metavar="FILE",
+                     help="also write the run as a one-run results.json")
     run.add_argument("--max-memory", default=None, metavar="SIZE", help=MAX_MEMORY_HELP)
     rep = sub.add_parser("report", help="run every scene and method, write the HTML report")
-    rep.add_argument("--out", default=None, metavar="DIR")
-    rep.add_argument("--quick", action="store_true")
-    rep.add_argument("--only", nargs="+", default=None, metavar="SCENE")
-    rep.add_argument("--jobs", type=int, default=1)
+    rep.add_argument("--out", default=None, metavar="DIR",
+                     help="output folder (default: reports/latest), replaced as a whole")
+    rep.add_argument("--quick", action="store_true",
+                     help="smaller sweeps of the expensive scenes")
+    rep.add_argument("--only", nargs="+", default=None, metavar="SCENE",
+                     help="run only these scenes (each once)")
+    rep.add_argument("--jobs", type=int, default=1,
+                     help="worker processes, 1 to the number of CPUs (default 1)")
     rep.add_argument("--max-memory", default=None, metavar="SIZE", help=MAX_MEMORY_HELP)
     cmp_ = sub.add_parser("compare", help="compare a results file against a baseline")
-    cmp_.add_argument("baseline")
-    cmp_.add_argument("new")
-    cmp_.add_argument("--rtol", type=float, default=None)
-    cmp_.add_argument("--atol", type=float, default=None)
+    cmp_.add_argument("baseline", help="the stored results.json")
+    cmp_.add_argument("new", help="the new results.json")
+    cmp_.add_argument("--rtol", type=float, default=None,
+                      help="relative threshold of a change (default 1e-3)")
+    cmp_.add_argument("--atol", type=float, default=None,
+                      help="absolute threshold (default 1e-9; 1e-6 points for *_pct metrics)")
     cmp_.add_argument("--summary", default=None, metavar="FILE",
                       help="also write the changes as JSON (FILE.json) or Markdown (else)")
     return parser
