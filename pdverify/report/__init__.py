@@ -119,7 +119,7 @@ def _build(cases, out, final, jobs, progress) -> int:
         sections.append((scene, html.scene_section(scene, mine, figs)))
     doc = write_results(os.path.join(out, "results.json"), results)
     atomic_write_text(os.path.join(out, "index.html"),
-                      html.page(doc, sections, time.perf_counter() - t0))
+                      html.page(doc, sections, time.perf_counter() - t0, results))
     failed = sum(r.status != "ok" for r in results)
     print(f"report: {len(results)} runs, {failed} failed, "
           f"{time.perf_counter() - t0:.1f} s -> {os.path.join(final, 'index.html')}",

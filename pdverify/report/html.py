@@ -98,7 +98,80 @@ def refinement_table(result) -> str:
     return f"<p><b>Refinement study</b> ({html.escape(result.method)}):</p><table>{head}{body}</table>"
 
 
-def page(doc: dict, sections: list[tuple], total_time: float) -> str:
+#: The error each scene is ranked by in the overview (default ``rel_l2_error``).
+HEADLINE_DEFAULT = "rel_l2_error"
+_LOG_RANGE = (-8.0, 0.0)  # colour scale of the overview: 1e-8 (green) .. 1 (red)
+
+
+def _headline_run(scene, method, runs):
+    """The run of ``method`` at its default params, else its first run."""
+    mine = [r for r in runs if r.method == method]
+    try:
+        defaults = scene.resolve(method, {})
+    except InputError:
+        defaults = None
+    return next((r for r in mine if r.params == defaults), mine[0] if mine else None)
+
+
+def _colour(value: float) -> str:
+    """Green (1e-8 or less) to red (1 or more), on a log scale of ``abs(value)``."""
+    import math
+    lo, hi = _LOG_RANGE
+    v = abs(value)
+    bad = 0.0 if v == 0 else (min(max(math.log10(v), lo), hi) - lo) / (hi - lo)
+    return f"rgb({int(150 + 100 * bad)},{int(235 - 85 * bad)},150)"
+
+
+def overview(scenes, results) -> str:
+    """Scene x method matrix: each cell the headline error of the method's default run
+    (coloured on a log scale, total time beneath), the best method per scene starred,
+    failed runs red with the reason on hover, FEM cells marked as the reference."""
+    methods = []
+    for scene in scenes:
+        for m in scene.methods:
+            if m.name not in methods:
+                methods.append(m.name)
+    methods.sort(key=lambda m: (m == "fem", m != "none", m))
+    head = "<tr><th class=l>scene</th><th class=l>error</th>" + "".join(
+        f"<th>{html.escape(m)}</th>" for m in methods) + "</tr>"
+    rows = []
+    for scene in scenes:
+        runs = [r for r in results if r.scene == scene.id]
+        metric = getattr(scene, "headline", HEADLINE_DEFAULT)
+        picked = {m: _headline_run(scene, m, runs) for m in methods}
+        values = {m: r.metrics.get(metric) for m, r in picked.items()
+                  if r is not None and r.status == "ok" and m != "fem"}
+        values = {m: v for m, v in values.items() if isinstance(v, (int, float))}
+        best = min(values, key=values.get) if len(values) > 1 else None
+        cells = []
+        for m in methods:
+            r = picked[m]
+            if r is None:
+                cells.append("<td></td>")
+            elif r.status != "ok":
+                cells.append(f'<td class="failed" title="{html.escape(r.message)}">failed</td>')
+            elif m == "fem":
+                cells.append(f"<td>reference<br><small>{r.timings.get('total_s', 0):.2g} s"
+                             "</small></td>")
+            elif m in values:
+                star = " &#9733;" if m == best else ""
+                cells.append(f'<td style="background:{_colour(values[m])}" '
+                             f'title="{html.escape(_params(r, scene))}">'
+                             f"{_num(float(values[m]))}{star}<br><small>"
+                             f"{r.timings.get('total_s', 0):.2g} s</small></td>")
+            else:
+                cells.append("<td>&ndash;</td>")
+        rows.append(f'<tr><td class=l><a href="#{scene.id}">{html.escape(scene.id)}</a></td>'
+                    f"<td class=l><code>{html.escape(metric)}</code></td>{''.join(cells)}</tr>")
+    return ("<h3>Overview: error and cost of each method at its default parameters</h3>"
+            "<p><small>Each cell: the scene's headline error for the method's run at its "
+            "default parameters (green 1e-8 to red 1, log scale), the total time beneath; "
+            "&#9733; the most accurate method of the scene; hover a cell for its parameters "
+            "or a failure's reason. Sweeps and variants are in each scene's table.</small>"
+            f"</p><table>{head}{''.join(rows)}</table>")
+
+
+def page(doc: dict, sections: list[tuple], total_time: float, results=None) -> str:
     runs = doc["runs"]
     failed = [r for r in runs if r["status"] != "ok"]
     warned = sum(1 for r in runs if r.get("warnings"))
@@ -118,6 +191,7 @@ Python {html.escape(str(doc['machine']['python']))} on {doc['machine']['cpus']} 
 <p>Each table lists one run per row: the method, the parameters that differ from the scene's
 defaults (the paper's values), the metrics with the paper's number beneath where the paper
 prints one, and the cost (setup and solve time, size).</p>
+{overview([s for s, _ in sections], results) if results is not None else ""}
 <h3>Methods</h3><ul>{legend}</ul>
 <h3>Scenes</h3><ul>{toc}</ul>
 {body}

@@ -47,6 +47,7 @@ class ForceFlux(Scene):
                   method="none"),
         Published("flux_max_ratio", 1.0, "seed 000 Eq. (33)", method="taylor-fictitious"),
     )
+    headline = "flux_table_error"  # the report overview's error for this scene
     horizon_default = 0.15
     report_m_ratios = (3, 6, 12, 24, 48)
 
