@@ -44,9 +44,6 @@ BYTES_PER_NONZERO = 64.0
 #: sheets (plate2d 0.025 m: 475 B; sheet2d 0.0005 m: 477 B; plane-strain 0.01 m, COLAMD:
 #: 671 B); the same count with reach 2 bounds the Q2 FEM solves (1.03-1.15x)
 BYTES_PER_FACTOR_ENTRY = 700.0
-#: the dense path of :func:`pdverify.solvers.dense.solve_square`: above 2000 unknowns and
-#: 10 % fill, two n x n float64 copies
-DENSE_MIN_UNKNOWNS, DENSE_FILL = 2000, 0.1
 
 _UNITS = {"": 1, "b": 1, "k": 2 ** 10, "kb": 10 ** 3, "kib": 2 ** 10, "m": 2 ** 20,
           "mb": 10 ** 6, "mib": 2 ** 20, "g": 2 ** 30, "gb": 10 ** 9, "gib": 2 ** 30,
@@ -172,6 +169,9 @@ def linear_system(nodes: float, dim: int, dofs_per_node: int, reach: float,
     """Memory of assembling and factoring a static system on ``nodes`` lattice nodes in
     ``dim`` dimensions whose stencil reaches ``reach`` node spacings (see the module
     docstring); ``dense_allowed``: the solver switches to dense LU when it is full."""
+    # solve_square's switch to its dense path (imported here: the CLI imports this module
+    # and must stay light)
+    from .solvers.dense import DENSE_FILL, DENSE_MIN_UNKNOWNS
     n = float(nodes) * dofs_per_node
     nnz = min(n * dofs_per_node * lattice_neighbours(dim, reach), n * n)
     sep = reach * float(nodes) ** ((dim - 1) / dim)

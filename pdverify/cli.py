@@ -18,7 +18,7 @@ import argparse
 import signal
 import sys
 
-from . import __version__
+from . import __version__, budget
 from .errors import STOP_REQUESTED, InputError
 
 
@@ -126,7 +126,6 @@ def main(argv=None) -> int:
         print("pdverify: interrupted", file=sys.stderr)
         return 130
     finally:
-        from . import budget
         budget.set_limit(None)  # --max-memory holds for this command only
 
 
@@ -135,7 +134,7 @@ def _dispatch(args) -> int:
         from .listing import format_listing
         print(format_listing())
         return 0
-    from . import budget, validate
+    from . import validate
     if args.command in ("run", "report"):
         budget.set_limit(args.max_memory)
     if args.command == "run":

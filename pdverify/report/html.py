@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import html
+import math
 
 from ..corrections import describe
 from ..errors import InputError
@@ -115,7 +116,6 @@ def _headline_run(scene, method, runs):
 
 def _colour(value: float) -> str:
     """Green (1e-8 or less) to red (1 or more), on a log scale of ``abs(value)``."""
-    import math
     lo, hi = _LOG_RANGE
     v = abs(value)
     bad = 0.0 if v == 0 else (min(max(math.log10(v), lo), hi) - lo) / (hi - lo)

@@ -368,8 +368,8 @@ class Constraints(BondBarScene):
         return 4 * m + 1  # the halves have (N_a + 1)/2 >= 2m + 1 points
 
     def estimate(self, method, p):
-        one = super().estimate(method, p)
-        return one + one + one  # bars a, b (half of a) and c (b plus a horizon), one by one
+        one = super().estimate(method, p)  # bars a, b (half of a), c (b plus a horizon)
+        return budget.Estimate(3 * one.memory, f"3 bars, the largest: {one.detail}")
 
     def check(self, method, p):
         if p["nodes"] % 2 == 0:

@@ -116,8 +116,7 @@ class FemAndPD(FemReference):
         if method == FEM.name:
             return super().estimate(method, p)
         # the FEM reference (at the fem method's defaults) runs first unless cached
-        fem_defaults = {q.name: q.default for q in self.method(FEM.name).params}
-        fem = super().estimate(FEM.name, {**fem_defaults, **{k: p[k] for k in self.shared}})
+        fem = super().estimate(FEM.name, self.reference_params(p))
         return budget.larger(self.estimate_pd(method, p), fem)
 
     def estimate_pd(self, method, p):
@@ -132,11 +131,15 @@ class FemAndPD(FemReference):
     def solve_pd(self, method, p, timer):
         raise NotImplementedError
 
+    def reference_params(self, p) -> dict:
+        """The params of the FEM reference a PD run compares with: the ``fem`` method's
+        defaults and this run's shared (physical) params."""
+        fem_defaults = {q.name: q.default for q in self.method(FEM.name).params}
+        return {**fem_defaults, **{k: p[k] for k in self.shared}}
+
     def fem_reference(self, p):
         """The converged FEM reference at this scene's shared params (cached on disk)."""
-        fem_defaults = {q.name: q.default for q in self.method(FEM.name).params}
-        return getattr(_reference_module(), self.function)(
-            **fem_defaults, **{k: p[k] for k in self.shared})
+        return getattr(_reference_module(), self.function)(**self.reference_params(p))
 
 
 @register

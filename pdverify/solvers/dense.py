@@ -12,6 +12,8 @@ from .static import CONDITION_LIMIT, equilibrate, relative_residual, solve_const
 #: Above this fill (nnz / n^2) a dense LAPACK LU beats SuperLU: in 3D state-based PD every
 #: node couples to all nodes within two horizons, i.e. to a large part of a small body.
 DENSE_FILL = 0.1
+#: ... and below this many unknowns SuperLU is used whatever the fill
+DENSE_MIN_UNKNOWNS = 2000
 
 
 def solve_square(K, f, *, where: str = "static solve", spd: bool = False,
@@ -25,7 +27,7 @@ def solve_square(K, f, *, where: str = "static solve", spd: bool = False,
     """
     K = sp.csr_matrix(K)
     n = K.shape[0]
-    if n < 2000 or K.nnz < DENSE_FILL * n * n:
+    if n < DENSE_MIN_UNKNOWNS or K.nnz < DENSE_FILL * n * n:
         u, _, info = solve_constrained(K, f, where=where, spd=spd, ordering=ordering)
         return u, info
     f = np.asarray(f, dtype=float)
