@@ -12,6 +12,7 @@ from ..errors import InputError, NumericalError
 from ..params import Param, resolve
 from ..pd.influence import INFLUENCES
 from ..results import RunResult, Timer
+from ..solvers.iterative import solver_error_warnings
 
 
 def conditioning_warnings(diagnostics: Mapping) -> list[str]:
@@ -167,7 +168,8 @@ class Scene:
                 raise NumericalError(f"metric {bad[0]} is not finite ({out.metrics[bad[0]]})")
             result.metrics, result.size = out.metrics, out.size
             result.fields, result.diagnostics = out.fields, out.diagnostics
-            result.warnings = conditioning_warnings(out.diagnostics)
+            result.warnings = (conditioning_warnings(out.diagnostics)
+                               + solver_error_warnings(out.diagnostics, out.metrics))
         except NumericalError as exc:
             where = f"{self.id}/{method}"
             msg = str(exc)

@@ -10,7 +10,8 @@ from ..metrics import rel_l2_error
 from ..params import Param, at_least, positive
 from ..pd import BondBasedModel, BoxGrid, Closure, bond_micromodulus, build_stencil, get_influence
 from ..pd.influence import bond_based_nu
-from ..solvers.dense import solve_with_dirichlet
+from ..solvers.dense import AUTO_ITERATIVE_UNKNOWNS, SOLVERS, solve_with_dirichlet
+from ..solvers.iterative import Lattice
 from . import Outcome, Published, register, whole_cells
 from .fem_references import FemAndPD
 
@@ -22,6 +23,9 @@ PD_COMMON = (
     Param("quadrature", "full-cells", "horizon quadrature: whole cells of the nodes with "
           "|xi| <= delta (reproduces Tables 1 and 2; Peridigm's default) or the exact cell "
           "fractions inside the horizon", choices=("full-cells", "partial-volume")),
+    Param("solver", "auto", "linear solver: direct (sparse LU), cg (conjugate gradients, "
+          "two-level smoothed aggregation one horizon wide) or auto (cg from "
+          f"{AUTO_ITERATIVE_UNKNOWNS} free unknowns)", choices=SOLVERS),
 )
 PAPER = {"micromodulus": "constant", "quadrature": "full-cells"}
 
@@ -56,13 +60,19 @@ class SheetScene(FemAndPD):
         return bond_micromodulus(p["micromodulus"], 2, p["E"], horizon, plane="stress")
 
     @staticmethod
-    def solve_fixed(model, fixed, values, where, f=None):
-        """K u = f with the given DOFs prescribed; returns (u, reactions K u - f, info)."""
+    def solve_fixed(model, fixed, values, where, f=None, solver="direct"):
+        """K u = f with the given DOFs prescribed; returns (u, reactions K u - f, info).
+
+        ``solver``: see :func:`~pdverify.solvers.dense.solve_with_dirichlet`; CG's
+        aggregates are one horizon (m nodes) wide."""
         K = model.K
         rhs = np.zeros(K.shape[0]) if f is None else f
         order = np.argsort(fixed)
-        u, info = solve_with_dirichlet(K, rhs, fixed[order], values[order], where=where,
-                                       spd=True)  # bond-based K with Dirichlet rows removed
+        g = model.grid
+        u, info = solve_with_dirichlet(  # bond-based K with Dirichlet rows removed: SPD
+            K, rhs, fixed[order], values[order], where=where, spd=True, solver=solver,
+            lattice=Lattice.component_major(g.index, g.x, g.dim),
+            aggregate_width=int(round(model.m_ratio)))
         return u, K @ u - rhs, info
 
 
@@ -193,7 +203,7 @@ class TensionSheet(SheetScene):
                           n + np.flatnonzero(np.isclose(x[:, 1], 0.0))]
         with timer.phase("solve"):
             u, _, info = self.solve_fixed(model, fixed, np.zeros(fixed.size),
-                                          f"{self.id}/{method}", f)
+                                          f"{self.id}/{method}", f, solver=p["solver"])
         U = u.reshape(2, n).T
         E_star, nu_star = lattice_moduli(model)
         metrics = {}
@@ -350,7 +360,8 @@ class ClampedSheet(SheetScene):
             values = np.r_[np.zeros(top.size + bottom.size), np.full(top.size, uy),
                            np.full(bottom.size, -uy)]
         with timer.phase("solve"):
-            u, reaction, info = self.solve_fixed(model, fixed, values, f"{self.id}/{method}")
+            u, reaction, info = self.solve_fixed(model, fixed, values, f"{self.id}/{method}",
+                                                  solver=p["solver"])
         with timer.phase("reference"):
             ref = self.fem_reference(p)
         stress = float(reaction[n + top].sum()) / (L * t) / 1e6

@@ -51,13 +51,28 @@ def solve_square(K, f, *, where: str = "static solve", spd: bool = False,
                "condition_estimate": float(cond), "solver": "dense LU (LAPACK)"}
 
 
+#: ``solver="auto"`` picks CG (SPD systems with a lattice) from this many free unknowns:
+#: below it the direct solve is fast (< 1 s) and exact to round-off, so the report's
+#: default-size runs keep their direct solutions.
+AUTO_ITERATIVE_UNKNOWNS = 20000
+SOLVERS = ("auto", "direct", "cg")
+
+
 def solve_with_dirichlet(K, rhs, fixed, values, where, spd: bool = False,
-                         ordering: str = "COLAMD"):
+                         ordering: str = "COLAMD", *, solver: str = "direct",
+                         lattice=None, aggregate_width: int = 1):
     """Solve K u = rhs with u[fixed] = values by elimination (their own rows dropped).
 
     The dropped rows are the equations of the prescribed unknowns (their reactions).
-    Returns the full solution and the solver's diagnostics.
+    ``solver``: ``direct`` (:func:`solve_square`), ``cg`` (conjugate gradients with the
+    two-level preconditioner of :mod:`pdverify.solvers.iterative`; needs ``spd`` and the
+    unknowns' ``lattice``, whose aggregates are ``aggregate_width`` nodes wide) or ``auto``
+    (``cg`` from :data:`AUTO_ITERATIVE_UNKNOWNS` free unknowns when it applies, else
+    ``direct``). Returns the full solution and the solver's diagnostics, which say what
+    was chosen and why.
     """
+    if solver not in SOLVERS:
+        raise ValueError(f"solver={solver!r}: allowed {SOLVERS}")
     n = K.shape[0]
     free = np.setdiff1d(np.arange(n), fixed)
     u = np.zeros(n)
@@ -65,6 +80,19 @@ def solve_with_dirichlet(K, rhs, fixed, values, where, spd: bool = False,
     Kc = K.tocsc()
     K_free = Kc[:, free].tocsr()[free]
     r = rhs[free] - (Kc[:, fixed] @ u[fixed])[free] if fixed.size else rhs[free]
-    u_free, info = solve_square(K_free, r, where=where, spd=spd, ordering=ordering)
+    iterative_ok = spd and lattice is not None
+    if solver == "cg" and not iterative_ok:
+        raise ValueError(f"{where}: solver=cg needs a symmetric positive definite system "
+                         "on a lattice")
+    use_cg = solver == "cg" or (solver == "auto" and iterative_ok
+                                and free.size >= AUTO_ITERATIVE_UNKNOWNS)
+    if use_cg:
+        from .iterative import solve_spd
+        u_free, info = solve_spd(K_free, r, lattice.take(free), aggregate_width, where=where)
+    else:
+        u_free, info = solve_square(K_free, r, where=where, spd=spd, ordering=ordering)
+    if solver == "auto":
+        info["solver_choice"] = (f"auto: {'cg' if use_cg else 'direct'} ({free.size} free "
+                                 f"unknowns; cg from {AUTO_ITERATIVE_UNKNOWNS} on SPD systems)")
     u[free] = u_free
     return u, info
