@@ -7,7 +7,8 @@ import scipy.sparse as sp
 from scipy.linalg import lapack
 
 from ..errors import NumericalError
-from .static import CONDITION_LIMIT, equilibrate, relative_residual, solve_constrained
+from .static import (CONDITION_LIMIT, equilibrate, relative_residual, solve_constrained,
+                     solve_nested)
 
 #: Above this fill (nnz / n^2) a dense LAPACK LU beats SuperLU: in 3D state-based PD every
 #: node couples to all nodes within two horizons, i.e. to a large part of a small body.
@@ -55,12 +56,12 @@ def solve_square(K, f, *, where: str = "static solve", spd: bool = False,
 #: below it the direct solve is fast (< 1 s) and exact to round-off, so the report's
 #: default-size runs keep their direct solutions.
 AUTO_ITERATIVE_UNKNOWNS = 20000
-SOLVERS = ("auto", "direct", "cg")
+SOLVERS = ("auto", "direct", "cg", "nested-dissection")
 
 
 def solve_with_dirichlet(K, rhs, fixed, values, where, spd: bool = False,
                          ordering: str = "COLAMD", *, solver: str = "direct",
-                         lattice=None, aggregate_width: int = 1):
+                         lattice=None, aggregate_width: int = 1, coords=None):
     """Solve K u = rhs with u[fixed] = values by elimination (their own rows dropped).
 
     The dropped rows are the equations of the prescribed unknowns (their reactions).
@@ -68,7 +69,8 @@ def solve_with_dirichlet(K, rhs, fixed, values, where, spd: bool = False,
     two-level preconditioner of :mod:`pdverify.solvers.iterative`; needs ``spd`` and the
     unknowns' ``lattice``, whose aggregates are ``aggregate_width`` nodes wide) or ``auto``
     (``cg`` from :data:`AUTO_ITERATIVE_UNKNOWNS` free unknowns when it applies, else
-    ``direct``). Returns the full solution and the solver's diagnostics, which say what
+    ``direct``), or ``nested-dissection`` (sparse LU under a geometric ordering,
+    :func:`~pdverify.solvers.static.solve_nested`; needs the unknowns' ``coords``). Returns the full solution and the solver's diagnostics, which say what
     was chosen and why.
     """
     if solver not in SOLVERS:
@@ -86,7 +88,11 @@ def solve_with_dirichlet(K, rhs, fixed, values, where, spd: bool = False,
                          "on a lattice")
     use_cg = solver == "cg" or (solver == "auto" and iterative_ok
                                 and free.size >= AUTO_ITERATIVE_UNKNOWNS)
-    if use_cg:
+    if solver == "nested-dissection":
+        if coords is None:
+            raise ValueError(f"{where}: solver=nested-dissection needs the unknowns' coordinates")
+        u_free, info = solve_nested(K_free, r, np.asarray(coords)[free], where=where)
+    elif use_cg:
         from .iterative import solve_spd
         u_free, info = solve_spd(K_free, r, lattice.take(free), aggregate_width, where=where)
     else:
