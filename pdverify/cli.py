@@ -5,7 +5,7 @@ usage:
   python -m pdverify run SCENE [--method M] [--set KEY=VALUE ...] [--json FILE]
                           [--max-memory SIZE]
   python -m pdverify report [--out DIR] [--quick] [--only SCENE ...] [--jobs N]
-                          [--max-memory SIZE]
+                          [--scheduler ADDRESS] [--max-memory SIZE]
   python -m pdverify compare BASELINE.json NEW.json [--rtol R] [--atol A] [--summary FILE]
 
 Exit codes: 0 success; 1 a run failed numerically or a regression was found;
@@ -55,6 +55,10 @@ def build_parser() -> argparse.ArgumentParser:
                      help="run only these scenes (each once)")
     rep.add_argument("--jobs", type=int, default=1,
                      help="worker processes, 1 to the number of CPUs (default 1)")
+    rep.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                     help="run the cases on the Dask cluster of this scheduler, e.g. "
+                          "tcp://10.0.0.5:8786 (default: $PDVERIFY_SCHEDULER, else the "
+                          "local processes of --jobs; needs the extra 'cluster')")
     rep.add_argument("--max-memory", default=None, metavar="SIZE", help=MAX_MEMORY_HELP)
     cmp_ = sub.add_parser("compare", help="compare a results file against a baseline")
     cmp_.add_argument("baseline", help="the stored results.json")
@@ -146,8 +150,10 @@ def _dispatch(args) -> int:
     if args.command == "report":
         from .report import DEFAULT_OUT, build_report
         out = validate.output_dir(DEFAULT_OUT if args.out is None else args.out)
+        from .cluster import scheduler_address
         return build_report(out=out, quick=args.quick, only=validate.only(args.only),
-                            jobs=validate.jobs(args.jobs))
+                            jobs=validate.jobs(args.jobs),
+                            scheduler=scheduler_address(args.scheduler))
     if args.command == "compare":
         from .compare import compare_files
         for path, what in ((args.baseline, "baseline"), (args.new, "new results")):

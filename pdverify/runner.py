@@ -36,9 +36,21 @@ def run_one(scene_id: str, *, method=None, overrides=None, json_path=None, strea
     return 0 if result.status == "ok" else 1
 
 
-def _run_case(case) -> RunResult:
+def run_case(case) -> RunResult:
+    """One (scene, method, overrides) case; numerical trouble is a failed result."""
     scene_id, method, overrides = case
     return get_scene(scene_id).run(method, overrides)
+
+
+def died_on_cluster(case, exc) -> RunResult:
+    """A failed result for a case whose cluster task raised (e.g. its worker died)."""
+    scene_id, method, overrides = case
+    res = RunResult(scene=scene_id, method=method,
+                    params=get_scene(scene_id).resolve(method, overrides),
+                    reference=get_scene(scene_id).reference)
+    res.status = "failed"
+    res.message = f"{scene_id}/{method}: the cluster task failed ({type(exc).__name__}: {exc})"
+    return res
 
 
 def plan(only=None, quick=False) -> list[tuple[str, str, dict]]:
@@ -83,7 +95,7 @@ def _worker(conn, inherited, parent_pid) -> None:
             return
         if case is None:
             return
-        conn.send(_run_case(case))
+        conn.send(run_case(case))
 
 
 def _died(case, exitcode) -> RunResult:
@@ -109,8 +121,11 @@ def _died(case, exitcode) -> RunResult:
                      timings={"setup_s": 0.0, "solve_s": 0.0, "total_s": 0.0})
 
 
-def run_cases(cases, *, jobs: int = 1, progress=None) -> list[RunResult]:
+def run_cases(cases, *, jobs: int = 1, progress=None, client=None) -> list[RunResult]:
     """Run ``cases`` in ``jobs`` supervised worker processes; one progress line per run.
+
+    With a Dask ``client`` (``report --scheduler``), the cases run as tasks on its
+    cluster instead (:mod:`pdverify.cluster`); ``jobs`` is then unused.
 
     Every case runs in a worker process, so a run that dies in native code (segfault,
     abort, out-of-memory kill) becomes a failed run naming the signal, a new worker takes
@@ -135,6 +150,15 @@ def run_cases(cases, *, jobs: int = 1, progress=None) -> list[RunResult]:
             print(f"[{done}/{total}] {res.scene} {res.method} {params} ... {status} "
                   f"({res.timings.get('total_s', 0):.2f} s) {format_metrics(res.metrics, 2)}",
                   file=progress, flush=True)
+
+    if client is not None:
+        from .cluster import run_cases_on
+
+        def count_and_note(k, res):
+            nonlocal done
+            done += 1
+            note(k, res)
+        return run_cases_on(client, cases, count_and_note)
 
     ctx = mp.get_context("fork")
     workers = {}          # connection -> [process, index of the case it runs or None]

@@ -70,36 +70,52 @@ def _swap_in(staging: str, out: str) -> None:
         shutil.rmtree(old, ignore_errors=True)
 
 
-def build_report(*, out=None, quick=False, only=None, jobs=1, progress=None) -> int:
+def build_report(*, out=None, quick=False, only=None, jobs=1, progress=None,
+                 scheduler=None) -> int:
     """Run the report; returns 0, or 1 if any run failed. Bad input raises before work.
 
     Figures, results.json and index.html are written into a staging folder next to
     ``out`` and swapped in as a whole at the end, under a lock on ``out``: a report that
     is killed or fails leaves the previous one intact (its staging folder is removed now,
     or by the next report into the same folder if the process was killed outright).
+    ``scheduler``: a Dask scheduler address; the runs then go to that cluster
+    (:mod:`pdverify.cluster`), which is reached before any work starts.
     """
     progress = progress or sys.stderr
     out = os.path.abspath(out or DEFAULT_OUT)
     cases = plan(only=only, quick=quick)  # raises InputError on unknown scenes
     parent, name = os.path.split(out)
-    with output_lock(out):
-        _clean_stale(parent, name)
-        staging = tempfile.mkdtemp(prefix=f".{name}.staging-", dir=parent)
-        os.chmod(staging, umask_mode(0o777))  # mkdtemp gives 0700
-        try:
-            code = _build(cases, staging, out, jobs, progress)
-            if STOP_REQUESTED["flag"]:  # an interrupt some library swallowed: publish nothing
-                raise KeyboardInterrupt
-            _swap_in(staging, out)
-        finally:
-            if os.path.exists(staging):
-                shutil.rmtree(staging, ignore_errors=True)
+    client = None
+    if scheduler is not None:
+        from ..cluster import connect
+        client = connect(scheduler)
+    try:
+        with output_lock(out):
+            return _locked(cases, out, parent, name, jobs, progress, client)
+    finally:
+        if client is not None:
+            client.close()
+
+
+def _locked(cases, out, parent, name, jobs, progress, client) -> int:
+    """The report's body, under the output lock: stage, build, swap in."""
+    _clean_stale(parent, name)
+    staging = tempfile.mkdtemp(prefix=f".{name}.staging-", dir=parent)
+    os.chmod(staging, umask_mode(0o777))  # mkdtemp gives 0700
+    try:
+        code = _build(cases, staging, out, jobs, progress, client)
+        if STOP_REQUESTED["flag"]:  # an interrupt some library swallowed: publish nothing
+            raise KeyboardInterrupt
+        _swap_in(staging, out)
+    finally:
+        if os.path.exists(staging):
+            shutil.rmtree(staging, ignore_errors=True)
     return code
 
 
-def _build(cases, out, final, jobs, progress) -> int:
+def _build(cases, out, final, jobs, progress, client=None) -> int:
     t0 = time.perf_counter()
-    results = run_cases(cases, jobs=jobs, progress=progress)
+    results = run_cases(cases, jobs=jobs, progress=progress, client=client)
     figdir = os.path.join(out, "figures")
     os.makedirs(figdir, exist_ok=True)
     from . import figures, html
