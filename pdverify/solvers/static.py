@@ -57,17 +57,9 @@ def solve_constrained(K, f, B=None, c=None, *, where: str = "static solve", spd:
         raise NumericalError(f"{where}: the system has non-finite entries")
     A_s, row_max, col_max = equilibrate(A, where)
     A_s = A_s.tocsc()
-    try:
-        lu = spla.splu(A_s, **(SPD_OPTIONS if spd and B is None else {"permc_spec": ordering}))
-    except RuntimeError as exc:  # "Factor is exactly singular"
-        raise NumericalError(f"{where}: singular system of size {A.shape[0]} ({exc})") from None
+    lu = _factor(A_s, where, **(SPD_OPTIONS if spd and B is None else {"permc_spec": ordering}))
     sol = lu.solve(rhs / row_max) / col_max
-    if not np.all(np.isfinite(sol)):
-        raise NumericalError(f"{where}: solution has non-finite values (singular system)")
-    cond = _condition_estimate(A_s, lu)
-    if cond > CONDITION_LIMIT:
-        raise NumericalError(f"{where}: near-singular system (condition estimate {cond:.2e} "
-                             f"> {CONDITION_LIMIT:.0e} after equilibration)")
+    cond = _checked_condition(sol, A_s, lu, where)
     info = {"unknowns": int(A.shape[0]), "relative_residual": relative_residual(A, sol, rhs),
             "condition_estimate": float(cond),  # of the equilibrated system
             "solver": "sparse LU (SuperLU, " + ("symmetric mode)" if spd and B is None
@@ -97,23 +89,35 @@ def solve_nested(A, rhs, coords, *, where: str = "static solve"):
     A_s, row_max, col_max = equilibrate(A, where)
     perm = nested_dissection(A_s, coords)
     A_p = A_s[perm][:, perm].tocsc()
-    try:
-        lu = spla.splu(A_p, permc_spec="NATURAL", diag_pivot_thresh=ND_PIVOT_THRESHOLD,
-                       options=dict(SymmetricMode=True))
-    except RuntimeError as exc:
-        raise NumericalError(f"{where}: singular system of size {A.shape[0]} ({exc})") from None
+    lu = _factor(A_p, where, permc_spec="NATURAL", diag_pivot_thresh=ND_PIVOT_THRESHOLD,
+                 options=dict(SymmetricMode=True))
     y = np.empty_like(rhs)
     y[perm] = lu.solve((rhs / row_max)[perm])
     sol = y / col_max
-    if not np.all(np.isfinite(sol)):
-        raise NumericalError(f"{where}: solution has non-finite values (singular system)")
-    cond = _condition_estimate(A_p, lu)
-    if cond > CONDITION_LIMIT:
-        raise NumericalError(f"{where}: near-singular system (condition estimate {cond:.2e} "
-                             f"> {CONDITION_LIMIT:.0e} after equilibration)")
+    cond = _checked_condition(sol, A_p, lu, where)
     return sol, {"unknowns": int(A.shape[0]), "relative_residual": relative_residual(A, sol, rhs),
                  "condition_estimate": float(cond), "factor_entries": int(lu.L.nnz + lu.U.nnz),
                  "solver": "sparse LU (SuperLU, nested-dissection ordering)"}
+
+
+def _factor(A, where: str, **options):
+    """SuperLU of the equilibrated ``A``; an exactly singular factor is a NumericalError."""
+    try:
+        return spla.splu(A, **options)
+    except RuntimeError as exc:  # "Factor is exactly singular"
+        raise NumericalError(f"{where}: singular system of size {A.shape[0]} ({exc})") from None
+
+
+def _checked_condition(sol, A, lu, where: str) -> float:
+    """The condition estimate of the factored ``A``, after refusing a non-finite solution
+    or a near-singular system (NumericalError naming ``where``)."""
+    if not np.all(np.isfinite(sol)):
+        raise NumericalError(f"{where}: solution has non-finite values (singular system)")
+    cond = _condition_estimate(A, lu)
+    if cond > CONDITION_LIMIT:
+        raise NumericalError(f"{where}: near-singular system (condition estimate {cond:.2e} "
+                             f"> {CONDITION_LIMIT:.0e} after equilibration)")
+    return cond
 
 
 def relative_residual(A, x, b) -> float:
