@@ -66,7 +66,8 @@ def scene_section(scene, results, figures) -> str:
         t = r.timings
         rows.append(f"<tr{cls}><td class=l>{html.escape(r.method)}</td>"
                     f"<td class=l>{_params(r, scene)}</td><td class=l>{status}</td>{''.join(cells)}"
-                    f"<td>{t.get('setup_s', 0):.3g}</td><td>{t.get('solve_s', 0):.3g}</td>"
+                    f"<td>{t.get('setup_s', 0):.3g}</td><td>{t.get('solve_s', 0):.3g}"
+                    f"{_solver_note(r.diagnostics)}</td>"
                     f"<td>{t.get('total_s', 0):.3g}</td><td class=l>{size}</td></tr>")
     parts.append(f"<table>{head}{''.join(rows)}</table>")
     for r in results:
@@ -80,6 +81,24 @@ def scene_section(scene, results, figures) -> str:
         parts.append(f'<figure><img src="figures/{name}" style="max-width:100%">'
                      f"<figcaption>{html.escape(caption)}</figcaption></figure>")
     return "\n".join(parts)
+
+
+def _solver_note(diagnostics) -> str:
+    """The linear solver a run used, as a short tag under its solve time (the full name,
+    and CG's iteration count, on hover)."""
+    solver = diagnostics.get("solver") if isinstance(diagnostics, dict) else None
+    if not isinstance(solver, str):
+        return ""
+    its = diagnostics.get("iterations")
+    if solver.startswith("CG"):
+        tag = f"CG {its} it" if isinstance(its, int) else "CG"
+    elif solver.startswith("dense"):
+        tag = "dense LU"
+    elif "nested-dissection" in solver:
+        tag = "LU, ND"
+    else:
+        tag = "LU"
+    return f'<br><small title="{html.escape(solver)}">{tag}</small>'
 
 
 def refinement_table(result) -> str:

@@ -130,3 +130,13 @@ def test_sheet_cg_matches_direct_through_the_scene():
     # seed 003 Table 1 metrics agree far below the method error (rel_l2 ~ 1e-2)
     for k in ("max_error_ux_pct", "max_error_uy_pct", "rel_l2_error"):
         assert a.metrics[k] == pytest.approx(b.metrics[k], rel=1e-6)
+
+
+def test_report_tags_the_solver_under_the_solve_time():
+    from pdverify.report.html import _solver_note
+    note = _solver_note({"solver": "CG + two-level smoothed aggregation (coarse 9)",
+                         "iterations": 12})
+    assert ">CG 12 it<" in note and 'title="CG + two-level' in note
+    assert ">LU, ND<" in _solver_note({"solver": "sparse LU (SuperLU, nested-dissection "
+                                                 "ordering)"})
+    assert _solver_note({}) == "" and _solver_note({"bar_0": {"solver": "x"}}) == ""
