@@ -10,7 +10,7 @@ from ..metrics import rel_l2_error
 from ..params import Param, at_least, positive
 from ..pd import BondBasedModel, BoxGrid, Closure, bond_micromodulus, build_stencil, get_influence
 from ..pd.influence import bond_based_nu
-from ..solvers.dense import AUTO_ITERATIVE_UNKNOWNS, SOLVERS, solve_with_dirichlet
+from ..solvers.dense import AUTO_ITERATIVE_UNKNOWNS, SPD_LATTICE_SOLVERS, solve_with_dirichlet
 from ..solvers.iterative import Lattice
 from . import Outcome, Published, register, whole_cells
 from .fem_references import FemAndPD
@@ -25,7 +25,7 @@ PD_COMMON = (
           "fractions inside the horizon", choices=("full-cells", "partial-volume")),
     Param("solver", "auto", "linear solver: direct (sparse LU), cg (conjugate gradients, "
           "two-level smoothed aggregation one horizon wide) or auto (cg from "
-          f"{AUTO_ITERATIVE_UNKNOWNS} free unknowns)", choices=SOLVERS),
+          f"{AUTO_ITERATIVE_UNKNOWNS} free unknowns)", choices=SPD_LATTICE_SOLVERS),
 )
 PAPER = {"micromodulus": "constant", "quadrature": "full-cells"}
 

@@ -57,6 +57,9 @@ def solve_square(K, f, *, where: str = "static solve", spd: bool = False,
 #: default-size runs keep their direct solutions.
 AUTO_ITERATIVE_UNKNOWNS = 20000
 SOLVERS = ("auto", "direct", "cg", "nested-dissection")
+#: the choices of a scene whose system is SPD on a lattice (bond-based): no coordinates
+#: are passed, so nested dissection is not among them
+SPD_LATTICE_SOLVERS = ("auto", "direct", "cg")
 
 
 def solve_with_dirichlet(K, rhs, fixed, values, where, spd: bool = False,
