@@ -37,7 +37,7 @@ import scipy.sparse.linalg as spla
 from pdverify.pd import BondBasedModel, BoxGrid, build_stencil, get_influence
 from pdverify.pd.influence import bond_micromodulus
 from pdverify.scenes import get_scene
-from pdverify.solvers.dense import solve_with_dirichlet
+from pdverify.solvers.dense import eliminate_dirichlet, solve_with_dirichlet
 from pdverify.solvers.iterative import Lattice, TwoLevelPreconditioner, cg_solve
 
 try:
@@ -150,16 +150,6 @@ def bench_spd(args, out):
 
 
 # ------------------------------------------------------------------ state-based systems
-def reduced(A, rhs, fixed, values):
-    """The free block and right-hand side after the Dirichlet elimination."""
-    n = A.shape[0]
-    free = np.setdiff1d(np.arange(n), fixed)
-    u = np.zeros(n)
-    u[fixed] = values
-    Ac = A.tocsc()
-    return Ac[:, free].tocsr()[free], rhs[free] - (Ac[:, fixed] @ u[fixed])[free], free
-
-
 def bench_state(args, out, scene_id, spacing, key):
     scene = get_scene(scene_id)
     systems = {}
@@ -180,7 +170,7 @@ def bench_state(args, out, scene_id, spacing, key):
                        coords=coords: solve_with_dirichlet(A, rhs, fixed, values, "bench",
                                                            solver=solver, coords=coords))
         if pypardiso is not None:
-            Af, bf, _ = reduced(A, rhs, fixed, values)
+            Af, bf, _, _ = eliminate_dirichlet(A, rhs, fixed, values)
             alts[f"PARDISO on {'K' if solver == 'direct' else 'the augmented system'}"] = (
                 lambda Af=Af, bf=bf: pardiso_factor_solve(Af, bf))
     res = alternate(alts, args.repeat)

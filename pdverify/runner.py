@@ -44,13 +44,22 @@ def run_case(case) -> RunResult:
 
 def died_on_cluster(case, exc) -> RunResult:
     """A failed result for a case whose cluster task raised (e.g. its worker died)."""
+    scene_id, method, _ = case
+    return _failed(case, f"{scene_id}/{method}: the cluster task failed "
+                         f"({type(exc).__name__}: {exc})")
+
+
+def _failed(case, message) -> RunResult:
+    """The failed record of a case that returned no result of its own."""
     scene_id, method, overrides = case
-    res = RunResult(scene=scene_id, method=method,
-                    params=get_scene(scene_id).resolve(method, overrides),
-                    reference=get_scene(scene_id).reference)
-    res.status = "failed"
-    res.message = f"{scene_id}/{method}: the cluster task failed ({type(exc).__name__}: {exc})"
-    return res
+    scene = get_scene(scene_id)
+    try:
+        params = scene.resolve(method, overrides)
+    except InputError:
+        params = dict(overrides)
+    return RunResult(scene=scene_id, method=method, params=params, reference=scene.reference,
+                     status="failed", message=message,
+                     timings={"setup_s": 0.0, "solve_s": 0.0, "total_s": 0.0})
 
 
 def plan(only=None, quick=False) -> list[tuple[str, str, dict]]:
@@ -101,7 +110,6 @@ def _worker(conn, inherited, parent_pid) -> None:
 def _died(case, exitcode) -> RunResult:
     """The failed record of a case whose worker process died in native code."""
     import signal
-    scene_id, method, overrides = case
     if exitcode is not None and exitcode < 0:
         try:
             how = f"signal {signal.Signals(-exitcode).name}"
@@ -109,16 +117,8 @@ def _died(case, exitcode) -> RunResult:
             how = f"signal {-exitcode}"
     else:
         how = f"exit code {exitcode}"
-    scene = get_scene(scene_id)
-    try:
-        params = scene.resolve(method, overrides)
-    except InputError:
-        params = dict(overrides)
-    return RunResult(scene=scene_id, method=method, params=params, reference=scene.reference,
-                     status="failed",
-                     message=f"the run's process died ({how}) in native code (e.g. a crash in "
-                             "a linear-algebra library, or killed for lack of memory)",
-                     timings={"setup_s": 0.0, "solve_s": 0.0, "total_s": 0.0})
+    return _failed(case, f"the run's process died ({how}) in native code (e.g. a crash in "
+                         "a linear-algebra library, or killed for lack of memory)")
 
 
 def run_cases(cases, *, jobs: int = 1, progress=None, client=None) -> list[RunResult]:

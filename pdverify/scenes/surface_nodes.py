@@ -110,8 +110,9 @@ QUADRATURE = Param("quadrature", "partial-volume",
 
 INFLUENCE = influence_param("gaussian", "seed 001, Eq. 7: Gaussian")
 #: ``solver=auto`` solves the augmented system under nested dissection from this many
-#: displacement unknowns; below it the direct solve of K is < 1 s and the report's
-#: default-size 2D runs keep their solutions bit for bit (benchmarks/solvers.py).
+#: displacement unknowns; below it the direct solve of K takes a few seconds at most
+#: (1.7 s at the plate's default 5,000) and the report's default-size 2D runs keep their
+#: solutions bit for bit.
 ND_FROM_UNKNOWNS = 8000
 SOLVER = Param("solver", "auto", "linear solver: direct (K multiplied out; sparse or dense "
                "LU), nested-dissection (dilatations kept as unknowns, sparse LU under a "
@@ -304,8 +305,8 @@ class SurfaceNodeScene(Scene):
 
     def solver_for(self, p, dim, unknowns) -> str:
         """The solver a run uses: p["solver"], or for ``auto`` nested dissection on 2D
-        systems from :data:`ND_FROM_UNKNOWNS` unknowns (measured 6.4x faster than the
-        direct solve at h = 0.01; in 3D at h = 0.05 it is as fast as the dense LU, so 3D
+        systems from :data:`ND_FROM_UNKNOWNS` unknowns (6.0x faster than the direct
+        solve at h = 0.01; in 3D at h = 0.05 it is as fast as the dense LU, so 3D
         stays direct until an iterative solver serves it: benchmarks/solvers.py)."""
         if p["solver"] != "auto":
             return p["solver"]

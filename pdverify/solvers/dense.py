@@ -53,13 +53,27 @@ def solve_square(K, f, *, where: str = "static solve", spd: bool = False,
 
 
 #: ``solver="auto"`` picks CG (SPD systems with a lattice) from this many free unknowns:
-#: below it the direct solve is fast (< 1 s) and exact to round-off, so the report's
-#: default-size runs keep their direct solutions.
+#: below it the direct solve takes about a second (1.2 s at the sheets' default 10,150
+#: unknowns) and is exact to round-off, and the report's default-size runs keep their
+#: direct solutions bit for bit.
 AUTO_ITERATIVE_UNKNOWNS = 20000
 SOLVERS = ("auto", "direct", "cg", "nested-dissection")
 #: the choices of a scene whose system is SPD on a lattice (bond-based): no coordinates
 #: are passed, so nested dissection is not among them
 SPD_LATTICE_SOLVERS = ("auto", "direct", "cg")
+
+
+def eliminate_dirichlet(K, rhs, fixed, values):
+    """The system left after prescribing u[fixed] = values: ``(K_free, rhs_free, free, u)``,
+    with ``free`` the other unknowns and ``u`` the full vector holding the values."""
+    n = K.shape[0]
+    free = np.setdiff1d(np.arange(n), fixed)
+    u = np.zeros(n)
+    u[fixed] = values
+    Kc = K.tocsc()
+    K_free = Kc[:, free].tocsr()[free]
+    r = rhs[free] - (Kc[:, fixed] @ u[fixed])[free] if fixed.size else rhs[free]
+    return K_free, r, free, u
 
 
 def solve_with_dirichlet(K, rhs, fixed, values, where, spd: bool = False,
@@ -78,13 +92,7 @@ def solve_with_dirichlet(K, rhs, fixed, values, where, spd: bool = False,
     """
     if solver not in SOLVERS:
         raise ValueError(f"solver={solver!r}: allowed {SOLVERS}")
-    n = K.shape[0]
-    free = np.setdiff1d(np.arange(n), fixed)
-    u = np.zeros(n)
-    u[fixed] = values
-    Kc = K.tocsc()
-    K_free = Kc[:, free].tocsr()[free]
-    r = rhs[free] - (Kc[:, fixed] @ u[fixed])[free] if fixed.size else rhs[free]
+    K_free, r, free, u = eliminate_dirichlet(K, rhs, fixed, values)
     iterative_ok = spd and lattice is not None
     if solver == "cg" and not iterative_ok:
         raise ValueError(f"{where}: solver=cg needs a symmetric positive definite system "

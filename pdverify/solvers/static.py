@@ -7,6 +7,7 @@ import scipy.sparse.linalg as spla
 
 from ..errors import NumericalError
 from ..metrics import scaled_norm
+from .ordering import nested_dissection
 
 #: Above this 1-norm condition estimate the solution has lost (almost) every digit of
 #: double precision (eps ~ 2.2e-16), so the run is refused as near-singular.
@@ -69,9 +70,10 @@ def solve_constrained(K, f, B=None, c=None, *, where: str = "static solve", spd:
 
 #: SuperLU's diagonal pivot threshold under the nested-dissection ordering: a diagonal
 #: entry is kept as pivot unless it is below 1e-3 of its column's largest, so the ordering
-#: survives; measured on the plane-strain plate, 1e-3 and 1e-2 give the same accuracy
-#: (solution error 7e-13 against PARDISO's 6e-13) and 1.0 (full partial pivoting) is 2.4x
-#: slower with 1.5x the fill.
+#: survives. Measured on the plane-strain plate's augmented system at h = 0.01 (a side
+#: measurement): 1e-3 and 1e-2 give the same accuracy (solution error 7e-13, PARDISO's
+#: 6e-13); 0.1 is 1.7x slower, and 1.0 (full partial pivoting) 9.8x slower with 3.3x the
+#: fill.
 ND_PIVOT_THRESHOLD = 1e-3
 
 
@@ -80,8 +82,6 @@ def solve_nested(A, rhs, coords, *, where: str = "static solve"):
     ordering (:func:`pdverify.solvers.ordering.nested_dissection`; ``coords``: one row
     per unknown). Same checks and diagnostics as :func:`solve_constrained`: equilibration,
     a 1-norm condition estimate, :class:`NumericalError` on (near-)singular systems."""
-    from .ordering import nested_dissection
-
     A = sp.csr_matrix(A)
     rhs = np.asarray(rhs, dtype=float)
     if not np.all(np.isfinite(A.data)) or not np.all(np.isfinite(rhs)):
