@@ -14,7 +14,15 @@ class NumericalError(RuntimeError):
 
     The message says what happened and where; the run is recorded as failed and
     never aborts a report.
+
+    ``partial``: what the run computed before the trouble (an ``Outcome`` of metrics and
+    fields, e.g. a load curve up to the depth where the lattice folded); the failed record
+    keeps it so that a report can show where and how the run broke down.
     """
+
+    def __init__(self, message: str, partial=None):
+        super().__init__(message)
+        self.partial = partial
 
 
 #: Set when the process was asked to stop (SIGTERM, Ctrl-C): a step that finishes after a

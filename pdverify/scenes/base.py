@@ -175,6 +175,9 @@ class Scene:
             msg = str(exc)
             result.status = "failed"
             result.message = msg if msg.startswith(where) else f"{where}: {msg}"
+            if exc.partial is not None:     # what was computed up to the trouble
+                result.metrics, result.size = exc.partial.metrics, exc.partial.size
+                result.fields, result.diagnostics = exc.partial.fields, exc.partial.diagnostics
         except (FloatingPointError, ArithmeticError, np.linalg.LinAlgError) as exc:
             result.status = "failed"
             result.message = f"numerical error: {type(exc).__name__}: {exc}"

@@ -5,12 +5,10 @@ from __future__ import annotations
 
 import dataclasses
 
-import numpy as np
-
 from .. import budget
 from ..errors import InputError
 from ..params import Param
-from . import MethodSpec, Outcome, Scene, register
+from . import MethodSpec, Outcome, Scene
 
 FEM = MethodSpec("fem")
 
@@ -140,27 +138,3 @@ class FemAndPD(FemReference):
     def fem_reference(self, p):
         """The converged FEM reference at this scene's shared params (cached on disk)."""
         return getattr(_reference_module(), self.function)(**self.reference_params(p))
-
-
-@register
-class IndentationFem(FemReference):
-    """Seed 003 §4.2 indentation: 40 x 40 mm block, rigid circular indenter R = 15 mm,
-    centred, depth 0 -> 2 mm in 20 output steps (each in sub-increments), sticking
-    contact (a top node the indenter reaches sticks and then moves rigidly with it),
-    bottom fixed, sides free, plane stress, E = 1 GPa, nu = 1/3, unit thickness, small
-    strain (the paper does not say; strains reach ~13 % under the indenter, so a
-    finite-strain reference could differ by a few percent). Metrics ``max_force`` (N per
-    m of thickness, at 2 mm), ``force_monotone`` (1 or 0), ``refinement_change_pct`` of
-    the force at 2 mm (issue #5: < 1 %); the force-depth curve and contact width per step
-    are in the figures.
-    """
-
-    id = "block2d-indentation"
-    title = "Rigid cylinder indenting a block, sticking contact (FEM reference)"
-    seed = "003 §4.2"
-    params_class, function = "IndentationParams", "indentation"
-
-    def extra_fields(self, res, fields):
-        fields.update(depths=np.asarray(res.depths), forces=np.asarray(res.forces),
-                      contact_widths=np.asarray(res.contact_widths))
-        return fields

@@ -1,0 +1,343 @@
+"""Seed 003 §4.2: a rigid cylinder indenting a block, sticking contact; FEM and
+geometrically nonlinear bond-based PD with and without the directional correction."""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from .. import budget
+from ..corrections.energy_directional import directional_closure
+from ..errors import InputError, NumericalError
+from ..params import Param, at_least, positive
+from ..pd import BondBasedModel, BoxGrid, Closure, get_influence
+from ..pd.influence import bond_based_nu
+from ..pd.nonlinear import LinearBondBased, NonlinearBondBased
+from ..solvers.dense import AUTO_ITERATIVE_UNKNOWNS, SPD_LATTICE_SOLVERS
+from ..solvers.iterative import Lattice
+from ..solvers.newton import DirichletLinearSolver, newton
+from . import Outcome, Published, register
+from .fem_references import FemAndPD, _reference_module
+from .sheets import PAPER, PD_COMMON, SheetScene, _grid_check
+
+#: Output depths left out of the force comparison: the first one (0.1 mm), where the
+#: sticking law catches a whole chord in one increment and the reference itself depends on
+#: the stepping by ~25 % (reference_fem.indentation, module docstring).
+SKIP_OUTPUT_STEPS = 1
+#: A free surface node is caught when it lies this fraction of R inside the indenter (the
+#: FEM reference's rule).
+CATCH_TOLERANCE = 1e-9
+KINEMATICS = ("nonlinear", "linear")
+
+
+@register
+class Indentation(FemAndPD):
+    """Seed 003 §4.2 (Figs. 4 and 5): block 40 x 40 mm, rigid cylinder R = 15 mm pressed
+    into the middle of the top edge to 2 mm; the parts of the surface it reaches stick to
+    it ("move without slip along with the indenter surface").
+
+    FEM (``fem``): small-strain Q2 with the same contact law, converged and cached
+    (``reference_fem.indentation``: 20 output depths, 8 increments each).
+
+    PD (``none``, ``energy-directional``): bond-based, plane stress, E = 1 GPa, nu = 1/3,
+    unit thickness (ERRATA: chosen), micromodulus calibrated to the bulk of a complete
+    continuous horizon; nodes on the surface (161 x 161 at spacing 0.25 mm, the paper's
+    "matching grid of nodes"; boundary nodes carry half a cell, corners a quarter, as in
+    §4.1), delta = 1.5 mm (m = 6). ``energy-directional`` applies Eq. (14) with all four
+    faces counted, as in §4.1. Bottom row fixed, sides free.
+
+    Kinematics (``kinematics``): ``nonlinear`` (default; ERRATA: §4.2 is beyond small
+    displacements) = the bond force acts along the current bond and depends on the
+    current length (:mod:`pdverify.pd.nonlinear`), solved by Newton with a line search
+    per increment; ``linear`` = the small-displacement model of §4.1 (one solve per
+    contact pass), to compare with the small-strain FEM like for like.
+
+    Contact law (the FEM reference's, node for node): the depth grows in
+    ``n_steps * substeps`` equal increments; stuck nodes move down with the indenter by
+    each increment, their x frozen; after each equilibrium every free node of the top row
+    whose deformed position lies inside the disc is caught: x frozen, y put on the
+    indenter surface; equilibrium again, until no free node penetrates. Stuck nodes never
+    release. Force = minus the sum of the stuck nodes' y reactions (N per m of thickness).
+
+    Breakdown: after each equilibrium every bond's current vector is compared with its
+    reference one; a bond turned by 90 degrees or more (cos <= 0: inverted, e.g. a
+    surface node pushed past the next row) ends the run as failed, naming the depth and
+    the bond. So does a Newton iteration that stalls or a tangent CG cannot solve. The
+    record keeps the curve up to the last equilibrium reached (``failure_depth_mm`` = the
+    depth of the increment that failed).
+
+    Metrics (against the FEM curve at the shared output depths, the first
+    :data:`SKIP_OUTPUT_STEPS` left out): ``force_error_pct`` = max |F_PD - F_FEM| / F_FEM,
+    ``force_bias_pct`` = the mean signed difference (negative: too soft),
+    ``force_error_final_pct`` = signed at the last output depth reached, ``max_force``,
+    ``failure_depth_mm`` (failed runs only), ``newton_iterations``, ``contact_nodes``,
+    ``cg_iterations``.
+
+    Not yet here (issue 14): the finite-strain FEM reference; the comparison is against
+    the small-strain FEM, which at 13 % strain under the indenter may differ from a
+    finite-strain one by a few percent.
+    """
+
+    id = "block2d-indentation"
+    title = "Rigid cylinder indenting a block, sticking contact: FEM and nonlinear PD (Fig. 4)"
+    seed = "003 §4.2"
+    figure = "indentation"
+    params_class, function = "IndentationParams", "indentation"
+    shared = ("width", "height", "radius", "depth", "n_steps", "E", "nu", "thickness")
+    pd_params = (
+        Param("spacing", 0.00025, "node spacing Delta [m] (161 x 161 nodes)", positive),
+        Param("horizon", 0.0015, "horizon delta [m] (m = 6)", positive),
+        *(q for q in PD_COMMON if q.name != "solver"),
+        Param("solver", "auto", "linear solver of each Newton step: direct (sparse LU), cg "
+              "(conjugate gradients, two-level smoothed aggregation one horizon wide, built "
+              "once and rebuilt when a solve slows down) or auto (cg from "
+              f"{AUTO_ITERATIVE_UNKNOWNS} unknowns)", choices=SPD_LATTICE_SOLVERS),
+        Param("substeps", 1, "depth increments per output depth (n_steps * substeps in all)",
+              at_least(1)),
+        Param("kinematics", "nonlinear", "nonlinear (current bond lengths and directions) "
+              "or linear (small displacements)", choices=KINEMATICS),
+    )
+    pd_methods = (("none", ()), ("energy-directional", ()))
+    published = (
+        Published("force_error_pct", 6, "seed 003 §4.2 (about 6 %)", method="energy-directional",
+                  where=PAPER),
+        Published("force_error_pct", 30, "seed 003 §4.2 (about 30 % too soft)", method="none",
+                  where=PAPER),
+        Published("failure_depth_mm", 0.4, "seed 003 §4.2 (about 0.4 mm)", method="none",
+                  where=PAPER),
+    )
+
+    def extra_fields(self, res, fields):
+        fields.update(depths=np.asarray(res.depths), forces=np.asarray(res.forces),
+                      contact_widths=np.asarray(res.contact_widths))
+        return fields
+
+    def check_pd(self, where, method, p):
+        rf = _reference_module()
+        try:
+            rf.IndentationParams(**self.reference_params(p))
+        except (TypeError, ValueError) as exc:
+            raise InputError(f"{where}: {exc}".replace("\n", " ")) from None
+        nu = bond_based_nu(2, "stress")
+        if abs(p["nu"] - nu) > 1e-12:
+            raise InputError(f"{where}: nu={p['nu']:g} is not allowed; bond-based PD in plane "
+                             f"stress represents only nu = 1/3 ({nu:.6g})")
+        _grid_check(where, (("width", p["width"]), ("height", p["height"])), p["spacing"],
+                    p["horizon"], "spacing")
+        if round(p["width"] / p["spacing"]) % 2:
+            raise InputError(f"{where}: width={p['width']:g} must be an even number of "
+                             "spacings (a node under the indenter's axis)")
+        if p["n_steps"] * p["substeps"] > 2000:
+            raise InputError(f"{where}: n_steps * substeps = {p['n_steps'] * p['substeps']} "
+                             "depth increments; allowed at most 2000")
+
+    def estimate_pd(self, method, p):
+        h = p["spacing"]
+        nodes = (p["width"] / h + 1) * (p["height"] / h + 1)
+        m = p["horizon"] / h
+        bonds = nodes * budget.lattice_neighbours(2, m) / 2
+        # the tangent's pattern positions and data, bond vectors, the CG preconditioner
+        return budget.linear_system(nodes, 2, 2, m, extra_bytes=400.0 * bonds)
+
+    def cases(self, quick=False):
+        out = [("fem", {})]
+        coarse = {"spacing": 0.001, "horizon": 0.006} if quick else {}
+        for method in ("none", "energy-directional"):
+            out.append((method, dict(coarse)))
+        if not quick:
+            out += [("energy-directional", {"kinematics": "linear"}),
+                    ("none", {"kinematics": "linear"})]
+        return out
+
+    def solve_pd(self, method, p, timer):
+        W, H, h, delta = p["width"], p["height"], p["spacing"], p["horizon"]
+        where = f"{self.id}/{method}"
+        with timer.phase("setup"):
+            grid = BoxGrid((W, H), (-W / 2, -H), h, placement="on-surface")
+            inf = get_influence(p["micromodulus"])
+            closure = (directional_closure(grid, (-W / 2, -H), (W / 2, 0.0), delta, inf)
+                       if method == "energy-directional" else Closure())
+            model = BondBasedModel(grid, SheetScene.stencil(p, delta / h),
+                                   SheetScene.micromodulus(p, delta), inf, closure,
+                                   thickness=p["thickness"])
+            kin = (NonlinearBondBased if p["kinematics"] == "nonlinear" else LinearBondBased)(model)
+            kin.pattern
+            unknowns = 2 * grid.n_ext
+            use_cg = p["solver"] == "cg" or (p["solver"] == "auto"
+                                             and unknowns >= AUTO_ITERATIVE_UNKNOWNS)
+            lin = DirichletLinearSolver(kin.pattern, "cg" if use_cg else "direct",
+                                        Lattice.component_major(grid.index, grid.x, 2),
+                                        width=int(round(delta / h)),
+                                        describe=lambda k: _describe(grid, k))
+        size = {"nodes": int(grid.n_ext), "unknowns": int(unknowns), "bonds": model.n_bonds(),
+                "tangent_nnz": int(kin.pattern.nnz)}
+        with timer.phase("reference"):
+            ref = self.fem_reference(p)
+        with timer.phase("solve"):
+            curve, failure = indent(kin, grid, p, lin, where)
+        metrics = curve_metrics(curve, ref, failure)
+        diagnostics = {"solver": ("CG + two-level smoothed aggregation, reused across Newton "
+                                  "iterations" if use_cg else "sparse LU per Newton iteration"),
+                       "linear_solves": lin.stats.solves,
+                       "preconditioner_builds": lin.stats.rebuilds,
+                       "preconditioner_setup_s": lin.stats.setup_s,
+                       "linear_solve_s": lin.stats.solve_s,
+                       "median_step_s": float(np.median(curve["step_s"])) if curve["step_s"] else 0.0,
+                       "max_step_s": float(np.max(curve["step_s"])) if curve["step_s"] else 0.0,
+                       "line_search_cuts": int(curve["cuts"])}
+        if use_cg:
+            metrics["cg_iterations"] = lin.stats.iterations
+        fields = {"depths": np.array(curve["depths"]), "forces": np.array(curve["forces"]),
+                  "contact_widths": np.array(curve["widths"]),
+                  "contact_counts": np.array(curve["counts"]),
+                  "step_s": np.array(curve["step_s"]),
+                  "min_bond_cosine": np.array(curve["min_cos"]),
+                  "min_bond_length_ratio": np.array(curve["min_stretch"]),
+                  "newton_residuals": curve["residuals"],
+                  "fem_depths": np.asarray(ref.depths), "fem_forces": np.asarray(ref.forces),
+                  "x": grid.x, "u": curve["u"].reshape(2, -1).T,
+                  "energy": kin.energy_density(curve["u"]), "spacing": h, "horizon": delta,
+                  "failure": failure}
+        if failure is None:
+            fields.update(u_ref=ref.evaluate(grid.x), energy_ref=ref.strain_energy_density(grid.x))
+            return Outcome(metrics=metrics, size=size, fields=fields, diagnostics=diagnostics)
+        raise NumericalError(failure["message"],
+                             partial=Outcome(metrics=metrics, size=size, fields=fields,
+                                             diagnostics=diagnostics))
+
+
+def indent(kin, grid, p, lin, where):
+    """Depth stepping with the sticking contact law of :class:`Indentation`; returns the
+    curve (dict of per-output-depth lists, the last equilibrium ``u``) and ``None``, or the
+    curve up to the last equilibrium and a failure dict (depth, message, node) when the
+    lattice folds or Newton fails."""
+    n = grid.n_ext
+    x0 = grid.x
+    R = p["radius"]
+    top = np.flatnonzero(grid.index[:, 1] == grid.index[:, 1].max())
+    top = top[np.argsort(x0[top, 0])]
+    bottom = np.flatnonzero(grid.index[:, 1] == 0)
+    fixed = np.zeros(2 * n, dtype=bool)
+    fixed[bottom] = fixed[n + bottom] = True
+    stuck = np.zeros(top.size, dtype=bool)
+    u = np.zeros(2 * n)
+    n_inc = p["n_steps"] * p["substeps"]
+    dd = p["depth"] / n_inc
+    curve = {"depths": [0.0], "forces": [0.0], "widths": [0.0], "counts": [0], "step_s": [],
+             "newton": [0], "residuals": [], "cuts": 0, "u": u.copy(), "min_cos": [1.0],
+             "min_stretch": [1.0]}
+    lin.set_fixed(fixed)
+    t_step = time.perf_counter()
+    iterations = 0
+    for inc in range(1, n_inc + 1):
+        d = p["depth"] * inc / n_inc
+        yc = R - d
+        at = f"{where}: depth {d * 1e3:.4g} mm"
+        previous = u.copy()
+        u[n + top[stuck]] -= dd
+        while True:
+            try:
+                rep = newton(kin, u, lin, where=at, previous=previous)
+            except NumericalError as exc:
+                return curve, _stalled(kin, grid, u, previous, d, str(exc))
+            iterations += rep.iterations
+            curve["cuts"] += rep.line_search_cuts
+            if len(curve["residuals"]) < 3 and rep.iterations >= 2:
+                curve["residuals"].append([r / rep.scale for r in rep.residuals])
+            folded = _folding(kin, grid, u, at)
+            if folded is not None:
+                folded["depth"] = d
+                return curve, folded
+            X = x0[top, 0] + u[top]
+            Y = x0[top, 1] + u[n + top]
+            new = ~stuck & (np.hypot(X, Y - yc) - R < -CATCH_TOLERANCE * R)
+            if not new.any():
+                break
+            idx = top[new]
+            previous = u.copy()
+            u[n + idx] = yc - np.sqrt(R ** 2 - X[new] ** 2) - x0[idx, 1]
+            stuck |= new
+            fixed[idx] = fixed[n + idx] = True
+            lin.set_fixed(fixed)
+        if inc % p["substeps"]:
+            continue
+        f = kin.internal_force(u)
+        xs = x0[top[stuck], 0] + u[top[stuck]]
+        curve["depths"].append(d)
+        curve["forces"].append(-float(f[n + top[stuck]].sum()))
+        curve["widths"].append(float(xs.max() - xs.min()) if xs.size else 0.0)
+        curve["counts"].append(int(stuck.sum()))
+        curve["newton"].append(iterations)
+        y, l = kin.bond_vectors(u)
+        curve["min_cos"].append(kin.min_bond_cosine(u)[0])
+        curve["min_stretch"].append(float(np.min(l / kin.L)))
+        curve["u"] = u.copy()
+        now = time.perf_counter()
+        curve["step_s"].append(now - t_step)
+        t_step = now
+    return curve, None
+
+
+def _describe(grid, k) -> str:
+    """Unknown k (component-major) as 'u_y of node i at (x, y) mm'."""
+    node, comp = k % grid.n_ext, k // grid.n_ext
+    x = grid.x[node] * 1e3
+    return f"u_{'xy'[comp]} of node {node} at ({x[0]:.4g}, {x[1]:.4g}) mm"
+
+
+def _folding(kin, grid, u, at):
+    """None, or a failure dict when a bond has turned by >= 90 degrees."""
+    cos, k = kin.min_bond_cosine(u)
+    if cos > 0:
+        return None
+    a, b = int(kin.a[k]), int(kin.b[k])
+    off = grid.index[b] - grid.index[a]
+    lower, upper = (a, b) if off[1] > 0 or (off[1] == 0 and off[0] > 0) else (b, a)
+    xa = grid.x[upper] * 1e3
+    what = ("pushed past the next row (its vertical nearest-neighbour bond inverted)"
+            if abs(off[0]) == 0 and abs(off[1]) == 1 else
+            f"bond to node {lower} (offset {tuple(int(v) for v in off)}) inverted")
+    return {"message": f"{at}: the lattice folds: node {upper} at ({xa[0]:.3g}, {xa[1]:.3g}) "
+                       f"mm {what}, cos = {cos:.3f}; the configuration is no longer a "
+                       "deformation (seed 003 §4.2)",
+            "node": upper, "bond": (a, b), "cos": cos}
+
+
+def _shortest(kin, grid, u) -> tuple[float, str]:
+    """The smallest current / reference bond length ratio and where (the upper node)."""
+    _, l = kin.bond_vectors(u)
+    k = int(np.argmin(l / kin.L))
+    a, b = int(kin.a[k]), int(kin.b[k])
+    upper = a if grid.x[a, 1] > grid.x[b, 1] else b
+    x = grid.x[upper] * 1e3
+    return float(l[k] / kin.L[k]), f"node {upper} at ({x[0]:.4g}, {x[1]:.4g}) mm"
+
+
+def _stalled(kin, grid, u, previous, depth, message):
+    """The failure dict of a Newton that gave up: what the lattice looked like at the last
+    equilibrium (``previous``) and at the last iterate (``u``)."""
+    ratio, where = _shortest(kin, grid, previous)
+    note = (f"; at the last equilibrium the shortest bond was {ratio:.2f} of its reference "
+            f"length ({where})")
+    folded = _folding(kin, grid, u, "the last iterate")
+    if folded is not None:
+        note += "; " + folded["message"]
+    return {"depth": depth, "message": message + note, "node": where}
+
+
+def curve_metrics(curve, ref, failure) -> dict:
+    """The force comparison of :class:`Indentation` at the output depths reached."""
+    F = np.array(curve["forces"])
+    k = np.arange(SKIP_OUTPUT_STEPS + 1, F.size)
+    F_ref = np.asarray(ref.forces)[k]
+    rel = (F[k] - F_ref) / F_ref * 100.0
+    metrics = {"max_force": float(F.max()), "contact_nodes": int(curve["counts"][-1]),
+               "newton_iterations": int(curve["newton"][-1]),
+               "depth_reached_mm": float(curve["depths"][-1] * 1e3)}
+    if rel.size:
+        metrics.update(force_error_pct=float(np.max(np.abs(rel))),
+                       force_bias_pct=float(np.mean(rel)),
+                       force_error_final_pct=float(rel[-1]))
+    if failure is not None:
+        metrics["failure_depth_mm"] = float(failure["depth"] * 1e3)
+    return metrics

@@ -1,0 +1,216 @@
+"""Newton's method with a line search for f(u) = 0 on the free unknowns, with prescribed
+(Dirichlet) unknowns that may change between solves (contact), and a linear solver that
+reuses its work across iterations and load steps.
+
+The tangent keeps one sparsity pattern; prescribed unknowns are handled in place on that
+pattern (their rows and columns zeroed, their diagonal kept), so the system keeps its size
+and a preconditioner built once stays applicable when the prescribed set grows.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse.linalg as spla
+
+from ..errors import NumericalError
+from .iterative import Lattice, TwoLevelPreconditioner, cg_solve
+
+#: Newton stops when ||f_free|| <= NEWTON_RTOL * max(||f_free|| at its start, ||reactions||):
+#: eight digits of the force balance (the reported forces are sums of reactions, compared
+#: with a reference at the percent level).
+NEWTON_RTOL = 1e-8
+#: Iterations before Newton is declared stalled.
+NEWTON_MAXITER = 30
+#: Step halvings before the line search gives up (the step is then 2^-12 of Newton's).
+LINE_SEARCH_HALVINGS = 12
+#: Forcing term of inexact Newton with CG: the linear solve's relative residual is
+#: min(FORCING_MAX, ||f|| / scale), which keeps Newton's quadratic convergence (the
+#: forcing term is O(||f||); Eisenstat and Walker 1996) and spends no iterations far away;
+#: it is never tighter than the last step to the stopping rule needs.
+FORCING_MAX = 1e-2
+#: Floor of the CG tolerance (the reference tolerance of the solver layer).
+FORCING_MIN = 1e-10
+#: The CG preconditioner, built on an earlier tangent, is rebuilt on the current one when
+#: a solve needs more than this many times the iterations per decade of residual
+#: reduction of the first solve after the last build (a fresh one needs ~1.2 per decade on
+#: the indentation-size stiffness, benchmarks/solvers.py; a build costs ~1.8 s, ~65 CG
+#: iterations).
+REBUILD_SLOWDOWN = 2.5
+
+
+@dataclass
+class LinearStats:
+    solves: int = 0
+    iterations: int = 0
+    rebuilds: int = 0
+    setup_s: float = 0.0
+    solve_s: float = 0.0
+    log: list = field(default_factory=list)          # (rtol, iterations) per CG solve
+
+
+class DirichletLinearSolver:
+    """Solves T du = -f with du = 0 on the prescribed unknowns, for tangents T given as data
+    on one CSR ``pattern`` (see :mod:`pdverify.pd.nonlinear`).
+
+    ``method``: ``direct`` (sparse LU of the free block, a fresh factorisation per solve) or
+    ``cg`` (conjugate gradients on the full-size system with the prescribed rows and
+    columns replaced by their diagonal, preconditioned by :class:`TwoLevelPreconditioner`
+    built on the first tangent and rebuilt only when a solve exceeds
+    :data:`REBUILD_ITERATIONS`). CG needs a symmetric positive definite tangent; a tangent
+    that has lost definiteness makes CG fail, which is reported as numerical trouble.
+    """
+
+    def __init__(self, pattern, method: str, lattice: Lattice | None = None, width: int = 1,
+                 describe=None):
+        if method not in ("direct", "cg"):
+            raise ValueError(f"method={method!r}: allowed direct, cg")
+        self.pattern, self.method, self.lattice, self.width = pattern, method, lattice, width
+        self.describe = describe or (lambda k: f"unknown {k}")
+        self.precond = None
+        self.fixed = None
+        self._diag0 = None
+        self.stats = LinearStats()
+
+    def set_fixed(self, fixed: np.ndarray) -> None:
+        """Mark the prescribed unknowns (boolean per unknown)."""
+        self.fixed = np.asarray(fixed, dtype=bool)
+        P = self.pattern
+        self._kill = np.flatnonzero(self.fixed[P.row_of] | self.fixed[P.indices])
+
+    def masked(self, data):
+        """The matrix with the prescribed rows and columns zeroed and their diagonal set to
+        that of the first tangent seen (positive, on the scale of the others; a prescribed
+        node's own current stiffness may be anything); ``data`` is overwritten."""
+        P = self.pattern
+        if self._diag0 is None:
+            self._diag0 = data[P.diagonal].copy()
+        data[self._kill] = 0.0
+        data[P.diagonal[self.fixed]] = self._diag0[self.fixed]
+        return P.matrix(data)
+
+    def solve(self, data, rhs, rtol: float, where: str) -> np.ndarray:
+        """du with T du = rhs on the free unknowns, du = 0 on the prescribed ones (``data``,
+        the tangent on the pattern, is overwritten)."""
+        free = ~self.fixed
+        diag = data[self.pattern.diagonal]
+        bad = np.flatnonzero(free & ~(diag > 0))
+        if bad.size:
+            k = bad[np.argmin(diag[bad])]
+            raise NumericalError(f"{where}: the tangent has lost definiteness: "
+                                 f"{self.describe(k)} has stiffness {diag[k]:.3g} <= 0 against "
+                                 "its own motion (compressed bonds' negative geometric "
+                                 "stiffness outweighs their axial stiffness there)")
+        r = np.where(free, rhs, 0.0)
+        t0 = time.perf_counter()
+        if self.method == "direct":
+            T = self.pattern.matrix(data).tocsc()
+            idx = np.flatnonzero(free)
+            try:
+                lu = spla.splu(T[idx][:, idx].tocsc(), permc_spec="MMD_AT_PLUS_A",
+                               options={"SymmetricMode": True})
+            except RuntimeError as exc:   # "Factor is exactly singular"
+                raise NumericalError(f"{where}: the tangent is singular ({exc})") from None
+            du = np.zeros_like(r)
+            du[idx] = lu.solve(r[idx])
+            self.stats.solves += 1
+            self.stats.solve_s += time.perf_counter() - t0
+            if not np.all(np.isfinite(du)):
+                raise NumericalError(f"{where}: the tangent solve gave non-finite values")
+            return du
+        T = self.masked(data)
+        if self.precond is None:
+            self._build(T)
+        du, info = cg_solve(T, r, self.precond, where=where, rtol=rtol)
+        self.stats.solves += 1
+        self.stats.iterations += info["iterations"]
+        self.stats.log.append((rtol, info["iterations"]))
+        self.stats.solve_s += info["cg_solve_s"]
+        decades = max(-np.log10(max(info["relative_residual"], 1e-16)), 1.0)
+        rate = max(info["iterations"], 1) / decades
+        if self._fresh_rate is None:
+            self._fresh_rate = rate
+        elif rate > REBUILD_SLOWDOWN * self._fresh_rate:
+            self.precond = None            # the next solve rebuilds on its own tangent
+        du[self.fixed] = 0.0
+        return du
+
+    def _build(self, T):
+        self.precond = TwoLevelPreconditioner(T, self.lattice, self.width)
+        self._fresh_rate = None
+        self.stats.rebuilds += 1
+        self.stats.setup_s += self.precond.setup_s
+
+
+@dataclass
+class NewtonReport:
+    iterations: int
+    residuals: list = field(default_factory=list)   # ||f_free|| per iterate, start first
+    line_search_cuts: int = 0
+    scale: float = 0.0                               # the force scale of the stopping rule
+
+
+def newton(model, u, solver: DirichletLinearSolver, *, where: str, previous=None,
+           rtol: float = NEWTON_RTOL, maxiter: int = NEWTON_MAXITER) -> NewtonReport:
+    """Solve model.internal_force(u) = 0 on the free unknowns of ``solver`` in place,
+    starting from ``u`` (whose prescribed entries hold their values).
+
+    ``previous``: the equilibrium ``u`` left (same free entries, other prescribed values).
+    The start is then the tangent predictor from it: the free unknowns follow the change
+    of the prescribed ones through the tangent at ``previous``, du_free = -T_ff^-1 (f_free
+    + T_fp du_p). Starting instead from the old free values next to the new prescribed
+    ones would compress the bonds between them by the whole increment (40 % of a
+    0.25 mm bond for a 0.1 mm indenter step), where the tangent is no longer definite.
+
+    Each step solves tangent du = -f and takes the largest of 1, 1/2, 1/4, ... that
+    reduces ||f_free|| by the Armijo fraction 1e-4 of the step. Stops at
+    ||f_free|| <= rtol * max(||f_free|| at the start, ||reactions||). A step the line
+    search cannot make, or ``maxiter`` iterations, raise :class:`NumericalError` naming
+    ``where`` and the residual reached.
+    """
+    free = ~solver.fixed
+
+    def residual(v):
+        f = model.internal_force(v)
+        if not np.all(np.isfinite(f)):
+            raise NumericalError(f"{where}: non-finite internal forces")
+        return f, float(np.linalg.norm(f[free]))
+
+    if previous is not None:
+        change = np.where(solver.fixed, u - previous, 0.0)
+        f0 = model.internal_force(previous)
+        T0 = solver.pattern.matrix(model.tangent_data(previous))
+        du = solver.solve(T0.data, -(f0 + T0 @ change), FORCING_MAX, where)
+        u[free] = previous[free] + du[free]
+    f, norm = residual(u)
+    scale = max(norm, float(np.linalg.norm(f[solver.fixed])))
+    report = NewtonReport(0, [norm], scale=scale)
+    if scale == 0.0:
+        return report
+    while norm > rtol * scale:
+        if report.iterations >= maxiter:
+            raise NumericalError(f"{where}: Newton stalled, {maxiter} iterations without "
+                                 f"convergence (residual {norm / scale:.1e} of the force scale)")
+        # O(||f||) for quadratic convergence, but no tighter than the stopping rule needs:
+        # the next residual is about eta ||f||, so eta ~ rtol scale / (2 ||f||) reaches it
+        eta = min(FORCING_MAX, max(FORCING_MIN, norm / scale, 0.5 * rtol * scale / norm))
+        du = solver.solve(model.tangent_data(u), -f, eta, where)
+        step = 1.0
+        for _ in range(LINE_SEARCH_HALVINGS + 1):
+            trial = u + step * du
+            f_t, n_t = residual(trial)
+            if n_t <= (1.0 - 1e-4 * step) * norm:
+                break
+            step *= 0.5
+            report.line_search_cuts += 1
+        else:
+            raise NumericalError(f"{where}: Newton stalled, the line search found no step that "
+                                 f"reduces the residual ({norm / scale:.1e} of the force scale)")
+        u[:] = trial
+        f, norm = f_t, n_t
+        scale = max(scale, float(np.linalg.norm(f[solver.fixed])))
+        report.iterations += 1
+        report.residuals.append(norm)
+    report.scale = scale
+    return report
