@@ -32,12 +32,13 @@ LINE_SEARCH_HALVINGS = 12
 FORCING_MAX = 1e-2
 #: Floor of the CG tolerance (the reference tolerance of the solver layer).
 FORCING_MIN = 1e-10
-#: The CG preconditioner, built on an earlier tangent, is rebuilt on the current one when
-#: a solve needs more than this many times the iterations per decade of residual
-#: reduction of the first solve after the last build (a fresh one needs ~1.2 per decade on
-#: the indentation-size stiffness, benchmarks/solvers.py; a build costs ~1.8 s, ~65 CG
-#: iterations).
-REBUILD_SLOWDOWN = 2.5
+#: The CG preconditioner, built on an earlier tangent (and an earlier set of prescribed
+#: unknowns), is rebuilt on the current one once the iterations it has lost since its build
+#: exceed what a build costs (both measured as the run goes): the loss of a solve is its
+#: iterations minus those the best rate seen since the build (iterations per decade of
+#: residual reduction) would have needed. The best rate is an optimistic estimate of a
+#: fresh build's, so the loss counts against REBUILD_FACTOR builds.
+REBUILD_FACTOR = 3.0
 
 
 @dataclass
@@ -57,8 +58,8 @@ class DirichletLinearSolver:
     ``method``: ``direct`` (sparse LU of the free block, a fresh factorisation per solve) or
     ``cg`` (conjugate gradients on the full-size system with the prescribed rows and
     columns replaced by their diagonal, preconditioned by :class:`TwoLevelPreconditioner`
-    built on the first tangent and rebuilt only when a solve exceeds
-    :data:`REBUILD_ITERATIONS`). CG needs a symmetric positive definite tangent; a tangent
+    built on the first tangent and rebuilt on the current one when the iterations lost
+    since exceed :data:`REBUILD_FACTOR` builds' cost). CG needs a symmetric positive definite tangent; a tangent
     that has lost definiteness makes CG fail, which is reported as numerical trouble.
     """
 
@@ -127,18 +128,19 @@ class DirichletLinearSolver:
         self.stats.iterations += info["iterations"]
         self.stats.log.append((rtol, info["iterations"]))
         self.stats.solve_s += info["cg_solve_s"]
+        k = info["iterations"]
         decades = max(-np.log10(max(info["relative_residual"], 1e-16)), 1.0)
-        rate = max(info["iterations"], 1) / decades
-        if self._fresh_rate is None:
-            self._fresh_rate = rate
-        elif rate > REBUILD_SLOWDOWN * self._fresh_rate:
+        self._best_rate = min(self._best_rate, max(k, 1) / decades)
+        self._lost += k - self._best_rate * decades
+        per_iteration = info["cg_solve_s"] / max(k, 1)
+        if self._lost * per_iteration > REBUILD_FACTOR * self.precond.setup_s:
             self.precond = None            # the next solve rebuilds on its own tangent
         du[self.fixed] = 0.0
         return du
 
     def _build(self, T):
         self.precond = TwoLevelPreconditioner(T, self.lattice, self.width)
-        self._fresh_rate = None
+        self._best_rate, self._lost = np.inf, 0.0
         self.stats.rebuilds += 1
         self.stats.setup_s += self.precond.setup_s
 

@@ -14,9 +14,12 @@ import matplotlib.pyplot as plt  # noqa: E402
 FAMILIES = {}
 
 
-def family(name):
-    """Register a figure function ``f(scene, results, folder) -> [(file, caption), ...]``."""
+def family(name, failed: bool = False):
+    """Register a figure function ``f(scene, results, folder) -> [(file, caption), ...]``;
+    ``failed``: it also draws failed runs that kept a partial result (e.g. a load curve up
+    to where the run broke down)."""
     def deco(fn):
+        fn.draws_failed = failed
         FAMILIES[name] = fn
         return fn
     return deco
@@ -31,7 +34,8 @@ def draw(scene, results, folder) -> list[tuple[str, str]]:
     """Draw ``scene``'s figure family for its successful runs; returns (file, caption) pairs."""
     _load_all()
     fn = FAMILIES.get(scene.figure)
-    ok = [r for r in results if r.status == "ok" and r.fields]
+    ok = [r for r in results if r.fields and (r.status == "ok" or fn is not None
+                                              and fn.draws_failed)]
     if fn is None or not ok:
         return []
     return fn(scene, ok, folder)

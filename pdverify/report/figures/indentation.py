@@ -1,0 +1,114 @@
+"""Figures of seed 003 §4.2: Fig. 4 (force-depth curves, failure points, the first 0.5 mm)
+and Fig. 5 (u_y, u_x and strain-energy density, FEM beside corrected PD)."""
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from . import family, fem_then_pd, node_image, save
+
+STYLE = {("none", "nonlinear"): ("tab:red", "-", "s"),
+         ("energy-directional", "nonlinear"): ("tab:blue", "-", "o"),
+         ("none", "linear"): ("tab:red", ":", "s"),
+         ("energy-directional", "linear"): ("tab:blue", ":", "o")}
+
+
+def _paper_grid(r):
+    return r.params.get("spacing") == 0.00025 and r.params.get("substeps") == 1 and \
+        r.params.get("micromodulus") == "constant" and r.params.get("quadrature") == "full-cells"
+
+
+def _label(r):
+    kin = r.params["kinematics"]
+    base = f"PD {r.method} ({kin})"
+    if r.status != "ok":
+        base += f", failed at {r.metrics['failure_depth_mm']:.3g} mm"
+    elif "force_error_pct" in r.metrics:
+        base += f", max error {r.metrics['force_error_pct']:.1f} %"
+    return base
+
+
+def _curves(ax, fem, runs, inset=False):
+    crossed = inset
+    if fem is not None:
+        ax.plot(fem["depths"] * 1e3, fem["forces"] / 1e3, "k-", lw=2,
+                label="FEM, small strain (reference)")
+    for r in runs:
+        f = r.fields
+        color, ls, marker = STYLE.get((r.method, r.params["kinematics"]), ("gray", "-", "."))
+        ax.plot(f["depths"] * 1e3, f["forces"] / 1e3, color=color, ls=ls, marker=marker, ms=3,
+                label=None if inset else _label(r))
+        if r.status != "ok":
+            d = r.metrics["failure_depth_mm"]
+            ax.plot([d], [np.interp(d, f["depths"] * 1e3, f["forces"] / 1e3,
+                                    right=f["forces"][-1] / 1e3)],
+                    "x", color="tab:green", ms=12, mew=3,
+                    label=None if crossed else "run fails (lattice folds / Newton stops)")
+            crossed = True
+
+
+@family("indentation", failed=True)
+def indentation_figures(scene, results, folder):
+    out, fem_runs, pd_runs = fem_then_pd(scene, results, folder)
+    runs = [r for r in pd_runs if _paper_grid(r)] or pd_runs
+    if not runs:
+        return out
+    fem = {"depths": runs[0].fields["fem_depths"], "forces": runs[0].fields["fem_forces"]}
+    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(13, 5), layout="constrained")
+    _curves(ax, fem, runs)
+    ax.set_xlabel("indentation depth [mm]")
+    ax.set_ylabel("force [kN per m of thickness]")
+    ax.set_title("Fig. 4 of seed 003: indentation curves")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="lower right")
+    ins = ax.inset_axes([0.08, 0.55, 0.35, 0.4])
+    _curves(ins, fem, runs, inset=True)
+    ins.set_xlim(0, 0.5 + 1e-9)
+    ins.set_ylim(0, 1.1 * np.interp(0.5, fem["depths"] * 1e3, fem["forces"] / 1e3))
+    ins.set_title("first 0.5 mm", fontsize=8)
+    ins.tick_params(labelsize=7)
+    ins.grid(alpha=0.3)
+    for r in runs:
+        color, ls, marker = STYLE.get((r.method, r.params["kinematics"]), ("gray", "-", "."))
+        ax2.plot(r.fields["depths"] * 1e3, r.fields["min_bond_length_ratio"], color=color,
+                 ls=ls, marker=marker, ms=3, label=f"{r.method} ({r.params['kinematics']})")
+    ax2.axhline(0, color="k", lw=0.8)
+    ax2.set_xlabel("indentation depth [mm]")
+    ax2.set_ylabel("shortest bond / its reference length")
+    ax2.set_title("how close the lattice is to folding (0: a node reaches the next row)")
+    ax2.set_ylim(0, 1.05)
+    ax2.grid(alpha=0.3)
+    ax2.legend(fontsize=8)
+    out.append((save(fig, folder, f"{scene.id}-fig4.png"),
+                "Fig. 4 of seed 003: indentation force against depth at the paper's grid "
+                "(161 x 161 nodes, m = 6), FEM (small strain) and PD with and without the "
+                "directional correction, nonlinear (solid) and linear (dotted) kinematics; "
+                "green crosses: where a run fails (the curve stops at its last equilibrium). "
+                "Right: the shortest bond's current length over its reference length, per depth."))
+    good = [r for r in runs if r.status == "ok" and r.method == "energy-directional"
+            and r.params["kinematics"] == "nonlinear" and "u_ref" in r.fields]
+    if good:
+        out.append(_fig5(scene, good[0], folder))
+    return out
+
+
+def _fig5(scene, r, folder):
+    f = r.fields
+    x, h = f["x"], f["spacing"]
+    rows = [("u_y [mm]", f["u_ref"][:, 1] * 1e3, f["u"][:, 1] * 1e3),
+            ("u_x [mm]", f["u_ref"][:, 0] * 1e3, f["u"][:, 0] * 1e3),
+            ("strain energy density [MJ/m^3]", f["energy_ref"] / 1e6, f["energy"] / 1e6)]
+    fig, axes = plt.subplots(3, 2, figsize=(10, 13), layout="constrained")
+    for (title, ref, pd), (a_ref, a_pd) in zip(rows, axes):
+        lo, hi = min(ref.min(), pd.min()), max(ref.max(), pd.max())
+        for ax, vals, who in ((a_ref, ref, "FEM"), (a_pd, pd, "PD, corrected")):
+            img, ext = node_image(x, h, vals, unit=1e3)
+            im = ax.imshow(img, origin="lower", extent=ext, cmap="viridis", vmin=lo, vmax=hi)
+            ax.set_title(f"{who}: {title}", fontsize=10)
+            ax.set_xlabel("x [mm]")
+        a_ref.set_ylabel("y [mm]")
+        fig.colorbar(im, ax=[a_ref, a_pd], shrink=0.8)
+    return (save(fig, folder, f"{scene.id}-fig5.png"),
+            "Fig. 5 of seed 003 at 2 mm depth: u_y, u_x and strain-energy density, FEM (left, "
+            "small strain, evaluated at the PD nodes) beside corrected nonlinear PD (right), "
+            "one colour scale per row.")
