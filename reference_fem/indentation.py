@@ -63,11 +63,13 @@ import scipy.sparse.linalg as spla
 from . import params as _p
 from .cache import cached
 from .elasticity import Material, TensorElasticity
+from .hyperelastic import StVenantKirchhoff
 from .field import midpoint_refined
 from .meshing import fine_then_geometric
 from .results import ReferenceResult, RefinementRow, change_pct
 
 REFERENCE = "block2d-indentation"
+KINEMATICS = ("small", "finite")
 
 
 @dataclass(frozen=True)
@@ -88,6 +90,7 @@ class IndentationParams:
     fine_depth: float = 0.004      # depth of the fine zone below the top (m)
     grading_ratio: float = 1.3     # element growth factor outside the fine zone (level 0)
     levels: int = 3                # level l halves every element l times
+    kinematics: str = "small"      # small strain, or finite (St Venant-Kirchhoff, Newton)
 
     def __post_init__(self):
         _p.positive(REFERENCE, width=self.width, height=self.height, radius=self.radius,
@@ -104,6 +107,8 @@ class IndentationParams:
         _p.require(1.0 <= self.grading_ratio <= 2.0, REFERENCE,
                    f"grading_ratio must lie in [1, 2], got {self.grading_ratio}")
         _p.require(2 <= self.levels <= 5, REFERENCE, f"levels must be 2..5, got {self.levels}")
+        _p.require(self.kinematics in KINEMATICS, REFERENCE,
+                   f"kinematics must be one of {', '.join(KINEMATICS)}, got {self.kinematics!r}")
 
     def finest_cells(self) -> tuple[int, int]:
         """Elements along x and y of the finest level, counted without building the mesh
@@ -237,6 +242,136 @@ def solve_level(p: IndentationParams, level: int, check_steps: bool = False) -> 
                 h_min=float(min(np.diff(model.coords[0]).min(), np.diff(model.coords[1]).min())))
 
 
+def solve_level_finite(p: IndentationParams, level: int, check_steps: bool = False) -> dict:
+    """The contact law of the module docstring with finite-strain kinematics
+    (:class:`~reference_fem.hyperelastic.StVenantKirchhoff`): each increment is solved by
+    Newton's method, candidates are tested at their deformed positions as before; with
+    ``check_steps`` the stepping is repeated with twice the increments."""
+    t0 = time.perf_counter()
+    model = TensorElasticity(mesh_coordinates(p, level),
+                             Material(p.E, p.nu, "plane_stress", p.thickness))
+    svk = StVenantKirchhoff(model)
+    tol = 1e-9 * p.height
+    bottom = model.dofs(lambda x, y: y < -p.height + tol)
+    on_top = lambda x, y: y > -tol  # noqa: E731
+    cx, cy = model.dofs(on_top, [0]), model.dofs(on_top, [1])
+    cx = cx[np.argsort(model.dof_coords[0, cx])]
+    cy = cy[np.argsort(model.dof_coords[0, cy])]
+    X0 = model.dof_coords[0, cx]
+    t_setup = time.perf_counter() - t0
+    t1 = time.perf_counter()
+    out = _finite_steps(p, p.substeps, svk, bottom, cx, cy, X0)
+    solve_s = time.perf_counter() - t1
+    step_change = float("nan")
+    if check_steps:
+        twice = _finite_steps(p, 2 * p.substeps, svk, bottom, cx, cy, X0)
+        step_change = float(100 * np.max(np.abs(twice["forces"] - out["forces"])[1:]
+                                         / twice["forces"][1:]))
+    u, stuck = out["u"], out["stuck"]
+    f = svk.internal_force(u)
+    bottom_y = model.dofs(lambda x, y: y < -p.height + tol, [1])
+    return dict(model=model, field=model.field(u), depths=out["depths"], forces=out["forces"],
+                widths=out["widths"], counts=out["counts"], contact_x=X0[stuck] + u[cx[stuck]],
+                contact_y=u[cy[stuck]], constraint_error=0.0,
+                bottom_reaction=float(f[bottom_y].sum()), n_solves=out["solves"],
+                step_change_pct=step_change, setup_s=t_setup, solve_s=solve_s,
+                h_min=float(min(np.diff(model.coords[0]).min(), np.diff(model.coords[1]).min())),
+                min_jacobian=out["min_jacobian"])
+
+
+def _finite_steps(p, substeps, svk, bottom, cx, cy, X0) -> dict:
+    N = svk.basis.N
+    R = p.radius
+    n_inc = p.n_steps * substeps
+    dd = p.depth / n_inc
+    fixed = np.zeros(N, dtype=bool)
+    fixed[bottom] = True
+    stuck = np.zeros(X0.size, dtype=bool)
+    u = np.zeros(N)
+    depths, forces, widths, counts = [0.0], [0.0], [0.0], [0]
+    solves, min_jac = 0, 1.0
+    for step in range(1, n_inc + 1):
+        d = p.depth * step / n_inc
+        yc = R - d
+        previous = u.copy()
+        u[cy[stuck]] -= dd
+        while True:
+            solves += _newton(svk, u, fixed, previous, d)
+            det, x = svk.min_jacobian(u)
+            min_jac = min(min_jac, det)
+            if det <= 0:
+                raise FloatingPointError(f"indentation (finite strain): the mesh folds at "
+                                         f"depth {d * 1e3:.4g} mm, det F = {det:.3g} at "
+                                         f"({x[0] * 1e3:.3g}, {x[1] * 1e3:.3g}) mm")
+            x, y = X0 + u[cx], u[cy]
+            new = ~stuck & (np.hypot(x, y - yc) - R < -1e-9 * R)
+            if not new.any():
+                break
+            previous = u.copy()
+            u[cy[new]] = yc - np.sqrt(R ** 2 - x[new] ** 2)
+            stuck |= new
+            fixed[cx[new]] = fixed[cy[new]] = True
+        if step % substeps:
+            continue
+        f = svk.internal_force(u)
+        xs = X0[stuck] + u[cx[stuck]]
+        depths.append(d)
+        forces.append(-float(f[cy[stuck]].sum()))
+        widths.append(float(xs.max() - xs.min()) if xs.size else 0.0)
+        counts.append(int(stuck.sum()))
+    return dict(u=u, stuck=stuck, depths=np.array(depths), forces=np.array(forces),
+                widths=np.array(widths), counts=np.array(counts), solves=solves,
+                min_jacobian=min_jac)
+
+
+#: Newton's stopping rule for the finite-strain steps: the free residual below 1e-10 of
+#: the larger of its start and the reactions (the forces are compared at 1e-2 and below).
+NEWTON_RTOL = 1e-10
+
+
+def _newton(svk, u, fixed, previous, depth, maxiter: int = 30) -> int:
+    """Equilibrium on the free dofs, in place, from the tangent predictor at ``previous``
+    (the last equilibrium; ``u`` holds the new prescribed values); returns the number of
+    linear solves. Sparse LU per iteration; a line search halves steps that do not reduce
+    the residual."""
+    free = np.flatnonzero(~fixed)
+
+    def lu_solve(K, r):
+        lu = spla.splu(K[free][:, free].tocsc(), permc_spec="MMD_AT_PLUS_A")
+        return lu.solve(r)
+
+    change = np.where(fixed, u - previous, 0.0)
+    K0 = svk.tangent(previous)
+    r0 = svk.internal_force(previous) + K0 @ change
+    u[free] = previous[free] - lu_solve(K0, r0[free])
+    solves = 1
+    f = svk.internal_force(u)
+    norm = float(np.linalg.norm(f[free]))
+    scale = max(norm, float(np.linalg.norm(f[fixed])))
+    for _ in range(maxiter):
+        if norm <= NEWTON_RTOL * scale:
+            return solves
+        du = -lu_solve(svk.tangent(u), f[free])
+        solves += 1
+        step = 1.0
+        for _ in range(13):
+            trial = u.copy()
+            trial[free] += step * du
+            f_t = svk.internal_force(trial)
+            n_t = float(np.linalg.norm(f_t[free]))
+            if n_t <= (1 - 1e-4 * step) * norm:
+                break
+            step *= 0.5
+        else:
+            raise FloatingPointError(f"indentation (finite strain): Newton's line search "
+                                     f"failed at depth {depth * 1e3:.4g} mm")
+        u[:] = trial
+        f, norm = f_t, n_t
+        scale = max(scale, float(np.linalg.norm(f[fixed])))
+    raise FloatingPointError(f"indentation (finite strain): Newton did not converge in "
+                             f"{maxiter} iterations at depth {depth * 1e3:.4g} mm")
+
+
 class _FlexibilityColumns:
     """Columns of G = K^-1 (rows: candidate DOFs) for unit forces at candidate nodes,
     computed once per node (two solves) when first needed.
@@ -321,7 +456,8 @@ def compute(p: IndentationParams) -> IndentationResult:
     t_start = time.perf_counter()
     rows, prev = [], None
     for level in range(p.levels):
-        s = solve_level(p, level, check_steps=level == p.levels - 1)
+        solver = solve_level if p.kinematics == "small" else solve_level_finite
+        s = solver(p, level, check_steps=level == p.levels - 1)
         q = float(s["forces"][-1])
         q_prev = None if prev is None else prev["forces"][-1]
         extra = {"contact_width_m": float(s["widths"][-1]),

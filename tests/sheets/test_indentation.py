@@ -201,16 +201,41 @@ def test_quick_uncorrected_run_fails_and_keeps_its_curve():
 
 @pytest.mark.slow
 def test_paper_grid_corrected_and_uncorrected_against_fem():
-    """Issue 14 / seed 003 §4.2 at the paper's grid (161 x 161 nodes, m = 6): corrected PD
-    within 10 % of the FEM force over the curve (paper: about 6 %), reaching 2 mm;
-    uncorrected 20-40 % too soft (paper: about 30 %) and failing, with the depth in the
-    record (paper: about 0.4 mm). The FEM here is the small-strain reference."""
+    """Issue 14 / seed 003 §4.2 at the paper's grid (161 x 161 nodes, m = 6): corrected
+    nonlinear PD within 10 % of the finite-strain FEM force over the curve (paper: about
+    6 %), reaching 2 mm; uncorrected 20-40 % too soft (paper: about 30 %) and failing, with
+    the depth in the record (paper: about 0.4 mm)."""
     scene = get_scene("block2d-indentation")
     good = scene.run("energy-directional")
     assert good.status == "ok", good.message
+    assert good.fields["fem_kinematics"] == "finite"
     assert good.metrics["depth_reached_mm"] == pytest.approx(2.0)
     assert good.metrics["force_error_pct"] < 10
+    assert good.metrics["force_error_pct_vs_small_strain"] < 10
     bad = scene.run("none")
     assert bad.status == "failed"
     assert -40 < bad.metrics["force_bias_pct"] < -20
     assert 0 < bad.metrics["failure_depth_mm"] < 2
+
+
+@pytest.mark.slow
+def test_paper_grid_linear_runs_against_small_strain_fem():
+    """Issue 14: the linear PD runs and the small-strain FEM agree at small depth the way
+    the nonlinear runs and the finite-strain FEM do: at 0.2-0.4 mm the force errors of the
+    two pairings differ by less than the kinematic effect itself (the finite- against the
+    small-strain FEM force at that depth, 2.2-3.3 %), for both methods; otherwise choosing
+    the like-for-like reference would not matter. Measured (corrected): 1.2, 1.6, 2.0
+    points; the gap grows with depth because the PD bonds and St Venant-Kirchhoff differ
+    at second order in the strain."""
+    scene = get_scene("block2d-indentation")
+    for method in ("energy-directional", "none"):
+        lin = scene.run(method, {"kinematics": "linear"})
+        nl = scene.run(method)
+        assert lin.fields["fem_kinematics"] == "small"
+        err = []
+        for r in (lin, nl):
+            F, F_ref = r.fields["forces"], r.fields["fem_forces"]
+            err.append((F[2:5] / F_ref[2:5] - 1) * 100)
+        kinematic = np.abs(nl.fields["fem_forces"][2:5] / nl.fields["fem_small_forces"][2:5]
+                           - 1) * 100
+        assert np.all(np.abs(err[0] - err[1]) < kinematic), (method, err, kinematic)
