@@ -174,9 +174,10 @@ def overview(scenes, results) -> str:
                              "</small></td>")
             elif m in values:
                 star = " &#9733;" if m == best else ""
-                cells.append(f'<td style="background:{_colour(values[m])}" '
+                pct = metric.endswith("_pct")      # a percentage: coloured as a fraction
+                cells.append(f'<td style="background:{_colour(values[m] / (100 if pct else 1))}" '
                              f'title="{html.escape(_params(r, scene))}">'
-                             f"{_num(float(values[m]))}{star}<br><small>"
+                             f"{_num(float(values[m]))}{' %' if pct else ''}{star}<br><small>"
                              f"{r.timings.get('total_s', 0):.2g} s</small></td>")
             else:
                 cells.append("<td>&ndash;</td>")

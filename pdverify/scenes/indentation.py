@@ -31,6 +31,8 @@ KINEMATICS = ("nonlinear", "linear")
 #: ``solver=auto`` uses CG from this many unknowns: on the quick grid (41 x 41 nodes, m = 6,
 #: 3,362 unknowns) a sparse LU per Newton step made the corrected curve 13 s, CG 2.6 s.
 CG_FROM_UNKNOWNS = 1000
+#: The paper's runs: its micromodulus and quadrature (as §4.1), nonlinear kinematics.
+NONLINEAR = {**PAPER, "kinematics": "nonlinear", "spacing": 0.00025, "horizon": 0.0015}
 #: The like-for-like reference of a nonlinear PD run: the finite-strain FEM (St Venant-
 #: Kirchhoff). Two levels (fine element edges 1 and 0.5 mm; the force at 2 mm changed by
 #: 0.08 % between them) and 4 increments per output depth (8 changed it by 0.01 %), so the
@@ -102,6 +104,7 @@ class Indentation(FemAndPD):
     title = "Rigid cylinder indenting a block, sticking contact: FEM and nonlinear PD (Fig. 4)"
     seed = "003 §4.2"
     figure = "indentation"
+    headline = "force_error_pct"  # the report overview's error for this scene
     params_class, function = "IndentationParams", "indentation"
     shared = ("width", "height", "radius", "depth", "n_steps", "E", "nu", "thickness")
     pd_params = (
@@ -120,11 +123,11 @@ class Indentation(FemAndPD):
     pd_methods = (("none", ()), ("energy-directional", ()))
     published = (
         Published("force_error_pct", 6, "seed 003 §4.2 (about 6 %)", method="energy-directional",
-                  where=PAPER),
-        Published("force_error_pct", 30, "seed 003 §4.2 (about 30 % too soft)", method="none",
-                  where=PAPER),
+                  where=NONLINEAR),
+        Published("force_bias_pct", -30, "seed 003 §4.2 (about 30 % too soft)", method="none",
+                  where=NONLINEAR),
         Published("failure_depth_mm", 0.4, "seed 003 §4.2 (about 0.4 mm)", method="none",
-                  where=PAPER),
+                  where=NONLINEAR),
     )
 
     def reference_params(self, p) -> dict:
