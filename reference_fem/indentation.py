@@ -267,12 +267,14 @@ def solve_level_finite(p: IndentationParams, level: int, check_steps: bool = Fal
         twice = _finite_steps(p, 2 * p.substeps, svk, bottom, cx, cy, X0)
         step_change = float(100 * np.max(np.abs(twice["forces"] - out["forces"])[1:]
                                          / twice["forces"][1:]))
-    u, stuck = out["u"], out["stuck"]
+    u, stuck, target = out["u"], out["stuck"], out["target"]
     f = svk.internal_force(u)
     bottom_y = model.dofs(lambda x, y: y < -p.height + tol, [1])
+    err = max(np.max(np.abs(u[cx[stuck]] - target[stuck, 0]), initial=0.0),
+              np.max(np.abs(u[cy[stuck]] - target[stuck, 1]), initial=0.0))
     return dict(model=model, field=model.field(u), depths=out["depths"], forces=out["forces"],
                 widths=out["widths"], counts=out["counts"], contact_x=X0[stuck] + u[cx[stuck]],
-                contact_y=u[cy[stuck]], constraint_error=0.0,
+                contact_y=target[stuck, 1], constraint_error=float(err / p.depth),
                 bottom_reaction=float(f[bottom_y].sum()), n_solves=out["solves"],
                 step_change_pct=step_change, setup_s=t_setup, solve_s=solve_s,
                 h_min=float(min(np.diff(model.coords[0]).min(), np.diff(model.coords[1]).min())),
@@ -287,6 +289,7 @@ def _finite_steps(p, substeps, svk, bottom, cx, cy, X0) -> dict:
     fixed = np.zeros(N, dtype=bool)
     fixed[bottom] = True
     stuck = np.zeros(X0.size, dtype=bool)
+    target = np.zeros((X0.size, 2))    # prescribed (u_x, u_y) of stuck nodes
     u = np.zeros(N)
     depths, forces, widths, counts = [0.0], [0.0], [0.0], [0]
     solves, min_jac = 0, 1.0
@@ -294,7 +297,8 @@ def _finite_steps(p, substeps, svk, bottom, cx, cy, X0) -> dict:
         d = p.depth * step / n_inc
         yc = R - d
         previous = u.copy()
-        u[cy[stuck]] -= dd
+        target[stuck, 1] -= dd
+        u[cy[stuck]] = target[stuck, 1]
         while True:
             solves += _newton(svk, u, fixed, previous, d)
             det, x = svk.min_jacobian(u)
@@ -308,7 +312,9 @@ def _finite_steps(p, substeps, svk, bottom, cx, cy, X0) -> dict:
             if not new.any():
                 break
             previous = u.copy()
-            u[cy[new]] = yc - np.sqrt(R ** 2 - x[new] ** 2)
+            target[new, 0] = u[cx[new]]
+            target[new, 1] = yc - np.sqrt(R ** 2 - x[new] ** 2)
+            u[cy[new]] = target[new, 1]
             stuck |= new
             fixed[cx[new]] = fixed[cy[new]] = True
         if step % substeps:
@@ -319,7 +325,7 @@ def _finite_steps(p, substeps, svk, bottom, cx, cy, X0) -> dict:
         forces.append(-float(f[cy[stuck]].sum()))
         widths.append(float(xs.max() - xs.min()) if xs.size else 0.0)
         counts.append(int(stuck.sum()))
-    return dict(u=u, stuck=stuck, depths=np.array(depths), forces=np.array(forces),
+    return dict(u=u, stuck=stuck, target=target, depths=np.array(depths), forces=np.array(forces),
                 widths=np.array(widths), counts=np.array(counts), solves=solves,
                 min_jacobian=min_jac)
 

@@ -106,10 +106,6 @@ class NonlinearBondBased:
         y -= np.take(U, self.a, axis=1)
         return y, np.sqrt(np.einsum("kb,kb->b", y, y))
 
-    def tensions(self, u) -> np.ndarray:
-        _, l = self.bond_vectors(u)
-        return self.s * (l - self.L)
-
     def internal_force(self, u) -> np.ndarray:
         y, l = self.bond_vectors(u)
         y *= self.s * (1.0 - self.L / l)          # the bond force vectors T y / l
@@ -157,21 +153,24 @@ class NonlinearBondBased:
     def tangent(self, u) -> sp.csr_matrix:
         return self.pattern.matrix(self.tangent_data(u))
 
-    def min_bond_cosine(self, u) -> tuple[float, int]:
-        """The smallest cos(angle between current and reference bond) and its bond: <= 0
-        means the bond has turned against its reference direction (inverted)."""
+    def bond_extremes(self, u) -> dict:
+        """The most turned and the most shortened bond: ``cos`` = the smallest
+        cos(angle between current and reference bond) and its bond ``cos_bond`` (<= 0: the
+        bond has turned against its reference direction, inverted); ``ratio`` = the smallest
+        current / reference length and its bond ``ratio_bond``."""
         y, l = self.bond_vectors(u)
+        ratio = l / self.L
         with np.errstate(divide="ignore", invalid="ignore"):
             cos = np.einsum("kb,kb->b", y, self.xi_t) / (l * self.L)
         cos = np.where(np.isfinite(cos), cos, -np.inf)
-        k = int(np.argmin(cos))
-        return float(cos[k]), k
+        k, j = int(np.argmin(cos)), int(np.argmin(ratio))
+        return {"cos": float(cos[k]), "cos_bond": k, "ratio": float(ratio[j]), "ratio_bond": j}
 
 
 class LinearBondBased(NonlinearBondBased):
     """The small-displacement model behind the same interface: f(u) = K u and the constant
     tangent K (the nonlinear tangent at u = 0, on the same pattern); its energy density is
-    the linear model's. The geometric checks (:meth:`min_bond_cosine`) still read the
+    the linear model's. The geometric checks (:meth:`bond_extremes`) still read the
     current bond vectors, so a linear run that folds the lattice is caught all the same."""
 
     def __init__(self, model: BondBasedModel):

@@ -192,7 +192,7 @@ class Indentation(FemAndPD):
                                    SheetScene.micromodulus(p, delta), inf, closure,
                                    thickness=p["thickness"])
             kin = (NonlinearBondBased if p["kinematics"] == "nonlinear" else LinearBondBased)(model)
-            kin.pattern
+            kin.pattern                  # the tangent's pattern, built in the setup phase
             unknowns = 2 * grid.n_ext
             use_cg = p["solver"] == "cg" or (p["solver"] == "auto"
                                              and unknowns >= CG_FROM_UNKNOWNS)
@@ -284,7 +284,8 @@ def indent(kin, grid, p, lin, where):
             curve["cuts"] += rep.line_search_cuts
             if len(curve["residuals"]) < 3 and rep.iterations >= 2:
                 curve["residuals"].append([r / rep.scale for r in rep.residuals])
-            folded = _folding(kin, grid, u, at)
+            state = kin.bond_extremes(u)
+            folded = _folding(kin, grid, u, at, state)
             if folded is not None:
                 folded["depth"] = d
                 return curve, folded
@@ -308,9 +309,8 @@ def indent(kin, grid, p, lin, where):
         curve["widths"].append(float(xs.max() - xs.min()) if xs.size else 0.0)
         curve["counts"].append(int(stuck.sum()))
         curve["newton"].append(iterations)
-        y, l = kin.bond_vectors(u)
-        curve["min_cos"].append(kin.min_bond_cosine(u)[0])
-        curve["min_stretch"].append(float(np.min(l / kin.L)))
+        curve["min_cos"].append(state["cos"])           # of the final u of this increment
+        curve["min_stretch"].append(state["ratio"])
         curve["u"] = u.copy()
         now = time.perf_counter()
         curve["step_s"].append(now - t_step)
@@ -318,47 +318,47 @@ def indent(kin, grid, p, lin, where):
     return curve, None
 
 
+def _node_at(grid, node) -> str:
+    x = grid.x[node] * 1e3
+    return f"node {node} at ({x[0]:.4g}, {x[1]:.4g}) mm"
+
+
 def _describe(grid, k) -> str:
     """Unknown k (component-major) as 'u_y of node i at (x, y) mm'."""
-    node, comp = k % grid.n_ext, k // grid.n_ext
-    x = grid.x[node] * 1e3
-    return f"u_{'xy'[comp]} of node {node} at ({x[0]:.4g}, {x[1]:.4g}) mm"
+    return f"u_{'xy'[k // grid.n_ext]} of {_node_at(grid, k % grid.n_ext)}"
 
 
-def _folding(kin, grid, u, at):
-    """None, or a failure dict when a bond has turned by >= 90 degrees."""
-    cos, k = kin.min_bond_cosine(u)
+def _ends(kin, grid, bond):
+    """(lower, upper) node of a bond in lattice order (row, then column), and its offset."""
+    a, b = int(kin.a[bond]), int(kin.b[bond])
+    off = grid.index[b] - grid.index[a]
+    return ((a, b) if off[1] > 0 or (off[1] == 0 and off[0] > 0) else (b, a)), off
+
+
+def _folding(kin, grid, u, at, state=None):
+    """None, or a failure dict when a bond has turned by >= 90 degrees (``state``: the
+    :meth:`bond_extremes` of ``u`` if already computed)."""
+    state = state or kin.bond_extremes(u)
+    cos = state["cos"]
     if cos > 0:
         return None
-    a, b = int(kin.a[k]), int(kin.b[k])
-    off = grid.index[b] - grid.index[a]
-    lower, upper = (a, b) if off[1] > 0 or (off[1] == 0 and off[0] > 0) else (b, a)
-    xa = grid.x[upper] * 1e3
+    (lower, upper), off = _ends(kin, grid, state["cos_bond"])
     what = ("pushed past the next row (its vertical nearest-neighbour bond inverted)"
             if abs(off[0]) == 0 and abs(off[1]) == 1 else
             f"bond to node {lower} (offset {tuple(int(v) for v in off)}) inverted")
-    return {"message": f"{at}: the lattice folds: node {upper} at ({xa[0]:.3g}, {xa[1]:.3g}) "
-                       f"mm {what}, cos = {cos:.3f}; the configuration is no longer a "
-                       "deformation (seed 003 §4.2)",
-            "node": upper, "bond": (a, b), "cos": cos}
-
-
-def _shortest(kin, grid, u) -> tuple[float, str]:
-    """The smallest current / reference bond length ratio and where (the upper node)."""
-    _, l = kin.bond_vectors(u)
-    k = int(np.argmin(l / kin.L))
-    a, b = int(kin.a[k]), int(kin.b[k])
-    upper = a if grid.x[a, 1] > grid.x[b, 1] else b
-    x = grid.x[upper] * 1e3
-    return float(l[k] / kin.L[k]), f"node {upper} at ({x[0]:.4g}, {x[1]:.4g}) mm"
+    return {"message": f"{at}: the lattice folds: {_node_at(grid, upper)} {what}, "
+                       f"cos = {cos:.3f}; the configuration is no longer a deformation "
+                       "(seed 003 §4.2)",
+            "node": upper, "bond": (lower, upper), "cos": cos}
 
 
 def _stalled(kin, grid, u, previous, depth, message):
     """The failure dict of a Newton that gave up: what the lattice looked like at the last
     equilibrium (``previous``) and at the last iterate (``u``)."""
-    ratio, where = _shortest(kin, grid, previous)
-    note = (f"; at the last equilibrium the shortest bond was {ratio:.2f} of its reference "
-            f"length ({where})")
+    state = kin.bond_extremes(previous)
+    where = _node_at(grid, _ends(kin, grid, state["ratio_bond"])[0][1])
+    note = (f"; at the last equilibrium the shortest bond was {state['ratio']:.2f} of its "
+            f"reference length ({where})")
     folded = _folding(kin, grid, u, "the last iterate")
     if folded is not None:
         note += "; " + folded["message"]

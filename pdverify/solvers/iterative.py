@@ -123,7 +123,12 @@ class TwoLevelPreconditioner:
         d_inv = 1.0 / diag
         s = np.sqrt(d_inv)
         scaled = sp.diags(s) @ K @ sp.diags(s)
-        rho = float(spla.eigsh(scaled, k=1, which="LA", tol=1e-2, return_eigenvectors=False)[0])
+        # a fixed start vector: ARPACK's own random one differs between calls in a process,
+        # which made rho, hence CG's iterates and a Newton run's last digits, depend on
+        # what ran before in the same worker
+        start = np.random.default_rng(0).standard_normal(K.shape[0])
+        rho = float(spla.eigsh(scaled, k=1, which="LA", tol=1e-2, v0=start,
+                               return_eigenvectors=False)[0])
         P = (T - sp.diags((PROLONGATOR_WEIGHT / rho) * d_inv) @ (K @ T)).tocsr()
         coarse = (P.T @ (K @ P)).toarray()
         try:

@@ -12,9 +12,9 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse.linalg as spla
 
 from ..errors import NumericalError
+from .dense import eliminate_dirichlet, solve_square
 from .iterative import Lattice, TwoLevelPreconditioner, cg_solve
 
 #: Newton stops when ||f_free|| <= NEWTON_RTOL * max(||f_free|| at its start, ||reactions||):
@@ -51,14 +51,14 @@ class LinearStats:
     rebuilds: int = 0
     setup_s: float = 0.0
     solve_s: float = 0.0
-    log: list = field(default_factory=list)          # (rtol, iterations) per CG solve
 
 
 class DirichletLinearSolver:
     """Solves T du = -f with du = 0 on the prescribed unknowns, for tangents T given as data
     on one CSR ``pattern`` (see :mod:`pdverify.pd.nonlinear`).
 
-    ``method``: ``direct`` (sparse LU of the free block, a fresh factorisation per solve) or
+    ``method``: ``direct`` (:func:`~pdverify.solvers.dense.solve_square` on the free block,
+    a fresh factorisation per solve) or
     ``cg`` (conjugate gradients on the full-size system with the prescribed rows and
     columns replaced by their diagonal, preconditioned by :class:`TwoLevelPreconditioner`
     built on the first tangent and rebuilt on the current one when the iterations lost
@@ -107,21 +107,13 @@ class DirichletLinearSolver:
                                  "its own motion (compressed bonds' negative geometric "
                                  "stiffness outweighs their axial stiffness there)")
         r = np.where(free, rhs, 0.0)
-        t0 = time.perf_counter()
-        if self.method == "direct":
-            T = self.pattern.matrix(data).tocsc()
-            idx = np.flatnonzero(free)
-            try:
-                lu = spla.splu(T[idx][:, idx].tocsc(), permc_spec="MMD_AT_PLUS_A",
-                               options={"SymmetricMode": True})
-            except RuntimeError as exc:   # "Factor is exactly singular"
-                raise NumericalError(f"{where}: the tangent is singular ({exc})") from None
-            du = np.zeros_like(r)
-            du[idx] = lu.solve(r[idx])
+        if self.method == "direct":       # the solver layer's checked sparse LU (SPD mode)
+            t0 = time.perf_counter()
+            K_free, r_free, idx, du = eliminate_dirichlet(
+                self.pattern.matrix(data), r, np.flatnonzero(self.fixed), 0.0)
+            du[idx], _ = solve_square(K_free, r_free, where=where, spd=True)
             self.stats.solves += 1
             self.stats.solve_s += time.perf_counter() - t0
-            if not np.all(np.isfinite(du)):
-                raise NumericalError(f"{where}: the tangent solve gave non-finite values")
             return du
         T = self.masked(data)
         if self.precond is None:
@@ -129,7 +121,6 @@ class DirichletLinearSolver:
         du, info = cg_solve(T, r, self.precond, where=where, rtol=rtol)
         self.stats.solves += 1
         self.stats.iterations += info["iterations"]
-        self.stats.log.append((rtol, info["iterations"]))
         self.stats.solve_s += info["cg_solve_s"]
         k = info["iterations"]
         decades = max(-np.log10(max(info["relative_residual"], 1e-16)), 1.0)
