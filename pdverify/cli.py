@@ -135,8 +135,10 @@ def main(argv=None) -> int:
 
 def _dispatch(args) -> int:
     if args.command == "list":
-        from .listing import format_listing
+        from .listing import format_listing, format_matrix
         print(format_listing())
+        print()
+        print(format_matrix())
         return 0
     from . import validate
     if args.command in ("run", "report"):

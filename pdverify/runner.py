@@ -68,7 +68,7 @@ def plan(only=None, quick=False) -> list[tuple[str, str, dict]]:
     scenes = [get_scene(s) for s in only] if only else all_scenes()
     cases = []
     for scene in scenes:
-        for method, overrides in scene.cases(quick=quick):
+        for method, overrides in scene.report_cases(quick=quick):
             scene.resolve(method, overrides)
             cases.append((scene.id, method, overrides))
     return cases

@@ -19,4 +19,8 @@ METHODS = {
 
 
 def describe(name: str) -> str:
-    return METHODS.get(name, "")
+    if name in METHODS:
+        return METHODS[name]
+    from .registry import bond_methods
+    m = bond_methods().get(name)
+    return "" if m is None else m.description

@@ -59,8 +59,16 @@ class BondBasedModel:
         self.bond_x, self.bond_n = x, xi / x[:, None]
         self.bond_factor = (closure.bond_factor(a, b, self.bond_n)
                             if closure.bond_factor is not None else np.ones(a.size))
-        self.bond_stiffness = (self.bond_factor * self.c * influence.omega(x, delta) * beta[which]
+        #: omega(|xi|) beta of every bond (the weight of its end's horizon sum)
+        self.bond_beta = beta[which]
+        self.bond_weight = influence.omega(x, delta) * self.bond_beta
+        self.bond_stiffness = (self.bond_factor * self.c * self.bond_weight
                                * self.node_volume[a] * self.node_volume[b] / x)
+        for hook in (closure.weight_factor, closure.force_factor):
+            if hook is not None:
+                factor = hook(self)
+                self.bond_factor = self.bond_factor * factor
+                self.bond_stiffness = self.bond_stiffness * factor
         self.n_unknown_nodes = (closure.n_unknown_nodes if closure.n_unknown_nodes is not None
                                 else grid.n_interior)
         self._K = None
@@ -122,6 +130,19 @@ class BondBasedModel:
         half = 0.25 * self.bond_stiffness * e * e
         n = self.grid.n_ext
         return (np.bincount(self.bond_a, half, n) + np.bincount(self.bond_b, half, n)) / self.node_volume
+
+    def bulk_work_density(self, strain) -> float:
+        """W = 1/4 sum_b f_b e_b / V_i at a node with a complete neighbourhood of the bulk
+        lattice under the homogeneous strain ``strain`` (d x d): every stencil offset a
+        bond, e = |xi| n.strain.n, f = s e (the energy density, seed 003 Eq. 5)."""
+        st, h = self.stencil, self.spacing
+        xi = st.offsets * h
+        r = np.linalg.norm(xi, axis=1)
+        n = xi / r[:, None]
+        e = r * np.einsum("bi,ij,bj->b", n, np.asarray(strain, dtype=float), n)
+        V = self.grid.volume * self.thickness
+        s = self.c * self.influence.omega(r, self.horizon) * st.beta * V * V / r
+        return float(0.25 * np.sum(s * e * e) / V)
 
     def lumped_mass(self, density: float) -> np.ndarray:
         """Nodal masses rho V_i of the real nodes (component-major, repeated per component)."""

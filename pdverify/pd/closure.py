@@ -32,8 +32,18 @@ class Closure:
       ``n_unknown_nodes`` its column count. Default: the real nodes are the unknowns.
     - ``dilatation_map`` (n_ext x n_real): all node dilatations from the real ones
       (state-based only). Default: zero on fictitious nodes.
-    - ``bond_factor(a, b, n) -> factor``: a stiffness factor per bond (end-bond, energy,
-      volume or directional corrections); ``n`` the unit bond vectors. Default: 1.
+    - ``bond_factor(a, b, n) -> factor``: a factor on each bond's weight beta (end-bond
+      or directional corrections); ``n`` the unit bond vectors. In the state-based model it
+      enters the weighted volume and the dilatation as well as the force. Default: 1.
+    - ``weight_factor(model) -> factor``: like ``bond_factor``, computed from the model's
+      bonds once they are known (``bond_a``, ``bond_b``, ``bond_n``, ``bond_x``,
+      ``bond_beta``, ``node_volume``, ``stencil``), before m and the operators (the
+      volume correction). Default: 1.
+    - ``force_factor(model) -> factor``: a factor on each bond's force only, computed
+      from the built, uncorrected model (its bond forces under a given field included);
+      m and the dilatation keep their weights (the energy correction). In the
+      bond-based model weight and force factors both multiply the spring stiffness.
+      Default: 1.
 
     Flux and constraint rows are built by the correction from the model's bonds after
     construction (e.g. :meth:`StateBasedModel.bond_force_rows`).
@@ -45,6 +55,8 @@ class Closure:
     dilatation_map: sp.spmatrix | None = None
     n_unknown_nodes: int | None = None
     bond_factor: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray] | None = None
+    weight_factor: Callable[[object], np.ndarray] | None = None
+    force_factor: Callable[[object], np.ndarray] | None = None
 
     def __post_init__(self):
         if self.weighted_volume not in WEIGHTED_VOLUMES:

@@ -87,6 +87,8 @@ class StateBasedModel:
         self.bond_beta = beta_h[which]
         if closure.bond_factor is not None:
             self.bond_beta = self.bond_beta * closure.bond_factor(a, b, self.bond_n)
+        if closure.weight_factor is not None:
+            self.bond_beta = self.bond_beta * closure.weight_factor(self)
         Va, Vb = self.node_volume[a], self.node_volume[b]
         if closure.weighted_volume == "complete":
             self.m = np.full(grid.n_ext, self.m_inf)
@@ -95,7 +97,16 @@ class StateBasedModel:
             self.m = np.bincount(a, w * Vb, grid.n_ext) + np.bincount(b, w * Va, grid.n_ext)
         self.n_unknown_nodes = (closure.n_unknown_nodes if closure.n_unknown_nodes is not None
                                 else grid.n_interior)
+        #: omega(|xi|) beta of every bond (the weight of its end's horizon sums)
+        self.bond_weight = self.bond_omega * self.bond_beta
         self._build_operators(Va, Vb)
+        #: factor on each bond's force only (Closure.force_factor), None = 1
+        self.bond_force_factor = None
+        if closure.force_factor is not None:
+            g = np.asarray(closure.force_factor(self), dtype=float)
+            self.bond_force_factor = g
+            self.K_e = (sp.diags(g) @ self.K_e).tocsr()
+            self.K_theta = (sp.diags(g) @ self.K_theta).tocsr()
 
     # ------------------------------------------------------------------ assembly
     @property
@@ -196,6 +207,23 @@ class StateBasedModel:
         """Scalar bond forces f (times beta V_a V_b, along a -> b) of the unknowns ``u``."""
         e = self.A_e @ (self.A_U_full @ np.asarray(u, dtype=float))
         return self.K_e @ e + self.K_theta @ (self.A_Theta @ (self.A_theta @ e))
+
+    def bulk_work_density(self, strain) -> float:
+        """W = 1/4 sum_b f_b e_b / V_i at a node of the bulk lattice (complete
+        neighbourhoods around it and its neighbours) under the homogeneous ``strain``:
+        e = |xi| n.strain.n per stencil offset, theta the complete-neighbourhood
+        dilatation, f = k_e omega beta V^2 (2/m) e + k_theta omega |xi| beta V^2 (2 theta/m)."""
+        st, h, c = self.stencil, self.spacing, self.constants
+        xi = st.offsets * h
+        r = np.linalg.norm(xi, axis=1)
+        n = xi / r[:, None]
+        e = r * np.einsum("bi,ij,bj->b", n, np.asarray(strain, dtype=float), n)
+        V = self.grid.volume * self.thickness
+        om, m = self.influence.omega(r, self.horizon), self.m_inf
+        theta = c.c_theta * np.sum(om * r * e * st.beta * V) / m
+        f = (c.k_e * om * st.beta * V * V * 2.0 / m * e
+             + c.k_theta * om * r * st.beta * V * V * 2.0 * theta / m)
+        return float(0.25 * np.sum(f * e) / V)
 
     def crossing_selector(self, planes, axis: int = 0) -> sp.csr_matrix:
         """Rows s (one per plane) with s @ f = the summed force of the bonds crossing it.

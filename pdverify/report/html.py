@@ -147,7 +147,7 @@ def overview(scenes, results) -> str:
     failed runs red with the reason on hover, FEM cells marked as the reference."""
     methods = []
     for scene in scenes:
-        for m in scene.methods:
+        for m in scene.all_methods:
             if m.name not in methods:
                 methods.append(m.name)
     methods.sort(key=lambda m: (m == "fem", m != "none", m))

@@ -38,15 +38,15 @@ class StateBar:
 
     ``K`` = -S K_b (Eq. 55) over the real displacements; K_b (the bond forces, D6) is
     multiplied out once: in 1D it is banded, and both K and the section-force rows of
-    Eq. (60) need it.
+    Eq. (60) need it. ``closure``: a bond method's closure on the uncorrected bar.
     """
 
-    def __init__(self, p: dict, order: int | None = None):
+    def __init__(self, p: dict, order: int | None = None, closure=None):
         p = {**{q.name: q.default for q in BAR_PARAMS}, **p}  # unset keys: the paper's values
         stencil = build_stencil(1, p["m_ratio"])
         layers = stencil.reach if order else 0
         self.grid = g = BoxGrid((p["length"],), (0.0,), p["spacing"], layers)
-        closure = fictitious_closure(g, order) if order else None
+        closure = fictitious_closure(g, order) if order else closure
         self.order = order
         self.model = StateBasedModel(g, stencil, StateBasedConstants("1d", p["E"], p["nu"]),
                                      get_influence(p["influence"]), closure,
@@ -118,6 +118,7 @@ class StaticBar(Scene):
     seed = "000"
     reference = "analytic"
     figure = "bar1d"
+    closure_theory = "state-based"
     load_param: Param
     methods = (NONE, TAYLOR)
     paper_orders: tuple[int, ...] = (1,)
@@ -152,7 +153,7 @@ class StaticBar(Scene):
     def solve(self, method, p, timer):
         with timer.phase("setup"):
             order = p.get("order") if method == TAYLOR.name else None
-            bar = StateBar(p, order)
+            bar = StateBar(p, order, closure=self.bond_closure(method, p))
             x = bar.x_real
             V = p["area"] * p["spacing"]
             f = self.body_force(x, p) * V

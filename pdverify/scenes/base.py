@@ -115,14 +115,47 @@ class Scene:
     methods: tuple[MethodSpec, ...] = ()
     published: tuple[Published, ...] = ()
     figure: str = ""  # name of the report figure family that draws this scene's runs
+    #: the theory of the scene's plain-grid model ("bond-based" or "state-based") when
+    #: it takes the bond methods of ``pdverify.corrections.registry`` (built-in and
+    #: plugins); None: only its own ``methods``
+    closure_theory: str | None = None
+    #: overrides of the bond methods' report cases under ``--quick``
+    quick_overrides: Mapping[str, Any] = {}
 
-    # -- parameters -------------------------------------------------------------------
+    # -- methods ----------------------------------------------------------------------
+    def bond_methods(self) -> dict:
+        """The registry's bond methods this scene offers beside its own ``methods``."""
+        if self.closure_theory is None:
+            return {}
+        from ..corrections.registry import bond_methods
+        own = {m.name for m in self.methods}
+        return {k: m for k, m in bond_methods().items() if m.serves(self) and k not in own}
+
+    @property
+    def all_methods(self) -> tuple[MethodSpec, ...]:
+        """The scene's own methods, then the bond methods, which take the params of the
+        uncorrected method ``none`` (they correct that model) and their own."""
+        own = tuple(self.methods)
+        base = next((m.params for m in own if m.name == "none"), ())
+        return own + tuple(MethodSpec(k, base + m.params) for k, m in self.bond_methods().items())
+
     def method(self, name: str) -> MethodSpec:
-        for m in self.methods:
+        for m in self.all_methods:
             if m.name == name:
+                bm = self.bond_methods().get(name)
+                if bm is not None and bm.unavailable:
+                    raise InputError(f"{self.id}: method {name} is unavailable here: "
+                                     f"{bm.unavailable}")
                 return m
-        allowed = ", ".join(m.name for m in self.methods)
-        raise InputError(f"{self.id}: unknown method {name!r}; allowed: {allowed}")
+        allowed = ", ".join(m.name for m in self.all_methods)
+        raise InputError(f"{self.id}: method {name!r} is not supported by this scene; "
+                         f"allowed: {allowed}")
+
+    def bond_closure(self, method: str, params: Mapping[str, Any]):
+        """The :class:`~pdverify.pd.closure.Closure` of a bond method, None for the
+        scene's own methods."""
+        bm = self.bond_methods().get(method)
+        return None if bm is None else bm.closure(params)
 
     @property
     def default_method(self) -> str:
@@ -151,6 +184,16 @@ class Scene:
 
     def cases(self, quick: bool = False) -> list[tuple[str, dict]]:
         return [(m.name, {}) for m in self.methods]
+
+    def report_cases(self, quick: bool = False) -> list[tuple[str, dict]]:
+        """:meth:`cases` and one run of every available bond method it does not list (at
+        :attr:`quick_overrides` under ``--quick``)."""
+        out = list(self.cases(quick=quick))
+        listed = {m for m, _ in out}
+        for name, bm in self.bond_methods().items():
+            if name not in listed and not bm.unavailable:
+                out.append((name, dict(self.quick_overrides) if quick else {}))
+        return out
 
     def run(self, method: str, overrides: Mapping[str, Any] | None = None) -> RunResult:
         """Resolve, solve and record one run; numerical trouble becomes a failed result.

@@ -35,6 +35,7 @@ class SheetScene(FemAndPD):
     bond-based PD runs of one scene (see :class:`FemAndPD` for the params' split)."""
 
     figure = "sheets"
+    closure_theory = "bond-based"
 
     def check_pd(self, where, method, p):
         nu = bond_based_nu(2, "stress")
@@ -189,7 +190,8 @@ class TensionSheet(SheetScene):
             stencil = self.stencil(p, delta / h)
             inf = get_influence(p["micromodulus"])
             closure = (directional_closure(grid, (-W / 2, -H / 2), (W / 2, H / 2), delta, inf)
-                       if method == "energy-directional" else Closure())
+                       if method == "energy-directional"
+                       else self.bond_closure(method, p) or Closure())
             c = self.micromodulus(p, delta)
             model = BondBasedModel(grid, stencil, c, inf, closure, thickness=t)
             n, x = grid.n_ext, grid.x
@@ -352,7 +354,8 @@ class ClampedSheet(SheetScene):
                 top = np.flatnonzero(np.isclose(y, L / 2))
                 bottom = np.flatnonzero(np.isclose(y, -L / 2))
                 closure = (directional_closure(grid, lo, hi, delta, inf)
-                           if method == "energy-directional" else Closure())
+                           if method == "energy-directional"
+                           else self.bond_closure(method, p) or Closure())
             model = BondBasedModel(grid, self.stencil(p, p["m_ratio"]),
                                    self.micromodulus(p, delta), inf, closure, thickness=t)
             n = grid.n_ext

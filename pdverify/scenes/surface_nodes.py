@@ -30,19 +30,20 @@ class StateBox:
     order N - 1 dilatation extrapolation, m of a complete neighbourhood, and one
     force-flux equation per surface node (Eq. 36) below the interior equations in P.
     ``quadrature``: the weights beta of Eqs. (22)-(24) (``pdverify.pd.bonds``); the
-    moment correction uses the state-based weight omega |xi|^2.
+    moment correction uses the state-based weight omega |xi|^2. ``closure``: a bond
+    method's closure on the uncorrected grid (``order=None`` only).
     """
 
     def __init__(self, lengths, origin, spacing, m_ratio, constants: StateBasedConstants,
                  order: int | None = None, quadrature: str = "partial-volume",
-                 influence: str = "gaussian"):
+                 influence: str = "gaussian", closure=None):
         inf = get_influence(influence)
         stencil = state_based_stencil(len(lengths), m_ratio, spacing, inf, quadrature)
         self.order = order
         self.grid = BoxGrid(lengths, origin, float(spacing),
                             stencil.reach if order is not None else 0)
         closure, flux = (surface_node_closure(self.grid, stencil, order) if order is not None
-                         else (None, None))
+                         else (closure, None))
         self.model = model = StateBasedModel(self.grid, stencil, constants, inf, closure)
         self.P = model.equilibrium_rows()
         if flux is not None:
@@ -223,6 +224,7 @@ class SurfaceNodeScene(Scene):
     seed = "001"
     figure = "surface-nodes"
     kind = "3d"
+    closure_theory = "state-based"
 
     # ----------------------------------------------------------------- hooks
     def box(self, p):
@@ -320,7 +322,8 @@ class SurfaceNodeScene(Scene):
         lengths, origin = self.box(p)
         c = self.constants(p)
         model = StateBox(lengths, origin, p["spacing"], p["m_ratio"], c, order=order,
-                         quadrature=p["quadrature"], influence=p["influence"])
+                         quadrature=p["quadrature"], influence=p["influence"],
+                         closure=self.bond_closure(method, p))
         g = model.grid
         d, ni, nu_ = g.dim, g.n_interior, model.n_unknown_nodes
         solver = self.solver_for(p, d, d * nu_)
@@ -417,6 +420,7 @@ BODY_PARAMS = (
 
 class Body3D(SurfaceNodeScene):
     kind = "3d"
+    quick_overrides = {"spacing": 0.1}
 
     def box(self, p):
         return (p["lx"], p["ly"], p["lz"]), (0.0, -p["ly"] / 2, -p["lz"] / 2)
@@ -624,6 +628,7 @@ class Plate2DPlaneStrain(SurfaceNodeScene):
     seed = "001 §5"
     reference = "analytic"
     kind = "plane-strain"
+    quick_overrides = {"spacing": 0.05}
     params = (
         Param("lx", 1.0, "plate width [m] (ERRATA seed 001: Table 2 missing)", positive),
         Param("ly", 1.0, "plate height [m]", positive),

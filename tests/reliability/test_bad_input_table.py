@@ -19,7 +19,11 @@ def _doc(runs, schema="pdverify.results/1"):
 CASES = [
     # ---------------------------------------------------------------- run: scene, method
     ("unknown-scene", ["run", "no-such-scene"], {}, "unknown scene"),
-    ("unknown-method", ["run", "bar1d-traction", "--method", "nope"], {}, "unknown method"),
+    ("unknown-method", ["run", "bar1d-traction", "--method", "nope"], {},
+     "not supported by this scene; allowed: none"),
+    ("method-not-on-scene", ["run", "stiffness3d-box", "--method", "energy-directional"], {},
+     "stiffness3d-box: method 'energy-directional' is not supported by this scene; allowed: "
+     "none, energy, volume"),
     ("unknown-command", ["frobnicate"], {}, "invalid choice"),
     ("unknown-flag", ["run", "bar1d-traction", "--fast"], {}, "unrecognized"),
     # ---------------------------------------------------------------- run: --set syntax

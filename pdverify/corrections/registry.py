@@ -1,0 +1,116 @@
+"""Methods that correct the PD model through its bonds alone, built in or from plugins.
+
+A :class:`BondMethod` turns its parameters into a :class:`~pdverify.pd.closure.Closure`
+(bond weights, force factors) and says which theories it serves. Every scene that
+declares ``closure_theory`` (its models are plain grids with truncated neighbourhoods)
+then offers the method in ``run``, ``list`` and ``report`` like its own.
+
+Plugins: another package registers methods through the Python entry point group
+``pdverify.methods``; each entry point loads a :class:`BondMethod` or a list of them,
+e.g. in the plugin's ``pyproject.toml``::
+
+    [project.entry-points."pdverify.methods"]
+    my-method = "my_package.pdverify_plugin:METHOD"
+
+A plugin that fails to load is listed as unavailable with its error; it never stops
+pdverify. A method whose optional dependency is missing says so in ``unavailable``
+(the install command), and a run of it is refused as bad input.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable, Mapping
+
+from ..params import Param
+from ..pd.closure import Closure
+
+THEORIES = ("bond-based", "state-based")
+ENTRY_POINT_GROUP = "pdverify.methods"
+
+
+@dataclass(frozen=True)
+class BondMethod:
+    """A correction that acts through the closure of a plain grid's model.
+
+    ``closure(params) -> Closure`` builds it from the method's resolved ``params``;
+    ``theories`` the models it applies to; ``scenes`` restricts it to these scene ids
+    (``None``: every scene of those theories); ``unavailable`` is ``None`` when it can
+    run, else why not and how to fix it. ``origin``: ``built-in`` or the plugin's
+    entry point.
+    """
+
+    name: str
+    description: str
+    source: str
+    closure: Callable[[Mapping], Closure]
+    theories: tuple[str, ...] = THEORIES
+    params: tuple[Param, ...] = ()
+    scenes: tuple[str, ...] | None = None
+    unavailable: str | None = None
+    origin: str = "built-in"
+
+    def __post_init__(self):
+        bad = [t for t in self.theories if t not in THEORIES]
+        if bad:
+            raise ValueError(f"method {self.name!r}: theories {bad} not in {THEORIES}")
+
+    def serves(self, scene) -> bool:
+        theory = getattr(scene, "closure_theory", None)
+        return (theory in self.theories
+                and (self.scenes is None or scene.id in self.scenes))
+
+
+def _builtin() -> list[BondMethod]:
+    from .energy import energy_closure
+    from .volume import volume_closure
+    return [
+        BondMethod("energy", "Le and Bobaru 2018 energy correction: per axis the ratio of a "
+                   "complete to the node's uniaxial-stretch energy, bonds by the ellipse of "
+                   "their ends' mean factors, applied to the bond force",
+                   "Le and Bobaru, Comput. Mech. 61 (2018) 499-518; Peridynamics.jl",
+                   energy_closure),
+        BondMethod("volume", "volume correction 2 V0 / (V_i + V_j) on the bond force (V the "
+                   "discrete horizon volume of each end)",
+                   "Le and Bobaru 2018; PeriLab, PeriPy, pypd", volume_closure),
+    ]
+
+
+_METHODS: dict[str, BondMethod] | None = None
+#: entry points that failed to load: name -> the error, shown by ``list``
+BROKEN: dict[str, str] = {}
+
+
+def _plugins():
+    from importlib.metadata import entry_points
+    for ep in entry_points(group=ENTRY_POINT_GROUP):
+        try:
+            obj = ep.load()
+            items = obj if isinstance(obj, (list, tuple)) else [obj]
+            for item in items:
+                if not isinstance(item, BondMethod):
+                    raise TypeError(f"{type(item).__name__} is not a pdverify BondMethod")
+                yield BondMethod(**{**item.__dict__, "origin": f"plugin {ep.value}"})
+        except Exception as exc:  # a broken plugin never stops pdverify
+            BROKEN[ep.name] = f"{type(exc).__name__}: {exc}"
+
+
+def bond_methods() -> dict[str, BondMethod]:
+    """Every bond method, built-in first, then the plugins (a plugin cannot replace a
+    built-in name: it is listed as broken instead)."""
+    global _METHODS
+    if _METHODS is None:
+        methods = {m.name: m for m in _builtin()}
+        for m in _plugins():
+            if m.name in methods:
+                BROKEN[m.name] = f"{m.origin}: the name {m.name!r} is taken"
+                continue
+            methods[m.name] = m
+        _METHODS = methods
+    return _METHODS
+
+
+def reload() -> None:
+    """Forget the loaded plugins (tests install one and look again)."""
+    global _METHODS
+    _METHODS = None
+    BROKEN.clear()

@@ -1,0 +1,240 @@
+"""Stiffness under homogeneous strain: the surface effect itself, method by method.
+
+Every node of a plain grid is given u = eps . x for a set of homogeneous strains eps (a
+uniaxial stretch along each axis and a pure shear in each coordinate plane). The strain
+energy density W_i of each node (half of each bond's work f e / 2 to each end,
+``pdverify.corrections.factors.work_density``) is divided by a node's of the bulk
+lattice (complete neighbourhoods; ``bulk_work_density``). A perfect surface correction
+gives W_i / W_bulk = 1 everywhere; the uncorrected model is softer (bond-based) or, for
+LPS with m over the truncated family, partly stiffer near the surface. This is what the
+energy, volume and directional corrections set out to fix (Le and Bobaru 2018 compare
+exactly these profiles), so it is where they are judged first; the displacement scenes
+(sheet2d-tension, body3d-traction, plate2d-plane-strain) then show what it does to a
+boundary value problem.
+
+Reference: the bulk lattice's own W (no continuum moduli involved, so the numbers are
+the surface effect alone). Metrics, in percent of W_bulk, over the strain states:
+``surface_energy_error_pct`` = the largest |W_i / W_bulk - 1| over nodes within one
+horizon of the surface, ``surface_energy_rms_pct`` their RMS, ``interior_energy_error_pct``
+the largest over the other nodes (a state-based node feels its neighbours' dilatations,
+so it is not zero there for LPS), ``energy_error_<state>_pct`` the largest per state over
+all nodes, ``energy_ratio_min`` / ``_max`` the extremes of W_i / W_bulk. The setup time
+(model and the correction's factors) is the cost; the evaluation is the 'solve' phase.
+"""
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+
+from .. import budget
+from ..corrections.energy_directional import directional_closure
+from ..corrections.factors import work_density
+from ..params import Param, at_least, open_interval, positive
+from ..pd import (BondBasedModel, BoxGrid, Closure, StateBasedConstants, StateBasedModel,
+                  bond_micromodulus, build_stencil, get_influence, state_based_stencil)
+from ..pd.influence import INFLUENCES
+from . import MethodSpec, Outcome, Scene, register, whole_cells
+
+AXES = "xyz"
+
+
+def strain_states(dim: int) -> list[tuple[str, np.ndarray]]:
+    """(name, eps): a unit uniaxial stretch per axis, then a unit pure shear per plane."""
+    out = []
+    for k in range(dim):
+        eps = np.zeros((dim, dim))
+        eps[k, k] = 1.0
+        out.append((f"uniaxial_{AXES[k]}", eps))
+    for i, j in itertools.combinations(range(dim), 2):
+        eps = np.zeros((dim, dim))
+        eps[i, j] = eps[j, i] = 0.5
+        out.append((f"shear_{AXES[i]}{AXES[j]}", eps))
+    return out
+
+
+def energy_ratios(model) -> dict[str, np.ndarray]:
+    """W_i / W_bulk at the real nodes, per strain state."""
+    ids = model.grid.interior_ids
+    return {name: work_density(model, eps)[ids] / model.bulk_work_density(eps)
+            for name, eps in strain_states(model.dim)}
+
+
+class StiffnessScene(Scene):
+    """Shared machinery: subclasses build the model of a method (``build``)."""
+
+    reference = "analytic"
+    figure = "stiffness"
+    headline = "surface_energy_error_pct"
+    methods = (MethodSpec("none"),)
+
+    def lengths(self, p):
+        raise NotImplementedError
+
+    def build(self, method, p, closure):
+        raise NotImplementedError
+
+    def horizon(self, p):
+        return p["m_ratio"] * p["spacing"]
+
+    def check(self, method, p):
+        whole_cells(f"{self.id} --method {method}", p["spacing"],
+                    [(f"l_{a}", L) for a, L in zip(AXES, self.lengths(p))])
+
+    def estimate(self, method, p):
+        """Bond arrays and the model's sparse operators: ~ (d + 4) entries a bond."""
+        lengths = self.lengths(p)
+        d = len(lengths)
+        nodes = float(np.prod([L / p["spacing"] + 1 for L in lengths]))
+        bonds = nodes * budget.lattice_neighbours(d, p["m_ratio"]) / 2
+        return budget.Estimate(budget.BYTES_PER_NONZERO * bonds * (d + 4),
+                               f"{nodes:.4g} nodes, ~{bonds:.3g} bonds, no solve")
+
+    def closure(self, method, p):
+        return self.bond_closure(method, p) or Closure()
+
+    def solve(self, method, p, timer):
+        with timer.phase("setup"):
+            model = self.build(method, p, self.closure(method, p))
+        with timer.phase("solve"):
+            ratios = energy_ratios(model)
+        g = model.grid
+        x = g.x[g.interior_ids]
+        lo = np.asarray(g.origin)
+        dist = np.minimum(x - lo, lo + np.asarray(g.lengths) - x).min(axis=1)
+        near = dist <= model.horizon + 1e-12 * model.horizon
+        err = {k: np.abs(v - 1.0) * 100.0 for k, v in ratios.items()}
+        stack = np.stack(list(err.values()), axis=1)
+        metrics = {
+            "surface_energy_error_pct": float(stack[near].max()),
+            "surface_energy_rms_pct": float(np.sqrt(np.mean(stack[near] ** 2))),
+            "interior_energy_error_pct": float(stack[~near].max()) if np.any(~near) else 0.0,
+            **{f"energy_error_{k}_pct": float(v.max()) for k, v in err.items()},
+            "energy_ratio_min": float(min(v.min() for v in ratios.values())),
+            "energy_ratio_max": float(max(v.max() for v in ratios.values())),
+        }
+        fields = {"x": x, "spacing": p["spacing"], "horizon": model.horizon,
+                  "lengths": np.asarray(g.lengths), "origin": lo,
+                  **{f"ratio_{k}": v for k, v in ratios.items()}}
+        size = {"nodes": int(g.n_interior), "bonds": int(model.bond_a.size)}
+        return Outcome(metrics=metrics, size=size, fields=fields)
+
+
+@register
+class SheetStiffness(StiffnessScene):
+    """Seed 003's sheet (§4.1.1 geometry) under homogeneous strains, bond-based.
+
+    50 x 100 mm, 51 x 101 nodes on the surface (half cells on edges, quarters at corners,
+    ERRATA seed 003), horizon 5 mm (m = 5), plane stress, E = 1 GPa, unit thickness,
+    micromodulus constant (the paper's) or conical, whole-cell quadrature (the paper's
+    Tables) or exact partial areas. Methods: ``none``, ``energy-directional`` (seed 003
+    Eq. 14, every face counted) and the registry's bond methods (``energy``, ``volume``,
+    plugins). W is the bond-based strain energy density of seed 003 Eq. (5).
+    """
+
+    id = "stiffness2d-sheet"
+    title = "Sheet under homogeneous strain: nodal energy density against the bulk"
+    seed = "003 §4.1.1"
+    closure_theory = "bond-based"
+    methods = (MethodSpec("none"), MethodSpec("energy-directional"))
+    params = (
+        Param("width", 0.05, "sheet width [m]", positive),
+        Param("length", 0.1, "sheet length [m]", positive),
+        Param("spacing", 0.001, "node spacing [m]", positive),
+        Param("m_ratio", 5.0, "horizon / spacing", at_least(2.0)),
+        Param("E", 1e9, "Young's modulus [Pa] (scales W and W_bulk alike)", positive),
+        Param("micromodulus", "constant", "c(xi): constant (seed 003) or conical",
+              choices=("constant", "conical")),
+        Param("quadrature", "full-cells", "horizon quadrature (see sheet2d-tension)",
+              choices=("full-cells", "partial-volume")),
+    )
+
+    def lengths(self, p):
+        return (p["width"], p["length"])
+
+    def build(self, method, p, closure):
+        W, H, h = p["width"], p["length"], p["spacing"]
+        delta = self.horizon(p)
+        grid = BoxGrid((W, H), (0.0, 0.0), h, placement="on-surface")
+        inf = get_influence(p["micromodulus"])
+        if method == "energy-directional":
+            closure = directional_closure(grid, (0.0, 0.0), (W, H), delta, inf)
+        c = bond_micromodulus(p["micromodulus"], 2, p["E"], delta, plane="stress")
+        return BondBasedModel(grid, build_stencil(2, p["m_ratio"], quadrature=p["quadrature"]),
+                              c, inf, closure)
+
+
+class _StateStiffness(StiffnessScene):
+    closure_theory = "state-based"
+    kind = "3d"
+
+    def build(self, method, p, closure):
+        lengths = self.lengths(p)
+        inf = get_influence(p["influence"])
+        stencil = state_based_stencil(len(lengths), p["m_ratio"], p["spacing"], inf,
+                                      p["quadrature"])
+        grid = BoxGrid(lengths, (0.0,) * len(lengths), p["spacing"], 0)
+        return StateBasedModel(grid, stencil, StateBasedConstants(self.kind, p["E"], p["nu"]),
+                               inf, closure)
+
+
+STATE_PARAMS = (
+    Param("E", 200e9, "Young's modulus [Pa]", positive),
+    Param("nu", 0.3, "Poisson's ratio", open_interval(-1.0, 0.5)),
+    Param("m_ratio", 3.0, "horizon / spacing", at_least(1.0)),
+    Param("quadrature", "partial-volume", "weights beta (see body3d-traction)",
+          choices=("partial-volume", "moment-corrected")),
+    Param("influence", "gaussian", "influence function (seed 001, Eq. 7: Gaussian)",
+          choices=tuple(sorted(INFLUENCES))),
+)
+
+
+@register
+class BoxStiffness(_StateStiffness):
+    """Seed 001's box (§4.1 geometry, ERRATA seed 001) under homogeneous strains, linear
+    ordinary state-based (LPS), m over the truncated family for ``none``.
+
+    1.0 x 0.5 x 0.5 m, cell-centred nodes at h = 0.05 m (2,000 nodes), m = 3, Gaussian
+    influence, E = 200 GPa, nu = 0.3. Methods: ``none`` and the registry's bond methods.
+    """
+
+    id = "stiffness3d-box"
+    title = "3D box under homogeneous strain: nodal energy density against the bulk"
+    seed = "001 §4.1"
+    kind = "3d"
+    quick_overrides = {"spacing": 0.1}
+    params = (Param("lx", 1.0, "box length [m]", positive),
+              Param("ly", 0.5, "box size l_y [m]", positive),
+              Param("lz", 0.5, "box size l_z [m]", positive),
+              Param("spacing", 0.05, "grid spacing h [m]", positive)) + STATE_PARAMS
+
+    def lengths(self, p):
+        return (p["lx"], p["ly"], p["lz"])
+
+    def cases(self, quick=False):
+        return [("none", dict(self.quick_overrides) if quick else {})]
+
+
+@register
+class PlateStiffness(_StateStiffness):
+    """Seed 001's plane-strain plate (§5, ERRATA seed 001) under homogeneous strains,
+    linear ordinary state-based (LPS), m over the truncated family for ``none``.
+
+    1 x 1 m, cell-centred nodes at h = 0.02 m, m = 3, Gaussian influence, plane-strain
+    constants of seed 001 §5, E = 200 GPa, nu = 0.3.
+    """
+
+    id = "stiffness2d-plate"
+    title = "Plane-strain plate under homogeneous strain: nodal energy density against the bulk"
+    seed = "001 §5"
+    kind = "plane-strain"
+    quick_overrides = {"spacing": 0.05}
+    params = (Param("lx", 1.0, "plate width [m]", positive),
+              Param("ly", 1.0, "plate height [m]", positive),
+              Param("spacing", 0.02, "grid spacing h [m]", positive)) + STATE_PARAMS
+
+    def lengths(self, p):
+        return (p["lx"], p["ly"])
+
+    def cases(self, quick=False):
+        return [("none", dict(self.quick_overrides) if quick else {})]
