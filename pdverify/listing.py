@@ -23,18 +23,23 @@ def format_listing() -> str:
     return "\n".join(lines)
 
 
+def method_columns(scenes) -> list[str]:
+    """Every method of ``scenes`` once: ``none`` first, the corrections by name, ``fem`` last."""
+    methods = []
+    for scene in scenes:
+        for m in scene.all_methods:
+            if m.name not in methods:
+                methods.append(m.name)
+    return sorted(methods, key=lambda m: (m == "fem", m != "none", m))
+
+
 def format_matrix() -> str:
     """Which method runs on which scene: one row a scene, one column a method (``x``
     supported; the FEM reference is ``ref``), then the bond methods' origins and any
     plugin that is unavailable or failed to load."""
     from .corrections.registry import BROKEN, bond_methods
     scenes = all_scenes()
-    methods = []
-    for scene in scenes:
-        for m in scene.all_methods:
-            if m.name not in methods:
-                methods.append(m.name)
-    methods.sort(key=lambda m: (m == "fem", m != "none", m))
+    methods = method_columns(scenes)
     width = max(len(s.id) for s in scenes)
     head = " " * width + "  " + "  ".join(methods)
     lines = ["method x scene:", head]

@@ -145,12 +145,8 @@ def overview(scenes, results) -> str:
     """Scene x method matrix: each cell the headline error of the method's default run
     (coloured on a log scale, total time beneath), the best method per scene starred,
     failed runs red with the reason on hover, FEM cells marked as the reference."""
-    methods = []
-    for scene in scenes:
-        for m in scene.all_methods:
-            if m.name not in methods:
-                methods.append(m.name)
-    methods.sort(key=lambda m: (m == "fem", m != "none", m))
+    from ..listing import method_columns
+    methods = method_columns(scenes)
     head = "<tr><th class=l>scene</th><th class=l>error</th>" + "".join(
         f"<th>{html.escape(m)}</th>" for m in methods) + "</tr>"
     rows = []

@@ -177,6 +177,9 @@ class _StateStiffness(StiffnessScene):
         return StateBasedModel(grid, stencil, StateBasedConstants(self.kind, p["E"], p["nu"]),
                                inf, closure)
 
+    def cases(self, quick=False):
+        return [("none", dict(self.quick_overrides) if quick else {})]
+
 
 STATE_PARAMS = (
     Param("E", 200e9, "Young's modulus [Pa]", positive),
@@ -211,9 +214,6 @@ class BoxStiffness(_StateStiffness):
     def lengths(self, p):
         return (p["lx"], p["ly"], p["lz"])
 
-    def cases(self, quick=False):
-        return [("none", dict(self.quick_overrides) if quick else {})]
-
 
 @register
 class PlateStiffness(_StateStiffness):
@@ -235,6 +235,3 @@ class PlateStiffness(_StateStiffness):
 
     def lengths(self, p):
         return (p["lx"], p["ly"])
-
-    def cases(self, quick=False):
-        return [("none", dict(self.quick_overrides) if quick else {})]
