@@ -5,35 +5,24 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..pd.bonds import homogeneous_extensions
+
 
 def horizon_sums(model, q) -> np.ndarray:
-    """S_i = sum over the bonds b of node i of q_b V_(other end), at every grid node.
-
-    ``q`` (n_bonds,) or (n_bonds, k): per-bond integrands (weights included)."""
+    """S_i = sum over the bonds b of node i of q_b V_(other end), at every grid node."""
     a, b, V = model.bond_a, model.bond_b, model.node_volume
     q = np.asarray(q, dtype=float)
     n = model.grid.n_ext
-    if q.ndim == 1:
-        return np.bincount(a, q * V[b], n) + np.bincount(b, q * V[a], n)
-    return np.stack([horizon_sums(model, q[:, k]) for k in range(q.shape[1])], axis=1)
+    return np.bincount(a, q * V[b], n) + np.bincount(b, q * V[a], n)
 
 
-def complete_sums(model, integrand) -> np.ndarray:
-    """The same sums over a complete neighbourhood of the bulk lattice: every stencil
-    offset xi with its weight omega(|xi|) beta and the bulk cell volume.
-
-    ``integrand(omega, beta, length, unit)`` per offset, like the per-bond ``q`` of
-    :func:`horizon_sums` (offsets of zero weight omega beta carry no bond and are left
-    out, as the models leave them out)."""
-    st, h = model.stencil, model.spacing
-    xi = st.offsets * h
-    r = np.linalg.norm(xi, axis=1)
-    om = model.influence.omega(r, model.horizon)
-    live = om * st.beta > 0
-    V = model.grid.volume * model.thickness
-    q = np.asarray(integrand(om[live], st.beta[live], r[live], xi[live] / r[live, None]),
-                   dtype=float)
-    return np.sum(q * V, axis=0)
+def complete_horizon_volume(model) -> float:
+    """sum beta V over a complete neighbourhood of the bulk lattice: every stencil offset
+    that carries a bond (weight omega beta > 0, as the models keep them), bulk cell volume."""
+    st = model.stencil
+    r, _ = st.vectors(model.spacing)
+    live = model.influence.omega(r, model.horizon) * st.beta > 0
+    return float(np.sum(st.beta[live]) * model.grid.volume * model.thickness)
 
 
 def guarded_ratio(full, part) -> np.ndarray:
@@ -56,9 +45,7 @@ def work_density(model, strain) -> np.ndarray:
     state-based model the work of its pair forces, the same attribution. Plain grids only
     (the unknowns are the real nodes)."""
     f = model.bond_forces(homogeneous_field(model, strain))
-    n = model.bond_n
-    e = model.bond_x * np.einsum("bi,ij,bj->b", n, np.asarray(strain, dtype=float), n)
-    w = 0.25 * f * e
+    w = 0.25 * f * homogeneous_extensions(model.bond_x, model.bond_n, strain)
     ne = model.grid.n_ext
     return (np.bincount(model.bond_a, w, ne) + np.bincount(model.bond_b, w, ne)) / model.node_volume
 

@@ -18,7 +18,7 @@ pdverify. A method whose optional dependency is missing says so in ``unavailable
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable, Mapping
 
 from ..params import Param
@@ -89,7 +89,7 @@ def _plugins():
             for item in items:
                 if not isinstance(item, BondMethod):
                     raise TypeError(f"{type(item).__name__} is not a pdverify BondMethod")
-                yield BondMethod(**{**item.__dict__, "origin": f"plugin {ep.value}"})
+                yield replace(item, origin=f"plugin {ep.value}")
         except Exception as exc:  # a broken plugin never stops pdverify
             BROKEN[ep.name] = f"{type(exc).__name__}: {exc}"
 

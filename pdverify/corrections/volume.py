@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..pd.closure import Closure
-from .factors import complete_sums, horizon_sums
+from .factors import complete_horizon_volume, horizon_sums
 
 
 def horizon_volumes(model) -> np.ndarray:
@@ -23,9 +23,8 @@ def horizon_volumes(model) -> np.ndarray:
 
 
 def volume_factors(model) -> np.ndarray:
-    V0 = complete_sums(model, lambda om, be, r, n: be)
     Vi = horizon_volumes(model)
-    return 2.0 * V0 / (Vi[model.bond_a] + Vi[model.bond_b])
+    return 2.0 * complete_horizon_volume(model) / (Vi[model.bond_a] + Vi[model.bond_b])
 
 
 def volume_closure(params=None) -> Closure:

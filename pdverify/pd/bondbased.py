@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from .bonds import Stencil, bond_pairs
+from .bonds import Stencil, bond_pairs, homogeneous_extensions
 from .closure import Closure, real_identity
 from .grid import BoxGrid
 from .influence import Influence
@@ -59,8 +59,8 @@ class BondBasedModel:
         self.bond_x, self.bond_n = x, xi / x[:, None]
         self.bond_factor = (closure.bond_factor(a, b, self.bond_n)
                             if closure.bond_factor is not None else np.ones(a.size))
-        #: omega(|xi|) beta of every bond (the weight of its end's horizon sum)
         self.bond_beta = beta[which]
+        #: omega(|xi|) beta of every bond (the weight of its end's horizon sum)
         self.bond_weight = influence.omega(x, delta) * self.bond_beta
         self.bond_stiffness = (self.bond_factor * self.c * self.bond_weight
                                * self.node_volume[a] * self.node_volume[b] / x)
@@ -135,11 +135,9 @@ class BondBasedModel:
         """W = 1/4 sum_b f_b e_b / V_i at a node with a complete neighbourhood of the bulk
         lattice under the homogeneous strain ``strain`` (d x d): every stencil offset a
         bond, e = |xi| n.strain.n, f = s e (the energy density, seed 003 Eq. 5)."""
-        st, h = self.stencil, self.spacing
-        xi = st.offsets * h
-        r = np.linalg.norm(xi, axis=1)
-        n = xi / r[:, None]
-        e = r * np.einsum("bi,ij,bj->b", n, np.asarray(strain, dtype=float), n)
+        st = self.stencil
+        r, n = st.vectors(self.spacing)
+        e = homogeneous_extensions(r, n, strain)
         V = self.grid.volume * self.thickness
         s = self.c * self.influence.omega(r, self.horizon) * st.beta * V * V / r
         return float(0.25 * np.sum(s * e * e) / V)

@@ -212,10 +212,21 @@ class Stencil:
     def half_beta(self) -> np.ndarray:
         return self.beta[self.half]
 
+    def vectors(self, spacing: float) -> tuple[np.ndarray, np.ndarray]:
+        """Lengths |xi| and unit vectors xi / |xi| of every offset at ``spacing``."""
+        xi = self.offsets * float(spacing)
+        r = np.linalg.norm(xi, axis=1)
+        return r, xi / r[:, None]
+
     @property
     def reach(self) -> int:
         """Largest offset along an axis: the fictitious layer that completes a neighbourhood."""
         return int(np.abs(self.offsets).max()) if self.offsets.size else 0
+
+
+def homogeneous_extensions(lengths, units, strain) -> np.ndarray:
+    """Linearised extensions e = |xi| n . strain . n of bonds under a homogeneous strain."""
+    return lengths * np.einsum("bi,ij,bj->b", units, np.asarray(strain, dtype=float), units)
 
 
 def build_stencil(dim: int, m_ratio: float, *, quadrature: str = "partial-volume",

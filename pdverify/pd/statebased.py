@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from .bonds import Stencil, bond_pairs, build_stencil
+from .bonds import Stencil, bond_pairs, build_stencil, homogeneous_extensions
 from .closure import Closure, real_identity
 from .grid import BoxGrid
 from .influence import Influence, StateBasedConstants
@@ -100,11 +100,8 @@ class StateBasedModel:
         #: omega(|xi|) beta of every bond (the weight of its end's horizon sums)
         self.bond_weight = self.bond_omega * self.bond_beta
         self._build_operators(Va, Vb)
-        #: factor on each bond's force only (Closure.force_factor), None = 1
-        self.bond_force_factor = None
-        if closure.force_factor is not None:
+        if closure.force_factor is not None:  # on each bond's force only
             g = np.asarray(closure.force_factor(self), dtype=float)
-            self.bond_force_factor = g
             self.K_e = (sp.diags(g) @ self.K_e).tocsr()
             self.K_theta = (sp.diags(g) @ self.K_theta).tocsr()
 
@@ -213,11 +210,9 @@ class StateBasedModel:
         neighbourhoods around it and its neighbours) under the homogeneous ``strain``:
         e = |xi| n.strain.n per stencil offset, theta the complete-neighbourhood
         dilatation, f = k_e omega beta V^2 (2/m) e + k_theta omega |xi| beta V^2 (2 theta/m)."""
-        st, h, c = self.stencil, self.spacing, self.constants
-        xi = st.offsets * h
-        r = np.linalg.norm(xi, axis=1)
-        n = xi / r[:, None]
-        e = r * np.einsum("bi,ij,bj->b", n, np.asarray(strain, dtype=float), n)
+        st, c = self.stencil, self.constants
+        r, n = st.vectors(self.spacing)
+        e = homogeneous_extensions(r, n, strain)
         V = self.grid.volume * self.thickness
         om, m = self.influence.omega(r, self.horizon), self.m_inf
         theta = c.c_theta * np.sum(om * r * e * st.beta * V) / m

@@ -10,6 +10,7 @@ import numpy as np
 from .. import budget
 from ..errors import InputError, NumericalError
 from ..params import Param, resolve
+from ..pd.closure import Closure
 from ..pd.influence import INFLUENCES
 from ..results import RunResult, Timer
 from ..solvers.iterative import solver_error_warnings
@@ -151,11 +152,11 @@ class Scene:
         raise InputError(f"{self.id}: method {name!r} is not supported by this scene; "
                          f"allowed: {allowed}")
 
-    def bond_closure(self, method: str, params: Mapping[str, Any]):
-        """The :class:`~pdverify.pd.closure.Closure` of a bond method, None for the
-        scene's own methods."""
+    def bond_closure(self, method: str, params: Mapping[str, Any]) -> Closure:
+        """The :class:`~pdverify.pd.closure.Closure` of a bond method; the uncorrected
+        ``Closure()`` for the scene's own methods."""
         bm = self.bond_methods().get(method)
-        return None if bm is None else bm.closure(params)
+        return Closure() if bm is None else bm.closure(params)
 
     @property
     def default_method(self) -> str:

@@ -191,7 +191,7 @@ class TensionSheet(SheetScene):
             inf = get_influence(p["micromodulus"])
             closure = (directional_closure(grid, (-W / 2, -H / 2), (W / 2, H / 2), delta, inf)
                        if method == "energy-directional"
-                       else self.bond_closure(method, p) or Closure())
+                       else self.bond_closure(method, p))
             c = self.micromodulus(p, delta)
             model = BondBasedModel(grid, stencil, c, inf, closure, thickness=t)
             n, x = grid.n_ext, grid.x
@@ -355,7 +355,7 @@ class ClampedSheet(SheetScene):
                 bottom = np.flatnonzero(np.isclose(y, -L / 2))
                 closure = (directional_closure(grid, lo, hi, delta, inf)
                            if method == "energy-directional"
-                           else self.bond_closure(method, p) or Closure())
+                           else self.bond_closure(method, p))
             model = BondBasedModel(grid, self.stencil(p, p["m_ratio"]),
                                    self.micromodulus(p, delta), inf, closure, thickness=t)
             n = grid.n_ext

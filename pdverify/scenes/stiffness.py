@@ -29,9 +29,9 @@ import numpy as np
 
 from .. import budget
 from ..corrections.energy_directional import directional_closure
-from ..corrections.factors import work_density
+from ..corrections.factors import uniaxial, work_density
 from ..params import Param, at_least, open_interval, positive
-from ..pd import (BondBasedModel, BoxGrid, Closure, StateBasedConstants, StateBasedModel,
+from ..pd import (BondBasedModel, BoxGrid, StateBasedConstants, StateBasedModel,
                   bond_micromodulus, build_stencil, get_influence, state_based_stencil)
 from ..pd.influence import INFLUENCES
 from . import MethodSpec, Outcome, Scene, register, whole_cells
@@ -41,11 +41,7 @@ AXES = "xyz"
 
 def strain_states(dim: int) -> list[tuple[str, np.ndarray]]:
     """(name, eps): a unit uniaxial stretch per axis, then a unit pure shear per plane."""
-    out = []
-    for k in range(dim):
-        eps = np.zeros((dim, dim))
-        eps[k, k] = 1.0
-        out.append((f"uniaxial_{AXES[k]}", eps))
+    out = [(f"uniaxial_{AXES[k]}", uniaxial(dim, k)) for k in range(dim)]
     for i, j in itertools.combinations(range(dim), 2):
         eps = np.zeros((dim, dim))
         eps[i, j] = eps[j, i] = 0.5
@@ -90,19 +86,15 @@ class StiffnessScene(Scene):
         return budget.Estimate(budget.BYTES_PER_NONZERO * bonds * (d + 4),
                                f"{nodes:.4g} nodes, ~{bonds:.3g} bonds, no solve")
 
-    def closure(self, method, p):
-        return self.bond_closure(method, p) or Closure()
-
     def solve(self, method, p, timer):
         with timer.phase("setup"):
-            model = self.build(method, p, self.closure(method, p))
+            model = self.build(method, p, self.bond_closure(method, p))
         with timer.phase("solve"):
             ratios = energy_ratios(model)
         g = model.grid
         x = g.x[g.interior_ids]
-        lo = np.asarray(g.origin)
-        dist = np.minimum(x - lo, lo + np.asarray(g.lengths) - x).min(axis=1)
-        near = dist <= model.horizon + 1e-12 * model.horizon
+        # a node exactly one horizon in counts as near (1e-12: round-off of the positions)
+        near = g.distance_to_surface(x) <= model.horizon * (1 + 1e-12)
         err = {k: np.abs(v - 1.0) * 100.0 for k, v in ratios.items()}
         stack = np.stack(list(err.values()), axis=1)
         metrics = {
@@ -114,7 +106,7 @@ class StiffnessScene(Scene):
             "energy_ratio_max": float(max(v.max() for v in ratios.values())),
         }
         fields = {"x": x, "spacing": p["spacing"], "horizon": model.horizon,
-                  "lengths": np.asarray(g.lengths), "origin": lo,
+                  "lengths": np.asarray(g.lengths), "origin": np.asarray(g.origin),
                   **{f"ratio_{k}": v for k, v in ratios.items()}}
         size = {"nodes": int(g.n_interior), "bonds": int(model.bond_a.size)}
         return Outcome(metrics=metrics, size=size, fields=fields)

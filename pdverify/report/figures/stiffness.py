@@ -22,7 +22,8 @@ def _mid_line(r):
 @family("stiffness")
 def stiffness(scene, runs, folder):
     out = []
-    default = [r for r in runs if r.params.get("spacing") == scene.resolve(r.method)["spacing"]]
+    spacing = next(q.default for q in scene.params if q.name == "spacing")
+    default = [r for r in runs if r.params.get("spacing") == spacing]
     runs = default or runs
     states = [k[len("ratio_"):] for k in runs[0].fields if k.startswith("ratio_")]
     shown = [s for s in ("uniaxial_x", "uniaxial_y", "shear_xy") if s in states]
