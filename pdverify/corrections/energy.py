@@ -12,14 +12,22 @@ Our choices where the sources leave room:
   bulk is then untouched (G = 1 exactly away from the surface) and the correction is
   about the surface alone. Peridynamics.jl divides the continuum W by the discrete one,
   which also rescales the bulk by the lattice's quadrature error.
-- W_i is the model's own energy density, half of each bond's work to each end
-  (``factors.work_density``). For bond-based models this is the sum Peridynamics.jl
-  uses. For state-based models Peridynamics.jl takes the bond-based sum too, but an
-  LPS model with m over the truncated family already stiffens its surface bonds by
-  1/m_i, and factors from the bond-based sum (all > 1) then correct in the wrong
-  direction: measured on body3d-traction at h = 0.1, 31 % (none) became 100 %. We
-  calibrate the state-based model's own work density instead; the factor multiplies
-  the bond force, m and the dilatation keep their weights, as in Peridynamics.jl.
+- W_i is the model's own energy density at node i (``factors.work_density``: the
+  work of node i's own force state on its bonds). For bond-based models this is the
+  sum Peridynamics.jl uses. For state-based models Peridynamics.jl takes the
+  bond-based sum too, but an LPS model with m over the truncated family already
+  stiffens its surface bonds by 1/m_i, and factors from the bond-based sum (all > 1)
+  then correct in the wrong direction: measured on body3d-traction at h = 0.1, 31 %
+  (none) became 100 %. We calibrate the state-based model's own energy density
+  instead (21 % there); the factor multiplies the bond force, m and the dilatation
+  keep their weights, as in Peridynamics.jl.
+- Consequence (finding): in 1D, LPS with m over the truncated family has the exact
+  energy density at every node under a uniform stretch (theta_i = c_theta eps and
+  sum omega e^2 / m_i = eps^2 whatever the family), so every factor is 1 and the
+  seed-000 bars' ``energy`` runs equal ``none``: their error is the imposition of the
+  boundary conditions, not a stiffness defect. (An earlier reading split each bond's
+  work evenly between its ends; that is not the node's energy for state-based models,
+  and it gave those bars 14 % instead of 24 %.)
 - The ellipse for bonds along an axis reduces to g_k, in any dimension.
 """
 from __future__ import annotations

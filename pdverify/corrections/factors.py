@@ -39,15 +39,20 @@ def homogeneous_field(model, strain) -> np.ndarray:
 
 
 def work_density(model, strain) -> np.ndarray:
-    """W_i = 1/4 sum over node i's bonds of f_b e_b / V_i under the homogeneous ``strain``
-    (d x d) on every node: half of each bond's work f e / 2 to each end. For the
-    bond-based model this is its strain energy density (seed 003, Eq. 5); for the
-    state-based model the work of its pair forces, the same attribution. Plain grids only
-    (the unknowns are the real nodes)."""
-    f = model.bond_forces(homogeneous_field(model, strain))
-    w = 0.25 * f * homogeneous_extensions(model.bond_x, model.bond_n, strain)
+    """W_i = 1/2 sum over node i's bonds of f_i,b e_b / V_i under the homogeneous
+    ``strain`` (d x d) on every node, f_i,b the part of bond b's force that node i's own
+    force state gives (``model.bond_end_forces``). This is node i's strain energy density
+    for any model with a quadratic energy (Euler: sum e dW_i/de = 2 W_i): for the
+    bond-based model half of each bond's energy (seed 003, Eq. 5); for LPS
+    k_theta theta_i^2 / (2 c_theta) + k_e / (2 m_i) sum omega e^2 beta V; for PALS its
+    kappa theta^2 / 2 + mu sum sigma (e^d)^2 beta V. For a force scaled after the fact
+    (the energy correction) it is the work of the scaled forces, attributed the same way.
+    Plain grids only (the unknowns are the real nodes)."""
+    f_a, f_b = model.bond_end_forces(homogeneous_field(model, strain))
+    e = homogeneous_extensions(model.bond_x, model.bond_n, strain)
     ne = model.grid.n_ext
-    return (np.bincount(model.bond_a, w, ne) + np.bincount(model.bond_b, w, ne)) / model.node_volume
+    return (np.bincount(model.bond_a, 0.5 * f_a * e, ne)
+            + np.bincount(model.bond_b, 0.5 * f_b * e, ne)) / model.node_volume
 
 
 def uniaxial(dim: int, k: int, eps: float = 1.0) -> np.ndarray:

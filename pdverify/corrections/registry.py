@@ -33,8 +33,8 @@ class BondMethod:
     """A correction that acts through the closure of a plain grid's model.
 
     ``closure(params) -> Closure`` builds it from the method's resolved ``params``;
-    ``theories`` the models it applies to; ``scenes`` restricts it to these scene ids
-    (``None``: every scene of those theories); ``unavailable`` is ``None`` when it can
+    ``theories`` the models it applies to, ``dims`` their dimensions; ``scenes``
+    restricts it to these scene ids (``None``: every scene of those theories); ``unavailable`` is ``None`` when it can
     run, else why not and how to fix it. ``origin``: ``built-in`` or the plugin's
     entry point.
     """
@@ -48,6 +48,7 @@ class BondMethod:
     scenes: tuple[str, ...] | None = None
     unavailable: str | None = None
     origin: str = "built-in"
+    dims: tuple[int, ...] = (1, 2, 3)
 
     def __post_init__(self):
         bad = [t for t in self.theories if t not in THEORIES]
@@ -56,12 +57,13 @@ class BondMethod:
 
     def serves(self, scene) -> bool:
         theory = getattr(scene, "closure_theory", None)
-        return (theory in self.theories
+        return (theory in self.theories and getattr(scene, "dim", None) in self.dims
                 and (self.scenes is None or scene.id in self.scenes))
 
 
 def _builtin() -> list[BondMethod]:
     from .energy import energy_closure
+    from .pals import pals_closure
     from .volume import volume_closure
     return [
         BondMethod("energy", "Le and Bobaru 2018 energy correction: per axis the ratio of a "
@@ -72,6 +74,12 @@ def _builtin() -> list[BondMethod]:
         BondMethod("volume", "volume correction 2 V0 / (V_i + V_j) on the bond force (V the "
                    "discrete horizon volume of each end)",
                    "Le and Bobaru 2018; PeriLab, PeriPy, pypd", volume_closure),
+        BondMethod("pals", "position-aware linear solid: per-node dilatation and deviatoric "
+                   "influence functions from the matching deformations (Lagrange "
+                   "multipliers); constraints as the uncorrected model imposes them",
+                   "Mitchell, Silling and Littlewood, J. Mech. Mater. Struct. 10 (2015) "
+                   "539-557; seed 001 §5.1; Peridigm pals.cxx", pals_closure,
+                   theories=("state-based",), dims=(2, 3)),
     ]
 
 

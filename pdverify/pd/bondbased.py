@@ -123,6 +123,11 @@ class BondBasedModel:
         """Scalar bond forces s_b e_b (tension positive) of the unknowns ``u``."""
         return self.bond_stiffness * self.bond_extensions(u)
 
+    def bond_end_forces(self, u) -> tuple[np.ndarray, np.ndarray]:
+        """The bond force split between its ends: half each (one pairwise spring)."""
+        half = 0.5 * self.bond_forces(u)
+        return half, half
+
     def strain_energy_density(self, u) -> np.ndarray:
         """W_i = 1 / (2 V_i) sum_(bonds at i) s_b e_b^2 / 2 at every grid node: half of each
         bond's energy s e^2 / 2 goes to each end (seed 003, Eq. 5 discretised)."""

@@ -44,6 +44,11 @@ class Closure:
       m and the dilatation keep their weights (the energy correction). In the
       bond-based model weight and force factors both multiply the spring stiffness.
       Default: 1.
+    - ``constitutive``: replaces the LPS force state of a state-based model (PALS): an
+      object with ``operators(model) -> (K_e, K_theta, A_theta, A_Theta, ke_share_a)``
+      (the model's factors, built from its bonds; the nodal scalar channel may carry
+      more than one value per node; ``ke_share_a`` end a's part of the diagonal K_e) and ``bulk_work_density(model, strain)``. Plain grids only.
+      Default: the model's own (LPS).
 
     Flux and constraint rows are built by the correction from the model's bonds after
     construction (e.g. :meth:`StateBasedModel.bond_force_rows`).
@@ -57,6 +62,7 @@ class Closure:
     bond_factor: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray] | None = None
     weight_factor: Callable[[object], np.ndarray] | None = None
     force_factor: Callable[[object], np.ndarray] | None = None
+    constitutive: object | None = None
 
     def __post_init__(self):
         if self.weighted_volume not in WEIGHTED_VOLUMES:

@@ -122,12 +122,17 @@ class StateBasedModel:
 
         self.A_U = (cl.displacement_map if cl.displacement_map is not None
                     else real_identity(g, nu_)).tocsr()
-        self.A_Theta = (cl.dilatation_map if cl.dilatation_map is not None
-                        else real_identity(g)).tocsr()
         # bond extension from all-node displacements (component-major columns)
         self.A_e = sp.hstack([sp.csr_matrix((np.r_[-n[:, k], n[:, k]],
                                              (np.r_[rows, rows], np.r_[a, b])), shape=(nb, ne))
                               for k in range(d)]).tocsr()
+        self.A_U_full = sp.kron(sp.identity(d, format="csr"), self.A_U, format="csr")
+        if cl.constitutive is not None:  # another force state on the same bonds (PALS)
+            (self.K_e, self.K_theta, self.A_theta, self.A_Theta,
+             self.ke_share_a) = cl.constitutive.operators(self)
+            return
+        self.A_Theta = (cl.dilatation_map if cl.dilatation_map is not None
+                        else real_identity(g)).tocsr()
         # real-node dilatations: every bond counts at each real end, with the other end's V
         coef = c.c_theta * om * x * be
         ia, ib = g.is_interior[a], g.is_interior[b]
@@ -138,10 +143,10 @@ class StateBasedModel:
         # bond forces times beta V_a V_b
         VV = Va * Vb
         self.K_e = sp.diags(c.k_e * om * be * VV * (1.0 / m[a] + 1.0 / m[b]))
+        self.ke_share_a = (1.0 / m[a]) / (1.0 / m[a] + 1.0 / m[b])
         kt = c.k_theta * om * x * be * VV
         self.K_theta = sp.csr_matrix((np.r_[kt / m[a], kt / m[b]], (np.r_[rows, rows], np.r_[a, b])),
                                      shape=(nb, ne))
-        self.A_U_full = sp.kron(sp.identity(d, format="csr"), self.A_U, format="csr")
 
     def bond_force_rows(self, node_rows, bonds, weights) -> sp.csr_matrix:
         """Rows r (d * n_unknown_nodes x bonds) with r @ f = sum weights f_b n_b per node.
@@ -205,11 +210,30 @@ class StateBasedModel:
         e = self.A_e @ (self.A_U_full @ np.asarray(u, dtype=float))
         return self.K_e @ e + self.K_theta @ (self.A_Theta @ (self.A_theta @ e))
 
+    def bond_end_forces(self, u) -> tuple[np.ndarray, np.ndarray]:
+        """The bond forces of :meth:`bond_forces` split by the end whose force state
+        gives them: f = f_a + f_b, f_a = beta V_a V_b t_a(xi) (k_e omega e / m_a +
+        k_theta omega |xi| theta_a / m_a for LPS). ``ke_share_a`` is end a's part of K_e;
+        a K_theta entry belongs to the end whose node its column is (modulo the grid's
+        node count: a force state may carry several nodal scalars per node)."""
+        e = self.A_e @ (self.A_U_full @ np.asarray(u, dtype=float))
+        Theta = self.A_Theta @ (self.A_theta @ e)
+        KT = self.K_theta.tocoo()
+        at_a = KT.col % self.grid.n_ext == self.bond_a[KT.row]
+        f_a = (self.ke_share_a * (self.K_e @ e)
+               + np.bincount(KT.row[at_a], KT.data[at_a] * Theta[KT.col[at_a]],
+                             self.bond_a.size))
+        return f_a, self.K_e @ e + self.K_theta @ Theta - f_a
+
     def bulk_work_density(self, strain) -> float:
-        """W = 1/4 sum_b f_b e_b / V_i at a node of the bulk lattice (complete
-        neighbourhoods around it and its neighbours) under the homogeneous ``strain``:
+        """W = 1/2 sum_b f_i,b e_b / V_i (end i's part: half of f_b there) at a node of
+        the bulk lattice (complete neighbourhoods around it and its neighbours) under the
+        homogeneous ``strain``:
         e = |xi| n.strain.n per stencil offset, theta the complete-neighbourhood
-        dilatation, f = k_e omega beta V^2 (2/m) e + k_theta omega |xi| beta V^2 (2 theta/m)."""
+        dilatation, f = k_e omega beta V^2 (2/m) e + k_theta omega |xi| beta V^2 (2 theta/m).
+        A closure's ``constitutive`` force state gives its own."""
+        if self.closure.constitutive is not None:
+            return self.closure.constitutive.bulk_work_density(self, strain)
         st, c = self.stencil, self.constants
         r, n = st.vectors(self.spacing)
         e = homogeneous_extensions(r, n, strain)

@@ -119,6 +119,7 @@ class StaticBar(Scene):
     reference = "analytic"
     figure = "bar1d"
     closure_theory = "state-based"
+    dim = 1
     load_param: Param
     methods = (NONE, TAYLOR)
     paper_orders: tuple[int, ...] = (1,)

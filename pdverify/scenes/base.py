@@ -120,6 +120,8 @@ class Scene:
     #: it takes the bond methods of ``pdverify.corrections.registry`` (built-in and
     #: plugins); None: only its own ``methods``
     closure_theory: str | None = None
+    #: the dimension of that model (a bond method may serve some dimensions only)
+    dim: int | None = None
     #: overrides of the bond methods' report cases under ``--quick``
     quick_overrides: Mapping[str, Any] = {}
 

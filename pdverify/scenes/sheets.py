@@ -36,6 +36,7 @@ class SheetScene(FemAndPD):
 
     figure = "sheets"
     closure_theory = "bond-based"
+    dim = 2
 
     def check_pd(self, where, method, p):
         nu = bond_based_nu(2, "stress")

@@ -2,11 +2,13 @@
 
 Every node of a plain grid is given u = eps . x for a set of homogeneous strains eps (a
 uniaxial stretch along each axis and a pure shear in each coordinate plane). The strain
-energy density W_i of each node (half of each bond's work f e / 2 to each end,
+energy density W_i of each node (the work of its own force state on its bonds:
+bond-based half of each bond's energy, LPS and PALS their node energies;
 ``pdverify.corrections.factors.work_density``) is divided by a node's of the bulk
 lattice (complete neighbourhoods; ``bulk_work_density``). A perfect surface correction
 gives W_i / W_bulk = 1 everywhere; the uncorrected model is softer (bond-based) or, for
-LPS with m over the truncated family, partly stiffer near the surface. This is what the
+LPS with m over the truncated family, softer in some states and stiffer in others near
+the surface (its uniaxial energy along a surface is exact in 1D and close in 2D/3D). This is what the
 energy, volume and directional corrections set out to fix (Le and Bobaru 2018 compare
 exactly these profiles), so it is where they are judged first; the displacement scenes
 (sheet2d-tension, body3d-traction, plate2d-plane-strain) then show what it does to a
@@ -16,8 +18,8 @@ Reference: the bulk lattice's own W (no continuum moduli involved, so the number
 the surface effect alone). Metrics, in percent of W_bulk, over the strain states:
 ``surface_energy_error_pct`` = the largest |W_i / W_bulk - 1| over nodes within one
 horizon of the surface, ``surface_energy_rms_pct`` their RMS, ``interior_energy_error_pct``
-the largest over the other nodes (a state-based node feels its neighbours' dilatations,
-so it is not zero there for LPS), ``energy_error_<state>_pct`` the largest per state over
+the largest over the other nodes (zero for an uncorrected model: a node's energy depends
+on its own bonds only; a correction may move it), ``energy_error_<state>_pct`` the largest per state over
 all nodes, ``energy_ratio_min`` / ``_max`` the extremes of W_i / W_bulk. The setup time
 (model and the correction's factors) is the cost; the evaluation is the 'solve' phase.
 """
@@ -128,6 +130,7 @@ class SheetStiffness(StiffnessScene):
     title = "Sheet under homogeneous strain: nodal energy density against the bulk"
     seed = "003 §4.1.1"
     closure_theory = "bond-based"
+    dim = 2
     methods = (MethodSpec("none"), MethodSpec("energy-directional"))
     params = (
         Param("width", 0.05, "sheet width [m]", positive),
@@ -197,6 +200,7 @@ class BoxStiffness(_StateStiffness):
     title = "3D box under homogeneous strain: nodal energy density against the bulk"
     seed = "001 §4.1"
     kind = "3d"
+    dim = 3
     quick_overrides = {"spacing": 0.1}
     params = (Param("lx", 1.0, "box length [m]", positive),
               Param("ly", 0.5, "box size l_y [m]", positive),
@@ -220,6 +224,7 @@ class PlateStiffness(_StateStiffness):
     title = "Plane-strain plate under homogeneous strain: nodal energy density against the bulk"
     seed = "001 §5"
     kind = "plane-strain"
+    dim = 2
     quick_overrides = {"spacing": 0.05}
     params = (Param("lx", 1.0, "plate width [m]", positive),
               Param("ly", 1.0, "plate height [m]", positive),

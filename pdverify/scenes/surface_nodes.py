@@ -420,6 +420,7 @@ BODY_PARAMS = (
 
 class Body3D(SurfaceNodeScene):
     kind = "3d"
+    dim = 3
     quick_overrides = {"spacing": 0.1}
 
     def box(self, p):
@@ -628,6 +629,7 @@ class Plate2DPlaneStrain(SurfaceNodeScene):
     seed = "001 §5"
     reference = "analytic"
     kind = "plane-strain"
+    dim = 2
     quick_overrides = {"spacing": 0.05}
     params = (
         Param("lx", 1.0, "plate width [m] (ERRATA seed 001: Table 2 missing)", positive),
