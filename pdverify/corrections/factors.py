@@ -5,7 +5,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import NumericalError
 from ..pd.bonds import homogeneous_extensions
+
+#: a node's scaled system counts as singular above this condition number (1 / 1e-12:
+#: machine epsilon times ~1e4, the solution would lose every digit)
+MAX_NODE_CONDITION = 1e12
 
 
 def horizon_sums(model, q) -> np.ndarray:
@@ -60,3 +65,24 @@ def uniaxial(dim: int, k: int, eps: float = 1.0) -> np.ndarray:
     out = np.zeros((dim, dim))
     out[k, k] = eps
     return out
+
+
+def solve_per_node(K, rhs, what, x) -> np.ndarray:
+    """Solve the small systems K_i y_i = rhs_i of every node (K: (n, p, p); rhs: (n, p)
+    or (n, p, r)) after scaling each to unit diagonal. A singular one (condition above
+    :data:`MAX_NODE_CONDITION`: its bonds do not span what it must fit) is a
+    NumericalError naming the first such node, at positions ``x``."""
+    diag = np.einsum("npp->np", K)
+    s = 1.0 / np.sqrt(np.where(diag > 0, diag, 1.0))
+    Ks = K * s[:, :, None] * s[:, None, :]
+    cond = np.linalg.cond(Ks)
+    bad = ~np.isfinite(cond) | (cond > MAX_NODE_CONDITION)
+    if np.any(bad):
+        i = int(np.flatnonzero(bad)[0])
+        raise NumericalError(f"{what} of the node at {np.array2string(x[i], precision=4)} "
+                             f"is singular (condition {cond[i]:.3g}): its bonds do not span "
+                             f"the fit ({int(bad.sum())} such nodes)")
+    vector = rhs.ndim == 2
+    r = (rhs[..., None] if vector else rhs) * s[:, :, None]
+    y = np.linalg.solve(Ks, r) * s[:, :, None]
+    return y[..., 0] if vector else y

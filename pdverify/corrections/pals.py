@@ -49,14 +49,9 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import NumericalError
 from ..pd.bonds import homogeneous_extensions
 from ..pd.closure import Closure
-
-#: a node's scaled Lagrange system counts as singular below this reciprocal condition
-#: number (machine epsilon times ~1e4: the multipliers would lose every digit)
-_RCOND = 1e-12
-
+from .factors import solve_per_node
 
 def _pairs(d: int) -> list[tuple[int, int]]:
     diag = [(k, k) for k in range(d)]
@@ -79,23 +74,6 @@ def matching_basis(xi: np.ndarray):
     if d == 2:  # D_y = -D_x: one uniaxial deviator in 2D (the pair would be singular)
         D, rhs_dev = D[:, [0, 2]], rhs_dev[[0, 2]]
     return E, D, tr, rhs_dev
-
-
-def _solve_nodes(K, rhs, where, x):
-    """Solve the per-node systems K_i lam_i = rhs_i (n, p, p) after scaling each to unit
-    diagonal; a singular node is a NumericalError naming it."""
-    diag = np.einsum("npp->np", K)
-    s = 1.0 / np.sqrt(np.where(diag > 0, diag, 1.0))
-    Ks = K * s[:, :, None] * s[:, None, :]
-    cond = np.linalg.cond(Ks)
-    bad = ~np.isfinite(cond) | (cond > 1.0 / _RCOND)
-    if np.any(bad):
-        i = int(np.flatnonzero(bad)[0])
-        raise NumericalError(f"pals: the {where} Lagrange system of the node at "
-                             f"{np.array2string(x[i], precision=4)} is singular (condition "
-                             f"{cond[i]:.3g}); its bonds do not span the matching "
-                             f"deformations ({int(bad.sum())} such nodes)")
-    return np.linalg.solve(Ks, (rhs * s)[..., None])[..., 0] * s
 
 
 class PalsConstitutive:
@@ -130,8 +108,8 @@ class PalsConstitutive:
         K_dev = (inc @ np.einsum("bk,bl->bkl", DD, DD).reshape(nb, q * q)).reshape(n, q, q)
         r_dil = rhs_dil[None, :] - inc @ (om0[:, None] * E)
         r_dev = rhs_dev[None, :] - inc @ (sg0[:, None] * DD)
-        lam = _solve_nodes(K_dil, r_dil, "dilatation", g.x)
-        mu_ = _solve_nodes(K_dev, r_dev, "deviatoric", g.x)
+        lam = solve_per_node(K_dil, r_dil, "pals: the dilatation Lagrange system", g.x)
+        mu_ = solve_per_node(K_dev, r_dev, "pals: the deviatoric Lagrange system", g.x)
         om_a = om0 + np.sum(E * lam[a], axis=1)
         om_b = om0 + np.sum(E * lam[b], axis=1)
         sg_a = sg0 + np.sum(DD * mu_[a], axis=1)

@@ -30,6 +30,9 @@ class Closure:
       unknowns, per component (identity on real nodes, extrapolation rows on fictitious
       or mirror nodes, columns for extra unknowns such as surface nodes);
       ``n_unknown_nodes`` its column count. Default: the real nodes are the unknowns.
+    - ``displacement_map_full`` (d n_ext x d n_unknown_nodes, component-major): instead
+      of I_d kron ``displacement_map`` when the components map differently (mirror
+      nodes: odd and even reflections). State-based models only.
     - ``dilatation_map`` (n_ext x n_real): all node dilatations from the real ones
       (state-based only). Default: zero on fictitious nodes.
     - ``bond_factor(a, b, n) -> factor``: a factor on each bond's weight beta (end-bond
@@ -59,6 +62,7 @@ class Closure:
     displacement_map: sp.spmatrix | None = None
     dilatation_map: sp.spmatrix | None = None
     n_unknown_nodes: int | None = None
+    displacement_map_full: sp.spmatrix | None = None
     bond_factor: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray] | None = None
     weight_factor: Callable[[object], np.ndarray] | None = None
     force_factor: Callable[[object], np.ndarray] | None = None

@@ -126,7 +126,9 @@ class StateBasedModel:
         self.A_e = sp.hstack([sp.csr_matrix((np.r_[-n[:, k], n[:, k]],
                                              (np.r_[rows, rows], np.r_[a, b])), shape=(nb, ne))
                               for k in range(d)]).tocsr()
-        self.A_U_full = sp.kron(sp.identity(d, format="csr"), self.A_U, format="csr")
+        self.A_U_full = (cl.displacement_map_full.tocsr()
+                         if cl.displacement_map_full is not None
+                         else sp.kron(sp.identity(d, format="csr"), self.A_U, format="csr"))
         if cl.constitutive is not None:  # another force state on the same bonds (PALS)
             (self.K_e, self.K_theta, self.A_theta, self.A_Theta,
              self.ke_share_a) = cl.constitutive.operators(self)

@@ -11,7 +11,9 @@ def _label(r) -> str:
     """Method and order, plus the parameters the seed-001 cases vary."""
     extra = [f"{k}={v}" for k, v in r.params.items()
              if (k == "quadrature" and v != "partial-volume") or (k == "m_ratio" and v != 3.0)
-             or k == "load_point"]
+             or k == "load_point" or (k == "neumann" and v != "full-traction")
+             or (k == "mirror_point" and v != "nearest")
+             or (k == "influence" and v != "gaussian")]
     return label(r) + "".join(", " + e for e in extra)
 
 
@@ -94,8 +96,56 @@ def _cost(scene, results, folder):
              "(the table above lists setup and solve time separately).")]
 
 
+#: the panels of seed 001 Figs. 14 and 15 (§5), in the paper's order, then ours
+SECTION5 = (("pals", {}, "(a) PALS"), ("mirror-nodes", {"neumann": "full-traction"}, "(b) MNM"),
+            ("pddo", {}, "(c) PDDO"), ("surface-nodes", {"order": 1}, "(d) SNM"),
+            ("mirror-nodes", {"neumann": "normal-only"}, "MNM, normal-only Neumann"),
+            ("none", {}, "none (uncorrected)"))
+
+
+def _section5(scene, results, folder):
+    """Figs. 14 and 15 side by side: one column per method at the paper's settings
+    (partial volumes, Gaussian influence, m = 3, the default spacing of the runs)."""
+    def paper(r):
+        return (r.params.get("quadrature") == "partial-volume"
+                and r.params.get("influence") == "gaussian" and r.params.get("m_ratio") == 3.0)
+    panels = []
+    for method, want, title in SECTION5:
+        hit = [r for r in results if r.method == method and paper(r)
+               and all(r.params.get(k) == v for k, v in want.items())]
+        if hit:
+            panels.append((title, hit[0]))
+    if len(panels) < 2:
+        return []
+    fig, axes = plt.subplots(2, len(panels), figsize=(3.1 * len(panels), 5.8), squeeze=False)
+    for col, (title, r) in enumerate(panels):
+        f = r.fields
+        L = f["lengths"]
+        for k, name in enumerate(("u (Fig. 14)", "v (Fig. 15)")):
+            ax = axes[k, col]
+            z = _grid_values(f, f["error"][:, k]).T
+            im = ax.imshow(z, origin="lower", extent=(0, L[0], 0, L[1]), cmap="viridis")
+            cb = fig.colorbar(im, ax=ax, shrink=0.8)
+            cb.ax.tick_params(labelsize=6)
+            ax.set_title(f"{title}\n{name}: max {np.nanmax(z):.3g} %", fontsize=8)
+            ax.tick_params(labelsize=6)
+    fig.suptitle(f"{scene.id}: Eq. (44) errors [%] of the §5 methods "
+                 f"(h = {panels[0][1].params['spacing']:g} m; one colour scale per panel)",
+                 fontsize=9)
+    fig.tight_layout()
+    name = _save(fig, folder, f"{scene.id}-section5.png")
+    return [(name, "Seed 001 §5, Figs. 14 (u) and 15 (v): PALS, the mirror node method, the "
+                   "PDDO boundary layer and the surface node method on the same plate, then "
+                   "our second MNM reading and the uncorrected model; each panel its own "
+                   "colour scale, its maximum in the title. The paper's ordering: PALS "
+                   "reduces the y error but keeps a large x error; MNM is close in x except "
+                   "one corner and worst in y; SNM smallest among the ordinary state-based "
+                   "methods; PDDO similar to SNM.")]
+
+
 @family("surface-nodes")
 def surface_node_figures(scene, results, folder):
     dim = results[0].fields["x"].shape[1]
     maps = _maps_3d(scene, results, folder) if dim == 3 else _maps_2d(scene, results, folder)
-    return maps + _cost(scene, results, folder)
+    front = _section5(scene, results, folder) if dim == 2 else []
+    return front + maps + _cost(scene, results, folder)

@@ -1,0 +1,161 @@
+"""The mirror node method and the PDDO boundary layer (seed 001 §5.2-5.3): affine fields
+reproduced where each claims it, and the §5 comparison on the plane-strain plate."""
+import numpy as np
+import pytest
+
+from pdverify.corrections.mirror_nodes import MirrorNodes, peridynamic_gradient
+from pdverify.corrections.pddo import derivative_operators, monomial_orders, pddo_system
+from pdverify.pd import (BoxGrid, StateBasedConstants, StateBasedModel, get_influence,
+                         state_based_stencil)
+from pdverify.scenes import get_scene
+from pdverify.solvers.dense import solve_with_dirichlet
+
+H, L = 0.1, (1.0, 0.8)
+C = StateBasedConstants("plane-strain", 200e9, 0.3)
+LAM, MU = C.moduli()
+GRAD = np.array([[1e-3, 2e-4], [-3e-4, 5e-4]])
+SHIFT = np.array([1e-4, -2e-4])
+ALL_FACES = [(f, k) for f in range(4) for k in range(2)]
+
+
+def affine(x):
+    return x @ GRAD.T + SHIFT
+
+
+def affine_traction(x, n, face):
+    eps = 0.5 * (GRAD + GRAD.T)
+    sig = LAM * np.trace(eps) * np.eye(2) + 2 * MU * eps
+    return n @ sig.T
+
+
+def stencil(quadrature="partial-volume"):
+    return state_based_stencil(2, 3.0, H, get_influence("gaussian"), quadrature)
+
+
+def solve_mirror(dirichlet, **kw):
+    st = stencil()
+    g = BoxGrid(L, (0.0, 0.0), H, st.reach)
+    mn = MirrorNodes(g, st, dirichlet, affine, affine_traction, (LAM, MU), **kw)
+    m = StateBasedModel(g, st, C, get_influence("gaussian"), mn.closure())
+    U_c = mn.constant_displacements()
+    rhs = -m.rows_of_state(U_c, m.A_Theta @ (m.A_theta @ (m.A_e @ U_c.T.ravel())))
+    x = g.x[g.interior_ids]
+    ni = x.shape[0]
+    fixed = np.zeros(0, dtype=int) if dirichlet else np.array([0, ni, 1])
+    values = np.zeros(0) if dirichlet else np.r_[affine(x[:1])[0], affine(x[1:2])[0, 0]]
+    u, _ = solve_with_dirichlet(m.stiffness(), rhs, fixed, values, "test")
+    return np.abs(u.reshape(2, ni).T - affine(x)).max() / np.abs(affine(x)).max(), mn, g
+
+
+def test_peridynamic_gradient_is_the_inward_normal_on_a_face():
+    """A fictitious node beside the middle of a face sees the body straight ahead."""
+    st = stencil()
+    g = BoxGrid(L, (0.0, 0.0), H, st.reach)
+    n = peridynamic_gradient(g, st)
+    mid = np.flatnonzero(np.isclose(g.x[:, 0], -0.05) & np.isclose(g.x[:, 1], 0.45))
+    assert np.allclose(n[mid], [[1.0, 0.0]], atol=1e-15)
+
+
+def test_mirror_traction_problem_with_an_affine_solution():
+    """Traction on every face, the full traction reading: the affine field is reproduced
+    to round-off (its tangential derivatives are differenced exactly; every real node
+    has a complete neighbourhood, where an affine field carries no net force)."""
+    err, _, _ = solve_mirror([])
+    assert err < 1e-10
+
+
+@pytest.mark.parametrize("mirror_point,exact", [("corrected", True), ("nearest", False)])
+def test_mirror_dirichlet_problem_with_an_affine_solution(mirror_point, exact):
+    """Dirichlet on every face: with the mirror mismatch corrected (our variant) the
+    affine field is reproduced to round-off; with the nearest node (the method) only the
+    fictitious nodes whose mirror point is a node are, and the rest (near the corners,
+    where the peridynamic gradient tilts) leave an error."""
+    err, mn, g = solve_mirror(ALL_FACES, mirror_point=mirror_point)
+    if exact:
+        assert err < 1e-10
+    else:
+        assert 1e-6 < err < 1e-2
+        star = g.x[mn.fictitious] + 2 * (mn.boundary_point - g.x[mn.fictitious])
+        on_node = np.all(np.isclose(star, g.x[mn.mirror], atol=1e-12), axis=1)
+        assert on_node.any() and not on_node.all()
+        x = g.x[g.interior_ids]
+        U = (mn.displacement_map(g.n_interior) @ affine(x).T.ravel()).reshape(2, -1).T
+        U_f = U[mn.fictitious] + mn.const
+        good = np.abs(U_f - affine(g.x[mn.fictitious])).max(axis=1) < 1e-15
+        assert np.array_equal(good[on_node], np.ones(on_node.sum(), dtype=bool))
+
+
+def test_pddo_operators_are_exact_for_quadratics():
+    """Every first and second derivative of a quadratic field, at every node (corners and
+    edges included), to round-off relative to the field's scale."""
+    st = stencil()
+    g = BoxGrid(L, (0.0, 0.0), H, 0)
+    m = StateBasedModel(g, st, C, get_influence("gaussian"))
+    D = derivative_operators(m)
+    x, y = g.x[:, 0], g.x[:, 1]
+    u = 1 + 2 * x - 3 * y + 4 * x * x - 5 * x * y + 6 * y * y
+    want = {(0,): 2 + 8 * x - 5 * y, (1,): -3 - 5 * x + 12 * y,
+            (0, 0): 8 + 0 * x, (0, 1): -5 + 0 * x, (1, 1): 12 + 0 * x}
+    assert set(D) == set(monomial_orders(2))
+    for o, w in want.items():
+        assert np.allclose(D[o] @ u, w, rtol=0, atol=1e-9 * 12)
+
+
+def test_pddo_dirichlet_problem_with_an_affine_solution():
+    """Dirichlet on every face: the PDDO boundary rows impose u on the boundary through
+    the nodes' Taylor expansion, the layer the PDDO equilibrium, the bulk LPS; the affine
+    field satisfies all three exactly (round-off)."""
+    st = state_based_stencil(2, 3.0, H / 2, get_influence("gaussian"))
+    g = BoxGrid(L, (0.0, 0.0), H / 2, 0)   # 20 x 16 cells: some nodes beyond 2 delta
+    m = StateBasedModel(g, st, C, get_influence("gaussian"))
+    A, rhs, counts = pddo_system(m, m.stiffness(), ALL_FACES, affine, affine_traction,
+                                 (LAM, MU))
+    assert min(counts.values()) > 0
+    u, _ = solve_with_dirichlet(A, rhs, np.zeros(0, dtype=int), np.zeros(0), "test")
+    x = g.x
+    assert np.abs(u.reshape(2, -1).T - affine(x)).max() < 1e-10 * np.abs(affine(x)).max()
+
+
+# ------------------------------------------------------------------ seed 001 §5
+@pytest.fixture(scope="module")
+def section5():
+    scene = get_scene("plate2d-plane-strain")
+    out = {}
+    for key, method, over in [("none", "none", {}), ("pals", "pals", {}),
+                              ("mnm", "mirror-nodes", {}),
+                              ("mnm-normal", "mirror-nodes", {"neumann": "normal-only"}),
+                              ("pddo", "pddo", {}), ("snm", "surface-nodes", {"order": 1})]:
+        r = scene.run(method, {"spacing": 0.05, **over})
+        assert r.status == "ok", r.message
+        out[key] = r.metrics
+    return out
+
+
+def test_section5_pals_and_snm(section5):
+    """Seed 001 §5: PALS lowers both errors of the uncorrected model (measured at
+    h = 0.05: u 17.3 -> 4.9 %, v 12.1 -> 5.6 %) and SNM is below PALS in both (1.2 and
+    0.51 %): 'SNM has the smallest errors of the ordinary state-based methods' holds
+    against PALS."""
+    s = section5
+    for k in ("max_error_u_pct", "max_error_v_pct"):
+        assert s["pals"][k] < s["none"][k]
+        assert s["snm"][k] < s["pals"][k]
+
+
+def test_section5_mnm_readings(section5):
+    """The paper's MNM is 'worst in y'. Our two readings bracket it: with the full
+    traction condition the plate's affine solution is reproduced to round-off (better
+    than SNM, which carries the discrete material's 1.2 % moduli error); with the normal
+    derivatives alone the free face x = l_x is forced to zero normal strain, and MNM is
+    worst in both components (u 96 %, v 21 %)."""
+    s = section5
+    assert s["mnm"]["max_error_pct"] < 1e-8
+    others = [s[k]["max_error_v_pct"] for k in ("pals", "pddo", "snm", "none")]
+    assert s["mnm-normal"]["max_error_v_pct"] > max(others)
+
+
+def test_section5_pddo(section5):
+    """The PDDO layer reproduces the plate's affine solution to round-off (its operators
+    are exact for quadratics; the bulk's LPS rows carry no force for an affine field):
+    'PDDO similar to SNM', here smaller."""
+    assert section5["pddo"]["max_error_pct"] < 1e-8
