@@ -64,7 +64,9 @@ class BondMethod:
 def _builtin() -> list[BondMethod]:
     from .energy import energy_closure
     from .pals import pals_closure
+    from .perifit_weights import INSTALL, SCENES, installed_version, perifit_closure
     from .volume import volume_closure
+    pv = installed_version()
     return [
         BondMethod("energy", "Le and Bobaru 2018 energy correction: per axis the ratio of a "
                    "complete to the node's uniaxial-stretch energy, bonds by the ellipse of "
@@ -80,6 +82,13 @@ def _builtin() -> list[BondMethod]:
                    "Mitchell, Silling and Littlewood, J. Mech. Mater. Struct. 10 (2015) "
                    "539-557; seed 001 §5.1; Peridigm pals.cxx", pals_closure,
                    theories=("state-based",), dims=(2, 3)),
+        BondMethod("perifit", "operator-matching nodal weights of the perifit package, "
+                   "(w_i + w_j) / 2 on each bond's weight", "perifit (PyPI), Shojaei and "
+                   "Hermann, Helmholtz-Zentrum Hereon", perifit_closure, scenes=SCENES,
+                   params=(Param("perifit_version", pv or "not installed",
+                                 "the perifit version that computes the weights (recorded "
+                                 "with every run)", choices=(pv or "not installed",)),),
+                   unavailable=None if pv else f"needs the optional extra: {INSTALL}"),
     ]
 
 
