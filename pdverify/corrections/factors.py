@@ -4,6 +4,7 @@ complete: the shared arithmetic of the corrections that scale bonds (``energy``,
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..errors import NumericalError
 from ..pd.bonds import homogeneous_extensions
@@ -65,6 +66,21 @@ def uniaxial(dim: int, k: int, eps: float = 1.0) -> np.ndarray:
     out = np.zeros((dim, dim))
     out[k, k] = eps
     return out
+
+
+def node_moments(nodes, weights, P, n) -> np.ndarray:
+    """M_i = sum over the rows r with nodes[r] = i of weights[r] P_r P_r^T, (n, p, p): the
+    per-node moment matrices of a fit over each node's bonds (one row per bond end)."""
+    m, p = P.shape
+    inc = sp.csr_matrix((weights, (nodes, np.arange(m))), shape=(n, m))
+    return (inc @ np.einsum("bk,bl->bkl", P, P).reshape(m, p * p)).reshape(n, p, p)
+
+
+def node_sums(nodes, weights, P, n) -> np.ndarray:
+    """S_i = sum over the rows r with nodes[r] = i of weights[r] P_r, (n, p)."""
+    m = P.shape[0]
+    inc = sp.csr_matrix((weights, (nodes, np.arange(m))), shape=(n, m))
+    return inc @ P
 
 
 def solve_per_node(K, rhs, what, x) -> np.ndarray:

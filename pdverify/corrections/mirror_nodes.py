@@ -88,7 +88,8 @@ class MirrorNodes:
     the prescribed values g; ``traction(x, normal, face) -> (n, d)`` the applied traction
     of each face (zero on free faces); ``moduli`` = (lambda, mu) of the material;
     ``neumann``: how a traction becomes the gradient of the Neumann relation
-    (:data:`NEUMANN_READINGS`, module docstring).
+    (:data:`NEUMANN_READINGS`); ``mirror_point``: the nearest node as it is, or with its
+    mismatch corrected by its gradient (:data:`MIRROR_POINTS`; module docstring).
     """
 
     def __init__(self, grid, stencil, dirichlet, exact, traction, moduli,
@@ -111,7 +112,6 @@ class MirrorNodes:
                        np.asarray(g.nodes_per_axis) - 1)
         mirror = g.ext_id(cell)
         self.fictitious, self.mirror, self.boundary_point = fict, mirror, xB
-        self.normal = n
         step = x - g.x[mirror]                       # x_f - x_m
         lam, mu = moduli
         tol = 1e-9 * h
@@ -132,13 +132,14 @@ class MirrorNodes:
         pairs = [_difference_pairs(g, cell, b) for b in range(d)]
         full = neumann == "full-traction"
         entries = []   # (fict mask, k, node ids, component j, coefficient per fict)
+        dirichlet_entries = []
 
-        def fd(mask, k, j, b, coef):
+        def fd(mask, k, j, b, coef, into=entries):
             """coef * du_j/dx_b (central difference at the mirror) into row k."""
             p_, q_, dist = pairs[b]
             c = coef / dist
-            entries.append((mask, k, p_, j, c))
-            entries.append((mask, k, q_, j, -c))
+            into.append((mask, k, p_, j, c))
+            into.append((mask, k, q_, j, -c))
 
         face_axis = np.full((nf, d), -1)            # the face (per axis) x_B lies on
         for face in range(2 * d):
@@ -167,21 +168,17 @@ class MirrorNodes:
                         fd(on_b, k, b, k, -w)
                 if full:     # an axis with no face at x_B: the gradient of the mirror
                     fd(~on_b, k, k, b, w)
-        self.dirichlet_entries = []
         if mirror_point == "corrected":  # u_f = 2 g - u_m + (x_f + x_m - 2 x_B) . grad u_m
             off = x + g.x[mirror] - 2.0 * xB
-            n_before = len(entries)
             for k in range(d):
                 for b in range(d):
-                    fd(np.ones(nf, dtype=bool), k, k, b, off[:, b])
-            self.dirichlet_entries = entries[n_before:]
-            del entries[n_before:]
+                    fd(np.ones(nf, dtype=bool), k, k, b, off[:, b], into=dirichlet_entries)
         self.dirichlet_k, self.entries = dirichlet_k, entries
+        self.dirichlet_entries = dirichlet_entries
         self.const = np.where(dirichlet_k, const_d, const)
-        self.neumann = neumann
 
-    def displacement_map(self, n_unknown_nodes: int) -> sp.csr_matrix:
-        """(d n_ext) x (d n_unknown), component-major: identity on real nodes; on a
+    def displacement_map(self) -> sp.csr_matrix:
+        """(d n_ext) x (d n_real), component-major: identity on real nodes; on a
         fictitious node -u_m,k for a Dirichlet component, u_m,k plus the gradient terms
         for a Neumann one."""
         g, d = self.grid, self.grid.dim
@@ -191,16 +188,16 @@ class MirrorNodes:
         rows, cols, vals = [], [], []
         for k in range(d):
             rows += [k * ne + g.interior_ids, k * ne + f]
-            cols += [k * n_unknown_nodes + np.arange(ni), k * n_unknown_nodes + num[m]]
+            cols += [k * ni + np.arange(ni), k * ni + num[m]]
             vals += [np.ones(ni), np.where(self.dirichlet_k[:, k], -1.0, 1.0)]
         for entries, want in ((self.entries, False), (self.dirichlet_entries, True)):
             for mask, k, nodes, j, coef in entries:
                 use = mask & (self.dirichlet_k[:, k] == want) & (coef != 0)
                 rows.append(k * ne + f[use])
-                cols.append(j * n_unknown_nodes + num[nodes[use]])
+                cols.append(j * ni + num[nodes[use]])
                 vals.append(coef[use])
         return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                             shape=(d * ne, d * n_unknown_nodes))
+                             shape=(d * ne, d * ni))
 
     def dilatation_map(self) -> sp.csr_matrix:
         """n_ext x n_real: real nodes their own, fictitious nodes their mirror's."""
@@ -217,7 +214,6 @@ class MirrorNodes:
         return out
 
     def closure(self) -> Closure:
-        g = self.grid
         return Closure(weighted_volume="complete",
-                       displacement_map_full=self.displacement_map(g.n_interior),
+                       displacement_map_full=self.displacement_map(),
                        dilatation_map=self.dilatation_map())

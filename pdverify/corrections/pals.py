@@ -51,11 +51,20 @@ import scipy.sparse as sp
 
 from ..pd.bonds import homogeneous_extensions
 from ..pd.closure import Closure
-from .factors import solve_per_node
+from .factors import node_moments, node_sums, solve_per_node
 
 def _pairs(d: int) -> list[tuple[int, int]]:
     diag = [(k, k) for k in range(d)]
     return diag + [(i, j) for i in range(d) for j in range(i + 1, d)]
+
+
+def matching_targets(d: int):
+    """The constraint values of the matching deformations: tr(eps_k) and eps_k' : eps_k'
+    ((d - 1) / d for a stretch, 2 for a shear; 2D: the x stretch and the shear)."""
+    pairs = _pairs(d)
+    tr = np.array([1.0 if i == j else 0.0 for i, j in pairs])
+    dev = np.array([(d - 1.0) / d if i == j else 2.0 for i, j in pairs])
+    return tr, (dev[[0, 2]] if d == 2 else dev)
 
 
 def matching_basis(xi: np.ndarray):
@@ -66,13 +75,11 @@ def matching_basis(xi: np.ndarray):
     eps_k' : eps_k'."""
     d = xi.shape[1]
     r = np.linalg.norm(xi, axis=1)
-    pairs = _pairs(d)
-    E = np.stack([xi[:, i] * xi[:, j] * (1.0 if i == j else 2.0) for i, j in pairs], axis=1)
-    tr = np.array([1.0 if i == j else 0.0 for i, j in pairs])
+    E = np.stack([xi[:, i] * xi[:, j] * (1.0 if i == j else 2.0) for i, j in _pairs(d)], axis=1)
+    tr, rhs_dev = matching_targets(d)
     D = E / r[:, None] - tr[None, :] * r[:, None] / d
-    rhs_dev = np.array([(d - 1.0) / d if i == j else 2.0 for i, j in pairs])
     if d == 2:  # D_y = -D_x: one uniaxial deviator in 2D (the pair would be singular)
-        D, rhs_dev = D[:, [0, 2]], rhs_dev[[0, 2]]
+        D = D[:, [0, 2]]
     return E, D, tr, rhs_dev
 
 
@@ -90,31 +97,46 @@ class PalsConstitutive:
         return d * om / model.m_inf, d * (d + 2) * om / (2.0 * model.m_inf)
 
     def influences(self, model):
-        """Per bond, at end a and at end b: omega_i and sigma_i (four arrays)."""
+        """Per bond, at end a and at end b: omega_i and sigma_i (four arrays), computed
+        once per model."""
+        cached = model.__dict__.get("_pals_influences")
+        if cached is not None:
+            return cached
         g, a, b = model.grid, model.bond_a, model.bond_b
         if g.n_ext != g.n_interior:
             raise ValueError("pals: plain grids only (no fictitious nodes)")
-        xi = model.bond_n * model.bond_x[:, None]
-        E, D, rhs_dil, rhs_dev = matching_basis(xi)
+        E, DD = self.bases(model.bond_n * model.bond_x[:, None])
         om0, sg0 = self.reference(model, model.bond_x)
-        V, beta, n = model.node_volume, model.bond_beta, g.n_ext
-        p, q, nb = E.shape[1], D.shape[1], a.size
+        V, beta = model.node_volume, model.bond_beta
         # end a's sums weigh a bond by beta V_b, end b's by beta V_a (xi -> -xi leaves
         # E and D unchanged: both are even)
-        inc = sp.csr_matrix((np.r_[beta * V[b], beta * V[a]],
-                             (np.r_[a, b], np.r_[np.arange(nb), np.arange(nb)])), shape=(n, nb))
-        DD = D ** 2
-        K_dil = (inc @ np.einsum("bk,bl->bkl", E, E).reshape(nb, p * p)).reshape(n, p, p)
-        K_dev = (inc @ np.einsum("bk,bl->bkl", DD, DD).reshape(nb, q * q)).reshape(n, q, q)
-        r_dil = rhs_dil[None, :] - inc @ (om0[:, None] * E)
-        r_dev = rhs_dev[None, :] - inc @ (sg0[:, None] * DD)
-        lam = solve_per_node(K_dil, r_dil, "pals: the dilatation Lagrange system", g.x)
-        mu_ = solve_per_node(K_dev, r_dev, "pals: the deviatoric Lagrange system", g.x)
-        om_a = om0 + np.sum(E * lam[a], axis=1)
-        om_b = om0 + np.sum(E * lam[b], axis=1)
-        sg_a = sg0 + np.sum(DD * mu_[a], axis=1)
-        sg_b = sg0 + np.sum(DD * mu_[b], axis=1)
-        return om_a, om_b, sg_a, sg_b
+        lam, mu_ = self.multipliers(np.r_[a, b], np.r_[beta * V[b], beta * V[a]],
+                                    np.vstack([E, E]), np.vstack([DD, DD]),
+                                    np.r_[om0, om0], np.r_[sg0, sg0], g.x)
+        out = (om0 + np.sum(E * lam[a], axis=1), om0 + np.sum(E * lam[b], axis=1),
+               sg0 + np.sum(DD * mu_[a], axis=1), sg0 + np.sum(DD * mu_[b], axis=1))
+        model._pals_influences = out
+        return out
+
+    @staticmethod
+    def bases(xi):
+        """E and D^2 of the matching deformations at bond vectors xi."""
+        E, D, _, _ = matching_basis(xi)
+        return E, D ** 2
+
+    @staticmethod
+    def multipliers(nodes, w, E, DD, om0, sg0, x):
+        """The Lagrange multipliers (lambda, mu) of every node from its bond ends (rows:
+        the node, its weight beta V_j, E, D^2, omega_0, sigma_0)."""
+        n, d = x.shape
+        rhs_dil, rhs_dev = matching_targets(d)
+        r_dil = rhs_dil[None, :] - node_sums(nodes, w * om0, E, n)
+        r_dev = rhs_dev[None, :] - node_sums(nodes, w * sg0, DD, n)
+        lam = solve_per_node(node_moments(nodes, w, E, n), r_dil,
+                             "pals: the dilatation Lagrange system", x)
+        mu_ = solve_per_node(node_moments(nodes, w, DD, n), r_dev,
+                             "pals: the deviatoric Lagrange system", x)
+        return lam, mu_
 
     def operators(self, model):
         """(K_e, K_theta, A_theta, A_Theta, end a's share of K_e) with the nodal
@@ -162,15 +184,13 @@ class PalsConstitutive:
         st, d = model.stencil, model.dim
         r, nvec = st.vectors(model.spacing)
         live = model.influence.omega(r, model.horizon) * st.beta > 0
-        r, nvec, beta = r[live], nvec[live], st.beta[live]
-        Vc = model.grid.volume * model.thickness
-        E, D, rhs_dil, rhs_dev = matching_basis(nvec * r[:, None])
+        r, nvec = r[live], nvec[live]
+        w = st.beta[live] * model.grid.volume * model.thickness
+        E, DD = self.bases(nvec * r[:, None])
         om0, sg0 = self.reference(model, r)
-        w = beta * Vc
-        DD = D ** 2
-        lam = np.linalg.solve(np.einsum("b,bk,bl->kl", w, E, E), rhs_dil - (w * om0) @ E)
-        mu_ = np.linalg.solve(np.einsum("b,bk,bl->kl", w, DD, DD), rhs_dev - (w * sg0) @ DD)
-        om, sg = om0 + E @ lam, sg0 + DD @ mu_
+        lam, mu_ = self.multipliers(np.zeros(r.size, dtype=int), w, E, DD, om0, sg0,
+                                    np.zeros((1, d)))
+        om, sg = om0 + E @ lam[0], sg0 + DD @ mu_[0]
         kappa, mu = self.moduli(model)
         e = homogeneous_extensions(r, nvec, strain)
         theta = np.sum(om * r * e * w)

@@ -34,7 +34,7 @@ import itertools
 import numpy as np
 import scipy.sparse as sp
 
-from .factors import solve_per_node
+from .factors import node_moments, solve_per_node
 
 
 def monomial_orders(d: int) -> list[tuple[int, ...]]:
@@ -50,20 +50,15 @@ def derivative_operators(model) -> dict[tuple[int, ...], sp.csr_matrix]:
     """{multi-index: D (n_real x n_real)} with D @ u = that derivative of the nodal field u
     at every real node (plain grid: the real nodes are all nodes)."""
     g, a, b = model.grid, model.bond_a, model.bond_b
-    d, n, nb = g.dim, g.n_ext, a.size
+    d, n = g.dim, g.n_ext
     orders = monomial_orders(d)
     q = len(orders)
     xi = model.bond_n * model.bond_x[:, None]
     w = model.bond_omega * model.bond_beta
     V = model.node_volume
     ends = ((a, b, xi, w * V[b]), (b, a, -xi, w * V[a]))   # (node, neighbour, xi, weight)
-    A = np.zeros((n, q, q))
-    P_end = []
-    for node, _, x_, wt in ends:
-        P = _monomials(x_, orders)
-        P_end.append(P)
-        inc = sp.csr_matrix((wt, (node, np.arange(nb))), shape=(n, nb))
-        A += (inc @ np.einsum("bk,bl->bkl", P, P).reshape(nb, q * q)).reshape(n, q, q)
+    P_end = [_monomials(x_, orders) for _, _, x_, _ in ends]
+    A = node_moments(np.r_[a, b], np.r_[ends[0][3], ends[1][3]], np.vstack(P_end), n)
     R = solve_per_node(A, np.broadcast_to(np.eye(q), (n, q, q)), "pddo: the moment matrix",
                        g.x)
     out = {}
@@ -101,12 +96,13 @@ def _choose_faces(touches, dir_faces, d):
     return out
 
 
-def pddo_system(model, K_pd, face_dirichlet, exact, traction, moduli, body_load=None):
-    """The square system (A, rhs, counts) of the PDDO boundary layer: ``A`` (d n x d n,
+def pddo_system(model, face_dirichlet, exact, traction, moduli, body_load=None):
+    """The square system (A, rhs, counts) of the PDDO boundary layer on the uncorrected
+    plain-grid ``model`` (its equilibrium rows serve the bulk): ``A`` (d n x d n,
     component-major: one row per component of every real node) and ``rhs``: the boundary
-    data on the outer rows, ``body_load`` (n, d; b V per node) on the others. ``K_pd``:
-    the uncorrected model's stiffness (its rows serve the bulk); ``face_dirichlet``:
-    (face, component) pairs prescribed at ``exact(x)``; ``traction(x, normal, face)``."""
+    data on the outer rows, ``body_load`` (n, d; b V per node) on the others.
+    ``face_dirichlet``: (face, component) pairs prescribed at ``exact(x)``;
+    ``traction(x, normal, face)``."""
     g, d, h = model.grid, model.dim, model.spacing
     n = g.n_interior
     lam, mu = moduli
@@ -121,10 +117,14 @@ def pddo_system(model, K_pd, face_dirichlet, exact, traction, moduli, body_load=
     # equilibrium with the PDDO operators: -(lam + mu) d_k d_j u_j - mu d_l d_l u_k, times V
     lap = sum(_d2(D, l, l) for l in range(d))
     Vd = sp.diags(model.node_volume)
-    nav = [[Vd @ (-(lam + mu) * _d2(D, k, j) - (mu * lap if j == k else 0 * lap))
-            for j in range(d)] for k in range(d)]
-    sel = sp.diags(np.tile(bulk, d).astype(float))
-    A = (sel @ K_pd + sp.diags(np.tile(layer, d).astype(float)) @ sp.bmat(nav)).tocoo()
+    nav = [[None] * d for _ in range(d)]
+    for k in range(d):
+        for j in range(d):
+            M = -(lam + mu) * _d2(D, k, j)
+            nav[k][j] = Vd @ (M - mu * lap if j == k else M)
+    bulk_rows = sp.diags(np.tile(bulk, d).astype(float)) @ model.equilibrium_rows()
+    A = (model.stiffness(bulk_rows)
+         + sp.diags(np.tile(layer, d).astype(float)) @ sp.bmat(nav)).tocoo()
     rows, cols, vals = [A.row], [A.col], [A.data]
     rhs = np.zeros(d * n)
     if body_load is not None:
@@ -157,7 +157,7 @@ def pddo_system(model, K_pd, face_dirichlet, exact, traction, moduli, body_load=
                     nrm[:, axis] = s
                     blocks = {}
                     for j in range(d):
-                        M = lam * grad_B(j) if k == axis else 0 * S
+                        M = lam * grad_B(j) if k == axis else sp.csr_matrix(S.shape)
                         if j == k:
                             M = M + mu * grad_B(axis)
                         if j == axis:

@@ -22,6 +22,7 @@ from importlib.metadata import PackageNotFoundError, version
 import numpy as np
 
 from ..pd.closure import Closure
+from ..pd.statebased import StateBasedModel
 
 INSTALL = 'pip install ".[peers]" (perifit from PyPI)'
 #: scenes whose model perifit supports: 3D LPS and bond-based, 2D bond-based
@@ -50,7 +51,7 @@ def node_weights(model) -> np.ndarray:
     """perifit's w_i at every grid node of a plain grid's model."""
     import perifit
     g = model.grid
-    state = hasattr(model, "m_inf")
+    state = isinstance(model, StateBasedModel)
     fam = families(model)
     if g.dim == 3:
         return perifit.compute_weights(g.x, model.node_volume, model.horizon,

@@ -34,8 +34,8 @@ class BondMethod:
 
     ``closure(params) -> Closure`` builds it from the method's resolved ``params``;
     ``theories`` the models it applies to, ``dims`` their dimensions; ``scenes``
-    restricts it to these scene ids (``None``: every scene of those theories); ``unavailable`` is ``None`` when it can
-    run, else why not and how to fix it. ``origin``: ``built-in`` or the plugin's
+    restricts it to these scene ids (``None``: every scene of those theories);
+    ``unavailable`` is ``None`` when it can run, else why not and how to fix it. ``origin``: ``built-in`` or the plugin's
     entry point.
     """
 

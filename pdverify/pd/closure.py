@@ -50,8 +50,9 @@ class Closure:
     - ``constitutive``: replaces the LPS force state of a state-based model (PALS): an
       object with ``operators(model) -> (K_e, K_theta, A_theta, A_Theta, ke_share_a)``
       (the model's factors, built from its bonds; the nodal scalar channel may carry
-      more than one value per node; ``ke_share_a`` end a's part of the diagonal K_e) and ``bulk_work_density(model, strain)``. Plain grids only.
-      Default: the model's own (LPS).
+      more than one value per node; ``ke_share_a`` end a's part of the diagonal K_e)
+      and ``bulk_work_density(model, strain)``. Plain grids only. Default: the
+      model's own (LPS).
 
     Flux and constraint rows are built by the correction from the model's bonds after
     construction (e.g. :meth:`StateBasedModel.bond_force_rows`).

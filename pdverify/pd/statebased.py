@@ -222,15 +222,15 @@ class StateBasedModel:
         Theta = self.A_Theta @ (self.A_theta @ e)
         KT = self.K_theta.tocoo()
         at_a = KT.col % self.grid.n_ext == self.bond_a[KT.row]
-        f_a = (self.ke_share_a * (self.K_e @ e)
+        ke = self.K_e @ e
+        f_a = (self.ke_share_a * ke
                + np.bincount(KT.row[at_a], KT.data[at_a] * Theta[KT.col[at_a]],
                              self.bond_a.size))
-        return f_a, self.K_e @ e + self.K_theta @ Theta - f_a
+        return f_a, ke + self.K_theta @ Theta - f_a
 
     def bulk_work_density(self, strain) -> float:
         """W = 1/2 sum_b f_i,b e_b / V_i (end i's part: half of f_b there) at a node of
-        the bulk lattice (complete neighbourhoods around it and its neighbours) under the
-        homogeneous ``strain``:
+        the bulk lattice (a complete neighbourhood) under the homogeneous ``strain``:
         e = |xi| n.strain.n per stencil offset, theta the complete-neighbourhood
         dilatation, f = k_e omega beta V^2 (2/m) e + k_theta omega |xi| beta V^2 (2 theta/m).
         A closure's ``constitutive`` force state gives its own."""

@@ -50,6 +50,8 @@ class StateBox:
         closure, flux = (surface_node_closure(self.grid, stencil, order) if order is not None
                          else (closure, None))
         self.mirror = None
+        #: node counts a method reports beside the size (pddo: its three subdomains)
+        self.counts = {}
         if mirror is not None:
             self.mirror = mirror(self.grid, stencil)
             closure = self.mirror.closure()
@@ -340,9 +342,14 @@ class SurfaceNodeScene(Scene):
         order = p["order"] if method == "surface-nodes" else None
         lengths, origin = self.box(p)
         c = self.constants(p)
+
+        def exact(x):                # the boundary data of mirror-nodes and pddo
+            return self.exact(x, p)
+
+        def traction(x, n, face):
+            return self.traction(x, n, face, p, c, None)
         mirror = (functools.partial(
-            MirrorNodes, dirichlet=self.face_dirichlet, exact=lambda x: self.exact(x, p),
-            traction=lambda x, n, face: self.traction(x, n, face, p, c, None),
+            MirrorNodes, dirichlet=self.face_dirichlet, exact=exact, traction=traction,
             moduli=c.moduli(), neumann=p["neumann"], mirror_point=p["mirror_point"])
             if method == "mirror-nodes" else None)
         model = StateBox(lengths, origin, p["spacing"], p["m_ratio"], c, order=order,
@@ -354,10 +361,8 @@ class SurfaceNodeScene(Scene):
         x_int = g.x[g.interior_ids]
         if method == "pddo":   # its own square system, nonsymmetric: direct LU
             body = self.body_force(x_int, p, c, model.horizon) * g.volume
-            A, rhs, counts = pddo_system(
-                model.model, model.stiffness(), self.face_dirichlet, lambda x: self.exact(x, p),
-                lambda x, n, face: self.traction(x, n, face, p, c, None), c.moduli(), body)
-            model.counts = counts
+            A, rhs, model.counts = pddo_system(model.model, self.face_dirichlet, exact,
+                                               traction, c.moduli(), body)
             return model, A, rhs, np.zeros(0, dtype=int), np.zeros(0), "direct"
         K = model.stiffness() if solver == "direct" else model.augmented()
         rhs = np.zeros((nu_, d))
@@ -437,7 +442,7 @@ class SurfaceNodeScene(Scene):
                   "spacing": p["spacing"], "horizon": model.horizon}
         size = model.size()
         size["stiffness_nnz" if solver == "direct" else "augmented_nnz"] = int(K.nnz)
-        size.update(getattr(model, "counts", {}))
+        size.update(model.counts)
         return Outcome(metrics=metrics, size=size, fields=fields, diagnostics=info)
 
 

@@ -16,6 +16,12 @@ LAM, MU = C.moduli()
 GRAD = np.array([[1e-3, 2e-4], [-3e-4, 5e-4]])
 SHIFT = np.array([1e-4, -2e-4])
 ALL_FACES = [(f, k) for f in range(4) for k in range(2)]
+#: exactness after a sparse LU solve, relative to the largest displacement: machine
+#: epsilon times the systems' condition (measured: 8.7e3 for the mirror traction
+#: problem, 7 and 17 for the Dirichlet ones), with a margin of about fifty
+SOLVED = 1e-10
+#: the same claim in percent (the scenes' metrics)
+SOLVED_PCT = 100 * SOLVED
 
 
 def affine(x):
@@ -53,7 +59,7 @@ def test_peridynamic_gradient_is_the_inward_normal_on_a_face():
     g = BoxGrid(L, (0.0, 0.0), H, st.reach)
     n = peridynamic_gradient(g, st)
     mid = np.flatnonzero(np.isclose(g.x[:, 0], -0.05) & np.isclose(g.x[:, 1], 0.45))
-    assert np.allclose(n[mid], [[1.0, 0.0]], atol=1e-15)
+    assert np.allclose(n[mid], [[1.0, 0.0]], atol=1e-15)  # a unit vector: a few ulps
 
 
 def test_mirror_traction_problem_with_an_affine_solution():
@@ -61,7 +67,7 @@ def test_mirror_traction_problem_with_an_affine_solution():
     to round-off (its tangential derivatives are differenced exactly; every real node
     has a complete neighbourhood, where an affine field carries no net force)."""
     err, _, _ = solve_mirror([])
-    assert err < 1e-10
+    assert err < SOLVED
 
 
 @pytest.mark.parametrize("mirror_point,exact", [("corrected", True), ("nearest", False)])
@@ -72,15 +78,19 @@ def test_mirror_dirichlet_problem_with_an_affine_solution(mirror_point, exact):
     where the peridynamic gradient tilts) leave an error."""
     err, mn, g = solve_mirror(ALL_FACES, mirror_point=mirror_point)
     if exact:
-        assert err < 1e-10
+        assert err < SOLVED
     else:
+        # measured 1.2e-3: far above round-off (a real mismatch), below 1e-2 (a mirror
+        # offset of under one cell times the gradient, against the largest value)
         assert 1e-6 < err < 1e-2
         star = g.x[mn.fictitious] + 2 * (mn.boundary_point - g.x[mn.fictitious])
+        # coordinates ~1 m: a mirror point on a node agrees to round-off
         on_node = np.all(np.isclose(star, g.x[mn.mirror], atol=1e-12), axis=1)
         assert on_node.any() and not on_node.all()
         x = g.x[g.interior_ids]
-        U = (mn.displacement_map(g.n_interior) @ affine(x).T.ravel()).reshape(2, -1).T
+        U = (mn.displacement_map() @ affine(x).T.ravel()).reshape(2, -1).T
         U_f = U[mn.fictitious] + mn.const
+        # values ~1e-3 from sums of three terms: 1e-15 is a few ulps
         good = np.abs(U_f - affine(g.x[mn.fictitious])).max(axis=1) < 1e-15
         assert np.array_equal(good[on_node], np.ones(on_node.sum(), dtype=bool))
 
@@ -98,6 +108,8 @@ def test_pddo_operators_are_exact_for_quadratics():
             (0, 0): 8 + 0 * x, (0, 1): -5 + 0 * x, (1, 1): 12 + 0 * x}
     assert set(D) == set(monomial_orders(2))
     for o, w in want.items():
+        # round-off of A^-1 (moment matrices scaled to unit diagonal, condition <= 95
+        # here, measured) on sums of O(100) terms, times the largest derivative, 12
         assert np.allclose(D[o] @ u, w, rtol=0, atol=1e-9 * 12)
 
 
@@ -108,12 +120,11 @@ def test_pddo_dirichlet_problem_with_an_affine_solution():
     st = state_based_stencil(2, 3.0, H / 2, get_influence("gaussian"))
     g = BoxGrid(L, (0.0, 0.0), H / 2, 0)   # 20 x 16 cells: some nodes beyond 2 delta
     m = StateBasedModel(g, st, C, get_influence("gaussian"))
-    A, rhs, counts = pddo_system(m, m.stiffness(), ALL_FACES, affine, affine_traction,
-                                 (LAM, MU))
+    A, rhs, counts = pddo_system(m, ALL_FACES, affine, affine_traction, (LAM, MU))
     assert min(counts.values()) > 0
     u, _ = solve_with_dirichlet(A, rhs, np.zeros(0, dtype=int), np.zeros(0), "test")
     x = g.x
-    assert np.abs(u.reshape(2, -1).T - affine(x)).max() < 1e-10 * np.abs(affine(x)).max()
+    assert np.abs(u.reshape(2, -1).T - affine(x)).max() < SOLVED * np.abs(affine(x)).max()
 
 
 # ------------------------------------------------------------------ seed 001 §5
@@ -149,7 +160,7 @@ def test_section5_mnm_readings(section5):
     derivatives alone the free face x = l_x is forced to zero normal strain, and MNM is
     worst in both components (u 96 %, v 21 %)."""
     s = section5
-    assert s["mnm"]["max_error_pct"] < 1e-8
+    assert s["mnm"]["max_error_pct"] < SOLVED_PCT
     others = [s[k]["max_error_v_pct"] for k in ("pals", "pddo", "snm", "none")]
     assert s["mnm-normal"]["max_error_v_pct"] > max(others)
 
@@ -158,4 +169,4 @@ def test_section5_pddo(section5):
     """The PDDO layer reproduces the plate's affine solution to round-off (its operators
     are exact for quadratics; the bulk's LPS rows carry no force for an affine field):
     'PDDO similar to SNM', here smaller."""
-    assert section5["pddo"]["max_error_pct"] < 1e-8
+    assert section5["pddo"]["max_error_pct"] < SOLVED_PCT
