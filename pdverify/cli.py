@@ -3,7 +3,7 @@
 usage:
   python -m pdverify list                                   scenes and their methods
   python -m pdverify run SCENE [--method M] [--set KEY=VALUE ...] [--json FILE]
-                          [--max-memory SIZE]
+                          [--vtu FILE] [--max-memory SIZE]
   python -m pdverify report [--out DIR] [--quick] [--only SCENE ...] [--jobs N]
                           [--scheduler ADDRESS] [--max-memory SIZE]
   python -m pdverify compare BASELINE.json NEW.json [--rtol R] [--atol A] [--summary FILE]
@@ -45,10 +45,15 @@ def build_parser() -> argparse.ArgumentParser:
                      help="override a scene or method parameter; repeat for several")
     run.add_argument("--json", default=None, metavar="FILE",
                      help="also write the run as a one-run results.json")
+    run.add_argument("--vtu", default=None, metavar="FILE",
+                     help="also write the run's fields as VTU for ParaView (FILE.vtu; a run "
+                          "with several node sets or a FEM grid adds a suffix per file)")
     run.add_argument("--max-memory", default=None, metavar="SIZE", help=MAX_MEMORY_HELP)
     rep = sub.add_parser("report", help="run every scene and method, write the HTML report")
     rep.add_argument("--out", default=None, metavar="DIR",
-                     help="output folder (default: reports/latest), replaced as a whole")
+                     help="output folder, replaced as a whole (default: reports/latest; "
+                          "reports/quick with --quick; reports/[quick-]only-SCENE with "
+                          "--only, so that neither replaces the full report)")
     rep.add_argument("--quick", action="store_true",
                      help="smaller sweeps of the expensive scenes")
     rep.add_argument("--only", nargs="+", default=None, metavar="SCENE",
@@ -147,13 +152,16 @@ def _dispatch(args) -> int:
         from .params import parse_assignments
         from .runner import run_one
         json_path = validate.output_file(args.json) if args.json is not None else None
+        vtu_path = validate.vtu_file(args.vtu) if args.vtu is not None else None
         return run_one(args.scene, method=args.method, overrides=parse_assignments(args.set),
-                       json_path=json_path)
+                       json_path=json_path, vtu_path=vtu_path)
     if args.command == "report":
-        from .report import DEFAULT_OUT, build_report
-        out = validate.output_dir(DEFAULT_OUT if args.out is None else args.out)
+        from .report import build_report, default_out
+        only = validate.only(args.only)
+        out = validate.output_dir(default_out(only, args.quick) if args.out is None
+                                  else args.out)
         from .cluster import scheduler_address
-        return build_report(out=out, quick=args.quick, only=validate.only(args.only),
+        return build_report(out=out, quick=args.quick, only=only,
                             jobs=validate.jobs(args.jobs),
                             scheduler=scheduler_address(args.scheduler))
     if args.command == "compare":

@@ -32,6 +32,8 @@ class RunResult:
     diagnostics: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
     fields: dict = field(default_factory=dict, repr=False)
+    #: files written from ``fields`` (VTU, relative to the report folder), if any
+    files: list = field(default_factory=list)
 
     @property
     def key(self) -> tuple:
@@ -50,6 +52,7 @@ class RunResult:
             "size": _plain(self.size),
             "diagnostics": _plain(self.diagnostics),
             "warnings": list(self.warnings),
+            **({"files": list(self.files)} if self.files else {}),
         }
 
 
@@ -155,7 +158,8 @@ def write_results(path, runs: list[RunResult]) -> dict:
 _RUN_FIELDS = {"scene": (str,), "method": (str,), "params": (dict,), "status": (str,),
                "metrics": (dict,)}
 _OPTIONAL_RUN_FIELDS = {"reference": (str,), "message": (str,), "timings": (dict,),
-                        "size": (dict,), "diagnostics": (dict,), "warnings": (list,)}
+                        "size": (dict,), "diagnostics": (dict,), "warnings": (list,),
+                        "files": (list,)}
 _TYPE_NAMES = {str: "a string", dict: "an object", list: "a list"}
 
 

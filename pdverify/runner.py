@@ -14,7 +14,8 @@ def format_metrics(metrics: dict, limit: int = 4) -> str:
     return " ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in items)
 
 
-def run_one(scene_id: str, *, method=None, overrides=None, json_path=None, stream=None) -> int:
+def run_one(scene_id: str, *, method=None, overrides=None, json_path=None, vtu_path=None,
+            stream=None) -> int:
     """``pdverify run``: resolve (exit 2 on bad input), run, print, optionally write JSON."""
     stream = stream or sys.stdout
     scene = get_scene(scene_id)
@@ -31,6 +32,12 @@ def run_one(scene_id: str, *, method=None, overrides=None, json_path=None, strea
     t = result.timings
     print(f"  time: setup {t['setup_s']:.4f} s, solve {t['solve_s']:.4f} s, "
           f"total {t['total_s']:.4f} s; size {result.size}", file=stream)
+    if vtu_path:
+        from .export import write_run_fields
+        paths = write_run_fields(result, vtu_path[: -len(".vtu")])
+        print("  fields: " + (", ".join(paths) if paths else "none (the run kept no node "
+                                                             "fields)"), file=stream)
+        result.files = paths
     if json_path:
         write_results(json_path, [result])
     return 0 if result.status == "ok" else 1

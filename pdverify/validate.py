@@ -63,6 +63,13 @@ def output_file(path, flag: str = "--json") -> str:
     return full
 
 
+def vtu_file(path) -> str:
+    """``run --vtu``: a writable file name ending in ``.vtu``."""
+    if not str(path).endswith(".vtu"):
+        raise InputError(f"--vtu {path!r}: the file name must end in .vtu")
+    return output_file(path, "--vtu")
+
+
 def input_file(path, what: str) -> str:
     """A file to read: exists and is a regular file."""
     if not str(path).strip():

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import fcntl
+import hashlib
 import os
 import shutil
 import sys
@@ -15,6 +16,18 @@ from ..runner import plan, run_cases
 from ..scenes import get_scene
 
 DEFAULT_OUT = os.path.join("reports", "latest")
+
+
+def default_out(only=None, quick=False) -> str:
+    """Where a report goes without ``--out``: the full report in ``reports/latest``, a
+    ``--quick`` one in ``reports/quick`` and an ``--only`` one in a folder named after its
+    scenes, so that neither ever replaces the full report."""
+    if only:
+        ids = list(dict.fromkeys(only))
+        name = ids[0] if len(ids) == 1 else f"{ids[0]}+{len(ids) - 1}-more-" + hashlib.sha1(
+            "\0".join(sorted(ids)).encode()).hexdigest()[:6]
+        return os.path.join("reports", ("quick-" if quick else "") + "only-" + name)
+    return os.path.join("reports", "quick") if quick else DEFAULT_OUT
 
 
 @contextmanager
@@ -82,7 +95,7 @@ def build_report(*, out=None, quick=False, only=None, jobs=1, progress=None,
     (:mod:`pdverify.cluster`), which is reached before any work starts.
     """
     progress = progress or sys.stderr
-    out = os.path.abspath(out or DEFAULT_OUT)
+    out = os.path.abspath(out or default_out(only, quick))
     cases = plan(only=only, quick=quick)  # raises InputError on unknown scenes
     parent, name = os.path.split(out)
     client = None
@@ -113,12 +126,24 @@ def _locked(cases, out, parent, name, jobs, progress, client) -> int:
     return code
 
 
+def export_fields(results, out) -> None:
+    """Every run's fields as VTU files in ``out/fields`` (:mod:`pdverify.export`), named
+    by the run's place in ``results.json``; each run lists its files under ``files``."""
+    from ..export import write_run_fields
+    for k, r in enumerate(results):
+        if not r.fields:
+            continue
+        stem = os.path.join(out, "fields", f"{k:03d}-{r.scene}-{r.method}")
+        r.files = [os.path.relpath(p, out) for p in write_run_fields(r, stem)]
+
+
 def _build(cases, out, final, jobs, progress, client=None) -> int:
     t0 = time.perf_counter()
     results = run_cases(cases, jobs=jobs, progress=progress, client=client)
     figdir = os.path.join(out, "figures")
     os.makedirs(figdir, exist_ok=True)
     from . import figures, html
+    from .figures import overview as _  # noqa: F401  (figures.overview)
     sections = []
     order = []
     for scene_id, _, _ in cases:
@@ -133,9 +158,16 @@ def _build(cases, out, final, jobs, progress, client=None) -> int:
             print(f"figure for {scene_id} failed: {type(exc).__name__}: {exc}", file=progress)
             figs = []
         sections.append((scene, html.scene_section(scene, mine, figs)))
+    export_fields(results, out)
+    scenes = [scene for scene, _ in sections]
+    try:
+        front = figures.overview.pareto(scenes, results, figdir)
+    except Exception as exc:  # a broken figure must not lose the numbers
+        print(f"error-against-cost figures failed: {type(exc).__name__}: {exc}", file=progress)
+        front = []
     doc = write_results(os.path.join(out, "results.json"), results)
     atomic_write_text(os.path.join(out, "index.html"),
-                      html.page(doc, sections, time.perf_counter() - t0, results))
+                      html.page(doc, sections, time.perf_counter() - t0, results, front))
     failed = sum(r.status != "ok" for r in results)
     print(f"report: {len(results)} runs, {failed} failed, "
           f"{time.perf_counter() - t0:.1f} s -> {os.path.join(final, 'index.html')}",

@@ -6,6 +6,8 @@ import math
 
 from ..corrections import describe
 from ..errors import InputError
+from ..papers import PAPERS, seed_of
+from .summary import default_run, headline, headline_value, summarise
 
 CSS = """
 body{font-family:system-ui,sans-serif;margin:2em auto;max-width:1250px;color:#222}
@@ -15,6 +17,9 @@ th{background:#f2f2f2} td.l,th.l{text-align:left}
 .failed{background:#fde2e2} .warning{color:#8a5a00} .doc{white-space:pre-wrap;font-size:12px;color:#444;
 background:#fafafa;border-left:3px solid #ddd;padding:.4em .8em}
 figure{margin:1em 0} figcaption{font-size:12px;color:#555} code{font-size:12px}
+td.p{max-width:260px;word-break:break-word} td.m{font-size:12px;white-space:nowrap} td.s{max-width:320px;word-break:break-word}
+div.wide{overflow-x:auto;max-width:100%} .dev{background:#fff8e5;border-left:3px solid #e0b84d;
+padding:.3em .8em;font-size:13px;margin:.5em 0}
 """
 
 
@@ -35,41 +40,92 @@ def _params(result, scene) -> str:
     return ", ".join(f"{k}={_num(v)}" for k, v in shown.items()) or "defaults"
 
 
-def scene_section(scene, results, figures) -> str:
-    parts = [f'<h2 id="{scene.id}">{html.escape(scene.id)}: {html.escape(scene.title)}</h2>',
-             f"<p>Seed {html.escape(scene.seed)}; reference: <b>{scene.reference}</b>.</p>",
-             f'<details><summary>What is implemented and every choice</summary>'
-             f'<div class="doc">{html.escape((type(scene).__doc__ or "").strip())}</div></details>']
-    metric_names = []
+#: at most this many metric columns in a scene's compact table (the rest are folded)
+KEY_METRICS = 4
+
+
+def key_metrics(scene, results) -> list[str]:
+    """The compact table's metric columns: the headline error, the metrics the paper
+    prints for this scene, then the scene's first metrics; at most :data:`KEY_METRICS`."""
+    present = []
     for r in results:
         for k in r.metrics:
-            if k not in metric_names:
-                metric_names.append(k)
-    head = ("<tr><th class=l>method</th><th class=l>params</th><th>status</th>"
-            + "".join(f"<th>{html.escape(m)}</th>" for m in metric_names)
-            + "<th>setup s</th><th>solve s</th><th>total s</th><th>size</th></tr>")
+            if k not in present:
+                present.append(k)
+    wanted = [headline(scene)] + [p.metric for p in scene.published] + present
+    out = []
+    for m in wanted:
+        if m in present and m not in out:
+            out.append(m)
+    return out[:KEY_METRICS]
+
+
+def _metric_cell(scene, r, m) -> str:
+    paper = scene.published_for(r.method, r.params)
+    cell = _num(r.metrics.get(m, ""))
+    if m in paper:
+        cell += (f'<br><small title="{html.escape(paper[m].source)}">paper: '
+                 f"{_num(paper[m].value)}</small>")
+    return f"<td>{cell}</td>"
+
+
+def _status(r) -> str:
+    status = r.status if r.status == "ok" else f"failed: {html.escape(r.message)}"
+    return status + "".join(f'<br><small class="warning">warning: {html.escape(w)}</small>'
+                            for w in r.warnings)
+
+
+def _table(scene, results, metrics, full: bool) -> str:
+    """One row per run: method, params that differ, status, then ``metrics`` as columns
+    and the total time (setup and solve on hover); ``full``: every metric of the run in
+    one wrapped cell, then setup, solve and total time and the size (so that a scene with
+    twenty metrics still fits the page)."""
+    if full:
+        head = ("<tr><th class=l>method</th><th class=l>params</th><th class=l>status</th>"
+                "<th class=l>metrics</th><th>setup s</th><th>solve s</th><th>total s</th>"
+                "<th class=l>size</th></tr>")
+    else:
+        head = ("<tr><th class=l>method</th><th class=l>params</th><th class=l>status</th>"
+                + "".join(f"<th>{html.escape(m)}</th>" for m in metrics) + "<th>total s</th></tr>")
     rows = []
     for r in results:
-        paper = scene.published_for(r.method, r.params)
-        cells = []
-        for m in metric_names:
-            v = r.metrics.get(m, "")
-            cell = _num(v)
-            if m in paper:
-                cell += f'<br><small title="{html.escape(paper[m].source)}">paper: {_num(paper[m].value)}</small>'
-            cells.append(f"<td>{cell}</td>")
-        status = r.status if r.status == "ok" else f"failed: {html.escape(r.message)}"
-        status += "".join(f'<br><small class="warning">warning: {html.escape(w)}</small>'
-                          for w in r.warnings)
-        cls = "" if r.status == "ok" else ' class="failed"'
-        size = ", ".join(f"{k} {v}" for k, v in r.size.items())
         t = r.timings
+        if full:
+            size = ", ".join(f"{k} {v}" for k, v in r.size.items())
+            values = "<br>".join(f"{html.escape(k)} = {_num(v)}" for k, v in r.metrics.items())
+            cells = (f'<td class="l m">{values}</td>'
+                     f"<td>{t.get('setup_s', 0):.3g}</td><td>{t.get('solve_s', 0):.3g}"
+                     f"{_solver_note(r.diagnostics)}</td><td>{t.get('total_s', 0):.3g}</td>"
+                     f'<td class="l p">{html.escape(size)}</td>')
+        else:
+            cells = ("".join(_metric_cell(scene, r, m) for m in metrics)
+                     + f'<td title="setup {t.get("setup_s", 0):.3g} s, solve '
+                     f'{t.get("solve_s", 0):.3g} s">{t.get("total_s", 0):.3g}'
+                     f"{_solver_note(r.diagnostics)}</td>")
+        cls = "" if r.status == "ok" else ' class="failed"'
         rows.append(f"<tr{cls}><td class=l>{html.escape(r.method)}</td>"
-                    f"<td class=l>{_params(r, scene)}</td><td class=l>{status}</td>{''.join(cells)}"
-                    f"<td>{t.get('setup_s', 0):.3g}</td><td>{t.get('solve_s', 0):.3g}"
-                    f"{_solver_note(r.diagnostics)}</td>"
-                    f"<td>{t.get('total_s', 0):.3g}</td><td class=l>{size}</td></tr>")
-    parts.append(f"<table>{head}{''.join(rows)}</table>")
+                    f'<td class="l p">{_params(r, scene)}</td><td class="l s">{_status(r)}</td>'
+                    f"{cells}</tr>")
+    return f"<table>{head}{''.join(rows)}</table>"
+
+
+def scene_section(scene, results, figures, deviations=()) -> str:
+    paper = PAPERS.get(seed_of(scene.seed), {})
+    cite = (f"{paper['authors']} ({paper['year'] or 'n.d.'})" if paper else "")
+    parts = [f'<h2 id="{scene.id}">{html.escape(scene.id)}: {html.escape(scene.title)}</h2>',
+             f"<p>Seed {html.escape(scene.seed)} ({html.escape(cite)}); reference: "
+             f"<b>{scene.reference}</b>; headline error <code>{headline(scene)}</code>.</p>"]
+    if deviations:
+        items = "".join(f"<li><b>{html.escape(d.kind)}</b>: {html.escape(d.text)} "
+                        f"<small>({html.escape(d.source)})</small></li>" for d in deviations)
+        parts.append(f'<div class="dev"><b>Deviations from the paper</b><ul>{items}</ul></div>')
+    parts.append(f'<details><summary>What is implemented and every choice</summary>'
+                 f'<div class="doc">{html.escape((type(scene).__doc__ or "").strip())}</div>'
+                 "</details>")
+    metrics = key_metrics(scene, results)
+    parts.append(_table(scene, results, metrics, full=False))
+    parts.append("<details><summary>Every metric, setup and solve time and size of each run"
+                 f"</summary>{_table(scene, results, (), full=True)}</details>")
     for r in results:
         if r.fields.get("refinement"):
             parts.append(refinement_table(r))
@@ -115,22 +171,11 @@ def refinement_table(result) -> str:
         f"<td>{_num(row['setup_s'])}</td><td>{_num(row['solve_s'])}</td>"
         + "".join(f"<td>{_num(row.get('extra', {}).get(k, ''))}</td>" for k in extra) + "</tr>"
         for row in rows)
-    return f"<p><b>Refinement study</b> ({html.escape(result.method)}):</p><table>{head}{body}</table>"
+    return (f"<p><b>Refinement study</b> ({html.escape(result.method)}):</p>"
+            f'<div class="wide"><table>{head}{body}</table></div>')
 
 
-#: The error each scene is ranked by in the overview (default ``rel_l2_error``).
-HEADLINE_DEFAULT = "rel_l2_error"
 _LOG_RANGE = (-8.0, 0.0)  # colour scale of the overview: 1e-8 (green) .. 1 (red)
-
-
-def _headline_run(scene, method, runs):
-    """The run of ``method`` at its default params, else its first run."""
-    mine = [r for r in runs if r.method == method]
-    try:
-        defaults = scene.resolve(method, {})
-    except InputError:
-        defaults = None
-    return next((r for r in mine if r.params == defaults), mine[0] if mine else None)
 
 
 def _colour(value: float) -> str:
@@ -152,12 +197,11 @@ def overview(scenes, results) -> str:
     rows = []
     for scene in scenes:
         runs = [r for r in results if r.scene == scene.id]
-        metric = getattr(scene, "headline", HEADLINE_DEFAULT)
-        picked = {m: _headline_run(scene, m, runs) for m in methods}
-        values = {m: r.metrics.get(metric) for m, r in picked.items()
-                  if r is not None and r.status == "ok" and m != "fem"}
-        values = {m: v for m, v in values.items() if isinstance(v, (int, float))}
-        best = min(values, key=values.get) if len(values) > 1 else None
+        metric = headline(scene)
+        picked = {m: default_run(scene, m, runs) for m in methods}
+        values = {m: r.metrics[metric] for m, r in picked.items()
+                  if r is not None and headline_value(scene, r) is not None}
+        best = summarise(scene, runs).best
         cells = []
         for m in methods:
             r = picked[m]
@@ -184,10 +228,27 @@ def overview(scenes, results) -> str:
             "default parameters (green 1e-8 to red 1, log scale), the total time beneath; "
             "&#9733; the most accurate method of the scene; hover a cell for its parameters "
             "or a failure's reason. Sweeps and variants are in each scene's table.</small>"
-            f"</p><table>{head}{''.join(rows)}</table>")
+            f'</p><div class="wide"><table>{head}{"".join(rows)}</table></div>')
 
 
-def page(doc: dict, sections: list[tuple], total_time: float, results=None) -> str:
+def papers(scenes) -> str:
+    """The seed papers the report's scenes come from, with the scenes of each."""
+    items = []
+    for key, p in PAPERS.items():
+        ids = [s.id for s in scenes if seed_of(s.seed) == key]
+        if not ids:
+            continue
+        doi = (f'<a href="https://doi.org/{html.escape(p["doi"])}">doi:{html.escape(p["doi"])}'
+               "</a>" if p["doi"] else "DOI not printed in the seed text")
+        venue = f", <i>{html.escape(p['venue'])}</i>" if p["venue"] else ""
+        items.append(f"<li>[{key}] {html.escape(p['authors'])} ({p['year'] or 'n.d.'}). "
+                     f"{html.escape(p['title'])}{venue}. {doi}. <small>Scenes: "
+                     + ", ".join(f'<a href="#{i}">{i}</a>' for i in ids) + "</small></li>")
+    return f"<h3>Papers</h3><ol>{''.join(items)}</ol>" if items else ""
+
+
+def page(doc: dict, sections: list[tuple], total_time: float, results=None,
+         front_figures=()) -> str:
     runs = doc["runs"]
     failed = [r for r in runs if r["status"] != "ok"]
     warned = sum(1 for r in runs if r.get("warnings"))
@@ -197,6 +258,9 @@ def page(doc: dict, sections: list[tuple], total_time: float, results=None) -> s
     legend = "".join(f"<li><code>{html.escape(m)}</code>: {html.escape(describe(m))}</li>"
                      for m in methods)
     body = "\n".join(text for _, text in sections)
+    figs = "".join(f'<figure><img src="figures/{name}" style="max-width:100%">'
+                   f"<figcaption>{html.escape(caption)}</figcaption></figure>"
+                   for name, caption in front_figures)
     return f"""<!doctype html><html><head><meta charset="utf-8"><title>pdverify report</title>
 <style>{CSS}</style></head><body>
 <h1>pdverify report</h1>
@@ -204,10 +268,13 @@ def page(doc: dict, sections: list[tuple], total_time: float, results=None) -> s
 Python {html.escape(str(doc['machine']['python']))} on {doc['machine']['cpus']} CPUs.
 {len(runs)} runs, {len(failed)} failed, {warned} ok with a warning, {total_time:.1f} s in all. Machine-readable:
 <a href="results.json">results.json</a> (schema <code>{html.escape(doc['schema'])}</code>).</p>
-<p>Each table lists one run per row: the method, the parameters that differ from the scene's
-defaults (the paper's values), the metrics with the paper's number beneath where the paper
-prints one, and the cost (setup and solve time, size).</p>
+<p>Each scene's table lists one run per row: the method, the parameters that differ from
+the scene's defaults (the paper's values), the status, the headline error and the metrics
+the paper prints (the paper's number beneath), and the total time (setup and solve on
+hover). Every metric, time and size of every run is in the folded table beneath it.</p>
 {overview([s for s, _ in sections], results) if results is not None else ""}
+{figs}
+{papers([s for s, _ in sections])}
 <h3>Methods</h3><ul>{legend}</ul>
 <h3>Scenes</h3><ul>{toc}</ul>
 {body}

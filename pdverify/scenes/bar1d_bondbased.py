@@ -131,6 +131,7 @@ class BondBarScene(Scene):
     """Shared checks and bar construction of the seed-004 scenes."""
 
     seed = "004"
+    dim = 1
     methods = (NONE, HOMOGENIZED)
 
     def min_nodes(self, m: int) -> int:

@@ -37,6 +37,7 @@ class ForceFlux(Scene):
     seed = "000 §2.2"
     reference = "analytic"
     figure = "bar1d-flux"
+    dim = 1
     params = BAR_PARAMS + (Param("strain", 1e-3, "imposed constant strain", positive),)
     methods = (NONE, TAYLOR)
     published = (

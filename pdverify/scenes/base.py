@@ -120,7 +120,8 @@ class Scene:
     #: it takes the bond methods of ``pdverify.corrections.registry`` (built-in and
     #: plugins); None: only its own ``methods``
     closure_theory: str | None = None
-    #: the dimension of that model (a bond method may serve some dimensions only)
+    #: the spatial dimension of the scene's model (1, 2 or 3): a bond method may serve
+    #: some dimensions only, and the report groups its error-against-cost plots by it
     dim: int | None = None
     #: overrides of the bond methods' report cases under ``--quick``
     quick_overrides: Mapping[str, Any] = {}

@@ -104,6 +104,7 @@ class Indentation(FemAndPD):
     title = "Rigid cylinder indenting a block, sticking contact: FEM and nonlinear PD (Fig. 4)"
     seed = "003 §4.2"
     figure = "indentation"
+    dim = 2
     headline = "force_error_pct"  # the report overview's error for this scene
     params_class, function = "IndentationParams", "indentation"
     shared = ("width", "height", "radius", "depth", "n_steps", "E", "nu", "thickness")

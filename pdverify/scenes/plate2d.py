@@ -183,6 +183,7 @@ class ClampedPlate(FemAndPD):
     seed = "000 §6.2"
     reference = "fem"
     figure = "plate2d"
+    dim = 2
     params_class, function = "PlateParams", "clamped_plate"
     shared = ("length", "width", "thickness", "E", "nu", "body_force")
     pd_params = (

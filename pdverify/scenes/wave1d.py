@@ -204,6 +204,7 @@ class Wave1DSurfaceNodes(Scene):
     seed = "002"
     reference = "analytic"
     figure = "wave1d"
+    dim = 1
     params = (
         Param("length", 1.0, "bar length l [m]", positive),
         Param("horizon", 0.1, "horizon delta [m] (0.1 l)", positive),
