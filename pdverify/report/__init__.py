@@ -143,7 +143,7 @@ def _build(cases, out, final, jobs, progress, client=None) -> int:
     figdir = os.path.join(out, "figures")
     os.makedirs(figdir, exist_ok=True)
     from . import figures, html
-    from .figures import overview as _  # noqa: F401  (figures.overview)
+    from .figures import overview
     sections = []
     order = []
     for scene_id, _, _ in cases:
@@ -161,7 +161,7 @@ def _build(cases, out, final, jobs, progress, client=None) -> int:
     export_fields(results, out)
     scenes = [scene for scene, _ in sections]
     try:
-        front = figures.overview.pareto(scenes, results, figdir)
+        front = overview.pareto(scenes, results, figdir)
     except Exception as exc:  # a broken figure must not lose the numbers
         print(f"error-against-cost figures failed: {type(exc).__name__}: {exc}", file=progress)
         front = []

@@ -1,6 +1,8 @@
 """Figures of seed 001: error maps (Figs. 9, 12, 14, 15) and error against cost."""
 from __future__ import annotations
 
+import warnings
+
 import matplotlib.pyplot as plt
 import numpy as np
 
@@ -143,9 +145,22 @@ def _section5(scene, results, folder):
                    "methods; PDDO similar to SNM.")]
 
 
+def _renderings_3d(scene, results, folder):
+    """pyvista renderings of |u| and the error (:mod:`.fields3d`); a renderer that fails
+    (no OpenGL, ...) costs these images only, with a warning naming the cause."""
+    try:
+        from .fields3d import render_box_fields
+        return render_box_fields(scene, results, folder)
+    except Exception as exc:  # noqa: BLE001  (any VTK/OpenGL failure: keep the report)
+        warnings.warn(f"{scene.id}: no 3D renderings ({type(exc).__name__}: {exc})",
+                      RuntimeWarning, stacklevel=2)
+        return []
+
+
 @family("surface-nodes")
 def surface_node_figures(scene, results, folder):
     dim = results[0].fields["x"].shape[1]
-    maps = _maps_3d(scene, results, folder) if dim == 3 else _maps_2d(scene, results, folder)
+    maps = (_maps_3d(scene, results, folder) + _renderings_3d(scene, results, folder)
+            if dim == 3 else _maps_2d(scene, results, folder))
     front = _section5(scene, results, folder) if dim == 2 else []
     return front + maps + _cost(scene, results, folder)
