@@ -1,0 +1,151 @@
+"""Off-screen pyvista renderings of the 3D boxes' displacement and error fields.
+
+Each image shows one run as two panels side by side: the displacement magnitude |u| and
+the nodal error of Eq. (38) of seed 001, both as cell data of the box's grid (every node
+is a cell centre) with one octant cut away so the interior shows. Only reshaping and the
+magnitude here: the values are the run's own fields. pyvista is imported only when
+something is rendered (the figure package imports every module of its own).
+"""
+from __future__ import annotations
+
+import contextlib
+import os
+
+import numpy as np
+
+from ...errors import InputError
+from . import label
+
+#: pixels of one image (two panels); a render takes about 0.3 s here (EGL, no GPU)
+WINDOW = (1400, 600)
+MM = 1e3  # displacements are in m, shown in mm
+
+
+def _cell_values(f, values):
+    """Nodal values as cell data of the box's ImageData (x fastest, VTK's order)."""
+    idx = np.rint((f["x"] - f["origin"]) / f["spacing"] - 0.5).astype(int)
+    shape = tuple(int(n) for n in f["cells"])
+    out = np.full(shape, np.nan)
+    out[tuple(idx.T)] = values
+    return out.ravel(order="F")
+
+
+def default_runs(scene, results):
+    """Per method, the first run at the method's default parameters (besides the spacing,
+    which ``--quick`` changes); the method's first run when none has them."""
+    out = {}
+    for r in results:
+        if r.method in out:
+            continue
+        try:
+            want = scene.resolve(r.method, {"spacing": r.params["spacing"]})
+        except InputError:  # a method the scene no longer offers
+            want = None
+        if want is not None and all(r.params.get(k) == v for k, v in want.items()):
+            out[r.method] = r
+    for r in results:
+        out.setdefault(r.method, r)
+    return [r for r in results if out.get(r.method) is r]
+
+
+def _octant(f):
+    """Cell ids kept (all but the octant of the cells at or beyond the grid's middle
+    cell on every axis) and the cut position on each axis."""
+    n = np.asarray(f["cells"], dtype=int)
+    i, j, k = np.meshgrid(*(np.arange(m) for m in n), indexing="ij")
+    cut = (i >= n[0] // 2) & (j >= n[1] // 2) & (k >= n[2] // 2)
+    keep = np.flatnonzero(~cut.ravel(order="F"))
+    # rounded for the labels (no -2.8e-17 for a cut at y = 0); + 0.0 turns -0.0 into 0.0
+    return keep, np.round(np.asarray(f["origin"]) + (n // 2) * f["spacing"], 12) + 0.0
+
+
+def _lift(camera, d):
+    """Move the view down by ``d`` (the body up in the image, clear of the colour bar)."""
+    up = np.asarray(camera.up, dtype=float)
+    shift = -d * up / np.linalg.norm(up)
+    camera.focal_point = tuple(np.asarray(camera.focal_point) + shift)
+    camera.position = tuple(np.asarray(camera.position) + shift)
+
+
+def _caption(r, cut):
+    return (f"{label(r)}: 3D rendering of the run's nodal fields on the grid cells (each "
+            f"node is a cell centre, h = {r.fields['spacing']:g} m), the octant x > "
+            f"{cut[0]:.3g} m, y > {cut[1]:.3g} m, z > {cut[2]:.3g} m cut away so the "
+            "interior mid-planes show; the box's outline in black. Left: displacement "
+            "magnitude |u| [mm]; right: the nodal error of Eq. (38) of seed 001 [%]. "
+            "Isometric view, each panel its own colour scale.")
+
+
+#: the two panels: cell-data name, scalar bar title (VTK renders a title with $...$ by
+#: matplotlib's mathtext; without it the default font draws "[" like "(" and "|" breaks
+#: the text), the nodal values (the metre displacements in mm)
+PANELS = (("u_mm", r"displacement $\Vert u\Vert$ [mm]",
+           lambda f: MM * np.linalg.norm(f["u"], axis=1)),
+          ("error_pct", r"error $\varepsilon$ [%], Eq. (38)", lambda f: f["error"]))
+
+
+def _grid(pv, f):
+    """The box's grid with the panels' nodal values as cell data."""
+    grid = pv.ImageData(dimensions=tuple(int(n) + 1 for n in f["cells"]),
+                        spacing=(float(f["spacing"]),) * 3,
+                        origin=tuple(float(v) for v in f["origin"]))
+    for name, _, values in PANELS:
+        grid.cell_data[name] = _cell_values(f, values(f))
+    return grid
+
+
+def render_box_fields(scene, results, folder) -> list[tuple[str, str]]:
+    """One png per run of :func:`default_runs` of ``results`` (3D box runs with fields):
+    |u| and the Eq. (38) error, octant cut away; returns (file, caption) pairs."""
+    import pyvista as pv
+
+    pv.OFF_SCREEN = True
+    out = []
+    for r in default_runs(scene, results):
+        f = r.fields
+        grid = _grid(pv, f)
+        keep, cut = _octant(f)
+        heads = (f"{scene.id}: {label(r)}, h = {f['spacing']:g} m",
+                 f"cut away: x > {cut[0]:.3g} m, y > {cut[1]:.3g} m, z > {cut[2]:.3g} m")
+        file = f"{scene.id}-{r.method}-3d-{len(out)}.png"
+        with _quiet(pv):
+            _render(pv, grid, grid.extract_cells(keep), heads, f["lengths"],
+                    os.path.join(folder, file))
+        out.append((file, _caption(r, cut)))
+    return out
+
+
+def _quiet(pv):
+    """VTK's log at errors only: a headless VTK first tries an X display and logs a
+    warning ("bad X server connection") before it falls back to EGL or OSMesa."""
+    verbosity = getattr(pv, "vtk_verbosity", None)  # pyvista >= 0.45
+    return verbosity("error") if verbosity is not None else contextlib.nullcontext()
+
+
+def _render(pv, grid, part, heads, lengths, path):
+    """The two panels of :data:`PANELS`: ``part`` of ``grid`` coloured on the scale of
+    the whole grid, the grid's outline, one colour bar each, isometric view."""
+    # a fresh plotter per image: one already shown renders again on every added actor
+    pl = pv.Plotter(shape=(1, 2), off_screen=True, window_size=WINDOW, border=False)
+    try:
+        for col, (name, title, _) in enumerate(PANELS):
+            pl.subplot(0, col)
+            top = float(np.nanmax(grid.cell_data[name]))
+            pl.add_mesh(part, scalars=name, cmap="viridis", show_edges=True,
+                        edge_color="#444444", line_width=0.5,
+                        ambient=0.65, diffuse=0.35, specular=0.0,  # faces darken little
+                        clim=(0.0, top if top > 0 else 1.0),
+                        scalar_bar_args={"title": title, "fmt": "%.3g", "vertical": False,
+                                         "title_font_size": 16, "label_font_size": 14,
+                                         "n_labels": 5, "position_x": 0.2,
+                                         "position_y": 0.03, "width": 0.6, "height": 0.1})
+            pl.add_mesh(grid.outline(), color="black", line_width=1.5)
+            # at a fixed size: a corner annotation ("upper_left") shrinks long text
+            pl.add_text(heads[col], position=(0.01, 0.93), viewport=True, font_size=10)
+            pl.add_axes(line_width=2)
+            pl.view_isometric()
+            pl.camera.zoom(0.9)
+            _lift(pl.camera, 0.09 * float(np.linalg.norm(lengths)))
+        pl.screenshot(path)
+    finally:
+        pl.close()

@@ -1,0 +1,75 @@
+"""The pyvista renderings of the 3D boxes (pdverify.report.figures.fields3d) are drawn.
+
+The report wraps them so that a failing renderer costs only these images; this test is
+where a failure shows: it calls the renderer directly, with nothing caught.
+"""
+import matplotlib.image as mpimg
+import pytest
+
+from pdverify.report.figures import fields3d, surface_nodes
+from pdverify.scenes import get_scene
+
+
+@pytest.fixture(scope="module")
+def run():
+    # 8 x 4 x 4 cells (128 nodes), about a second; spacing 0.125 is a valid box size
+    # for the uncorrected model (the surface-node orders >= 3 need more cells)
+    scene = get_scene("body3d-traction")
+    r = scene.run("none", {"spacing": 0.125})
+    assert r.status == "ok"
+    return scene, r
+
+
+def test_render_box_fields_writes_one_nonblank_png_per_run(tmp_path, run):
+    scene, r = run
+    out = fields3d.render_box_fields(scene, [r], str(tmp_path))
+    assert [name for name, _ in out] == ["body3d-traction-none-3d-0.png"]
+    assert "Eq. (38)" in out[0][1] and "[mm]" in out[0][1]
+    path = tmp_path / out[0][0]
+    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    img = mpimg.imread(path)  # floats in [0, 1]
+    w, h = fields3d.WINDOW
+    assert img.shape[:2] == (h, w)
+    rgb = img[..., :3]
+    # a blank frame (all background) has std 0, one with only the panel titles and the
+    # axes triads about 0.04 (measured, 1400 x 600); the rendering, a white background
+    # with coloured bodies and colour bars, about 0.33: 0.15 lies well between
+    assert rgb.std() > 0.15
+    # both panels drew their body: in each half over 5 % of the pixels have a channel
+    # below 0.5 (about 36 % here; the titles and triad alone cover well under 1 %)
+    for half in (rgb[:, : w // 2], rgb[:, w // 2:]):
+        assert (half.min(axis=-1) < 0.5).mean() > 0.05
+
+
+def test_default_runs_pick_one_run_per_method_at_its_defaults():
+    scene = get_scene("body3d-manufactured")
+
+    class R:
+        def __init__(self, method, **params):
+            self.method = method
+            self.params = scene.resolve(method, {"spacing": 0.1, **params})
+
+    runs = [R("none"), R("none", load_point="surface"), R("surface-nodes", order=1),
+            R("surface-nodes", order=3), R("surface-nodes", order=3, surface_load="centre")]
+    picked = fields3d.default_runs(scene, runs)
+    assert picked == [runs[0], runs[3]]  # surface-nodes defaults to order 3 here
+
+
+def test_the_family_draws_the_renderings_after_its_maps(tmp_path, run):
+    scene, r = run
+    names = [name for name, _ in surface_nodes.surface_node_figures(scene, [r], str(tmp_path))]
+    assert names == ["body3d-traction-none-0-0.png", "body3d-traction-none-3d-0.png",
+                     "body3d-traction-cost.png"]
+
+
+def test_the_family_keeps_its_maps_when_the_renderer_fails(tmp_path, monkeypatch, run):
+    scene, r = run
+
+    def broken(*args):
+        raise RuntimeError("no OpenGL")
+
+    monkeypatch.setattr(fields3d, "render_box_fields", broken)
+    with pytest.warns(RuntimeWarning, match="no 3D renderings.*no OpenGL"):
+        figs = surface_nodes.surface_node_figures(scene, [r], str(tmp_path))
+    assert figs and not any("-3d-" in name for name, _ in figs)
+    assert all((tmp_path / name).exists() for name, _ in figs)
