@@ -76,11 +76,13 @@ class StateBox:
 
     def unknown_coords(self):
         """Coordinates of the augmented system's unknowns: the displacement components of
-        the interior then (surface nodes) surface nodes, then the interior dilatations."""
+        the interior then (surface nodes) surface nodes, then the interior dilatations (and
+        any further nodal scalars of the closure, e.g. PALS's second one), node-major."""
         g = self.grid
         x_int = g.x[g.interior_ids]
         nodes = np.r_[x_int, g.surface_x] if self.order is not None else x_int
-        return np.r_[np.tile(nodes, (self.dim, 1)), x_int]
+        scalars = self.model.A_theta.shape[0] // len(x_int)
+        return np.r_[np.tile(nodes, (self.dim, 1)), np.tile(x_int, (scalars, 1))]
 
     def rows_of_state(self, U_ext, Theta_ext):
         return self.model.rows_of_state(U_ext, Theta_ext, self.P)
@@ -407,8 +409,8 @@ class SurfaceNodeScene(Scene):
         order_idx = np.argsort(fixed)
         fixed, values = fixed[order_idx], values[order_idx]
         rhs = rhs.T.ravel()
-        if solver != "direct":
-            rhs = np.r_[rhs, np.zeros(ni)]
+        if solver != "direct":   # zero rows of the nodal scalars (dilatations; PALS: two)
+            rhs = np.r_[rhs, np.zeros(K.shape[0] - rhs.size)]
         return model, K, rhs, fixed, values, solver
 
     def solve(self, method, p, timer):

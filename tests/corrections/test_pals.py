@@ -110,3 +110,16 @@ def test_pals_stiffness_scene_is_exact(scene, over):
     # EPS in percent (1e-10), with a factor 10 for the bulk reference's own round-off
     assert r.metrics["surface_energy_error_pct"] < 1e-9
     assert r.metrics["interior_energy_error_pct"] < 1e-9
+
+
+def test_augmented_system_carries_both_nodal_scalars():
+    """PALS has two nodal scalars (theta and the sigma-weighted sum), so its augmented
+    system (solver=nested-dissection) has 2 n_interior extra rows: it must give the
+    direct solve's answer (it once indexed past the right-hand side)."""
+    scene = get_scene("plate2d-plane-strain")
+    over = {"spacing": 0.05}
+    direct = scene.run("pals", {**over, "solver": "direct"})
+    nd = scene.run("pals", {**over, "solver": "nested-dissection"})
+    assert direct.status == nd.status == "ok", nd.message
+    # two sparse LUs of the same system: round-off of a 1e3-conditioned solve
+    assert nd.metrics["rel_l2_error"] == pytest.approx(direct.metrics["rel_l2_error"], rel=1e-9)
