@@ -36,7 +36,8 @@ def build_parser() -> argparse.ArgumentParser:
                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"pdverify {__version__}")
     sub = parser.add_subparsers(dest="command", parser_class=_Parser)
-    sub.add_parser("list", help="list scenes, methods and parameters")
+    sub.add_parser("list", help="list scenes, methods and parameters "
+                                "(name=default {allowed values})")
     run = sub.add_parser("run", help="run one scene with one method")
     run.add_argument("scene", help="scene id (see: python -m pdverify list)")
     run.add_argument("--method", default=None,

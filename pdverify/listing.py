@@ -9,14 +9,23 @@ def _fmt(value) -> str:
     return f"{value:g}" if isinstance(value, float) else str(value)
 
 
+def format_param(p) -> str:
+    """``name=default``, and the allowed values of a choice param: ``plane=strain
+    {strain|stress}``."""
+    text = f"{p.name}={_fmt(p.default)}"
+    if p.choices:
+        text += " {" + "|".join(_fmt(c) for c in p.choices) + "}"
+    return text
+
+
 def format_listing() -> str:
     lines = []
     for scene in all_scenes():
         lines.append(f"{scene.id}  [seed {scene.seed}; reference: {scene.reference}]  {scene.title}")
-        params = ", ".join(f"{p.name}={_fmt(p.default)}" for p in scene.params)
+        params = ", ".join(format_param(p) for p in scene.params)
         lines.append(f"    params: {params}")
         for m in scene.all_methods:
-            extra = ", ".join(f"{p.name}={_fmt(p.default)}" for p in m.params)
+            extra = ", ".join(format_param(p) for p in m.params)
             tag = " (default)" if m.name == scene.default_method else ""
             lines.append(f"    method {m.name}{tag}" + (f"  [{extra}]" if extra else "")
                          + (f"  - {describe(m.name)}" if describe(m.name) else ""))

@@ -42,5 +42,7 @@ PAPERS = {
 
 
 def seed_of(scene_seed: str) -> str:
-    """The paper key of a scene's ``seed`` field, e.g. ``"001 §4.1"`` -> ``"001"``."""
-    return scene_seed.split()[0]
+    """The paper key of a scene's ``seed`` field, e.g. ``"001 §4.1"`` -> ``"001"``; ""
+    for a scene without a seed (e.g. a plugin's or a test's)."""
+    parts = (scene_seed or "").split()
+    return parts[0] if parts else ""

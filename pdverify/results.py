@@ -109,7 +109,9 @@ def machine_info() -> dict:
             "cpus": os.cpu_count()}
 
 
-def document(runs: list[RunResult]) -> dict:
+def document(runs: list[RunResult], extra: dict | None = None) -> dict:
+    """The results document; ``extra``: further top-level sections (e.g. the report's
+    ``convergence`` studies), written after ``runs``."""
     from . import __version__
     return {
         "schema": SCHEMA,
@@ -117,6 +119,7 @@ def document(runs: list[RunResult]) -> dict:
         "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
         "machine": machine_info(),
         "runs": [r.to_json() for r in runs],
+        **{k: _plain(v) for k, v in (extra or {}).items()},
     }
 
 
@@ -148,8 +151,8 @@ def atomic_write_text(path: str | os.PathLike, text: str) -> None:
         raise
 
 
-def write_results(path, runs: list[RunResult]) -> dict:
-    doc = document(runs)
+def write_results(path, runs: list[RunResult], extra: dict | None = None) -> dict:
+    doc = document(runs, extra)
     atomic_write_text(path, json.dumps(doc, indent=1, allow_nan=False) + "\n")
     return doc
 

@@ -14,6 +14,10 @@ def format_metrics(metrics: dict, limit: int = 4) -> str:
     return " ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in items)
 
 
+def _paper_value(value) -> str:
+    return f"{value:.6g}" if isinstance(value, float) else str(value)
+
+
 def run_one(scene_id: str, *, method=None, overrides=None, json_path=None, vtu_path=None,
             stream=None) -> int:
     """``pdverify run``: resolve (exit 2 on bad input), run, print, optionally write JSON."""
@@ -22,11 +26,14 @@ def run_one(scene_id: str, *, method=None, overrides=None, json_path=None, vtu_p
     method = method or scene.default_method
     scene.resolve(method, overrides)  # bad input fails here, before any work
     result = scene.run(method, overrides)
-    print(f"{scene.id} --method {method}: {result.status}"
+    print(f"{scene.id} --method {method} (reference: {scene.reference}): {result.status}"
           + (f" ({result.message})" if result.message else ""), file=stream)
+    paper = scene.published_for(method, result.params)
     for key, value in result.metrics.items():
-        print(f"  {key:24s} {value:.10g}" if isinstance(value, float) else f"  {key:24s} {value}",
-              file=stream)
+        text = f"  {key:24s} {value:.10g}" if isinstance(value, float) else f"  {key:24s} {value}"
+        if key in paper:  # the paper's value for this method and these params
+            text += f"   paper: {_paper_value(paper[key].value)} ({paper[key].source})"
+        print(text, file=stream)
     for text in result.warnings:
         print(f"  warning: {text}", file=stream)
     t = result.timings
@@ -72,12 +79,20 @@ def _failed(case, message) -> RunResult:
 def plan(only=None, quick=False) -> list[tuple[str, str, dict]]:
     """The (scene, method, overrides) cases of a report; validates every case up front."""
     from .scenes import all_scenes
+    from . import convergence
+    from .results import run_key
     scenes = [get_scene(s) for s in only] if only else all_scenes()
-    cases = []
+    cases, seen = [], set()
     for scene in scenes:
         for method, overrides in scene.report_cases(quick=quick):
-            scene.resolve(method, overrides)
+            seen.add(run_key(scene.id, method, scene.resolve(method, overrides)))
             cases.append((scene.id, method, overrides))
+    # the convergence studies' levels, unless a scene case already runs them
+    for scene_id, method, overrides in convergence.cases([s.id for s in scenes], quick):
+        key = run_key(scene_id, method, get_scene(scene_id).resolve(method, overrides))
+        if key not in seen:
+            seen.add(key)
+            cases.append((scene_id, method, overrides))
     return cases
 
 
@@ -128,8 +143,22 @@ def _died(case, exitcode) -> RunResult:
                          "a linear-algebra library, or killed for lack of memory)")
 
 
+def run_line(case, res) -> str:
+    """A finished run's progress line (after ``[done/total] ``): ``scene method params ...
+    status (seconds) metrics``."""
+    params = " ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}"
+                      for k, v in sorted(case[2].items()))
+    status = res.status if res.status == "ok" else f"FAILED: {res.message}"
+    if res.warnings:
+        status += f" ({len(res.warnings)} warning)"
+    return (f"{res.scene} {res.method} {params} ... {status} "
+            f"({res.timings.get('total_s', 0):.2f} s) {format_metrics(res.metrics, 2)}")
+
+
 def run_cases(cases, *, jobs: int = 1, progress=None, client=None) -> list[RunResult]:
-    """Run ``cases`` in ``jobs`` supervised worker processes; one progress line per run.
+    """Run ``cases`` in ``jobs`` supervised worker processes, showing their progress on the
+    stream ``progress`` (:class:`pdverify.progress.RunProgress`: a live display on a
+    terminal, one line per finished run otherwise; None: silent).
 
     With a Dask ``client`` (``report --scheduler``), the cases run as tasks on its
     cluster instead (:mod:`pdverify.cluster`); ``jobs`` is then unused.
@@ -138,35 +167,39 @@ def run_cases(cases, *, jobs: int = 1, progress=None, client=None) -> list[RunRe
     abort, out-of-memory kill) becomes a failed run naming the signal, a new worker takes
     over, and the other runs go on. Results come back in the order of ``cases``.
     """
-    import multiprocessing as mp
-    from multiprocessing.connection import wait
+    from .progress import RunProgress
 
     if jobs < 1:
         raise InputError(f"--jobs={jobs} must be >= 1")
-    total = len(cases)
-    results: list[RunResult | None] = [None] * total
-    done = 0
 
-    def note(k, res):
-        if progress is not None:
-            params = " ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}"
-                              for k, v in sorted(cases[k][2].items()))
-            status = res.status if res.status == "ok" else f"FAILED: {res.message}"
-            if res.warnings:
-                status += f" ({len(res.warnings)} warning)"
-            print(f"[{done}/{total}] {res.scene} {res.method} {params} ... {status} "
-                  f"({res.timings.get('total_s', 0):.2f} s) {format_metrics(res.metrics, 2)}",
-                  file=progress, flush=True)
+    def line(k, res):
+        return run_line(cases[k], res)
 
     if client is not None:
         from .cluster import run_cases_on
+        try:
+            workers = sum(client.nthreads().values())
+        except Exception:  # the count only scales the ETA
+            workers = 1
+        with RunProgress(cases, workers, progress, auto_refresh=True, line=line) as shown:
+            for k in range(len(cases)):
+                shown.started(k, timed=False)   # queued on the cluster
+            return run_cases_on(client, cases, shown.finished)
 
-        def count_and_note(k, res):
-            nonlocal done
-            done += 1
-            note(k, res)
-        return run_cases_on(client, cases, count_and_note)
+    with RunProgress(cases, min(jobs, len(cases)), progress, line=line) as shown:
+        return _run_local(cases, jobs, shown)
 
+
+def _run_local(cases, jobs, shown) -> list[RunResult]:
+    """The supervised local pool of :func:`run_cases`; ``shown`` (a
+    :class:`~pdverify.progress.RunProgress`) hears of every start and finish here, in the
+    main process, and is redrawn every ``shown.tick_s`` while no run finishes."""
+    import multiprocessing as mp
+    from multiprocessing.connection import wait
+
+    total = len(cases)
+    results: list[RunResult | None] = [None] * total
+    done = 0
     ctx = mp.get_context("fork")
     workers = {}          # connection -> [process, index of the case it runs or None]
     pending = list(range(total))
@@ -185,6 +218,7 @@ def run_cases(cases, *, jobs: int = 1, progress=None, client=None) -> list[RunRe
             k = pending.pop(0)
             workers[conn][1] = k
             conn.send(cases[k])
+            shown.started(k)
         else:
             workers[conn][1] = None
 
@@ -195,7 +229,8 @@ def run_cases(cases, *, jobs: int = 1, progress=None, client=None) -> list[RunRe
             give(conn)
         while done < total:
             busy = {c: w for c, w in workers.items() if w[1] is not None}
-            ready = wait(list(busy) + [w[0].sentinel for w in busy.values()])
+            ready = wait(list(busy) + [w[0].sentinel for w in busy.values()],
+                         timeout=shown.tick_s)
             for conn, (proc, k) in list(busy.items()):
                 res = None
                 if conn in ready or proc.sentinel in ready:
@@ -214,8 +249,9 @@ def run_cases(cases, *, jobs: int = 1, progress=None, client=None) -> list[RunRe
                         conn = start()
                     results[k] = res
                     done += 1
-                    note(k, res)
+                    shown.finished(k, res)
                     give(conn)
+            shown.tick()
     finally:
         for conn, (proc, _) in workers.items():
             try:

@@ -27,5 +27,6 @@ def test_ci_runs_the_readme_test_command_verbatim():
 def test_every_dependency_imported_is_declared():
     # a missing install step would pass here (same machine) but fail on a fresh one
     toml = (ROOT / "pyproject.toml").read_text()
-    for pkg in ("numpy", "scipy", "scikit-fem", "meshio", "pyvista", "matplotlib", "sympy"):
+    for pkg in ("numpy", "scipy", "scikit-fem", "meshio", "pyvista", "matplotlib", "sympy",
+                "rich"):
         assert f'"{pkg}' in toml, pkg

@@ -14,6 +14,11 @@ METHODS = {
                           "along the bond direction (bond-based)",
     "virtual-nodes": "seed 003 §4.1.2: buffer layers of thickness delta outside the clamped edges, "
                      "displaced rigidly (bond-based)",
+    "mirror-nodes": "seed 001 §5: a delta-thick fictitious layer whose nodes copy mirror "
+                    "nodes inside the body (odd reflection for Dirichlet components, the "
+                    "traction through the Neumann relation)",
+    "pddo": "seed 001 §5: peridynamic differential operator (moment matrices exact for "
+            "quadratics) for the boundary rows and the equilibrium within 2 delta, LPS beyond",
     "fem": "classical-elasticity FEM reference (reference_fem)",
 }
 

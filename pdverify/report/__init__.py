@@ -11,7 +11,7 @@ import time
 from contextlib import contextmanager
 
 from ..errors import STOP_REQUESTED, InputError
-from ..results import atomic_write_text, umask_mode, write_results
+from ..results import atomic_write_text, run_key, umask_mode, write_results
 from ..runner import plan, run_cases
 from ..scenes import get_scene
 
@@ -104,19 +104,19 @@ def build_report(*, out=None, quick=False, only=None, jobs=1, progress=None,
         client = connect(scheduler)
     try:
         with output_lock(out):
-            return _locked(cases, out, parent, name, jobs, progress, client)
+            return _locked(cases, out, parent, name, jobs, progress, client, quick)
     finally:
         if client is not None:
             client.close()
 
 
-def _locked(cases, out, parent, name, jobs, progress, client) -> int:
+def _locked(cases, out, parent, name, jobs, progress, client, quick=False) -> int:
     """The report's body, under the output lock: stage, build, swap in."""
     _clean_stale(parent, name)
     staging = tempfile.mkdtemp(prefix=f".{name}.staging-", dir=parent)
     os.chmod(staging, umask_mode(0o777))  # mkdtemp gives 0700
     try:
-        code = _build(cases, staging, out, jobs, progress, client)
+        code = _build(cases, staging, out, jobs, progress, client, quick)
         if STOP_REQUESTED["flag"]:  # an interrupt some library swallowed: publish nothing
             raise KeyboardInterrupt
         _swap_in(staging, out)
@@ -137,13 +137,13 @@ def export_fields(results, out) -> None:
         r.files = [os.path.relpath(p, out) for p in write_run_fields(r, stem)]
 
 
-def _build(cases, out, final, jobs, progress, client=None) -> int:
+def _build(cases, out, final, jobs, progress, client=None, quick=False) -> int:
     t0 = time.perf_counter()
     results = run_cases(cases, jobs=jobs, progress=progress, client=client)
     figdir = os.path.join(out, "figures")
     os.makedirs(figdir, exist_ok=True)
     from . import figures, html
-    from .figures import overview
+    from .figures import convergence, overview
     sections = []
     order = []
     for scene_id, _, _ in cases:
@@ -151,7 +151,9 @@ def _build(cases, out, final, jobs, progress, client=None) -> int:
             order.append(scene_id)
     for scene_id in order:
         scene = get_scene(scene_id)
-        mine = [r for r in results if r.scene == scene_id]
+        # the scene's own cases; the convergence studies' extra levels have their section
+        own = {run_key(scene_id, m, scene.resolve(m, o)) for m, o in scene.report_cases(quick)}
+        mine = [r for r in results if r.scene == scene_id and r.key in own]
         try:
             figs = figures.draw(scene, mine, figdir)
         except Exception as exc:  # a broken figure must not lose the numbers
@@ -165,10 +167,23 @@ def _build(cases, out, final, jobs, progress, client=None) -> int:
     except Exception as exc:  # a broken figure must not lose the numbers
         print(f"error-against-cost figures failed: {type(exc).__name__}: {exc}", file=progress)
         front = []
-    doc = write_results(os.path.join(out, "results.json"), results)
+    from ..convergence import collect
+    studies = collect(results, quick)
+    try:
+        conv = convergence.draw(studies, figdir)
+    except Exception as exc:  # a broken figure must not lose the numbers
+        print(f"convergence figures failed: {type(exc).__name__}: {exc}", file=progress)
+        conv = {}
+    sections = [(scene, text + html.convergence_section(
+        [s for s in studies if s["scene"] == scene.id], conv.get(scene.id, [])))
+        for scene, text in sections]
+    doc = write_results(os.path.join(out, "results.json"), results,
+                        {"convergence": studies})
     atomic_write_text(os.path.join(out, "index.html"),
                       html.page(doc, sections, time.perf_counter() - t0, results, front))
     failed = sum(r.status != "ok" for r in results)
+    from .summary import print_summary
+    print_summary(scenes, results, progress)  # one row per scene, before the last line
     print(f"report: {len(results)} runs, {failed} failed, "
           f"{time.perf_counter() - t0:.1f} s -> {os.path.join(final, 'index.html')}",
           file=progress)

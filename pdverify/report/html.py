@@ -109,7 +109,11 @@ def _table(scene, results, metrics, full: bool) -> str:
     return f"<table>{head}{''.join(rows)}</table>"
 
 
-def scene_section(scene, results, figures, deviations=()) -> str:
+def scene_section(scene, results, figures, deviations=None) -> str:
+    """A scene's section; ``deviations``: default those of :mod:`pdverify.deviations`."""
+    if deviations is None:
+        from ..deviations import for_scene
+        deviations = for_scene(scene.id)
     paper = PAPERS.get(seed_of(scene.seed), {})
     cite = (f"{paper['authors']} ({paper['year'] or 'n.d.'})" if paper else "")
     parts = [f'<h2 id="{scene.id}">{html.escape(scene.id)}: {html.escape(scene.title)}</h2>',
@@ -137,6 +141,45 @@ def scene_section(scene, results, figures, deviations=()) -> str:
         parts.append(f'<figure><img src="figures/{name}" style="max-width:100%">'
                      f"<figcaption>{html.escape(caption)}</figcaption></figure>")
     return "\n".join(parts)
+
+
+def convergence_section(studies, figures) -> str:
+    """A scene's convergence studies: one row per method, its rate in each study, the
+    errors of the coarsest and finest levels, the figure beneath."""
+    if not studies:
+        return ""
+    kinds = [k for k in ("delta", "m") if any(s["study"] == k for s in studies)]
+    fixed = {k: next(s["fixed"] for s in studies if s["study"] == k) for k in kinds}
+    head = ("<tr><th class=l>method</th>" + "".join(
+        f"<th>{k}-refinement rate<br><small>fixed {html.escape(fixed[k])}</small></th>"
+        f"<th class=l>errors, coarsest &rarr; finest</th>" for k in kinds) + "</tr>")
+    rows = []
+    for method in dict.fromkeys(s["method"] for s in studies):
+        cells = []
+        for k in kinds:
+            e = next((s for s in studies if s["method"] == method and s["study"] == k), None)
+            if e is None:
+                cells.append("<td></td><td></td>")
+                continue
+            rate = (f"{e['rate']:.2f}" if e["rate"] is not None
+                    else f"<small>{html.escape(e['note'])}</small>")
+            errs = " &rarr; ".join("failed" if lv["error"] is None else f"{lv['error']:.3g}"
+                                   for lv in e["levels"])
+            cells.append(f"<td>{rate}</td><td class=l><small>{errs}</small></td>")
+        rows.append(f"<tr><td class=l>{html.escape(method)}</td>{''.join(cells)}</tr>")
+    levels = "; ".join(
+        f"{k}: " + ", ".join(f"h={lv['h']:.4g} (spacing {lv['spacing']:.4g}, m {lv['m_ratio']:g})"
+                             for lv in next(s for s in studies if s["study"] == k)["levels"])
+        for k in kinds)
+    figs = "".join(f'<figure><img src="figures/{name}" style="max-width:100%">'
+                   f"<figcaption>{html.escape(caption)}</figcaption></figure>"
+                   for name, caption in figures)
+    return (f'<h3 id="{studies[0]["scene"]}-convergence">Convergence of every method</h3>'
+            f"<p><small>Rate p of {html.escape(studies[0]['metric'])} ~ h^p by least squares "
+            f"over the levels ({html.escape(levels)}); h is the horizon for the "
+            "delta-refinement and the grid spacing for the m-refinement. The levels are "
+            "ordinary runs in results.json; the rates are under <code>convergence</code>."
+            f"</small></p><table>{head}{''.join(rows)}</table>{figs}")
 
 
 def _solver_note(diagnostics) -> str:

@@ -40,7 +40,9 @@ def pareto(scenes, results, folder) -> list[tuple[str, str]]:
             by_dim.setdefault(scene.dim or 0, []).append((scene, pts))
     methods = sorted({p[2] for groups in by_dim.values() for _, pts in groups for p in pts},
                      key=lambda m: (m != "none", m))
-    colours = {m: plt.get_cmap("tab20")(k % 20) for k, m in enumerate(methods)}
+    # tab20's dark shades first, then its light ones: neighbours in the list differ
+    colours = {m: plt.get_cmap("tab20")((2 * k) % 20 + (2 * k) // 20 % 2)
+               for k, m in enumerate(methods)}
     out = []
     for dim in sorted(by_dim):
         groups = by_dim[dim]

@@ -1,0 +1,177 @@
+"""The report a researcher reads at a glance: live progress (plain lines off a terminal),
+the end-of-report summary, choices in ``list``, the paper's value in ``run``."""
+import io
+import re
+
+import pytest
+
+from pdverify.cli import main
+from pdverify.progress import RunProgress, clock, is_terminal
+from pdverify.report import build_report
+from pdverify.report.summary import SceneSummary, format_summary, summarise
+from pdverify.results import RunResult
+from pdverify.runner import plan, run_cases
+from pdverify.scenes import get_scene
+
+#: today's line, then the elapsed time and the ETA
+LINE = re.compile(r"^\[(\d+)/(\d+)\] (\S+) (\S+) .*\.\.\. (ok|FAILED: .*) \(\d+\.\d\d s\).*"
+                  r" \| elapsed (\d+:\d\d), ETA (\d+:\d\d|\?)$")
+ANSI = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]")
+
+
+class FakeTTY(io.StringIO):
+    """A stream that says it is a terminal, so the live (rich) display is drawn."""
+
+    def isatty(self):
+        return True
+
+
+def _result(scene, method, total_s, status="ok", message=""):
+    return RunResult(scene=scene, method=method, params={}, reference="analytic",
+                     status=status, message=message, metrics={"rel_l2_error": 0.5},
+                     timings={"setup_s": 0.0, "solve_s": total_s, "total_s": total_s})
+
+
+CASES = [("bar1d-traction", "none", {}), ("bar1d-traction", "taylor-fictitious", {"order": 2}),
+         ("bar1d-traction", "energy", {}), ("bar1d-traction", "volume", {}),
+         ("bar1d-traction", "none", {"spacing": 0.025})]
+
+
+def test_clock():
+    assert [clock(s) for s in (None, 0, 7.4, 754, 3723)] == ["?", "0:00", "0:07", "12:34",
+                                                             "1:02:03"]
+
+
+def test_eta_is_mean_run_time_times_runs_left_over_workers():
+    stream = io.StringIO()
+    with RunProgress(CASES, 2, stream) as shown:
+        assert not shown.live and shown.eta() is None
+        shown.started(0, timed=False)   # its own run time (3 s) stands for its duration
+        shown.finished(0, _result("bar1d-traction", "none", 3.0))
+        assert shown.eta() == pytest.approx(3.0 * 4 / 2)
+        shown.started(1, timed=False)
+        shown.finished(1, _result("bar1d-traction", "taylor-fictitious", 5.0))
+        assert shown.eta() == pytest.approx(4.0 * 3 / 2)
+    lines = stream.getvalue().splitlines()
+    assert lines[0].startswith("[1/5] bar1d-traction none") and lines[0].endswith(", ETA 0:06")
+    assert lines[1].startswith("[2/5] ") and lines[1].endswith(", ETA 0:06")
+    assert all(" | elapsed 0:0" in line for line in lines)
+
+
+def test_plain_lines_off_a_terminal_carry_elapsed_and_eta():
+    stream = io.StringIO()
+    assert not is_terminal(stream)
+    results = run_cases(CASES, jobs=2, progress=stream)
+    assert [r.status for r in results] == ["ok"] * len(CASES)
+    lines = stream.getvalue().splitlines()
+    assert len(lines) == len(CASES)
+    matched = [LINE.match(line) for line in lines]
+    assert all(matched), lines
+    assert [int(m.group(1)) for m in matched] == list(range(1, len(CASES) + 1))
+    assert {int(m.group(2)) for m in matched} == {len(CASES)}
+    assert all(m.group(7) != "?" for m in matched)  # every line follows a finished run
+    assert "\x1b[" not in stream.getvalue()         # no terminal control codes
+    # the format older tools parse: "[k/n] scene method ... ok ("
+    assert all(re.match(r"^\[\d+/\d+\] bar1d-traction \S+ .*\.\.\. ok \(", x) for x in lines)
+
+
+def test_live_display_on_a_terminal_shows_runs_in_flight_and_eta():
+    stream = FakeTTY()
+    assert is_terminal(stream)
+    with RunProgress(CASES, 2, stream) as shown:
+        assert shown.live and shown.tick_s is not None
+        shown.started(0)
+        shown.started(1)
+        shown.tick()
+        first = ANSI.sub("", stream.getvalue())
+        assert "0/5 runs" in first and "ETA ?" in first
+        assert "running bar1d-traction none" in first
+        assert "running bar1d-traction taylor-fictitious order=2" in first
+        shown.in_flight[0] = None       # as if queued on a cluster: its run time counts
+        shown.finished(0, _result("bar1d-traction", "none", 4.0))
+        shown.started(2)
+        shown.tick()
+    text = ANSI.sub("", stream.getvalue())
+    assert "[1/5] bar1d-traction none" in text      # the finished run, above the display
+    assert "1/5 runs" in text and "ETA 0:08" in text  # 4 s x 4 left / 2 workers
+    assert "running bar1d-traction energy" in text
+    assert "\x1b[" in stream.getvalue()             # drawn with terminal control codes
+
+
+def test_live_display_through_the_worker_pool():
+    stream = FakeTTY()
+    results = run_cases(CASES[:3], jobs=2, progress=stream)
+    assert [r.status for r in results] == ["ok"] * 3
+    text = ANSI.sub("", stream.getvalue())
+    assert "3/3 runs" in text and "ETA 0:00" in text and "running bar1d-traction" in text
+    assert text.count("[3/3] ") == 1
+
+
+def test_format_summary_lists_every_scene_with_its_best_method():
+    only = ["bar1d-traction", "sheet2d-clamped"]
+    cases = plan(only=only, quick=True)
+    results = run_cases(cases, jobs=2)
+    summaries = [summarise(get_scene(s), [r for r in results if r.scene == s]) for s in only]
+    text = format_summary(summaries)
+    lines = text.splitlines()
+    assert lines[0].split()[:3] == ["scene", "best", "method"]
+    assert "first failure" not in lines[0]          # no run failed
+    for s in summaries:
+        assert s.best is not None
+        row = next(line for line in lines if line.startswith(s.scene + " "))
+        assert row.split()[1] == s.best
+        assert f"{100 * s.best_error:.3g} %" in row
+        assert row.split()[-2:] == [str(s.runs), "0"]
+    assert [s.best for s in summaries] == ["taylor-fictitious", "energy-directional"]
+
+
+def test_format_summary_shortens_the_first_failure():
+    long = "numerical error: LinAlgError: " + "Singular matrix " * 10
+    text = format_summary([
+        SceneSummary("a-scene", "rel_l2_error", "energy", 0.0123, 1.5, 3, []),
+        SceneSummary("b-scene", "max_error_pct", None, None, None, 2,
+                     [("none", long), ("energy", "second")])])
+    lines = text.splitlines()
+    assert "first failure" in lines[0]
+    a = next(line for line in lines if line.startswith("a-scene"))
+    b = next(line for line in lines if line.startswith("b-scene"))
+    assert "energy" in a and "1.23 %" in a and "1.50 s" in a
+    assert "none: numerical error" in b and b.endswith("...") and "second" not in b
+    assert len(b) < len(long)
+
+
+def test_report_prints_the_summary_before_its_last_line(tmp_path):
+    stream = io.StringIO()
+    assert build_report(out=str(tmp_path / "rep"), quick=True,
+                        only=["bar1d-traction", "sheet2d-clamped"], progress=stream) == 0
+    lines = stream.getvalue().splitlines()
+    assert lines[-1].startswith("report: ")
+    head = next(k for k, line in enumerate(lines) if line.startswith("scene "))
+    rows = lines[head + 1:-1]
+    assert [r.split()[:2] for r in rows] == [["bar1d-traction", "taylor-fictitious"],
+                                             ["sheet2d-clamped", "energy-directional"]]
+    assert all(LINE.match(line) for line in lines[:head])
+
+
+def test_list_shows_the_choices_of_a_choice_param(capsys):
+    assert main(["list"]) == 0
+    out = capsys.readouterr().out
+    assert "plane=strain {strain|stress}" in out
+    assert "end_weight=full {full|half}" in out
+    assert "length=1," in out and "length=1 {" not in out  # no braces without choices
+
+
+@pytest.mark.parametrize("args, reference, metric, paper", [
+    (["sheet2d-clamped", "--method", "none"], "fem", "tensile_stress_mpa",
+     "paper: 4.17 (seed 003 Table 2, row 2)"),
+    (["bar1d-homogenization", "--method", "homogenized"], "analytic", "micromodulus_factor",
+     "paper: 1.067 (seed 004 Table 1, f_1(m))"),
+])
+def test_run_prints_the_reference_and_the_paper_value(args, reference, metric, paper, capsys):
+    assert main(["run", *args]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert f"(reference: {reference}): ok" in lines[0]
+    row = next(line for line in lines if line.split()[0] == metric)
+    assert row.endswith(paper)
+    # a metric the paper does not print has no paper value
+    assert any(line.split()[0] == "rel_l2_error" and "paper" not in line for line in lines)
