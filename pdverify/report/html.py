@@ -235,8 +235,9 @@ def overview(scenes, results) -> str:
     failed runs red with the reason on hover, FEM cells marked as the reference."""
     from ..listing import method_columns
     methods = method_columns(scenes)
-    head = "<tr><th class=l>scene</th><th class=l>error</th>" + "".join(
-        f"<th>{html.escape(m)}</th>" for m in methods) + "</tr>"
+    # method names break at their hyphens so that ~15 columns fit a 1400 px screen
+    head = "<tr><th class=l>scene<br><small>headline error</small></th>" + "".join(
+        f"<th>{html.escape(m).replace('-', '-<wbr>')}</th>" for m in methods) + "</tr>"
     rows = []
     for scene in scenes:
         runs = [r for r in results if r.scene == scene.id]
@@ -253,19 +254,20 @@ def overview(scenes, results) -> str:
             elif r.status != "ok":
                 cells.append(f'<td class="failed" title="{html.escape(r.message)}">failed</td>')
             elif m == "fem":
-                cells.append(f"<td>reference<br><small>{r.timings.get('total_s', 0):.2g} s"
+                cells.append(f'<td title="the scene\'s FEM reference">ref.<br><small>'
+                             f"{r.timings.get('total_s', 0):.2g} s"
                              "</small></td>")
             elif m in values:
                 star = " &#9733;" if m == best else ""
                 pct = metric.endswith("_pct")      # a percentage: coloured as a fraction
                 cells.append(f'<td style="background:{_colour(values[m] / (100 if pct else 1))}" '
                              f'title="{html.escape(_params(r, scene))}">'
-                             f"{_num(float(values[m]))}{' %' if pct else ''}{star}<br><small>"
+                             f"{float(values[m]):.3g}{' %' if pct else ''}{star}<br><small>"
                              f"{r.timings.get('total_s', 0):.2g} s</small></td>")
             else:
                 cells.append("<td>&ndash;</td>")
-        rows.append(f'<tr><td class=l><a href="#{scene.id}">{html.escape(scene.id)}</a></td>'
-                    f"<td class=l><code>{html.escape(metric)}</code></td>{''.join(cells)}</tr>")
+        rows.append(f'<tr><td class=l><a href="#{scene.id}">{html.escape(scene.id)}</a><br>'
+                    f"<small><code>{html.escape(metric)}</code></small></td>{''.join(cells)}</tr>")
     return ("<h3>Overview: error and cost of each method at its default parameters</h3>"
             "<p><small>Each cell: the scene's headline error for the method's run at its "
             "default parameters (green 1e-8 to red 1, log scale), the total time beneath; "
