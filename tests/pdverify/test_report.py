@@ -1,5 +1,6 @@
 """The report: files written, atomic results.json, failures recorded, not fatal."""
 import json
+import os
 
 import pytest
 
@@ -68,3 +69,30 @@ def test_parallel_jobs_give_the_same_numbers(tmp_path):
     ra = json.loads((a / "results.json").read_text())["runs"]
     rb = json.loads((b / "results.json").read_text())["runs"]
     assert [r["metrics"] for r in ra] == [r["metrics"] for r in rb]
+
+
+def test_only_without_out_leaves_the_full_report_untouched(tmp_path):
+    """report --only X (and --quick) without --out write their own folders."""
+    import subprocess
+    import sys
+
+    from pdverify.report import default_out
+    assert default_out() == os.path.join("reports", "latest")
+    assert default_out(quick=True) == os.path.join("reports", "quick")
+    assert default_out(["bar1d-traction"]) == os.path.join("reports", "only-bar1d-traction")
+    two = default_out(["bar1d-traction", "bar1d-sine-load"], quick=True)
+    assert two.startswith(os.path.join("reports", "quick-only-bar1d-traction+1-more-"))
+    # the hash names the set of scenes, whatever their order
+    assert two[-6:] == default_out(["bar1d-sine-load", "bar1d-traction"], quick=True)[-6:]
+    full = tmp_path / "reports" / "latest"
+    full.mkdir(parents=True)
+    (full / "index.html").write_text("the full report")
+    repo = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    env = {**os.environ, "PYTHONPATH": repo + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    proc = subprocess.run([sys.executable, "-m", "pdverify", "report", "--quick", "--only",
+                           "bar1d-traction"], cwd=tmp_path, env=env, capture_output=True,
+                          text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert (full / "index.html").read_text() == "the full report"
+    assert sorted(os.listdir(full)) == ["index.html"]
+    assert (tmp_path / "reports" / "quick-only-bar1d-traction" / "results.json").exists()
