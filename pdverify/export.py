@@ -74,12 +74,13 @@ def meshes(result) -> list[tuple[str, object]]:
     set); [] for a run without node fields."""
     import meshio
     f = result.fields or {}
-    times = f.get("times", f.get("t"))
-    times = times if isinstance(times, np.ndarray) and times.ndim == 1 else None
+    time_key = next((k for k in ("times", "t")
+                     if isinstance(f.get(k), np.ndarray) and f[k].ndim == 1), None)
+    times = f[time_key] if time_key else None
     sets = sorted(k for k in f if (k == "x" or k.startswith("x_"))
                   and isinstance(f[k], np.ndarray) and f[k].ndim in (1, 2)
                   and f[k].dtype.kind == "f")
-    out, used = [], set(sets) | ({"times"} if "times" in f else set())
+    out, used = [], set(sets) | ({time_key} if time_key else set())
     groups = []
     for key in sets:
         suffix = key[1:]                        # '' or '_a'
@@ -87,7 +88,7 @@ def meshes(result) -> list[tuple[str, object]]:
         n = len(x)
         data = {}
         for name, a in f.items():
-            if name in sets or name in ("times", "t"):
+            if name in used:
                 continue
             if suffix and not name.endswith(suffix):
                 continue
@@ -99,8 +100,6 @@ def meshes(result) -> list[tuple[str, object]]:
                 data.update(arrays)
                 used.add(name)
         groups.append((suffix, x, data))
-    if times is not None:
-        used.add("t" if "t" in f and f["t"] is times else "times")
     grid = f.get("grid")
     if isinstance(grid, dict):
         used.add("grid")

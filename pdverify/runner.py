@@ -146,8 +146,8 @@ def _died(case, exitcode) -> RunResult:
 def run_line(case, res) -> str:
     """A finished run's progress line (after ``[done/total] ``): ``scene method params ...
     status (seconds) metrics``."""
-    params = " ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}"
-                      for k, v in sorted(case[2].items()))
+    from .progress import format_overrides
+    params = format_overrides(case[2])
     status = res.status if res.status == "ok" else f"FAILED: {res.message}"
     if res.warnings:
         status += f" ({len(res.warnings)} warning)"

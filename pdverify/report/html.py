@@ -137,9 +137,7 @@ def scene_section(scene, results, figures, deviations=None) -> str:
     if sources:
         parts.append("<p><small>paper values from: " + "; ".join(map(html.escape, sources))
                      + "</small></p>")
-    for name, caption in figures:
-        parts.append(f'<figure><img src="figures/{name}" style="max-width:100%">'
-                     f"<figcaption>{html.escape(caption)}</figcaption></figure>")
+    parts.append(figure_list(figures))
     return "\n".join(parts)
 
 
@@ -171,15 +169,20 @@ def convergence_section(studies, figures) -> str:
         f"{k}: " + ", ".join(f"h={lv['h']:.4g} (spacing {lv['spacing']:.4g}, m {lv['m_ratio']:g})"
                              for lv in next(s for s in studies if s["study"] == k)["levels"])
         for k in kinds)
-    figs = "".join(f'<figure><img src="figures/{name}" style="max-width:100%">'
-                   f"<figcaption>{html.escape(caption)}</figcaption></figure>"
-                   for name, caption in figures)
+    figs = figure_list(figures)
     return (f'<h3 id="{studies[0]["scene"]}-convergence">Convergence of every method</h3>'
             f"<p><small>Rate p of {html.escape(studies[0]['metric'])} ~ h^p by least squares "
             f"over the levels ({html.escape(levels)}); h is the horizon for the "
             "delta-refinement and the grid spacing for the m-refinement. The levels are "
             "ordinary runs in results.json; the rates are under <code>convergence</code>."
             f"</small></p><table>{head}{''.join(rows)}</table>{figs}")
+
+
+def figure_list(figures) -> str:
+    """``(file, caption)`` pairs of ``figures/`` as HTML figures."""
+    return "".join(f'<figure><img src="figures/{name}" style="max-width:100%">'
+                   f"<figcaption>{html.escape(caption)}</figcaption></figure>"
+                   for name, caption in figures)
 
 
 def _solver_note(diagnostics) -> str:
@@ -303,9 +306,7 @@ def page(doc: dict, sections: list[tuple], total_time: float, results=None,
     legend = "".join(f"<li><code>{html.escape(m)}</code>: {html.escape(describe(m))}</li>"
                      for m in methods)
     body = "\n".join(text for _, text in sections)
-    figs = "".join(f'<figure><img src="figures/{name}" style="max-width:100%">'
-                   f"<figcaption>{html.escape(caption)}</figcaption></figure>"
-                   for name, caption in front_figures)
+    figs = figure_list(front_figures)
     return f"""<!doctype html><html><head><meta charset="utf-8"><title>pdverify report</title>
 <style>{CSS}</style></head><body>
 <h1>pdverify report</h1>

@@ -48,11 +48,7 @@ class SceneSummary:
 
 
 def summarise(scene, runs) -> SceneSummary:
-    methods = []
-    for r in runs:
-        if r.method not in methods:
-            methods.append(r.method)
-    picked = {m: default_run(scene, m, runs) for m in methods}
+    picked = {m: default_run(scene, m, runs) for m in dict.fromkeys(r.method for r in runs)}
     values = {m: headline_value(scene, r) for m, r in picked.items() if r is not None}
     values = {m: v for m, v in values.items() if v is not None}
     best = min(values, key=values.get) if len(values) > 1 else None

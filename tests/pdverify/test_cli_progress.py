@@ -48,6 +48,7 @@ def test_eta_is_mean_run_time_times_runs_left_over_workers():
         assert not shown.live and shown.eta() is None
         shown.started(0, timed=False)   # its own run time (3 s) stands for its duration
         shown.finished(0, _result("bar1d-traction", "none", 3.0))
+        # the ETA formula in floats: pytest.approx's default rel 1e-6 covers its rounding
         assert shown.eta() == pytest.approx(3.0 * 4 / 2)
         shown.started(1, timed=False)
         shown.finished(1, _result("bar1d-traction", "taylor-fictitious", 5.0))

@@ -23,11 +23,8 @@ MM = 1e3  # displacements are in m, shown in mm
 
 def _cell_values(f, values):
     """Nodal values as cell data of the box's ImageData (x fastest, VTK's order)."""
-    idx = np.rint((f["x"] - f["origin"]) / f["spacing"] - 0.5).astype(int)
-    shape = tuple(int(n) for n in f["cells"])
-    out = np.full(shape, np.nan)
-    out[tuple(idx.T)] = values
-    return out.ravel(order="F")
+    from .surface_nodes import _grid_values
+    return _grid_values(f, values).ravel(order="F")
 
 
 def default_runs(scene, results):
