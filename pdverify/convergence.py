@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -43,37 +44,88 @@ EXACT = 1e-10
 
 @dataclass(frozen=True)
 class Study:
+    """One refinement of one scene: ``levels`` are parameter overrides, coarsest first;
+    ``h_of`` maps a level to the refined length h (the horizon for a delta-refinement,
+    the spacing for an m-refinement, or those over the body's size where the scene is
+    given in relative terms); ``fixed`` says what stays fixed, ``h_label`` names h."""
     scene: str
     kind: str                  # "delta" (fixed m) or "m" (fixed delta)
     levels: tuple              # overrides per level, coarsest first
+    h_of: Callable[[dict], float]
+    fixed: str
+    h_label: str
     metric: str = "rel_l2_error"
 
-    @property
-    def fixed(self) -> str:
-        first = self.levels[0]
-        if self.kind == "delta":
-            return f"m = {first['m_ratio']:g}"
-        return f"delta = {first['m_ratio'] * first['spacing']:g}"
-
     def h(self, level: dict) -> float:
-        """The refined length: the horizon (delta-refinement) or the spacing (m)."""
-        return level["spacing"] * (level["m_ratio"] if self.kind == "delta" else 1.0)
+        return float(self.h_of(level))
 
     def used_levels(self, quick: bool) -> tuple:
         return self.levels[:2] if quick else self.levels
 
 
-def _lv(spacing, m):
-    return {"spacing": spacing, "m_ratio": float(m)}
+def _mratio(scene, kind, levels):
+    """Levels given as spacing and m_ratio (delta = m_ratio x spacing)."""
+    lv = tuple({"spacing": h, "m_ratio": float(m)} for h, m in levels)
+    if kind == "delta":
+        return Study(scene, kind, lv, lambda p: p["spacing"] * p["m_ratio"],
+                     f"m = {lv[0]['m_ratio']:g}", "horizon delta [m]")
+    return Study(scene, kind, lv, lambda p: p["spacing"],
+                 f"delta = {lv[0]['spacing'] * lv[0]['m_ratio']:g}", "grid spacing Delta [m]")
+
+
+def _sheet(kind, levels):
+    """sheet2d-tension: the spacing and the horizon are parameters, the sheet is fixed."""
+    lv = tuple({"spacing": h, "horizon": d} for h, d in levels)
+    if kind == "delta":
+        return Study("sheet2d-tension", kind, lv, lambda p: p["horizon"],
+                     f"m = {lv[0]['horizon'] / lv[0]['spacing']:g}", "horizon delta [m]")
+    return Study("sheet2d-tension", kind, lv, lambda p: p["spacing"],
+                 f"delta = {lv[0]['horizon']:g}", "grid spacing Delta [m]")
+
+
+def _clamped(kind, levels):
+    """sheet2d-clamped: the side is side_factor x delta and the load a strain, so the
+    relative errors depend only on delta / L = 1 / side_factor and m; a delta-refinement
+    at a fixed sheet is a growing side_factor."""
+    lv = tuple({"side_factor": float(s), "m_ratio": float(m)} for s, m in levels)
+    if kind == "delta":
+        return Study("sheet2d-clamped", kind, lv, lambda p: 1.0 / p["side_factor"],
+                     f"m = {lv[0]['m_ratio']:g}", "delta / L (side L)")
+    return Study("sheet2d-clamped", kind, lv,
+                 lambda p: 1.0 / (p["side_factor"] * p["m_ratio"]),
+                 f"delta / L = 1/{lv[0]['side_factor']:g}", "Delta / L (side L)")
+
+
+def _vibration(kind, levels):
+    """bar1d-vibration: N points on L = 1 (spacing 1 / (N - 1)), delta = ratio x spacing."""
+    lv = tuple({"nodes": int(n), "horizon_ratio": float(r)} for n, r in levels)
+    if kind == "delta":
+        return Study("bar1d-vibration", kind, lv,
+                     lambda p: p["horizon_ratio"] / (p["nodes"] - 1),
+                     f"delta / Delta = {lv[0]['horizon_ratio']:g}", "horizon delta [m]")
+    return Study("bar1d-vibration", kind, lv, lambda p: 1.0 / (p["nodes"] - 1),
+                 f"delta = {lv[0]['horizon_ratio'] / (lv[0]['nodes'] - 1):g}",
+                 "grid spacing Delta [m]")
 
 
 STUDIES = (
-    Study("bar1d-sine-load", "delta", tuple(_lv(h, 3) for h in (0.1, 0.05, 0.025, 0.0125))),
-    Study("bar1d-sine-load", "m", tuple(_lv(0.15 / m, m) for m in (3, 6, 12, 24))),
-    Study("plate2d-plane-strain", "delta", tuple(_lv(h, 3) for h in (0.1, 0.05, 0.025, 0.0125))),
-    Study("plate2d-plane-strain", "m", tuple(_lv(0.2 / m, m) for m in (2, 4, 8))),
-    Study("body3d-manufactured", "delta", tuple(_lv(h, 3) for h in (0.1, 0.0625, 0.05))),
-    Study("body3d-manufactured", "m", tuple(_lv(1 / (6 * m), m) for m in (2, 3))),
+    _mratio("bar1d-sine-load", "delta", [(h, 3) for h in (0.1, 0.05, 0.025, 0.0125)]),
+    _mratio("bar1d-sine-load", "m", [(0.15 / m, m) for m in (3, 6, 12, 24)]),
+    # seed 004: the homogenised bond bar; free-end history against Rao's series
+    _vibration("delta", [(n, 4) for n in (26, 51, 101, 201)]),
+    _vibration("m", [(int(12.5 * r) + 1, r) for r in (2, 4, 8, 16)]),   # delta = 0.08
+    # seed 003: bond-based sheets (the directional, energy, volume, perifit corrections)
+    _sheet("delta", [(d / 4, d) for d in (0.01, 0.005, 0.0025)]),   # even spacings a side
+    _sheet("m", [(0.005 / m, 0.005) for m in (2, 4, 8)]),
+    _clamped("delta", [(s, 6) for s in (4, 8, 12)]),   # 16: 10 s a run
+    _clamped("m", [(4, m) for m in (3, 6, 12)]),
+    # seed 000 §6: the scene's own sweeps (same levels, so no extra runs in a full report)
+    _mratio("plate2d-clamped", "delta", [(h, 3) for h in (0.2, 0.1, 0.05)]),
+    _mratio("plate2d-clamped", "m", [(0.2 / m, m) for m in (2, 3, 4)]),
+    _mratio("plate2d-plane-strain", "delta", [(h, 3) for h in (0.1, 0.05, 0.025, 0.0125)]),
+    _mratio("plate2d-plane-strain", "m", [(0.2 / m, m) for m in (2, 4, 8)]),
+    _mratio("body3d-manufactured", "delta", [(h, 3) for h in (0.1, 0.0625, 0.05)]),
+    _mratio("body3d-manufactured", "m", [(1 / (6 * m), m) for m in (2, 3)]),
 )
 
 
@@ -139,14 +191,18 @@ def collect(results, quick: bool = False) -> list[dict]:
             else:
                 rate = fit_rate([lv["h"] for lv in levels], errs)
             out.append({"scene": st.scene, "dim": scene.dim, "study": st.kind,
-                        "fixed": st.fixed, "h": "delta" if st.kind == "delta" else "spacing",
+                        "fixed": st.fixed, "h": st.h_label,
                         "metric": st.metric, "method": method, "rate": rate, "note": note,
                         "levels": levels})
     return out
 
 
+#: the keys of a collected level that are results, not the level's parameters
+LEVEL_RESULTS = ("h", "error", "status", "total_s")
+
+
 def key(entry: dict) -> tuple:
     """Identity of a study entry across result files."""
     return entry["scene"], entry["study"], entry["method"], json.dumps(
-        [{k: v for k, v in lv.items() if k in ("spacing", "m_ratio")} for lv in entry["levels"]],
+        [{k: v for k, v in lv.items() if k not in LEVEL_RESULTS} for lv in entry["levels"]],
         sort_keys=True)

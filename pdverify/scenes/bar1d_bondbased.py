@@ -216,6 +216,34 @@ def _table12_published(key, cell: Table12Cell) -> Published:
                             "micromodulus": "triangular", "calibration": "discrete"})
 
 
+#: Seed 004 Tables 6, 7 and 11 as printed: the factor on the bond (1, 1 + k), k = 1, 2, ...
+#: (alpha, beta, gamma, ...), by horizon ratio; (table, end weight, {ratio: factors}).
+FACTOR_TABLES = (
+    (6, "half", {2.0: ("2",), 3.0: ("3", "2"), 4.0: ("4", "3", "2"), 5.0: ("5", "4", "3", "2")}),
+    (7, "full", {3.0: ("3/2", "1"), 4.0: ("2", "3/2", "1"), 5.0: ("5/2", "2", "3/2", "1")}),
+    (11, "full", {2.5: ("4/3",), 3.5: ("9/5", "4/3"), 4.5: ("16/7", "9/5", "4/3"),
+                  5.5: ("25/9", "16/7", "9/5", "4/3")}),
+)
+#: Seed 004 Table 14 as printed: C of the end equations' right-hand side b_1 / (c1 A) =
+#: C sigma Delta / E (App. 1, Eq. A1.7), by (horizon ratio, end weight); (2, full): "-".
+TABLE14 = {(2.0, "half"): "1", (3.0, "half"): "8/3", (4.0, "half"): "5",
+           (2.5, "half"): "2", (3.5, "half"): "4", (4.5, "half"): "20/3",
+           (3.0, "full"): "4/3", (4.0, "full"): "5/2",
+           (2.5, "full"): "1", (3.5, "full"): "2", (4.5, "full"): "10/3"}
+#: the adjusted bonds reported as metrics (the tables print at most four)
+FACTOR_METRICS = 4
+
+
+def _factor_tables():
+    for table, weight, rows in FACTOR_TABLES:
+        for ratio, factors in rows.items():
+            for k, value in enumerate(factors, start=1):
+                yield Published(f"end_factor_{k}", value, f"seed 004 Table {table}",
+                                method=HOMOGENIZED.name,
+                                where={"horizon_ratio": ratio, "end_weight": weight,
+                                       "micromodulus": "triangular"})
+
+
 def _micromodulus_table(ratio, value, table):
     return Published("micromodulus_factor", value, f"seed 004 Table {table}, f_1(m)",
                      where={"horizon_ratio": ratio, "micromodulus": "triangular"})
@@ -240,7 +268,10 @@ class Homogenization(BondBarScene):
 
     Metrics: ``strain_factor`` f(N) = (u_N - u_1) E / ((N - 1) Delta sigma), the strain
     between the end points over sigma/E (Table 12; f = 1 for the classical bar);
-    ``micromodulus_factor`` c1(m)/c_inf (Eqs. 27/31, Tables 1-2); ``max_error_pct``
+    ``micromodulus_factor`` c1(m)/c_inf (Eqs. 27/31, Tables 1-2); ``end_load_C`` the
+    coefficient C of the end equations' right-hand side (App. 1, Table 14);
+    ``end_factor_k`` the homogenising factor on the bond (1, 1 + k), k <= 4 (Tables 6, 7,
+    11; homogenized only); ``max_error_pct``
     max |u - u_cl| / max |u_cl| in percent and ``rel_l2_error``, with u_cl = sigma/E
     (x - x_centre).
 
@@ -272,6 +303,10 @@ class Homogenization(BondBarScene):
            (32, "1.001"))),
         *(_micromodulus_table(m + 0.5, v, 2) for m, v in
           ((2, "1.042"), (3, "1.021"), (4, "1.0125"), (5, "1.0083"), (15, "1.001"))),
+        *_factor_tables(),
+        *(Published("end_load_C", v, "seed 004 Table 14",
+                    where={"horizon_ratio": r, "end_weight": w, "micromodulus": "triangular",
+                           "calibration": "discrete"}) for (r, w), v in TABLE14.items()),
     )
 
     table12 = TABLE12
@@ -287,6 +322,17 @@ class Homogenization(BondBarScene):
                 out.append((method, {**params, "nodes": 2 * int(ratio) + 1}))
             if not quick:
                 out.append((HOMOGENIZED.name, {**params, "nodes": 1001}))
+        # the rest of Tables 6, 7, 11 (m = 5) and Table 14 (half weight between elements,
+        # uncorrected: homogenisation has no factors there)
+        for _table, weight, rows in FACTOR_TABLES:
+            for ratio in rows:
+                if (ratio, weight) not in cells:
+                    out.append((HOMOGENIZED.name, {"horizon_ratio": ratio, "end_weight": weight,
+                                                   "nodes": 2 * int(ratio) + 1}))
+        for ratio, weight in TABLE14:
+            if (ratio, weight) not in cells:
+                out.append((NONE.name, {"horizon_ratio": ratio, "end_weight": weight,
+                                        "nodes": 2 * int(ratio) + 1}))
         if not quick:
             for ratio in (6.0, 8.0, 6.5, 8.5):
                 out.append((HOMOGENIZED.name, {"horizon_ratio": ratio, "nodes": 1001}))
@@ -316,6 +362,13 @@ class Homogenization(BondBarScene):
                                                        p["micromodulus"]),
             "max_error_pct": max_error_of_peak_pct(u, u_cl),
             "rel_l2_error": rel_l2_error(u, u_cl),
+            # Table 14: b_1 / (c1 A) = C sigma Delta / E with b_1 = sigma / (w Delta) on an
+            # end element of weight w, so C = E / (c1 A Delta^2 w): a check on c1
+            "end_load_C": bar.E / (bar.c1 * bar.area * bar.spacing ** 2
+                                   * (0.5 if p["end_weight"] == "half" else 1.0)),
+            # Tables 6, 7, 11: the factor on the bond (1, 1 + k)
+            **{f"end_factor_{k}": a for k, a in
+               enumerate(bar.end_factors[:FACTOR_METRICS], start=1)},
         }
         fields = {"x": x, "u": u, "u_ref": u_cl, "sweep_nodes": sweep_n, "sweep_f": sweep_f}
         return Outcome(metrics=metrics, size=bar.size(), fields=fields,

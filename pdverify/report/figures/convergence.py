@@ -29,14 +29,14 @@ def draw(studies, folder) -> dict:
                 if pts:
                     ax.loglog(*zip(*pts), "o-", ms=4, label=_legend(e))
             fixed = entries[0]["fixed"]
-            ax.set_xlabel("horizon delta [m]" if kind == "delta" else "grid spacing Delta [m]")
+            ax.set_xlabel(entries[0]["h"])
             ax.set_ylabel(entries[0]["metric"])
             ax.set_title(f"{'delta' if kind == 'delta' else 'm'}-refinement at fixed {fixed}",
                          fontsize=10)
             ax.grid(True, which="both", alpha=0.3)
             ax.legend(fontsize=7)
         fig.suptitle(f"{scene}: convergence of every method", fontsize=11)
-        name = save(fig, folder, f"{scene}-convergence.png")
+        name = save(fig, folder, f"{scene}-convergence-studies.png")
         out[scene] = [(name, f"{scene}: error against the refined length, one line per "
                              "method, the least-squares rate p of error ~ h^p in the legend "
                              "(or why there is none: exact at every level, a failed level). "

@@ -1,4 +1,5 @@
-"""Figures of seed 003 §4.1: Fig. 2 error maps, m-convergence, Fig. 3 energy density maps."""
+"""Figures of seed 003 §4.1: Fig. 2 error maps, Fig. 3 energy density maps (the sheets'
+convergence is drawn with every other study, :mod:`.convergence`)."""
 from __future__ import annotations
 
 import matplotlib.pyplot as plt
@@ -28,8 +29,7 @@ def _tension(scene, runs, folder):
     pick = {r.method: r for r in runs if _is_default(r) and r.params["spacing"] == 0.001}
     if {"none", "energy-directional"} <= pick.keys():
         fig, axes = plt.subplots(1, 4, figsize=(15, 5.2), layout="constrained")
-        cmap = plt.get_cmap("viridis").copy()
-        cmap.set_bad("black")
+        cmap = plt.get_cmap("viridis").with_extremes(bad="black")
         panels = [("none", 1, "(a)"), ("energy-directional", 1, "(b)"), ("none", 0, "(c)"),
                   ("energy-directional", 0, "(d)")]
         for ax, (method, k, tag) in zip(axes, panels):
@@ -47,25 +47,6 @@ def _tension(scene, runs, folder):
                     "Fig. 2 of seed 003: relative nodal errors against the closed form with the "
                     "lattice's bulk moduli, uncorrected and corrected, u_y (a, b) and u_x (c, d); "
                     "black: symmetry lines, where both displacements vanish (undefined). Log scale."))
-    sweep = [r for r in runs if _is_default(r)]
-    fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    for method, marker in (("none", "s"), ("energy-directional", "o")):
-        rs = sorted((r for r in sweep if r.method == method),
-                    key=lambda r: r.params["horizon"] / r.params["spacing"])
-        if len(rs) < 2:
-            continue
-        m = np.array([r.params["horizon"] / r.params["spacing"] for r in rs])
-        e = np.array([r.metrics["rel_l2_error"] for r in rs])
-        slope = np.polyfit(np.log(m), np.log(e), 1)[0]
-        ax.loglog(m, e * 100, marker + "-", label=f"{method} (fitted slope {slope:.2f})")
-    ax.set_xlabel("m = delta / Delta (delta = 5 mm fixed)")
-    ax.set_ylabel("rel. L2 error vs closed form [%]")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    ax.set_title("m-convergence of the tension sheet")
-    out.append((save(fig, folder, f"{scene.id}-m-convergence.png"),
-                "m-convergence at fixed delta: relative L2 error against the closed form with "
-                "the discretisation's bulk moduli, fitted log-log slope in the legend."))
     return out
 
 
