@@ -137,9 +137,23 @@ def export_fields(results, out) -> None:
         r.files = [os.path.relpath(p, out) for p in write_run_fields(r, stem)]
 
 
+class _Phases(dict):
+    """Wall time of each phase of the report, seconds by name (summed over re-entries)."""
+
+    @contextmanager
+    def __call__(self, name):
+        t0 = time.perf_counter()
+        try:
+            yield
+        finally:
+            self[name] = self.get(name, 0.0) + time.perf_counter() - t0
+
+
 def _build(cases, out, final, jobs, progress, client=None, quick=False) -> int:
     t0 = time.perf_counter()
-    results = run_cases(cases, jobs=jobs, progress=progress, client=client)
+    phase = _Phases()
+    with phase("runs_s"):
+        results = run_cases(cases, jobs=jobs, progress=progress, client=client)
     figdir = os.path.join(out, "figures")
     os.makedirs(figdir, exist_ok=True)
     from . import figures, html
@@ -154,33 +168,42 @@ def _build(cases, out, final, jobs, progress, client=None, quick=False) -> int:
         # the scene's own cases; the convergence studies' extra levels have their section
         own = {run_key(scene_id, m, scene.resolve(m, o)) for m, o in scene.report_cases(quick)}
         mine = [r for r in results if r.scene == scene_id and r.key in own]
-        try:
-            figs = figures.draw(scene, mine, figdir)
-        except Exception as exc:  # a broken figure must not lose the numbers
-            print(f"figure for {scene_id} failed: {type(exc).__name__}: {exc}", file=progress)
-            figs = []
-        sections.append((scene, html.scene_section(scene, mine, figs)))
-    export_fields(results, out)
+        with phase("figures_s"):
+            try:
+                figs = figures.draw(scene, mine, figdir)
+            except Exception as exc:  # a broken figure must not lose the numbers
+                print(f"figure for {scene_id} failed: {type(exc).__name__}: {exc}",
+                      file=progress)
+                figs = []
+        with phase("pages_s"):
+            sections.append((scene, html.scene_section(scene, mine, figs)))
+    with phase("fields_s"):
+        export_fields(results, out)
     scenes = [scene for scene, _ in sections]
-    try:
-        front = overview.pareto(scenes, results, figdir)
-    except Exception as exc:  # a broken figure must not lose the numbers
-        print(f"error-against-cost figures failed: {type(exc).__name__}: {exc}", file=progress)
-        front = []
     from ..convergence import collect
     studies = collect(results, quick)
-    try:
-        conv = convergence.draw(studies, figdir)
-    except Exception as exc:  # a broken figure must not lose the numbers
-        print(f"convergence figures failed: {type(exc).__name__}: {exc}", file=progress)
-        conv = {}
-    sections = [(scene, text + html.convergence_section(
-        [s for s in studies if s["scene"] == scene.id], conv.get(scene.id, [])))
-        for scene, text in sections]
-    doc = write_results(os.path.join(out, "results.json"), results,
-                        {"convergence": studies})
-    atomic_write_text(os.path.join(out, "index.html"),
-                      html.page(doc, sections, time.perf_counter() - t0, results, front))
+    with phase("figures_s"):
+        try:
+            front = overview.pareto(scenes, results, figdir)
+        except Exception as exc:  # a broken figure must not lose the numbers
+            print(f"error-against-cost figures failed: {type(exc).__name__}: {exc}",
+                  file=progress)
+            front = []
+        try:
+            conv = convergence.draw(studies, figdir)
+        except Exception as exc:  # a broken figure must not lose the numbers
+            print(f"convergence figures failed: {type(exc).__name__}: {exc}", file=progress)
+            conv = {}
+    with phase("pages_s"):
+        sections = [(scene, text + html.convergence_section(
+            [s for s in studies if s["scene"] == scene.id], conv.get(scene.id, [])))
+            for scene, text in sections]
+        # the phases so far; the page and results.json themselves take a few ms
+        phases = {**phase, "total_s": time.perf_counter() - t0}
+        doc = write_results(os.path.join(out, "results.json"), results,
+                            {"convergence": studies, "report_phases": phases})
+        atomic_write_text(os.path.join(out, "index.html"),
+                          html.page(doc, sections, time.perf_counter() - t0, results, front))
     failed = sum(r.status != "ok" for r in results)
     from .summary import print_summary
     print_summary(scenes, results, progress)  # one row per scene, before the last line

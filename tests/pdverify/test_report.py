@@ -20,6 +20,13 @@ def test_quick_report_writes_results_html_and_figures(tmp_path, capsys):
     assert "bar1d-traction" in html and "paper:" in html
     pngs = list((out / "figures").glob("*.png"))
     assert len(pngs) >= 2
+    # where the time went: each phase measured, their sum within the total (the phases
+    # are disjoint intervals of it), the runs' share shown in the header
+    phases = doc["report_phases"]
+    assert set(phases) == {"runs_s", "figures_s", "fields_s", "pages_s", "total_s"}
+    assert all(v >= 0 for v in phases.values())
+    assert sum(v for k, v in phases.items() if k != "total_s") <= phases["total_s"]
+    assert f"runs {phases['runs_s']:.1f} s, figures {phases['figures_s']:.1f} s" in html
     # one progress line per run
     err = capsys.readouterr().err
     assert err.count("] bar1d-") == len(doc["runs"])
