@@ -149,6 +149,16 @@ class _Phases(dict):
             self[name] = self.get(name, 0.0) + time.perf_counter() - t0
 
 
+def _drawn(what, draw, args, empty, progress):
+    """``draw(*args)``, or ``empty`` and a note if it raises: a broken figure must not
+    lose the numbers."""
+    try:
+        return draw(*args)
+    except Exception as exc:
+        print(f"{what} failed: {type(exc).__name__}: {exc}", file=progress)
+        return empty
+
+
 def _build(cases, out, final, jobs, progress, client=None, quick=False) -> int:
     t0 = time.perf_counter()
     phase = _Phases()
@@ -169,12 +179,8 @@ def _build(cases, out, final, jobs, progress, client=None, quick=False) -> int:
         own = {run_key(scene_id, m, scene.resolve(m, o)) for m, o in scene.report_cases(quick)}
         mine = [r for r in results if r.scene == scene_id and r.key in own]
         with phase("figures_s"):
-            try:
-                figs = figures.draw(scene, mine, figdir)
-            except Exception as exc:  # a broken figure must not lose the numbers
-                print(f"figure for {scene_id} failed: {type(exc).__name__}: {exc}",
-                      file=progress)
-                figs = []
+            figs = _drawn(f"figure for {scene_id}", figures.draw, (scene, mine, figdir), [],
+                          progress)
         with phase("pages_s"):
             sections.append((scene, html.scene_section(scene, mine, figs)))
     with phase("fields_s"):
@@ -183,17 +189,9 @@ def _build(cases, out, final, jobs, progress, client=None, quick=False) -> int:
     from ..convergence import collect
     studies = collect(results, quick)
     with phase("figures_s"):
-        try:
-            front = overview.pareto(scenes, results, figdir)
-        except Exception as exc:  # a broken figure must not lose the numbers
-            print(f"error-against-cost figures failed: {type(exc).__name__}: {exc}",
-                  file=progress)
-            front = []
-        try:
-            conv = convergence.draw(studies, figdir)
-        except Exception as exc:  # a broken figure must not lose the numbers
-            print(f"convergence figures failed: {type(exc).__name__}: {exc}", file=progress)
-            conv = {}
+        front = _drawn("error-against-cost figures", overview.pareto,
+                       (scenes, results, figdir), [], progress)
+        conv = _drawn("convergence figures", convergence.draw, (studies, figdir), {}, progress)
     with phase("pages_s"):
         sections = [(scene, text + html.convergence_section(
             [s for s in studies if s["scene"] == scene.id], conv.get(scene.id, [])))

@@ -103,3 +103,24 @@ def test_only_without_out_leaves_the_full_report_untouched(tmp_path):
     assert (full / "index.html").read_text() == "the full report"
     assert sorted(os.listdir(full)) == ["index.html"]
     assert (tmp_path / "reports" / "quick-only-bar1d-traction" / "results.json").exists()
+
+
+def test_a_broken_figure_keeps_the_numbers(tmp_path, monkeypatch, capsys):
+    """Every figure step that raises costs only its figures: results.json and index.html
+    are written and the failure is named on the progress stream."""
+    from pdverify.report import figures
+    from pdverify.report.figures import convergence, overview
+
+    def broken(*args):
+        raise RuntimeError("no ink")
+    for module, name in ((figures, "draw"), (overview, "pareto"), (convergence, "draw")):
+        monkeypatch.setattr(module, name, broken)
+    out = tmp_path / "rep"
+    assert build_report(out=str(out), quick=True, only=["bar1d-sine-load"]) == 0
+    doc = json.loads((out / "results.json").read_text())
+    assert doc["runs"] and doc["convergence"]
+    assert "bar1d-sine-load" in (out / "index.html").read_text()
+    err = capsys.readouterr().err
+    for what in ("figure for bar1d-sine-load", "error-against-cost figures",
+                 "convergence figures"):
+        assert f"{what} failed: RuntimeError: no ink" in err
