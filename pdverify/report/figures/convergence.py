@@ -4,6 +4,7 @@ rate of each method in the legend."""
 from __future__ import annotations
 
 import matplotlib.pyplot as plt
+from matplotlib.ticker import NullFormatter
 
 from . import save
 
@@ -28,6 +29,11 @@ def draw(studies, folder) -> dict:
                        if lv["error"] is not None]
                 if pts:
                     ax.loglog(*zip(*pts), "o-", ms=4, label=_legend(e))
+            # ticks at the levels only: log axes within a decade otherwise label every
+            # minor tick and the labels run into each other
+            hs = sorted({lv["h"] for e in entries for lv in e["levels"]})
+            ax.xaxis.set_minor_formatter(NullFormatter())
+            ax.set_xticks(hs, [f"{h:.3g}" for h in hs])
             fixed = entries[0]["fixed"]
             ax.set_xlabel(entries[0]["h"])
             ax.set_ylabel(entries[0]["metric"])
