@@ -23,6 +23,10 @@ def _strip(doc):
     for key in ("created", "machine"):
         doc.pop(key)
     doc["runs"] = [{k: v for k, v in r.items() if k != "timings"} for r in doc["runs"]]
+    doc.pop("report_phases")          # times
+    doc["convergence"] = [{**e, "levels": [{k: v for k, v in lv.items() if k != "total_s"}
+                                           for lv in e["levels"]]}
+                          for e in doc["convergence"]]
     return doc
 
 
