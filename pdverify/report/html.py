@@ -79,6 +79,11 @@ def _solver(diagnostics) -> dict | None:
     return {"tag": tag, "full": solver}
 
 
+def _solver_note(diagnostics) -> Markup:
+    """The solver tag as the tables show it (under a solve time; empty without a solver)."""
+    return _ENV.get_template("macros.html").module.solver_note(_solver(diagnostics))
+
+
 def _row(scene, r, metrics) -> dict:
     """What the compact and the full table show of one run."""
     t = r.timings
