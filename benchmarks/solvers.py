@@ -18,7 +18,10 @@ extra ``bench``); without it those rows are skipped. Cases:
   >= 8x PARDISO's factor-and-solve, >= 200x scipy's default, residual <= 1e-10.
 - ``plate``: the seed-001 plane-strain plate at h = 0.01 (20,800 displacement unknowns).
   Today's direct solve of K (SuperLU, COLAMD) against ours (the augmented system under
-  nested dissection), and PARDISO on both matrices. Budget: >= 1x PARDISO, >= 10x today.
+  nested dissection: float32 LU, two halves in parallel, refined in float64), and PARDISO
+  on both matrices. Budget: >= 1x PARDISO, >= 10x today. Ours is also compared (untimed)
+  with the same ordering's float64 LU, the path before the mixed precision; ``--with-double``
+  times that path as well.
 - ``body3d``: body3d-traction, surface nodes, h = 0.1 and 0.05: today's dense LU against
   nested dissection and PARDISO; the fitted time exponent over the sizes run.
 """
@@ -39,6 +42,7 @@ from pdverify.pd.influence import bond_micromodulus
 from pdverify.scenes import get_scene
 from pdverify.solvers.dense import eliminate_dirichlet, solve_with_dirichlet
 from pdverify.solvers.iterative import Lattice, TwoLevelPreconditioner, cg_solve
+from pdverify.solvers.static import solve_nested
 
 try:
     import pypardiso
@@ -173,11 +177,33 @@ def bench_state(args, out, scene_id, spacing, key):
             Af, bf, _, _ = eliminate_dirichlet(A, rhs, fixed, values)
             alts[f"PARDISO on {'K' if solver == 'direct' else 'the augmented system'}"] = (
                 lambda Af=Af, bf=bf: pardiso_factor_solve(Af, bf))
+    model, A, rhs, fixed, values, _ = systems["nested-dissection"]
+    Af, bf, free, u_fixed = eliminate_dirichlet(A, rhs, fixed, values)
+    coords_free = np.asarray(model.unknown_coords())[free]
+    if args.with_double:
+        alts["ours before: nested dissection, float64 LU"] = (
+            lambda: solve_nested(Af, bf, coords_free, where="bench", mixed=False))
     res = alternate(alts, args.repeat)
     ref = res["today: direct (K multiplied out)"][1][0]
     ours = res["ours: nested dissection (augmented)"][0]
+    u_ours, info = res["ours: nested dissection (augmented)"][1]
+    u_double = (res["ours before: nested dissection, float64 LU"][1][0] if args.with_double
+                else solve_nested(Af, bf, coords_free, where="bench", mixed=False)[0])
+    diff = np.abs(u_ours[free] - u_double).max() / np.abs(u_double).max()
+    print(f"  ours: {info.get('mixed_precision', 'float64 LU')}; refinement steps "
+          f"{info.get('refinement_steps', '-')}, residuals "
+          f"{', '.join(f'{r:.1e}' for r in info.get('refinement_residuals', []))}; "
+          f"condition estimate {info['condition_estimate']:.3e}; relative residual "
+          f"{info['relative_residual']:.1e}")
+    print(f"  ours vs the float64 LU of the same ordering: max |du| / max |u| = {diff:.1e}")
     for name, (t, r) in res.items():
-        if isinstance(r, tuple):
+        if name.startswith("ours before"):   # the free unknowns only
+            full = u_fixed.copy()
+            full[free] = r[0]
+            x = full[:ref.size]
+            agree = np.linalg.norm(x - ref) / np.linalg.norm(ref)
+            note = f"solution vs today's {agree:.1e}"
+        elif isinstance(r, tuple):
             x = r[0][:ref.size]
             agree = np.linalg.norm(x - ref) / np.linalg.norm(ref)
             note = f"solution vs today's {agree:.1e}"
@@ -198,6 +224,8 @@ def main(argv=None):
                     help="rounds for scipy's default spsolve and today's SuperLU on the SPD "
                          "case (~3 min a round; 0 skips them)")
     ap.add_argument("--json", default=None, help="write the medians to this file")
+    ap.add_argument("--with-double", action="store_true",
+                    help="also time ours with the float64 LU (the path before mixed precision)")
     ap.add_argument("--only", nargs="*", choices=("spd", "plate", "body3d"),
                     default=("spd", "plate", "body3d"))
     args = ap.parse_args(argv)

@@ -37,10 +37,61 @@ def test_ordering_is_a_permutation_whose_separators_separate():
     assert nd.L.nnz + nd.U.nnz < colamd.L.nnz + colamd.U.nnz
 
 
+def reference_nested_dissection(A, coords, leaf):
+    """The ordering's definition, one subdomain at a time (the first implementation)."""
+    G = (abs(sp.csr_matrix(A)) + abs(sp.csr_matrix(A)).T).tocsr()
+    G.data[:] = 1.0
+    n = G.shape[0]
+    on_right = np.zeros(n)
+    pieces = []
+    stack = [(np.arange(n), False)]
+    while stack:
+        idx, emit = stack.pop()
+        if emit or idx.size <= leaf:
+            pieces.append(idx)
+            continue
+        x = coords[idx]
+        axis = int(np.argmax(np.ptp(x, axis=0)))
+        left = x[:, axis] < np.median(x[:, axis])
+        if left.all() or not left.any():
+            left = np.zeros(idx.size, bool)
+            left[np.argsort(x[:, axis], kind="stable")[: idx.size // 2]] = True
+        L, R = idx[left], idx[~left]
+        on_right[R] = 1.0
+        touches = (G[L] @ on_right) > 0
+        on_right[R] = 0.0
+        stack += [(L[touches], True), (R, False), (L[~touches], False)]
+    return np.concatenate(pieces)
+
+
+@pytest.mark.parametrize("n, reach, leaf, coords", [
+    (24, 2, 16, "lattice"), (30, 1, 5, "lattice"), (9, 3, 4, "lattice"),
+    (20, 2, 16, "ties"), (20, 2, 8, "3d")])
+def test_level_by_level_ordering_is_the_recursive_one(n, reach, leaf, coords):
+    """All subdomains of a depth are split at once: the permutation is exactly the
+    one-at-a-time post-order, also with tied coordinates (halved by rank) and in 3D."""
+    A, x = lattice_operator(n, reach)
+    A = A.tocsr()
+    row = np.repeat(np.arange(A.shape[0]), np.diff(A.indptr))
+    A.data[((row == 0) & (A.indices == 1)) | ((row == 1) & (A.indices == 0))] = 0.0
+    # (0, 1) and (1, 0) are stored zeros now, which couple nothing
+    assert A.nnz == lattice_operator(n, reach)[0].nnz and (A.data == 0).sum() == 2
+    if coords == "ties":
+        x[:, 0] = 0.0
+    elif coords == "3d":
+        x = np.c_[x, np.round(np.random.default_rng(0).uniform(size=len(x)), 1)]
+    expected = reference_nested_dissection(A, x, leaf)
+    assert np.array_equal(nested_dissection(A, x, leaf), expected)
+    perm, (n1, n2) = nested_dissection(A, x, leaf, top_split=True)
+    assert np.array_equal(perm, expected)
+    Ap = A[perm][:, perm]
+    assert Ap[:n1, n1:n1 + n2].nnz == 0 and Ap[n1:n1 + n2, :n1].nnz == 0
+
+
 def test_solve_nested_matches_a_direct_solve():
     A, x = lattice_operator(20, 2)
     b = np.random.default_rng(2).normal(size=A.shape[0])
-    u, info = solve_nested(A, b, x, where="test")
+    u, info = solve_nested(A, b, x, where="test", mixed=False)
     exact = spla.spsolve(A.tocsc(), b)
     # condition 18 (numpy.linalg.cond), n = 400: a backward-stable LU's error is below
     # ~ kappa * n * eps = 7e3 eps
@@ -72,13 +123,19 @@ def test_augmented_schur_complement_is_the_stiffness(order):
     assert box.unknown_coords().shape == (A.shape[0], 2)
 
 
-def test_plate_nested_dissection_agrees_with_direct():
+@pytest.mark.parametrize("mixed_from", [None, 0])
+def test_plate_nested_dissection_agrees_with_direct(monkeypatch, mixed_from):
+    """Also with the single-precision factor and refinement forced on (mixed_from = 0)."""
+    from pdverify.solvers import static
+    if mixed_from is not None:
+        monkeypatch.setattr(static, "MIXED_FROM_UNKNOWNS", mixed_from)
     scene = get_scene("plate2d-plane-strain")
     small = {"spacing": 0.05}
     a = scene.run("surface-nodes", {**small, "solver": "nested-dissection"})
     b = scene.run("surface-nodes", {**small, "solver": "direct"})
     assert a.status == b.status == "ok"
     assert a.diagnostics["solver"].endswith("nested-dissection ordering)")
+    assert ("float32" in a.diagnostics["solver"]) == (mixed_from == 0)
     # both are direct solves of the same equations, condition ~1e5 after equilibration:
     # the metrics agree to 1e5 * eps relative, far inside the compare gate's 1e-8
     for k, v in b.metrics.items():

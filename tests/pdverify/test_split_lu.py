@@ -1,0 +1,247 @@
+"""Single-precision split LU with refinement in double (pdverify.solvers.static.SplitLU)."""
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from pdverify.errors import NumericalError
+from pdverify.solvers import static
+from pdverify.solvers.ordering import nested_dissection
+from pdverify.solvers.static import SplitLU, equilibrate, refine, solve_nested
+
+EPS = np.finfo(float).eps
+EPS32 = np.finfo(np.float32).eps
+
+
+def lattice_operator(n, reach, seed=1):
+    """A nonsymmetric operator coupling lattice nodes within ``reach`` (2D), diagonally
+    dominant (condition ~20, numpy.linalg.cond)."""
+    ij = np.stack(np.meshgrid(np.arange(n), np.arange(n), indexing="ij"), -1).reshape(-1, 2)
+    d = np.abs(ij[:, None, :] - ij[None, :, :]).max(-1)
+    rng = np.random.default_rng(seed)
+    A = np.where(d <= reach, rng.uniform(-1, 0, d.shape), 0.0)
+    np.fill_diagonal(A, 0.0)
+    np.fill_diagonal(A, -A.sum(1) + 1.0)
+    return sp.csr_matrix(A), ij.astype(float)
+
+
+def split_system(n=24, reach=2):
+    A, x = lattice_operator(n, reach)
+    perm, (n1, n2) = nested_dissection(A, x, leaf=16, top_split=True)
+    return A[perm][:, perm].tocsr(), n1, n2
+
+
+def test_top_split_decouples_the_halves():
+    """What SplitLU relies on: no entry couples the two halves of the top split."""
+    A, n1, n2 = split_system()
+    assert n1 > 0 and n2 > 0 and n1 + n2 < A.shape[0]
+    assert A[:n1, n1:n1 + n2].nnz == 0 and A[n1:n1 + n2, :n1].nnz == 0
+    A, x = lattice_operator(3, 1)        # 9 unknowns, below the leaf: not split
+    perm, top = nested_dissection(A, x, leaf=16, top_split=True)
+    assert top == (0, 0) and np.array_equal(np.sort(perm), np.arange(9))
+
+
+@pytest.mark.parametrize("trans", ["N", "T"])
+def test_split_lu_in_double_is_an_exact_inverse(trans):
+    """In float64 the block elimination is exact: condition ~20, n = 576, so a
+    backward-stable solve is accurate to ~kappa n eps ~ 1e4 eps."""
+    A, n1, n2 = split_system()
+    b = np.random.default_rng(3).normal(size=(A.shape[0], 2))
+    lu = SplitLU(A, n1, n2, dtype=np.float64)
+    assert lu.separator == A.shape[0] - n1 - n2
+    M = A.toarray() if trans == "N" else A.toarray().T
+    exact = np.linalg.solve(M, b)
+    x = lu.solve(b, trans=trans)
+    assert np.abs(x - exact).max() / np.abs(exact).max() < 1e4 * EPS
+    assert np.abs(lu.solve(b[:, 0], trans=trans) - exact[:, 0]).max() < 1e4 * EPS * np.abs(
+        exact).max()
+
+
+def crossed_system():
+    """The split system with three half unknowns' diagonals made weak (1e-5) and a large
+    entry (-40) in a separator row of their columns: SuperLU's threshold pivoting (1e-3)
+    takes a separator row as pivot of a half's column."""
+    A, n1, n2 = split_system()
+    C = A.tocsc()
+    pairs = [(j, k) for j in range(n1, n1 + n2)
+             for k in C[:, j].nonzero()[0][-1:] if k >= n1 + n2][:3]
+    A = A.tolil()
+    for j, k in pairs:
+        A[j, j], A[k, j] = 1e-5, -40.0
+    return A.tocsr(), n1, n2
+
+
+@pytest.mark.parametrize("trans", ["N", "T"])
+def test_split_lu_with_a_separator_pivot_is_exact_in_double(trans):
+    """The rank-one correction of T_i for a separator row pivoted into a half: still an
+    exact inverse in float64 (condition 531, numpy.linalg.cond; n = 576: ~kappa n eps =
+    7e-11, and 1e4 eps = 2e-12 holds)."""
+    A, n1, n2 = crossed_system()
+    lu = SplitLU(A, n1, n2, dtype=np.float64)
+    assert lu.crossed_pivots >= 1
+    b = np.random.default_rng(8).normal(size=(A.shape[0], 2))
+    M = A.toarray() if trans == "N" else A.toarray().T
+    exact = np.linalg.solve(M, b)
+    assert np.abs(lu.solve(b, trans=trans) - exact).max() / np.abs(exact).max() < 1e4 * EPS
+
+
+def test_crossed_pivots_in_float32_and_beyond_the_limit(monkeypatch):
+    A, n1, n2 = crossed_system()
+    b = np.random.default_rng(9).normal(size=A.shape[0])
+    exact = np.linalg.solve(A.toarray(), b)
+    lu = SplitLU(A, n1, n2)
+    assert lu.crossed_pivots >= 1
+    x, _, _, ok = refine(A, b, lu.solve)
+    assert ok and np.abs(x - exact).max() / np.abs(exact).max() < 1e4 * EPS
+    monkeypatch.setattr(static, "MAX_CROSSED_PIVOTS", 0)
+    with pytest.raises(RuntimeError, match="separator rows into a half"):
+        SplitLU(A, n1, n2)
+
+
+def test_float32_split_lu_refines_to_double_accuracy():
+    """One float32 solve is accurate to ~kappa eps32 (kappa ~ 20: ~1e-5); the refinement
+    then reaches LAPACK dsgesv's test, residual <= sqrt(n) eps."""
+    A, n1, n2 = split_system()
+    b = np.random.default_rng(4).normal(size=A.shape[0])
+    lu = SplitLU(A, n1, n2)
+    exact = np.linalg.solve(A.toarray(), b)
+    once = lu.solve(b)
+    err_once = np.abs(once - exact).max() / np.abs(exact).max()
+    assert 1e3 * EPS < err_once < 1e3 * EPS32      # single, not double, precision
+    x, steps, history, ok = refine(A, b, lu.solve)
+    assert ok and 1 <= steps <= 5
+    assert history[-1] <= np.sqrt(A.shape[0]) * EPS
+    # each step until the last (which may be the one that stalls) at least halves it
+    assert all(h1 < 0.5 * h0 for h0, h1 in zip(history[:-1], history[1:-1]))
+    assert np.abs(x - exact).max() / np.abs(exact).max() < 1e4 * EPS
+
+
+def test_solve_nested_mixed_matches_double():
+    A, x = lattice_operator(24, 2)
+    b = np.random.default_rng(5).normal(size=A.shape[0])
+    u_m, info_m = solve_nested(A, b, x, where="test", mixed=True)
+    u_d, info_d = solve_nested(A, b, x, where="test", mixed=False)
+    # both are solutions to ~kappa n eps (kappa ~ 20, n = 576)
+    assert np.linalg.norm(u_m - u_d) / np.linalg.norm(u_d) < 1e4 * EPS
+    assert info_m["mixed_precision"].startswith("float32 LU")
+    assert info_m["refinement_steps"] >= 1
+    assert info_m["refinement_residuals"][-1] <= np.sqrt(A.shape[0]) * EPS
+    assert info_m["relative_residual"] < 1e2 * EPS
+    # both estimate the exact 1-norm condition of the equilibrated matrix from below,
+    # Hager-Higham estimates "rarely more than 3 times too small" (Higham, Accuracy and
+    # Stability, 15.3); the float32 solves perturb the mixed one by ~kappa eps32 ~ 1e-6
+    exact = np.linalg.cond(equilibrate(A, "test")[0].toarray(), 1)
+    for info in (info_m, info_d):
+        assert exact / 3 <= info["condition_estimate"] <= exact * (1 + 1e-5)
+    assert "mixed_precision" not in info_d and "float32" not in info_d["solver"]
+    assert info_m["solver"].endswith("nested-dissection ordering)")
+
+
+def ill_conditioned(kappa, n=24, reach=2):
+    """A symmetric lattice operator shifted to within ~1/kappa of singular."""
+    A, x = lattice_operator(n, reach)
+    S = 0.5 * (A + A.T).toarray()
+    w, V = np.linalg.eigh(S)
+    S = S - (w[0] - w[-1] / kappa) * np.eye(S.shape[0])    # smallest eigenvalue w[-1]/kappa
+    return sp.csr_matrix(S), x
+
+
+def test_ill_conditioned_system_falls_back_to_the_double_lu():
+    """kappa = 1e9 > 1/eps32: the float32 factor cannot be refined; the double LU solves
+    it to ~kappa n eps. Its estimate: the 1e9 built in, to within the estimator's usual
+    factor 3 and what the diagonal equilibration changes (> 1e8)."""
+    A, x = ill_conditioned(1e9)
+    b = np.random.default_rng(6).normal(size=A.shape[0])
+    u, info = solve_nested(A, b, x, where="test", mixed=True)
+    assert info["mixed_precision"].startswith("not used")
+    assert "float32" not in info["solver"]
+    assert info["condition_estimate"] > 1e8
+    exact = np.linalg.solve(A.toarray(), b)
+    assert np.linalg.norm(u - exact) / np.linalg.norm(exact) < 1e9 * A.shape[0] * EPS
+
+
+def test_moderately_conditioned_system_stays_mixed():
+    """kappa = 1e4: kappa eps32 ~ 1e-3, so the refinement converges (a few more steps than
+    at kappa 20) and the double LU is not needed."""
+    A, x = ill_conditioned(1e4)
+    b = np.random.default_rng(7).normal(size=A.shape[0])
+    u, info = solve_nested(A, b, x, where="test", mixed=True)
+    assert info["mixed_precision"].startswith("float32 LU")
+    exact = np.linalg.solve(A.toarray(), b)
+    assert np.linalg.norm(u - exact) / np.linalg.norm(exact) < 1e4 * A.shape[0] * EPS
+    # the estimate from the probe: below the exact 1-norm condition, within Hager-Higham's
+    # usual factor 3 (the float32 solves perturb it by ~kappa eps32 ~ 1e-3)
+    kappa = np.linalg.cond(equilibrate(A, "test")[0].toarray(), 1)
+    assert kappa / 3 <= info["condition_estimate"] <= kappa * (1 + 1e-2)
+
+
+@pytest.mark.parametrize("mixed", [True, False])
+def test_singular_system_is_refused_either_way(mixed):
+    """Two equal rows, and equal right-hand sides there: the system is consistent, so the
+    refinement of b alone converges on a float32 factor that rounding made regular; the
+    random probe refined alongside cannot, and the double LU refuses the system."""
+    A, x = lattice_operator(10, 1)
+    A = A.tolil()
+    A[5, :] = A[4, :]
+    with pytest.raises(NumericalError, match="test: (singular|near-singular)"):
+        solve_nested(A.tocsr(), np.ones(A.shape[0]), x, where="test", mixed=mixed)
+
+
+def test_refinement_reports_divergence():
+    """An approximate inverse that is not one (half the true solve) does not converge."""
+    A, n1, n2 = split_system()
+    lu = SplitLU(A, n1, n2, dtype=np.float64)
+    b = np.ones(A.shape[0])
+    _, _, history, ok = refine(A, b, lambda r: -0.5 * lu.solve(r))
+    assert not ok and history[-1] > 0.5 * history[-2]
+
+
+def test_equilibrate_unchanged():
+    """The scaled matrix is the diagonal-product form's, entry for entry."""
+    A, _ = lattice_operator(12, 2, seed=9)
+    A = sp.diags(np.logspace(-6, 6, A.shape[0])) @ A @ sp.diags(np.logspace(3, -3, A.shape[0]))
+    A = sp.csr_matrix(A)
+    A.data[::7] = 0.0                       # stored zeros
+    A_s, r, c = equilibrate(A, "test")
+    ref = sp.diags(1 / r) @ A
+    ref = (ref @ sp.diags(1 / abs(ref).max(axis=0).toarray().ravel())).tocsr()
+    assert abs(A_s - ref).max() == 0 and A_s.nnz == ref.nnz == np.count_nonzero(A.data)
+    assert np.array_equal(r, abs(sp.csr_matrix(A)).max(axis=1).toarray().ravel())
+    # each column's largest is 1 up to the rounding of x * (1 / x)
+    assert np.abs(abs(A_s).max(axis=0).toarray() - 1.0).max() <= EPS
+
+
+def test_default_switch_is_by_size(monkeypatch):
+    A, x = lattice_operator(12, 2)
+    b = np.ones(A.shape[0])
+    monkeypatch.setattr(static, "MIXED_FROM_UNKNOWNS", A.shape[0] + 1)
+    assert "mixed_precision" not in solve_nested(A, b, x, where="test")[1]
+    monkeypatch.setattr(static, "MIXED_FROM_UNKNOWNS", A.shape[0])
+    assert solve_nested(A, b, x, where="test")[1]["mixed_precision"].startswith("float32")
+
+
+@pytest.mark.parametrize("size", [1e-300, 1e300])
+def test_right_hand_sides_beyond_single_precision_range(size):
+    """Single precision spans 1e-38..3e38; each right-hand side is scaled into it (by a
+    power of two, exactly), so the refinement still converges and the solution is the
+    scaled one to the double LU's accuracy (condition ~20, n = 576: 1e4 eps)."""
+    A, x = lattice_operator(24, 2)
+    b = np.random.default_rng(10).normal(size=A.shape[0])
+    u, info = solve_nested(A, size * b, x, where="test", mixed=True)
+    assert info["mixed_precision"].startswith("float32 LU")
+    ref, _ = solve_nested(A, b, x, where="test", mixed=False)
+    assert np.abs(u / size - ref).max() / np.abs(ref).max() < 1e4 * EPS
+
+
+def test_solve_in_a_forked_process():
+    """The worker threads are made per process: a child forked after the parent used them
+    (as report workers may be) still solves instead of waiting on threads it lacks."""
+    import multiprocessing
+    A, x = lattice_operator(24, 2)
+    b = np.ones(A.shape[0])
+    parent, _ = solve_nested(A, b, x, where="test", mixed=True)
+    ctx = multiprocessing.get_context("fork")
+    with ctx.Pool(1) as pool:
+        child, info = pool.apply_async(solve_nested, (A, b, x),
+                                       {"where": "test", "mixed": True}).get(timeout=120)
+    assert info["mixed_precision"].startswith("float32 LU") and info["separator_unknowns"] > 0
+    assert np.array_equal(child, parent)      # the same operations: bit for bit
