@@ -22,8 +22,14 @@ extra ``bench``); without it those rows are skipped. Cases:
   on both matrices. Budget: >= 1x PARDISO, >= 10x today. Ours is also compared (untimed)
   with the same ordering's float64 LU, the path before the mixed precision; ``--with-double``
   times that path as well.
-- ``body3d``: body3d-traction, surface nodes, h = 0.1 and 0.05: today's dense LU against
-  nested dissection and PARDISO; the fitted time exponent over the sizes run.
+- ``body3d``: body3d-traction, surface nodes, h = 0.1 and 0.05: the LU of K (dense at
+  h = 0.05) against nested dissection and PARDISO; then ours alone at h = 1/30 (27,000
+  unknowns, ~3 min and ~8 GB: the dense LU would need ~12 GB), the fitted exponent of its
+  solve time over h = 0.1 ... 1/30, and the memory estimate of h = 0.025 and of a ~100 k-node
+  body (h = 1/70), which are not run.
+- ``crossover3d``: whole runs (assembly and solve, ``scene.run``) of the 3D scenes with
+  ``solver=direct`` against ``solver=nested-dissection`` over small to default sizes:
+  where ``solver=auto`` switches in 3D (``ND3D_FROM_UNKNOWNS``).
 """
 from __future__ import annotations
 
@@ -217,6 +223,69 @@ def bench_state(args, out, scene_id, spacing, key):
     return n_disp, rows
 
 
+def bench_3d_large(args, out, sizes):
+    """Ours alone at h = 1/30 (27,000 unknowns; the dense LU would need ~12 GB): one whole
+    run, /usr/bin/time-free (the run records its own setup and solve time); the fitted
+    exponent of ours over h = 0.1 ... 1/30; the budget's estimate for h = 0.025 and for a
+    ~100 k-node body, which the run refuses above the memory limit."""
+    import pdverify.budget as budget
+    from pdverify.errors import InputError
+    scene = get_scene("body3d-traction")
+    name = "ours: nested dissection (augmented)"
+    points = [(n, rows[name]) for n, rows in sizes]
+    h = 1 / 30
+    budget.set_limit("20G")
+    r = scene.run("surface-nodes", {"spacing": h})
+    t = r.timings["solve_s"]
+    n = r.size["dofs"]
+    print(f"\n[body3d h=1/30] ours only: {n} unknowns, status {r.status}; setup "
+          f"{r.timings['setup_s']:.1f} s, solve {t:.1f} s; factor entries "
+          f"{r.diagnostics.get('factor_entries', 0):.3g}; refinement steps "
+          f"{r.diagnostics.get('refinement_steps')}; rel_l2_error {r.metrics['rel_l2_error']:.6e}")
+    out["body3d h=1/30"] = {"unknowns": int(n), name: t, "setup": r.timings["setup_s"]}
+    points.append((n, t))
+    x = np.log([p[0] for p in points])
+    y = np.log([p[1] for p in points])
+    a = np.polyfit(x, y, 1)[0]
+    print(f"  fitted solve time ~ N^a over h = 0.1, 0.05, 1/30 (ours): a = {a:.2f}")
+    out["body3d exponent"] = float(a)
+    budget.set_limit(None)
+    for label, over in (("h = 0.025", {"spacing": 0.025}),
+                        ("~100 k nodes (h = 1/70: 85,750 interior, 12,250 surface)", {"spacing": 1 / 70})):
+        budget.set_limit("1000T")            # the estimate, not the refusal
+        est = scene.estimate("surface-nodes", scene.resolve("surface-nodes", over))
+        budget.set_limit(None)
+        try:
+            scene.resolve("surface-nodes", over)
+            verdict = "within this machine's limit"
+        except InputError as exc:
+            verdict = f"refused: {str(exc).split(' of memory')[0].split(': ')[-1]}"
+        print(f"  {label}: estimate {est.memory / 1e9:.1f} GB ({est.detail}); not run, "
+              f"{verdict}")
+
+
+def bench_crossover3d(args, out):
+    """Whole runs, direct against nested dissection, 3D scenes at growing sizes."""
+    print("\n[crossover3d] whole runs (setup + solve), solver=direct vs nested-dissection")
+    cases = [("body3d-traction", "surface-nodes", h) for h in (0.125, 0.1, 1 / 12, 1 / 14, 1 / 16)]
+    cases += [("body3d-manufactured", "surface-nodes", h) for h in (0.1, 1 / 12, 1 / 14)]
+    cases += [("body3d-traction", "none", h) for h in (0.125, 0.1)]
+    for scene_id, method, h in cases:
+        scene = get_scene(scene_id)
+        alts = {solver: (lambda solver=solver: scene.run(
+            method, {"spacing": h, "solver": solver})) for solver in ("direct",
+                                                                      "nested-dissection")}
+        res = alternate(alts, args.repeat)
+        n = res["direct"][1].size["dofs"]
+        t_d, t_n = res["direct"][0], res["nested-dissection"][0]
+        err = [r[1].metrics["rel_l2_error"] for r in res.values()]
+        print(f"  {scene_id:20s} {method:14s} h = {h:.4f} ({n:5d} unknowns): direct "
+              f"{t_d:6.2f} s, nested dissection {t_n:6.2f} s ({t_d / t_n:4.2f}x); "
+              f"rel_l2_error {err[0]:.6e} / {err[1]:.6e}")
+        out[f"crossover3d {scene_id} {method} h={h:.4f}"] = {
+            "unknowns": int(n), "direct": t_d, "nested-dissection": t_n}
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3, help="rounds per alternative (median)")
@@ -226,7 +295,7 @@ def main(argv=None):
     ap.add_argument("--json", default=None, help="write the medians to this file")
     ap.add_argument("--with-double", action="store_true",
                     help="also time ours with the float64 LU (the path before mixed precision)")
-    ap.add_argument("--only", nargs="*", choices=("spd", "plate", "body3d"),
+    ap.add_argument("--only", nargs="*", choices=("spd", "plate", "body3d", "crossover3d"),
                     default=("spd", "plate", "body3d"))
     args = ap.parse_args(argv)
     print(f"median of {args.repeat}; PARDISO: {'pypardiso' if pypardiso else 'not installed'}")
@@ -251,9 +320,9 @@ def main(argv=None):
             (n0, r0), (n1, r1) = sizes[0], sizes[1]
             a = math.log(r1[name] / r0[name]) / math.log(n1 / n0)
             print(f"  fitted time ~ N^a over h = 0.1, 0.05 ({name}): a = {a:.2f}")
-        print("  h = 0.025 (~60 k unknowns) is not run: today's dense LU would need ~29 GB and "
-              "the nested-dissection factor grows like N^2 in 3D; 3D waits for an iterative "
-              "solver (issue 12, open)")
+        bench_3d_large(args, out, sizes)
+    if "crossover3d" in args.only:
+        bench_crossover3d(args, out)
     if args.json:
         with open(args.json, "w") as fh:
             json.dump(out, fh, indent=1)

@@ -138,10 +138,17 @@ INFLUENCE = influence_param("gaussian", "seed 001, Eq. 7: Gaussian")
 #: (1.7 s at the plate's default 5,000) and the report's default-size 2D runs keep their
 #: solutions bit for bit.
 ND_FROM_UNKNOWNS = 8000
+#: the same in 3D, where K is a dense LU: whole runs (assembly and solve) of body3d-traction,
+#: surface nodes, direct against nested dissection (benchmarks/solvers.py --only
+#: crossover3d, median of 3, quiet machine): 0.85 / 0.99 s at 2,376 unknowns, 1.79 / 2.02 s
+#: at 3,528, 4.22 / 2.99 s at 4,992 (where the float32 factor starts), and at the default
+#: 9,000 15.7 / 7.9 s with peak memory 2.67 / 1.33 GB (``pdverify run``, /usr/bin/time)
+ND3D_FROM_UNKNOWNS = 4000
 SOLVER = Param("solver", "auto", "linear solver: direct (K multiplied out; sparse or dense "
                "LU), nested-dissection (dilatations kept as unknowns, sparse LU under a "
                f"geometric nested-dissection ordering) or auto (nested-dissection from "
-               f"{ND_FROM_UNKNOWNS} unknowns)", choices=("auto", "direct", "nested-dissection"))
+               f"{ND_FROM_UNKNOWNS} unknowns in 2D, {ND3D_FROM_UNKNOWNS} in 3D)",
+               choices=("auto", "direct", "nested-dissection"))
 # published numbers sit beside the paper's quadrature and influence only
 PAPER_QUADRATURE = {"quadrature": "partial-volume", "influence": "gaussian"}
 MOMENT = {"quadrature": "moment-corrected"}
@@ -293,8 +300,10 @@ class SurfaceNodeScene(Scene):
 
     def estimate(self, method, p):
         """Unknowns on the cell-centred nodes and (surface-nodes) one surface node per
-        boundary cell face; the dilatation couples nodes 2m spacings apart. The fictitious
-        layer (m deep) folds into the unknowns through its Taylor rows, which are stored."""
+        boundary cell face; the dilatation couples nodes 2m spacings apart (m in the
+        augmented system of the nested-dissection solve, which has a dilatation unknown per
+        node). The fictitious layer (m deep) folds into the unknowns through its Taylor
+        rows, which are stored."""
         lengths, _ = self.box(p)
         m, d = p["m_ratio"], len(lengths)
         cells = [L / p["spacing"] for L in lengths]
@@ -303,6 +312,9 @@ class SurfaceNodeScene(Scene):
             nodes += 2 * sum(nodes / c for c in cells)
             fictitious = math.prod(c + 2 * m for c in cells) - math.prod(cells)
             rows = budget.BYTES_PER_NONZERO * fictitious * d * d * budget.lattice_neighbours(d, m)
+        if d == 3 and self.solver_for(p, d, d * nodes) == "nested-dissection":
+            # the augmented system: d displacements and a dilatation per node, reach m
+            return budget.nested_dissection_3d(nodes, d + 1, m, extra_bytes=rows)
         return budget.linear_system(nodes, d, d, 2 * m, dense_allowed=True, extra_bytes=rows)
 
     # ----------------------------------------------------------------- checks
@@ -329,13 +341,14 @@ class SurfaceNodeScene(Scene):
         return StateBasedConstants(self.kind, p["E"], p["nu"])
 
     def solver_for(self, p, dim, unknowns) -> str:
-        """The solver a run uses: p["solver"], or for ``auto`` nested dissection on 2D
-        systems from :data:`ND_FROM_UNKNOWNS` unknowns (6.0x faster than the direct
-        solve at h = 0.01; in 3D at h = 0.05 it is as fast as the dense LU, so 3D
-        stays direct until an iterative solver serves it: benchmarks/solvers.py)."""
+        """The solver a run uses: p["solver"], or for ``auto`` nested dissection from
+        :data:`ND_FROM_UNKNOWNS` unknowns in 2D (11x faster than the direct solve at
+        h = 0.01) and :data:`ND3D_FROM_UNKNOWNS` in 3D (2x faster and half the memory of
+        the dense LU at h = 0.05): benchmarks/solvers.py."""
         if p["solver"] != "auto":
             return p["solver"]
-        return "nested-dissection" if dim == 2 and unknowns >= ND_FROM_UNKNOWNS else "direct"
+        return ("nested-dissection" if unknowns >= (ND_FROM_UNKNOWNS if dim == 2
+                                                     else ND3D_FROM_UNKNOWNS) else "direct")
 
     def assemble(self, method, p):
         """The run's linear system: ``(model, A, rhs, fixed, values, solver)``. ``A`` is K
@@ -428,7 +441,8 @@ class SurfaceNodeScene(Scene):
             sol = sol[:d * nu_]
             if p["solver"] == "auto":
                 info["solver_choice"] = (f"auto: {solver} ({d * nu_} unknowns; nested "
-                                         f"dissection from {ND_FROM_UNKNOWNS} in 2D)")
+                                         f"dissection from {ND_FROM_UNKNOWNS} in 2D, "
+                                         f"{ND3D_FROM_UNKNOWNS} in 3D)")
         U = sol.reshape(d, nu_).T
         u = U[:ni]
         u_ref = self.exact(x_int, p)
