@@ -164,6 +164,13 @@ def lattice_neighbours(dim: int, reach: float) -> float:
             3: 4.0 / 3.0 * math.pi * r ** 3 + 1}[dim]
 
 
+def _unknowns_and_nonzeros(nodes: float, dim: int, dofs_per_node: int, reach: float):
+    """Unknowns, and stored non-zeros of a lattice operator whose rows reach ``reach``
+    spacings (at most a full matrix)."""
+    n = float(nodes) * dofs_per_node
+    return n, min(n * dofs_per_node * lattice_neighbours(dim, reach), n * n)
+
+
 def linear_system(nodes: float, dim: int, dofs_per_node: int, reach: float,
                   dense_allowed: bool = False, extra_bytes: float = 0.0) -> Estimate:
     """Memory of assembling and factoring a static system on ``nodes`` lattice nodes in
@@ -172,8 +179,7 @@ def linear_system(nodes: float, dim: int, dofs_per_node: int, reach: float,
     # solve_square's switch to its dense path (imported here: the CLI imports this module
     # and must stay light)
     from .solvers.dense import DENSE_FILL, DENSE_MIN_UNKNOWNS
-    n = float(nodes) * dofs_per_node
-    nnz = min(n * dofs_per_node * lattice_neighbours(dim, reach), n * n)
+    n, nnz = _unknowns_and_nonzeros(nodes, dim, dofs_per_node, reach)
     sep = reach * float(nodes) ** ((dim - 1) / dim)
     factor = dofs_per_node ** 2 * max(float(nodes) * reach, sep * sep)
     dense = dense_allowed and n >= DENSE_MIN_UNKNOWNS and nnz >= DENSE_FILL * n * n
@@ -204,8 +210,7 @@ def nested_dissection_3d(nodes: float, dofs_per_node: int, reach: float,
     of ~ :data:`ND3D_LEVELS` d^2 (r N^(2/3))^2 entries at :data:`BYTES_PER_ND3D_ENTRY` (the
     count is within 1.3x of SuperLU's at h = 0.05 and of PARDISO's predicted 8.8e8 at
     h = 0.025)."""
-    n = float(nodes) * dofs_per_node
-    nnz = min(n * dofs_per_node * lattice_neighbours(3, reach), n * n)
+    n, nnz = _unknowns_and_nonzeros(nodes, 3, dofs_per_node, reach)
     sep = reach * float(nodes) ** (2.0 / 3.0)
     factor = min(ND3D_LEVELS * dofs_per_node ** 2 * sep * sep, n * n)
     memory = BYTES_PER_NONZERO * nnz + extra_bytes + BYTES_PER_ND3D_ENTRY * factor

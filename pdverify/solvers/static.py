@@ -101,8 +101,10 @@ MAX_CROSSED_PIVOTS = 32
 #: :class:`SplitLU` splits at the top separator only while its dense blocks (s^2 entries,
 #: s^3 work) stay small against the halves: s^2 <= this many times the unknowns. The 2D
 #: plates have s^2 / n ~ 28 at every h (m = 3; 921 of 30,600 unknowns at h = 0.01), the
-#: 3D bodies 236 (h = 0.1) and 336 (h = 0.05), where the split measured slower than one
-#: float32 LU of the whole matrix (h = 0.05: 11.1 s against 6.9 s; float64 LU 12.9 s).
+#: 3D bodies 236 (h = 0.1) and 336 (h = 0.05), where the split gains nothing over one
+#: float32 LU of the whole matrix (h = 0.05, quiet machine, the whole solve: 7.8-8.1 s
+#: against 7.5-8.5 s; each half's factor with the separator 1.9 s and 3.3 s against 0.5 s
+#: for a half alone: the separator's coupling, not the parallel factors, costs).
 SPLIT_MAX_SEPARATOR = 100
 #: LAPACK's mixed-precision dsgesv: at most 30 refinement steps, converged when
 #: ||r||_inf <= ||x||_inf ||A||_inf eps sqrt(n); otherwise the double LU takes over.
@@ -150,14 +152,11 @@ def solve_nested(A, rhs, coords, *, where: str = "static solve", mixed: bool | N
     if y is None:
         lu = _factor(A_p.tocsc(), where, **ND_OPTIONS)
         y = lu.solve(b_p)
-        if not np.all(np.isfinite(y)):
-            raise NumericalError(f"{where}: solution has non-finite values (singular system)")
-        cond = _condition_estimate(A_p, lu)
+        cond = _checked_condition(y, A_p, lu, where)
         info["factor_entries"] = int(lu.L.nnz + lu.U.nnz)
         info["solver"] = "sparse LU (SuperLU, nested-dissection ordering)"
-    if cond > CONDITION_LIMIT:
-        raise NumericalError(f"{where}: near-singular system (condition estimate {cond:.2e} "
-                             f"> {CONDITION_LIMIT:.0e} after equilibration)")
+    else:
+        _refuse_near_singular(cond, where)
     sol = np.empty_like(y)
     sol[perm] = y
     sol /= col_max
@@ -444,10 +443,16 @@ def _checked_condition(sol, A, lu, where: str) -> float:
     if not np.all(np.isfinite(sol)):
         raise NumericalError(f"{where}: solution has non-finite values (singular system)")
     cond = _condition_estimate(A, lu)
+    _refuse_near_singular(cond, where)
+    return cond
+
+
+def _refuse_near_singular(cond: float, where: str) -> None:
+    """NumericalError naming ``where`` when the condition estimate ``cond`` of the
+    equilibrated system exceeds :data:`CONDITION_LIMIT`."""
     if cond > CONDITION_LIMIT:
         raise NumericalError(f"{where}: near-singular system (condition estimate {cond:.2e} "
                              f"> {CONDITION_LIMIT:.0e} after equilibration)")
-    return cond
 
 
 def relative_residual(A, x, b) -> float:
