@@ -95,7 +95,8 @@ def end_bond_closure(nodes: int, end_factors) -> Closure:
 
 def bond_bar(*, nodes: int, spacing: float, horizon_ratio: float, E: float, area: float = 1.0,
              end_weight: str = "full", micromodulus: str = "triangular",
-             calibration: str = "discrete", end_factors=()) -> BondBasedModel:
+             calibration: str = "discrete", end_factors=(),
+             closure: Closure | None = None) -> BondBasedModel:
     """The bar of seed 004 as an engine model: N points x_i = (i - 1) Delta on the surface
     (``on-surface`` grid), linearised bond-based PD (Eq. 33).
 
@@ -105,6 +106,8 @@ def bond_bar(*, nodes: int, spacing: float, horizon_ratio: float, E: float, area
     :class:`~pdverify.pd.BondBasedModel`), so that the force on i is Eq. (33) times the
     volume V_i of the subject point; alpha is the end-bond factor of
     :func:`end_bond_closure` (``end_factors``; ``()`` = the uncorrected bar).
+    ``closure``: another boundary treatment of the uncorrected bar instead (a bond method
+    of the registry, e.g. ``energy`` or ``volume``); it excludes ``end_factors``.
     """
     if end_weight not in END_WEIGHTS:
         raise ValueError(f"end_weight={end_weight!r}; allowed: {', '.join(END_WEIGHTS)}")
@@ -118,13 +121,17 @@ def bond_bar(*, nodes: int, spacing: float, horizon_ratio: float, E: float, area
     factors = np.asarray(end_factors, dtype=float)
     if factors.size and not (factors.size <= offsets.max() and np.all(factors > 0)):
         raise ValueError(f"end_factors={end_factors!r}: at most {offsets.max()} positive factors")
+    if factors.size and closure is not None:
+        raise ValueError("bond_bar: end_factors and closure are two boundary treatments; "
+                         "give one")
     grid = BoxGrid(((nodes - 1) * spacing,), (0.0,), spacing, placement="on-surface",
                    boundary_volume="partial" if end_weight == "half" else "full")
     stencil = build_stencil(1, float(horizon_ratio))
     c1 = micromodulus_c1(horizon_ratio, E=E, area=area, spacing=spacing,
                          micromodulus=micromodulus, calibration=calibration)
     return BondBasedModel(grid, stencil, c1, get_influence(micromodulus),
-                          end_bond_closure(nodes, factors), thickness=area)
+                          closure if closure is not None else end_bond_closure(nodes, factors),
+                          thickness=area)
 
 
 #: A consistent system is solved to round-off (relative residual ~1e-16, the equations

@@ -26,8 +26,8 @@ from ..pd.statebased import StateBasedModel
 
 INSTALL = 'pip install ".[peers]" (perifit from PyPI)'
 #: scenes whose model perifit supports: 3D LPS and bond-based, 2D bond-based
-SCENES = ("stiffness3d-box", "body3d-traction", "body3d-manufactured",
-          "stiffness2d-sheet", "sheet2d-tension", "sheet2d-clamped")
+SCENES = ("stiffness3d-box", "stiffness3d-box-bond", "body3d-traction", "body3d-manufactured",
+          "stiffness2d-sheet", "sheet2d-tension", "sheet2d-clamped", "block2d-indentation")
 
 
 def installed_version() -> str | None:

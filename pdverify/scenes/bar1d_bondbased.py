@@ -71,10 +71,12 @@ class BondBar:
     """
 
     def __init__(self, *, nodes, spacing, horizon_ratio, E, area=1.0, end_weight="full",
-                 micromodulus="triangular", calibration="discrete", end_factors=()):
+                 micromodulus="triangular", calibration="discrete", end_factors=(),
+                 closure=None):
         self.model = bond_bar(nodes=nodes, spacing=spacing, horizon_ratio=horizon_ratio, E=E,
                               area=area, end_weight=end_weight, micromodulus=micromodulus,
-                              calibration=calibration, end_factors=end_factors)
+                              calibration=calibration, end_factors=end_factors,
+                              closure=closure)
         self.nodes, self.spacing, self.E, self.area = nodes, spacing, E, area
         self.m, self.beta = split_horizon_ratio(horizon_ratio)
         self.end_factors = tuple(float(a) for a in end_factors)
@@ -128,10 +130,16 @@ class BondBar:
 
 
 class BondBarScene(Scene):
-    """Shared checks and bar construction of the seed-004 scenes."""
+    """Shared checks and bar construction of the seed-004 scenes.
+
+    Besides ``none`` and ``homogenized`` the scenes take the registry's bond-based
+    methods (``energy``, ``volume``, plugins), which correct the uncorrected bar with
+    ``none``'s parameters; the scene's metrics and load stay as they are.
+    """
 
     seed = "004"
     dim = 1
+    closure_theory = "bond-based"
     methods = (NONE, HOMOGENIZED)
 
     def min_nodes(self, m: int) -> int:
@@ -165,7 +173,9 @@ class BondBarScene(Scene):
         return BondBar(nodes=nodes, spacing=spacing, horizon_ratio=float(p["horizon_ratio"]),
                        E=p["E"], area=AREA, end_weight=p["end_weight"],
                        micromodulus=p["micromodulus"], calibration=p["calibration"],
-                       end_factors=self.factors(method, p))
+                       end_factors=self.factors(method, p),
+                       closure=self.bond_closure(method, p) if self.bond_methods().get(method)
+                       else None)
 
 
 # --------------------------------------------------------------------------- Sec. 6.1

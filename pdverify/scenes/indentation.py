@@ -10,7 +10,7 @@ from .. import budget
 from ..corrections.energy_directional import directional_closure
 from ..errors import InputError, NumericalError
 from ..params import Param, at_least, positive
-from ..pd import BondBasedModel, BoxGrid, Closure, get_influence
+from ..pd import BondBasedModel, BoxGrid, get_influence
 from ..pd.influence import bond_based_nu
 from ..pd.nonlinear import LinearBondBased, NonlinearBondBased
 from ..solvers.dense import SPD_LATTICE_SOLVERS
@@ -105,6 +105,9 @@ class Indentation(FemAndPD):
     seed = "003 §4.2"
     figure = "indentation"
     dim = 2
+    closure_theory = "bond-based"
+    #: the quick report's coarse grid (m = 6 kept), for every PD method
+    quick_overrides = {"spacing": 0.001, "horizon": 0.006}
     headline = "force_error_pct"  # the report overview's error for this scene
     params_class, function = "IndentationParams", "indentation"
     shared = ("width", "height", "radius", "depth", "n_steps", "E", "nu", "thickness")
@@ -173,7 +176,7 @@ class Indentation(FemAndPD):
 
     def cases(self, quick=False):
         out = [("fem", {}), ("fem", dict(FINITE_REFERENCE))]
-        coarse = {"spacing": 0.001, "horizon": 0.006} if quick else {}
+        coarse = self.quick_overrides if quick else {}
         for method in ("none", "energy-directional"):
             out.append((method, dict(coarse)))
         if not quick:
@@ -188,7 +191,7 @@ class Indentation(FemAndPD):
             grid = BoxGrid((W, H), (-W / 2, -H), h, placement="on-surface")
             inf = get_influence(p["micromodulus"])
             closure = (directional_closure(grid, (-W / 2, -H), (W / 2, 0.0), delta, inf)
-                       if method == "energy-directional" else Closure())
+                       if method == "energy-directional" else self.bond_closure(method, p))
             model = BondBasedModel(grid, SheetScene.stencil(p, delta / h),
                                    SheetScene.micromodulus(p, delta), inf, closure,
                                    thickness=p["thickness"])

@@ -38,17 +38,20 @@ class StatePlate:
     corners by the 2D expansion of Eq. 69 to order n; dilatations to order n - 1) and the
     clamped edges as constraint rows (Eq. 58 for u and v, corner lines by ``corners``).
     ``K`` = the equilibrium rows of the real nodes (component-major, u then v).
+    ``closure``: another treatment of the uncorrected model (``order=None``): a bond
+    method of the registry (``energy``, ``volume``, ``pals``), clamped as ``none`` is.
     """
 
     def __init__(self, lengths, spacing, m_ratio, constants, influence="hyperbolic",
                  order=None, quadrature="partial-volume", thickness=1.0,
-                 corners="normal-only"):
+                 corners="normal-only", closure=None):
         inf = get_influence(influence)
         stencil = state_based_stencil(2, m_ratio, spacing, inf, quadrature)
         self.order = order
         self.grid = g = BoxGrid(tuple(lengths), (0.0, 0.0), float(spacing),
                                 stencil.reach if order is not None else 0)
-        closure = fictitious_closure(g, order) if order is not None else None
+        if order is not None:
+            closure = fictitious_closure(g, order)
         self.model = StateBasedModel(g, stencil, constants, inf, closure, thickness=thickness)
         self.horizon = self.model.horizon
         self.x = g.x[g.interior_ids]
@@ -184,6 +187,7 @@ class ClampedPlate(FemAndPD):
     reference = "fem"
     figure = "plate2d"
     dim = 2
+    closure_theory = "state-based"
     params_class, function = "PlateParams", "clamped_plate"
     shared = ("length", "width", "thickness", "E", "nu", "body_force")
     pd_params = (
@@ -267,7 +271,8 @@ class ClampedPlate(FemAndPD):
             c = StateBasedConstants("plane-stress", p["E"], p["nu"])
             plate = StatePlate(lengths, p["spacing"], p["m_ratio"], c, p["influence"], order,
                                p["quadrature"], p["thickness"],
-                               p.get("corners", "normal-only"))
+                               p.get("corners", "normal-only"),
+                               closure=self.bond_closure(method, p))
             x = plate.x
             u_ref = ref.evaluate(x)
             f = np.zeros(2 * x.shape[0])

@@ -208,3 +208,126 @@ def test_perifit_weights_on_the_sheet():
         assert pf[key] < none[key]
     r = get_scene("stiffness2d-sheet").run("perifit")
     assert r.params["perifit_version"] == version("perifit")
+
+
+# ---------------------------------------------------------------- every scene it applies to
+def test_bond_based_box_energy_and_volume_beat_none():
+    """stiffness3d-box-bond (the box in the formulation the peers' corrections were
+    written for): energy and volume lower the largest and the RMS surface error at the
+    default size (measured: largest 83.2 -> 53.5 / 59.2 %, RMS 39.0 -> 20.8 / 23.1 %)."""
+    none = metrics("stiffness3d-box-bond", "none")
+    for method in ("energy", "volume"):
+        m = metrics("stiffness3d-box-bond", method)
+        for key in ("surface_energy_error_pct", "surface_energy_rms_pct"):
+            assert m[key] < none[key], (method, key)
+
+
+def test_perifit_beats_none_on_the_bond_based_box():
+    """With perifit installed: its bb weights beat none on the bond-based box (measured:
+    largest 83.2 -> 61.7 %, RMS 39.0 -> 28.3 %)."""
+    pytest.importorskip("perifit")
+    none, pf = metrics("stiffness3d-box-bond", "none"), metrics("stiffness3d-box-bond", "perifit")
+    for key in ("surface_energy_error_pct", "surface_energy_rms_pct"):
+        assert pf[key] < none[key]
+
+
+def _lps_box(quadrature, closure):
+    inf = get_influence("gaussian")
+    st = (build_stencil(3, 3.0, quadrature="full-cells") if quadrature == "full-cells"
+          else state_based_stencil(3, 3.0, 0.05, inf, quadrature))
+    g = BoxGrid((1.0, 0.5, 0.5), (0.0,) * 3, 0.05, 0)
+    return StateBasedModel(g, st, StateBasedConstants("3d", 200e9, 0.3), inf, closure)
+
+
+def _largest_surface_error(model):
+    g = model.grid
+    near = g.distance_to_surface(g.x[g.interior_ids]) <= model.horizon * (1 + 1e-12)
+    return max(np.abs(work_density(model, eps)[g.interior_ids][near]
+                      / model.bulk_work_density(eps) - 1).max() * 100
+               for _, eps in strain_states(3))
+
+
+@pytest.mark.parametrize("quadrature", ["partial-volume", "full-cells"])
+def test_perifit_does_not_beat_none_on_the_lps_box_in_any_reading(quadrature):
+    """Finding (with perifit installed), stiffness3d-box at its default size: no reading
+    of perifit's osb weights beats the uncorrected LPS box. The weights on the bond's
+    weight with m over the weighted truncated family (ours), with m of a complete
+    neighbourhood, or on the bond force only; with the scene's partial volumes, or with
+    whole cells (the only volumes perifit's API takes). Measured, largest surface error
+    (none 39.4 / 40.5 %): 55.8 / 64.3, 88.2 / 59.7, 83.9 / 193.5 %. LPS with m over the
+    truncated family is exact for a surface node on a flat face in the continuum limit
+    (half a ball has the ball's moment ratios), so weights fitted to restore the ball's
+    operators reweight bonds that needed none."""
+    pytest.importorskip("perifit")
+    from pdverify.corrections.perifit_weights import node_weights
+    none = _lps_box(quadrature, None)
+    w = node_weights(none)
+
+    def factors(model):
+        return 0.5 * (w[model.bond_a] + w[model.bond_b])
+
+    base = _largest_surface_error(none)
+    for closure in (Closure(weight_factor=factors),
+                    Closure(weight_factor=factors, weighted_volume="complete"),
+                    Closure(force_factor=factors)):
+        assert _largest_surface_error(_lps_box(quadrature, closure)) > base, closure
+
+
+@pytest.mark.parametrize("scene,key,best", [
+    ("bar1d-homogenization", "max_error_pct", True),
+    ("bar1d-constraints", "max_error_pct", True),
+    ("bar1d-vibration", "max_error_pct", False)])
+def test_energy_and_volume_on_the_seed_004_bars(scene, key, best):
+    """The bond-based bars of seed 004 take energy and volume beside homogenized. Both
+    lower none's error (measured, max_error_pct: tension 21.8 -> 12.2 / 10.5, constraints
+    10.9 -> 6.1 / 5.2, vibration 29.4 -> 6.5 / 8.7); the end-bond homogenisation stays
+    exact in statics (0 to round-off) but not in the vibration, whose full-weight free end
+    carries a tip mass none of the stiffness corrections removes (13.9 %)."""
+    scene_obj = get_scene(scene)
+    assert {"energy", "volume"} <= {m.name for m in scene_obj.all_methods}
+    none = metrics(scene, "none")[key]
+    homog = metrics(scene, "homogenized")[key]
+    for method in ("energy", "volume"):
+        m = metrics(scene, method)[key]
+        assert m < none, method
+        assert (homog < m) == best, method
+
+
+def test_bond_bar_takes_one_boundary_treatment():
+    from pdverify.corrections.homogenized import bond_bar
+    with pytest.raises(ValueError, match="two boundary treatments"):
+        bond_bar(nodes=9, spacing=1.0, horizon_ratio=4.0, E=1.0, end_factors=(2.0, 1.5, 1.0),
+                 closure=Closure())
+
+
+def test_bond_methods_on_the_clamped_plate():
+    """plate2d-clamped (seed 000's plate, LPS) takes energy, volume and PALS, clamped as
+    none is (the ring at the FEM value). Measured at Table 4's grid, max_error_u_pct:
+    none 7.43, energy 6.52, volume 6.40, PALS 10.29, taylor-fictitious (n = 1) 1.47.
+    Finding: PALS makes every node's energy exact under homogeneous strain, yet the
+    clamped ring it shares with none leaves it worse here."""
+    none = metrics("plate2d-clamped", "none")["max_error_u_pct"]
+    got = {m: metrics("plate2d-clamped", m)["max_error_u_pct"]
+           for m in ("energy", "volume", "pals")}
+    assert got["energy"] < none and got["volume"] < none
+    assert got["pals"] > none
+    assert max(got.values()) > metrics("plate2d-clamped", "taylor-fictitious")["max_error_u_pct"]
+
+
+def test_energy_and_volume_on_the_indentation():
+    """block2d-indentation takes energy and volume (and perifit when installed) at the
+    quick report's coarse grid (spacing 1 mm, m = 6): both reach 2 mm where none folds at
+    1.8 mm, yet stay far softer than the FEM (measured force_error_pct: none 66.8, energy
+    50.3, volume 53.7, energy-directional 4.8 %): corrections calibrated on a small
+    uniaxial stretch do not restore the stiffness under the indenter that seed 003's
+    directional factor does."""
+    coarse = get_scene("block2d-indentation").quick_overrides
+    scene = get_scene("block2d-indentation")
+    assert {"energy", "volume"} <= {m.name for m in scene.all_methods}
+    r = scene.run("none", coarse)
+    assert r.status == "failed" and r.metrics["depth_reached_mm"] < 2
+    directional = metrics("block2d-indentation", "energy-directional", **coarse)
+    for method in ("energy", "volume"):
+        m = metrics("block2d-indentation", method, **coarse)
+        assert m["depth_reached_mm"] == pytest.approx(2.0)
+        assert directional["force_error_pct"] < m["force_error_pct"] < r.metrics["force_error_pct"]

@@ -7,10 +7,15 @@ import numpy as np
 
 from . import family, fem_then_pd, node_image, save
 
-STYLE = {("none", "nonlinear"): ("tab:red", "-", "s"),
-         ("energy-directional", "nonlinear"): ("tab:blue", "-", "o"),
-         ("none", "linear"): ("tab:red", ":", "s"),
-         ("energy-directional", "linear"): ("tab:blue", ":", "o")}
+#: colour and marker per method; solid nonlinear, dotted linear kinematics
+METHOD_STYLE = {"none": ("tab:red", "s"), "energy-directional": ("tab:blue", "o"),
+                "energy": ("tab:orange", "^"), "volume": ("tab:purple", "v"),
+                "perifit": ("tab:brown", "D")}
+
+
+def _style(r):
+    color, marker = METHOD_STYLE.get(r.method, ("gray", "."))
+    return color, "-" if r.params["kinematics"] == "nonlinear" else ":", marker
 
 
 def _paper_grid(r):
@@ -35,7 +40,7 @@ def _curves(ax, fem, runs, inset=False):
                 label="FEM, small strain (reference)")
     for r in runs:
         f = r.fields
-        color, ls, marker = STYLE.get((r.method, r.params["kinematics"]), ("gray", "-", "."))
+        color, ls, marker = _style(r)
         ax.plot(f["depths"] * 1e3, f["forces"] / 1e3, color=color, ls=ls, marker=marker, ms=3,
                 label=None if inset else _label(r))
         if r.status != "ok":
@@ -69,7 +74,7 @@ def indentation_figures(scene, results, folder):
     ins.tick_params(labelsize=7)
     ins.grid(alpha=0.3)
     for r in runs:
-        color, ls, marker = STYLE.get((r.method, r.params["kinematics"]), ("gray", "-", "."))
+        color, ls, marker = _style(r)
         ax2.plot(r.fields["depths"] * 1e3, r.fields["min_bond_length_ratio"], color=color,
                  ls=ls, marker=marker, ms=3, label=f"{r.method} ({r.params['kinematics']})")
     ax2.axhline(0, color="k", lw=0.8)
@@ -81,8 +86,9 @@ def indentation_figures(scene, results, folder):
     ax2.legend(fontsize=8)
     out.append((save(fig, folder, f"{scene.id}-fig4.png"),
                 "Fig. 4 of seed 003: indentation force against depth at the paper's grid "
-                "(161 x 161 nodes, m = 6), FEM (small strain) and PD with and without the "
-                "directional correction, nonlinear (solid) and linear (dotted) kinematics; "
+                "(161 x 161 nodes, m = 6), FEM (small strain) and PD without correction, with "
+                "the directional correction and with the energy, volume (and perifit) "
+                "corrections, nonlinear (solid) and linear (dotted) kinematics; "
                 "green crosses: where a run fails (the curve stops at its last equilibrium). "
                 "Right: the shortest bond's current length over its reference length, per depth."))
     good = [r for r in runs if r.status == "ok" and r.method == "energy-directional"
