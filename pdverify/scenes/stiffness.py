@@ -187,6 +187,17 @@ STATE_PARAMS = (
 )
 
 
+#: seed 001's box (§4.1 geometry) and grid, shared by the LPS and bond-based readings
+BOX_PARAMS = (Param("lx", 1.0, "box length [m]", positive),
+              Param("ly", 0.5, "box size l_y [m]", positive),
+              Param("lz", 0.5, "box size l_z [m]", positive),
+              Param("spacing", 0.05, "grid spacing h [m]", positive))
+
+
+def box_lengths(p):
+    return (p["lx"], p["ly"], p["lz"])
+
+
 @register
 class BoxStiffness(_StateStiffness):
     """Seed 001's box (§4.1 geometry, ERRATA seed 001) under homogeneous strains, linear
@@ -211,13 +222,10 @@ class BoxStiffness(_StateStiffness):
     kind = "3d"
     dim = 3
     quick_overrides = {"spacing": 0.1}
-    params = (Param("lx", 1.0, "box length [m]", positive),
-              Param("ly", 0.5, "box size l_y [m]", positive),
-              Param("lz", 0.5, "box size l_z [m]", positive),
-              Param("spacing", 0.05, "grid spacing h [m]", positive)) + STATE_PARAMS
+    params = BOX_PARAMS + STATE_PARAMS
 
     def lengths(self, p):
-        return (p["lx"], p["ly"], p["lz"])
+        return box_lengths(p)
 
 
 @register
@@ -244,19 +252,16 @@ class BondBoxStiffness(StiffnessScene):
     closure_theory = "bond-based"
     dim = 3
     quick_overrides = {"spacing": 0.1}
-    params = (Param("lx", 1.0, "box length [m]", positive),
-              Param("ly", 0.5, "box size l_y [m]", positive),
-              Param("lz", 0.5, "box size l_z [m]", positive),
-              Param("spacing", 0.05, "grid spacing h [m]", positive),
-              Param("m_ratio", 3.0, "horizon / spacing", at_least(1.0)),
-              Param("E", 200e9, "Young's modulus [Pa] (scales W and W_bulk alike)", positive),
-              Param("micromodulus", "constant", "c(xi): constant or conical",
-                    choices=("constant", "conical")),
-              Param("quadrature", "full-cells", "horizon quadrature: whole cells (perifit's "
-                    "view) or exact partial volumes", choices=("full-cells", "partial-volume")))
+    params = BOX_PARAMS + (
+        Param("m_ratio", 3.0, "horizon / spacing", at_least(1.0)),
+        Param("E", 200e9, "Young's modulus [Pa] (scales W and W_bulk alike)", positive),
+        Param("micromodulus", "constant", "c(xi): constant or conical",
+              choices=("constant", "conical")),
+        Param("quadrature", "full-cells", "horizon quadrature: whole cells (perifit's view) "
+              "or exact partial volumes", choices=("full-cells", "partial-volume")))
 
     def lengths(self, p):
-        return (p["lx"], p["ly"], p["lz"])
+        return box_lengths(p)
 
     def build(self, method, p, closure):
         lengths = self.lengths(p)
