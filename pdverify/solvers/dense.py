@@ -7,8 +7,8 @@ import scipy.sparse as sp
 from scipy.linalg import lapack
 
 from ..errors import NumericalError
-from .static import (CONDITION_LIMIT, equilibrate, relative_residual, solve_constrained,
-                     solve_nested)
+from .static import (CONDITION_LIMIT, equilibrate, relative_residual, rounded_estimate,
+                     solve_constrained, solve_nested)
 
 #: Above this fill (nnz / n^2) a dense LAPACK LU beats SuperLU: in 3D state-based PD every
 #: node couples to all nodes within two horizons, i.e. to a large part of a small body.
@@ -41,7 +41,7 @@ def solve_square(K, f, *, where: str = "static solve", spd: bool = False,
     if info_ > 0:
         raise NumericalError(f"{where}: singular system of size {n} (zero pivot {info_})")
     rcond, _ = lapack.dgecon(lu, anorm, norm="1")
-    cond = np.inf if rcond == 0 else 1.0 / rcond
+    cond = np.inf if rcond == 0 else rounded_estimate(1.0 / rcond)
     if cond > CONDITION_LIMIT:
         raise NumericalError(f"{where}: near-singular system (condition estimate {cond:.2e} "
                              f"> {CONDITION_LIMIT:.0e} after equilibration)")

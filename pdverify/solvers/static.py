@@ -226,7 +226,7 @@ def _probe_condition_estimate(A, lu, probe, solution) -> float:
     Y = lu.solve(rhs)
     inv_norm = max(float(np.abs(solution).sum()) / scale, float(np.abs(Y[:, 0]).sum()),
                    2.0 * float(np.abs(Y[:, 1]).sum()) / (3.0 * n))
-    return float(abs(A).sum(axis=0).max()) * inv_norm
+    return rounded_estimate(float(abs(A).sum(axis=0).max()) * inv_norm)
 
 
 def refine(A, b, solve, *, stop=None, max_steps: int = REFINE_MAX_STEPS):
@@ -500,6 +500,18 @@ def equilibrate(A, where: str):
     return A_s, row_max, col_max
 
 
+#: significant digits a condition estimate keeps. The estimators' NumPy sums can round
+#: differently with the arrays' memory alignment (the same system gave 367.962170351635
+#: and 367.9621703516349 in two processes), and an estimate good to a factor of a few
+#: has no last bit to keep: rounded, it is the same in every process (a 1-ulp spread
+#: straddles a 6-digit rounding boundary with probability ~1e-10).
+ESTIMATE_DIGITS = 6
+
+
+def rounded_estimate(value: float) -> float:
+    return float(f"{value:.{ESTIMATE_DIGITS}g}")
+
+
 def _condition_estimate(A, lu) -> float:
     """kappa_1(A) ~ ||A||_1 ||A^-1||_1: ||A||_1 exactly, ||A^-1||_1 by Higham's estimator
     on the LU solves. The estimator draws random +-1 start vectors from NumPy's global
@@ -507,13 +519,13 @@ def _condition_estimate(A, lu) -> float:
     always gets the same estimate, and hence the same accept/refuse verdict."""
     n = A.shape[0]
     if n <= 2:
-        return float(np.linalg.cond(A.toarray(), 1))
+        return rounded_estimate(np.linalg.cond(A.toarray(), 1))
     inv = spla.LinearOperator(A.shape, matvec=lu.solve, rmatvec=lambda v: lu.solve(v, trans="T"),
                               dtype=float)
     norm_a = float(abs(A).sum(axis=0).max())
     state = np.random.get_state()
     try:
         np.random.seed(20211121)
-        return norm_a * float(spla.onenormest(inv))
+        return rounded_estimate(norm_a * float(spla.onenormest(inv)))
     finally:
         np.random.set_state(state)
