@@ -174,8 +174,8 @@ class BondBarScene(Scene):
                        E=p["E"], area=AREA, end_weight=p["end_weight"],
                        micromodulus=p["micromodulus"], calibration=p["calibration"],
                        end_factors=self.factors(method, p),
-                       closure=self.bond_closure(method, p) if self.bond_methods().get(method)
-                       else None)
+                       closure=None if method == HOMOGENIZED.name
+                       else self.bond_closure(method, p))
 
 
 # --------------------------------------------------------------------------- Sec. 6.1

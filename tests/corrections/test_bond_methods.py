@@ -323,8 +323,8 @@ def test_energy_and_volume_on_the_indentation():
     directional factor does. (At the paper's grid, in the full report, all three fail by
     a Newton stall at 1.0-1.1 mm, later than none's 0.7 mm: a finding in the scene's
     docstring.)"""
-    coarse = get_scene("block2d-indentation").quick_overrides
     scene = get_scene("block2d-indentation")
+    coarse = scene.quick_overrides
     assert {"energy", "volume"} <= {m.name for m in scene.all_methods}
     r = scene.run("none", coarse)
     assert r.status == "failed" and r.metrics["depth_reached_mm"] < 2

@@ -79,9 +79,9 @@ def homogenization_figures(scene, results, folder):
     name = _save(fig, folder, f"{scene.id}-strain-factor.png")
     caption = ("Left: strain factor f(N) of the non-homogenised bars (ours, solid) against Table "
                "12's closed or fitted forms (dashed) and its printed values at N = 2m + 1 "
-               "(the energy and volume corrections dotted, at the scene's defaults) "
-               "(squares; the cross is the erratum 1.043, exactly 5/3). Right: |f(N) - 1| of "
-               "the homogenised bars, at round-off for every N.")
+               "(squares; the cross is the erratum 1.043, exactly 5/3); the energy and volume "
+               "corrections dotted, at the scene's defaults. Right: |f(N) - 1| of the "
+               "homogenised bars, at round-off for every N.")
     return [(name, caption)]
 
 
