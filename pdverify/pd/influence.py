@@ -191,8 +191,11 @@ class StateBasedConstants:
         return (15.0 / 2.0 if self.kind == "3d" else 4.0) * self.E / (1 + self.nu)
 
     def moduli(self) -> tuple[float, float]:
-        """The classical (lambda, mu) the constants reproduce (plane stress: lambda*)."""
+        """The classical (lambda, mu) the constants reproduce (plane stress: lambda*; 1D:
+        a bar sees only lambda + 2 mu, which is E there, with mu = E / (2 (1 + nu)))."""
         mu = self.E / (2 * (1 + self.nu))
+        if self.kind == "1d":
+            return self.E - 2 * mu, mu
         if self.kind == "plane-stress":
             return self.E * self.nu / (1 - self.nu ** 2), mu
         return self.E * self.nu / ((1 + self.nu) * (1 - 2 * self.nu)), mu

@@ -11,8 +11,9 @@ from ..errors import InputError
 from ..metrics import max_relative_error_pct, nodal_relative_error_pct, rel_l2_error
 from ..params import Param, at_least, open_interval, positive
 from ..pd import BoxGrid, StateBasedConstants, StateBasedModel, build_stencil, get_influence
-from ..solvers.static import solve_constrained
-from . import MethodSpec, Outcome, Published, Scene, influence_param, register
+from ..pd.problem import FaceCondition, StaticProblem
+from . import MethodSpec, Outcome, Published, influence_param, register
+from .family import StaticStateScene
 
 #: Table 3 of seed 000.
 BAR_PARAMS = (
@@ -96,32 +97,42 @@ def bar_estimate(p) -> budget.Estimate:
     return budget.linear_system(p["length"] / p["spacing"] + 1 + 2 * m, 1, 1, 2 * m)
 
 
-class StaticBar(Scene):
+class StaticBar(StaticStateScene):
     """Shared machinery of the four bars of seed 000 §5 (clamped at x = 0).
 
-    Uncorrected baseline ``none`` (ERRATA seed 000): no fictitious nodes, m_i from
-    Eq. (50) over real neighbours, the Dirichlet value imposed on the node nearest the
-    boundary (its classical value u_cl(x_1)), an end force applied to the node nearest
-    the end. ``taylor-fictitious`` (order n): fictitious layers at both ends (Eqs. 40-47),
-    u(0) = 0 by Taylor extrapolation (Eq. 58) and the end force (or zero traction) as the
-    force flux of the bonds crossing x = l (Eq. 60), both by Lagrange multipliers (Eq. 63).
-    Nodal loads are b(x_i) A Delta (Eq. 54). Param ``influence``: seed 000's hyperbolic
-    delta/|xi| by default, any registered influence function on request (the published
-    values are shown beside hyperbolic runs only).
+    The problem, stated once: a bar of cross-section A on [0, l], real nodes at the cell
+    centres, the 1D state-based model with ``influence`` (seed 000's hyperbolic delta/|xi|
+    by default; any registered influence function on request, the published values are
+    shown beside hyperbolic runs only) and the seed-000 1D partial volumes; u = u_cl(0) = 0
+    on x-, the end force f as the traction f / A on x+ (zero for the distributed loads),
+    the body force b(x) on every node (nodal loads b(x_i) A Delta, Eq. 54).
+
+    Every treatment of the ``static-state`` family imposes these in its own way
+    (``pdverify.corrections.static_state``): the uncorrected baseline ``none`` (ERRATA
+    seed 000) has no fictitious nodes, m_i from Eq. (50) over real neighbours, the
+    Dirichlet value on the node nearest the boundary (its classical value u_cl(x_1)) and
+    the end force on the node nearest the end; ``taylor-fictitious`` (order n) has
+    fictitious layers at both ends (Eqs. 40-47), u(0) = 0 by Taylor extrapolation
+    (Eq. 58) and the end force (or zero traction) as the force flux of the bonds crossing
+    x = l (Eq. 60), both by Lagrange multipliers (Eq. 63); ``surface-nodes`` (seed 002's
+    1D surface nodes) carries u(0) on the surface node at x = 0 and the force flux Eq. (36)
+    on the one at x = l; ``mirror-nodes`` and ``pddo`` are seed 001 §5's methods in 1D
+    (their 1D modulus is E = lambda + 2 mu).
     Metrics: ``max_error_pct`` (Eq. 64 against the classical solution), ``rel_l2_error``,
-    ``reaction_force`` (force flux through x = 0, tension positive, Remark 3; for ``none``
-    the reaction at the constrained node), ``reaction_error_pct`` against the total load,
-    and ``gap_nonlinearity``: max |d - linear fit of d| / max |u_cl| with d = u - u_cl
-    (zero when PD and classical differ only by the App. C flux term).
+    ``reaction_force`` (the normal force through x = 0, tension positive: the force flux
+    of the bonds crossing it, Remark 3, for the fictitious-layer and surface-node
+    methods; the reaction of the prescribed node for ``none`` and the bond methods; not
+    defined for ``mirror-nodes`` and ``pddo``, whose loads enter only through their
+    boundary relations), ``reaction_error_pct`` against the total load, and
+    ``gap_nonlinearity``: max |d - linear fit of d| / max |u_cl| with d = u - u_cl (zero
+    when PD and classical differ only by the App. C flux term).
     """
 
     seed = "000"
     reference = "analytic"
     figure = "bar1d"
-    closure_theory = "state-based"
     dim = 1
     load_param: Param
-    methods = (NONE, TAYLOR)
     paper_orders: tuple[int, ...] = (1,)
 
     @property
@@ -142,51 +153,54 @@ class StaticBar(Scene):
         raise NotImplementedError
 
     # -------------------------------------------------------------------------------
+    def box(self, p):
+        return (p["length"],), (0.0,)
+
+    def problem(self, p, where):
+        force = self.end_force(p)
+        loaded = FaceCondition(traction=lambda x, n: np.full_like(x, force / p["area"]))
+        return StaticProblem(
+            (p["length"],), (0.0,), p["spacing"], build_stencil(1, p["m_ratio"]),
+            StateBasedConstants("1d", p["E"], p["nu"]), get_influence(p["influence"]),
+            conditions={"x-": FaceCondition(prescribed=(0,)),
+                        **({"x+": loaded} if force else {})},
+            exact=lambda x: self.classical(x[:, 0], p)[:, None],
+            body_force=lambda x: self.body_force(x[:, 0], p)[:, None],
+            thickness=p["area"], load_point=p.get("load_point", "surface"),
+            solver="direct", where=where)
+
     def check(self, method, p):
         check_bar_grid(self.id, method, p, min_horizons=2.0)
+        super().check(method, p)
 
     def estimate(self, method, p):
         return bar_estimate(p)
 
     def cases(self, quick=False):
-        return [("none", {})] + [(TAYLOR.name, {"order": n}) for n in self.paper_orders]
+        return [("none", {})] + [("taylor-fictitious", {"order": n}) for n in self.paper_orders]
 
-    def solve(self, method, p, timer):
-        with timer.phase("setup"):
-            order = p.get("order") if method == TAYLOR.name else None
-            bar = StateBar(p, order, closure=self.bond_closure(method, p))
-            x = bar.x_real
-            V = p["area"] * p["spacing"]
-            f = self.body_force(x, p) * V
-            u_ref = self.classical(x, p)
-            if order is None:
-                f[-1] += self.end_force(p)
-                B = np.zeros((1, bar.grid.n_interior))
-                B[0, 0] = 1.0
-                c = [u_ref[0]]
-            else:
-                B = np.vstack([bar.boundary_value_row("left"),
-                               bar.flux_rows([p["length"]]).toarray()])
-                c = [0.0, self.end_force(p)]
-        with timer.phase("solve"):
-            u, lam, info = solve_constrained(bar.K, f, B, c, where=f"{self.id}/{method}")
-        if order is None:
-            reaction = -float((bar.K @ u - f)[0])
-        else:
-            reaction = float((bar.flux_rows([0.0]) @ u)[0])
-        total = self.total_load(p)
+    def measure(self, p, problem, system, x, info):
+        g = system.model.grid
+        xr = g.x[g.interior_ids, 0]
+        u = self.solution(system, x)[0][:, 0]
+        u_ref = self.classical(xr, p)
         d = u - u_ref
-        fit = np.polyval(np.polyfit(x, d, 1), x)
-        metrics = {
-            "max_error_pct": max_relative_error_pct(u, u_ref),
-            "rel_l2_error": rel_l2_error(u, u_ref),
-            "reaction_force": reaction,
-            "reaction_error_pct": abs(reaction - total) / abs(total) * 100.0,
-            "gap_nonlinearity": float(np.max(np.abs(d - fit)) / np.max(np.abs(u_ref))),
-        }
-        fields = {"x": x, "u": u, "u_ref": u_ref, "error_pct": nodal_relative_error_pct(u, u_ref),
-                  "horizon": bar.horizon, "length": p["length"]}
-        return Outcome(metrics=metrics, size=bar.size(), fields=fields, diagnostics=info)
+        fit = np.polyval(np.polyfit(xr, d, 1), xr)
+        metrics = {"max_error_pct": max_relative_error_pct(u, u_ref),
+                   "rel_l2_error": rel_l2_error(u, u_ref)}
+        if system.reaction is not None:
+            total = self.total_load(p)
+            reaction = system.reaction(x, 0)
+            metrics["reaction_force"] = reaction
+            metrics["reaction_error_pct"] = abs(reaction - total) / abs(total) * 100.0
+        metrics["gap_nonlinearity"] = float(np.max(np.abs(d - fit)) / np.max(np.abs(u_ref)))
+        fields = {"x": xr, "u": u, "u_ref": u_ref,
+                  "error_pct": nodal_relative_error_pct(u, u_ref),
+                  "horizon": system.model.horizon, "length": p["length"]}
+        size = {"nodes": int(g.n_ext), "real_nodes": int(g.n_interior),
+                "dofs": int(system.dofs), "bonds": int(system.model.bond_a.size),
+                **system.counts}
+        return Outcome(metrics=metrics, size=size, fields=fields, diagnostics=info)
 
 
 @register

@@ -1,8 +1,9 @@
 """The scene contract: parameters, supported methods, run, and the report's cases."""
 from __future__ import annotations
 
+import difflib
 import traceback
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Mapping
 
 import numpy as np
@@ -117,43 +118,79 @@ class Scene:
     published: tuple[Published, ...] = ()
     figure: str = ""  # name of the report figure family that draws this scene's runs
     #: the theory of the scene's plain-grid model ("bond-based" or "state-based") when
-    #: it takes the bond methods of ``pdverify.corrections.registry`` (built-in and
-    #: plugins); None: only its own ``methods``
+    #: it takes the closure treatments (bond methods) of ``pdverify.corrections.registry``
+    #: (built-in and plugins) through :meth:`bond_closure`; None: only its own ``methods``
     closure_theory: str | None = None
+    #: the problem family the scene describes (``static-state``:
+    #: :class:`~pdverify.pd.problem.StaticProblem`), whose treatments assemble its system;
+    #: None: the scene implements its own ``methods``
+    family: str | None = None
+    #: the theory of a family scene's model (closure scenes: ``closure_theory``)
+    theory: str | None = None
     #: the spatial dimension of the scene's model (1, 2 or 3): a bond method may serve
     #: some dimensions only, and the report groups its error-against-cost plots by it
     dim: int | None = None
-    #: overrides of the bond methods' report cases under ``--quick``
+    #: overrides of the offered treatments' report cases under ``--quick``
     quick_overrides: Mapping[str, Any] = {}
+    #: the scene's defaults of treatment parameters (e.g. a Taylor order), by name
+    treatment_defaults: Mapping[str, Any] = {}
 
     # -- methods ----------------------------------------------------------------------
-    def bond_methods(self) -> dict:
-        """The registry's bond methods this scene offers beside its own ``methods``."""
-        if self.closure_theory is None:
+    @property
+    def model_theory(self) -> str | None:
+        return self.theory or self.closure_theory
+
+    def offered(self) -> dict:
+        """The registry's treatments this scene offers beside its own ``methods``: the
+        closure treatments of its theory, and the treatments of its problem family."""
+        if self.closure_theory is None and self.family is None:
             return {}
-        from ..corrections.registry import bond_methods
+        from ..corrections.registry import treatments
         own = {m.name for m in self.methods}
-        return {k: m for k, m in bond_methods().items() if m.serves(self) and k not in own}
+        return {k: t for k, t in treatments().items()
+                if k not in own and t.kind != "hand-wired" and t.serves(self)}
+
+    def bond_methods(self) -> dict:
+        """The registry's closure treatments (bond methods) this scene offers."""
+        return {k: t for k, t in self.offered().items() if t.kind == "closure"}
+
+    def family_refusal(self, treatment) -> str | None:
+        """Why a treatment of this scene's family cannot serve it (None: it can)."""
+        return None
+
+    def _with_defaults(self, params) -> tuple[Param, ...]:
+        if not self.treatment_defaults:
+            return tuple(params)
+        return tuple(replace(q, default=self.treatment_defaults[q.name])
+                     if q.name in self.treatment_defaults else q for q in params)
 
     @property
     def all_methods(self) -> tuple[MethodSpec, ...]:
-        """The scene's own methods, then the bond methods, which take the params of the
-        uncorrected method ``none`` (they correct that model) and their own."""
+        """The scene's own methods, then the offered treatments (closure treatments take
+        the params of the uncorrected method ``none``, which they correct, and their
+        own)."""
         own = tuple(self.methods)
-        base = next((m.params for m in own if m.name == "none"), ())
-        return own + tuple(MethodSpec(k, base + m.params) for k, m in self.bond_methods().items())
+        offered = self.offered()
+        base = next((m.params for m in own if m.name == "none"),
+                    offered["none"].params if "none" in offered else ())
+        return own + tuple(
+            MethodSpec(k, self._with_defaults((base if t.kind == "closure" else ())
+                                              + t.params))
+            for k, t in offered.items())
 
     def method(self, name: str) -> MethodSpec:
         for m in self.all_methods:
             if m.name == name:
-                bm = self.bond_methods().get(name)
-                if bm is not None and bm.unavailable:
+                t = self.offered().get(name)
+                if t is not None and t.unavailable:
                     raise InputError(f"{self.id}: method {name} is unavailable here: "
-                                     f"{bm.unavailable}")
+                                     f"{t.unavailable}")
                 return m
-        allowed = ", ".join(m.name for m in self.all_methods)
-        raise InputError(f"{self.id}: method {name!r} is not supported by this scene; "
-                         f"allowed: {allowed}")
+        allowed = [m.name for m in self.all_methods]
+        close = difflib.get_close_matches(name, allowed, n=3)
+        hint = f"; did you mean {' or '.join(close)}?" if close else ""
+        raise InputError(f"{self.id}: method {name!r} is not supported by this scene{hint}; "
+                         f"allowed: {', '.join(allowed)}")
 
     def bond_closure(self, method: str, params: Mapping[str, Any]) -> Closure:
         """The :class:`~pdverify.pd.closure.Closure` of a bond method; the uncorrected
@@ -163,7 +200,7 @@ class Scene:
 
     @property
     def default_method(self) -> str:
-        return self.methods[0].name
+        return (self.methods or self.all_methods)[0].name
 
     def resolve(self, method: str, overrides: Mapping[str, Any] | None = None) -> dict:
         """Effective parameters (scene + method) with ``overrides`` applied and checked."""
@@ -190,12 +227,12 @@ class Scene:
         return [(m.name, {}) for m in self.methods]
 
     def report_cases(self, quick: bool = False) -> list[tuple[str, dict]]:
-        """:meth:`cases` and one run of every available bond method it does not list (at
-        :attr:`quick_overrides` under ``--quick``)."""
+        """:meth:`cases` and one run of every available offered treatment it does not
+        list (at :attr:`quick_overrides` under ``--quick``)."""
         out = list(self.cases(quick=quick))
         listed = {m for m, _ in out}
-        for name, bm in self.bond_methods().items():
-            if name not in listed and not bm.unavailable:
+        for name, t in self.offered().items():
+            if name not in listed and not t.unavailable:
                 out.append((name, dict(self.quick_overrides) if quick else {}))
         return out
 

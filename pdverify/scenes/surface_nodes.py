@@ -2,24 +2,20 @@
 from __future__ import annotations
 
 import functools
-import math
 
 import numpy as np
 
 from manufactured import surface3d as closed
 
-from .. import budget
-from ..corrections.mirror_nodes import MIRROR_POINTS, NEUMANN_READINGS, MirrorNodes
-from ..corrections.pddo import pddo_system
-from ..corrections.surface_nodes import MAX_ORDER, flux_rows, surface_node_closure
-from ..errors import InputError
+from ..corrections.surface_nodes import flux_rows, surface_node_closure
 from ..metrics import rel_l2_error
 from ..params import Param, at_least, open_interval, positive
 from ..pd import (QUADRATURES, BoxGrid, StateBasedConstants, StateBasedModel, get_influence,
                   state_based_stencil)
-from ..solvers.dense import solve_with_dirichlet
-from . import (MethodSpec, Outcome, Published, Scene, influence_param, register,
-               require_influence, whole_cells)
+from ..pd.problem import FACES, FaceCondition, StaticProblem
+from ..solvers.policy import ND3D_FROM_UNKNOWNS, ND_FROM_UNKNOWNS, STATIC_SOLVERS
+from . import Outcome, Published, influence_param, register, require_influence
+from .family import StaticStateScene, surface_error_pct
 
 
 class StateBox:
@@ -99,31 +95,10 @@ class StateBox:
             out["fictitious_nodes"] = int(g.n_ext - g.n_interior)
         return out
 
-NONE = MethodSpec("none")
-NONE_LOAD_POINT = MethodSpec("none", (Param(
-    "load_point", "node", "where the uncorrected model evaluates a surface load: at the "
-    "node it is applied to (like its constraints) or at the face centre on the surface",
-    choices=("node", "surface")),))
-
-
-def _order_check(value):
-    return None if 1 <= value <= MAX_ORDER else f"must be 1, 2 or 3 (Taylor orders above {MAX_ORDER} are not supported)"
-
-
-MIRROR = MethodSpec("mirror-nodes", (
-    Param("neumann", "full-traction", "how a face's traction sets the gradient in the "
-          "mirror relation: the full traction condition with the tangential derivatives "
-          "at the mirror node (central differences), or the normal derivatives alone "
-          "(tangential terms dropped)", choices=NEUMANN_READINGS),
-    Param("mirror_point", "nearest", "mirror node: the real node nearest the mirror point "
-          "(the method), or that node with the mismatch corrected by its gradient "
-          "(our variant; exact for linear fields)", choices=MIRROR_POINTS)))
-
-
-def surface_method(default_order: int) -> MethodSpec:
-    return MethodSpec("surface-nodes", (Param("order", default_order,
-                                              "Taylor truncation order N (displacements N, "
-                                              "dilatations N - 1)", _order_check),))
+def _next_to_x0(cells):
+    """The boundary cells in the cell layer next to x = 0 (seed 001 Fig. 8's edge
+    constraints, moved onto the face next to that edge)."""
+    return cells[:, 0] == 0
 
 
 GEOMETRY = Param("geometry", "box", "body shape (only boxes are supported)", choices=("box",))
@@ -133,55 +108,14 @@ QUADRATURE = Param("quadrature", "partial-volume",
                    "the discrete bulk then has the continuum moduli)", choices=QUADRATURES)
 
 INFLUENCE = influence_param("gaussian", "seed 001, Eq. 7: Gaussian")
-#: ``solver=auto`` solves the augmented system under nested dissection from this many
-#: displacement unknowns; below it the direct solve of K takes a few seconds at most
-#: (1.7 s at the plate's default 5,000) and the report's default-size 2D runs keep their
-#: solutions bit for bit.
-ND_FROM_UNKNOWNS = 8000
-#: the same in 3D, where K is a dense LU: whole runs (assembly and solve) of body3d-traction,
-#: surface nodes, direct against nested dissection (benchmarks/solvers.py --only
-#: crossover3d, median of 3, quiet machine): 0.85 / 0.99 s at 2,376 unknowns, 1.79 / 2.02 s
-#: at 3,528, 4.22 / 2.99 s at 4,992 (where the float32 factor starts), and at the default
-#: 9,000 15.7 / 7.9 s with peak memory 2.67 / 1.33 GB (``pdverify run``, /usr/bin/time)
-ND3D_FROM_UNKNOWNS = 4000
 SOLVER = Param("solver", "auto", "linear solver: direct (K multiplied out; sparse or dense "
                "LU), nested-dissection (dilatations kept as unknowns, sparse LU under a "
                f"geometric nested-dissection ordering) or auto (nested-dissection from "
                f"{ND_FROM_UNKNOWNS} unknowns in 2D, {ND3D_FROM_UNKNOWNS} in 3D)",
-               choices=("auto", "direct", "nested-dissection"))
+               choices=STATIC_SOLVERS)
 # published numbers sit beside the paper's quadrature and influence only
 PAPER_QUADRATURE = {"quadrature": "partial-volume", "influence": "gaussian"}
 MOMENT = {"quadrature": "moment-corrected"}
-
-#: Gauss-Legendre points per tangential axis of a face resultant (exact to degree 5).
-_FACE_GAUSS = 3
-
-
-def face_resultant(traction, centres, normals, spacing):
-    """Mean of ``traction(x, n)`` over the square (2D: segment) cell face at each centre.
-
-    A surface node represents the area A of its cell face (seed 001 §3), so the load of
-    Eq. (36) is the resultant of the traction over that face: p_i A_i = int_(A_i) t dA.
-    For constant or linear tractions this is the value at the centre; for the quadratic
-    shear of Eq. (41) the centre value misses h^2/12 t'' and the flux equations see it.
-    Tensor Gauss-Legendre with 3 points per tangential axis (exact to degree 5).
-    """
-    centres = np.asarray(centres, dtype=float)
-    n, d = centres.shape
-    axis = np.argmax(np.abs(normals), axis=1)
-    t, w = np.polynomial.legendre.leggauss(_FACE_GAUSS)
-    t, w = 0.5 * spacing * t, 0.5 * w
-    tangents = [(axis + k) % d for k in range(1, d)]
-    out = np.zeros_like(centres)
-    for combo in np.ndindex(*([_FACE_GAUSS] * (d - 1))):
-        x = centres.copy()
-        weight = 1.0
-        for tang, q in zip(tangents, combo):
-            x[np.arange(n), tang] += t[q]
-            weight *= w[q]
-        out += weight * traction(x, normals)
-    return out
-
 
 def error_metrics(x, u, u_ref, dist, horizon, dim) -> tuple[dict, np.ndarray]:
     """Eq. (38) (3D) / Eq. (44) (2D) errors in percent, overall and split at delta.
@@ -248,18 +182,16 @@ METHOD_CHOICES = """
 """
 
 
-class SurfaceNodeScene(Scene):
-    """Shared machinery; subclasses define the geometry, loads and constraints."""
+class SurfaceNodeScene(StaticStateScene):
+    """Shared description of seed 001's boxes; subclasses state the geometry, loads and
+    conditions (:meth:`conditions`), every treatment of the ``static-state`` family
+    imposes them (``pdverify.corrections.static_state``)."""
 
     seed = "001"
     figure = "surface-nodes"
     kind = "3d"
-    closure_theory = "state-based"
 
     # ----------------------------------------------------------------- hooks
-    def box(self, p):
-        raise NotImplementedError
-
     def exact(self, x, p):
         raise NotImplementedError
 
@@ -277,188 +209,63 @@ class SurfaceNodeScene(Scene):
             t[:, self.uniform_load[1]] = p["traction"]
         return t
 
-    def surface_dirichlet(self, grid, p):
-        """[(surface-node mask, component)] prescribed on surface nodes (exact values)."""
-        raise NotImplementedError
-
-    def interior_dirichlet(self, grid, p):
-        """[(interior-node mask, component)] for the uncorrected model (exact values)."""
+    def conditions(self, p) -> dict:
+        """``{face name: (prescribed components, where)}`` of the Dirichlet faces; every
+        other face of :meth:`loaded_faces` carries :meth:`traction`."""
         raise NotImplementedError
 
     def loaded_faces(self, p):
-        """Faces whose traction is applied (the others are Dirichlet faces)."""
+        """Faces whose traction is applied (the others are free or prescribed)."""
         raise NotImplementedError
 
-    def _face_load(self, face, centres, normals, p, c, horizon, grid):
-        """Force on each cell face of ``face``: the traction's resultant over the face
-        (default) or, with ``surface_load=centre``, its value at the centre times A."""
-        def traction(x, n):
-            return self.traction(x, n, face, p, c, horizon)
-        if p.get("surface_load", "face-mean") == "centre":
-            return traction(centres, normals) * grid.face_area
-        return face_resultant(traction, centres, normals, grid.spacing) * grid.face_area
-
-    def estimate(self, method, p):
-        """Unknowns on the cell-centred nodes and (surface-nodes) one surface node per
-        boundary cell face; the dilatation couples nodes 2m spacings apart (m in the
-        augmented system of the nested-dissection solve, which has a dilatation unknown per
-        node). The fictitious layer (m deep) folds into the unknowns through its Taylor
-        rows, which are stored."""
-        lengths, _ = self.box(p)
-        m, d = p["m_ratio"], len(lengths)
-        cells = [L / p["spacing"] for L in lengths]
-        nodes, rows = math.prod(cells), 0.0
-        if method == "surface-nodes":
-            nodes += 2 * sum(nodes / c for c in cells)
-            fictitious = math.prod(c + 2 * m for c in cells) - math.prod(cells)
-            rows = budget.BYTES_PER_NONZERO * fictitious * d * d * budget.lattice_neighbours(d, m)
-        if d == 3 and self.solver_for(p, d, d * nodes) == "nested-dissection":
-            # the augmented system: d displacements and a dilatation per node, reach m
-            return budget.nested_dissection_3d(nodes, d + 1, m, extra_bytes=rows)
-        return budget.linear_system(nodes, d, d, 2 * m, dense_allowed=True, extra_bytes=rows)
-
-    # ----------------------------------------------------------------- checks
-    def check(self, method, p):
-        where = f"{self.id} --method {method}"
-        lengths, _ = self.box(p)
-        h = p["spacing"]
-        whole_cells(where, h, [(f"l_{name}", L) for name, L in zip("xyz", lengths)])
-        if method == "surface-nodes":
-            m = p["m_ratio"]
-            if abs(m - round(m)) > 1e-12:
-                raise InputError(f"{where}: m_ratio={m:g} must be a whole number for "
-                                 "surface-nodes (the fictitious layer of thickness delta must "
-                                 "be a whole number of cells)")
-            N = p["order"]
-            need = max(N + 1, 2 * ((N + 1) // 2) + 1)
-            for name, L in zip("xyz", lengths):
-                if round(L / h) < need:
-                    raise InputError(f"{where}: l_{name}={L:g} has {round(L / h)} cells; order "
-                                     f"{N} needs at least {need} for the Taylor stencils")
-
-    # ----------------------------------------------------------------- solve
+    # ----------------------------------------------------------------- the problem
     def constants(self, p):
         return StateBasedConstants(self.kind, p["E"], p["nu"])
 
-    def solver_for(self, p, dim, unknowns) -> str:
-        """The solver a run uses: p["solver"], or for ``auto`` nested dissection from
-        :data:`ND_FROM_UNKNOWNS` unknowns in 2D (11x faster than the direct solve at
-        h = 0.01) and :data:`ND3D_FROM_UNKNOWNS` in 3D (2x faster and half the memory of
-        the dense LU at h = 0.05): benchmarks/solvers.py."""
-        if p["solver"] != "auto":
-            return p["solver"]
-        return ("nested-dissection" if unknowns >= (ND_FROM_UNKNOWNS if dim == 2
-                                                     else ND3D_FROM_UNKNOWNS) else "direct")
-
-    def assemble(self, method, p):
-        """The run's linear system: ``(model, A, rhs, fixed, values, solver)``. ``A`` is K
-        (``direct``) or the augmented system with dilatation unknowns, whose ``rhs`` then
-        has zeros appended; ``fixed``/``values``: the prescribed unknowns, sorted."""
-        order = p["order"] if method == "surface-nodes" else None
+    def problem(self, p, where):
         lengths, origin = self.box(p)
         c = self.constants(p)
+        inf = get_influence(p["influence"])
+        horizon = p["m_ratio"] * p["spacing"]
+        conditions = {}
+        for face in self.loaded_faces(p):
+            conditions[FACES[face]] = FaceCondition(traction=functools.partial(
+                self._traction, face=face, p=p, c=c, horizon=horizon))
+        for name, (prescribed, part) in self.conditions(p).items():
+            old = conditions.get(name, FaceCondition())
+            conditions[name] = FaceCondition(prescribed=prescribed, where=part,
+                                             traction=old.traction)
+        return StaticProblem(
+            lengths, origin, float(p["spacing"]),
+            state_based_stencil(len(lengths), p["m_ratio"], p["spacing"], inf,
+                                p["quadrature"]),
+            c, inf, conditions, exact=lambda x: self.exact(x, p),
+            body_force=lambda x: self.body_force(x, p, c, horizon),
+            face_load="centre" if p.get("surface_load", "face-mean") == "centre"
+            else "face-mean", load_point=p.get("load_point", "surface"),
+            solver=p["solver"], where=where)
 
-        def exact(x):                # the boundary data of mirror-nodes and pddo
-            return self.exact(x, p)
+    def _traction(self, x, normal, face, p, c, horizon):
+        return self.traction(x, normal, face, p, c, horizon)
 
-        def traction(x, n, face):
-            return self.traction(x, n, face, p, c, None)
-        mirror = (functools.partial(
-            MirrorNodes, dirichlet=self.face_dirichlet, exact=exact, traction=traction,
-            moduli=c.moduli(), neumann=p["neumann"], mirror_point=p["mirror_point"])
-            if method == "mirror-nodes" else None)
-        model = StateBox(lengths, origin, p["spacing"], p["m_ratio"], c, order=order,
-                         quadrature=p["quadrature"], influence=p["influence"],
-                         closure=self.bond_closure(method, p), mirror=mirror)
-        g = model.grid
-        d, ni, nu_ = g.dim, g.n_interior, model.n_unknown_nodes
-        solver = self.solver_for(p, d, d * nu_)
-        x_int = g.x[g.interior_ids]
-        if method == "pddo":   # its own square system, nonsymmetric: direct LU
-            body = self.body_force(x_int, p, c, model.horizon) * g.volume
-            A, rhs, model.counts = pddo_system(model.model, self.face_dirichlet, exact,
-                                               traction, c.moduli(), body)
-            return model, A, rhs, np.zeros(0, dtype=int), np.zeros(0), "direct"
-        K = model.stiffness() if solver == "direct" else model.augmented()
-        rhs = np.zeros((nu_, d))
-        rhs[:ni] = self.body_force(x_int, p, c, model.horizon) * g.volume
-        fixed, values = [], []
-        if model.mirror is not None:   # loads and constraints through the mirror relations
-            m_ = model.model
-            U_c = model.mirror.constant_displacements()
-            e_c = m_.A_e @ U_c.T.ravel()
-            rhs[:ni] -= m_.rows_of_state(U_c, m_.A_Theta @ (m_.A_theta @ e_c),
-                                         model.P).reshape(d, nu_).T
-            fixed, values = [np.zeros(0, dtype=int)], [np.zeros(0)]
-        elif order is None:
-            cells = g.index[g.interior_ids]
-            for face in self.loaded_faces(p):
-                axis, side, _ = g.faces[face]
-                on = cells[:, axis] == g.boundary_layer(face)
-                xs = x_int[on].copy()
-                if p.get("load_point", "surface") == "surface":
-                    xs[:, axis] = g.face_coordinate(face)
-                nrm = np.zeros_like(xs)
-                nrm[:, axis] = -1.0 if side == 0 else 1.0
-                rhs[:ni][on] += self._face_load(face, xs, nrm, p, c, model.horizon, g)
-            u_ref_all = self.exact(x_int, p)
-            for mask, k in self.interior_dirichlet(g, p):
-                nodes = np.flatnonzero(mask)
-                fixed.append(k * nu_ + nodes)
-                values.append(u_ref_all[nodes, k])
-        else:
-            xs, nrm = g.surface_x, g.surface_normal
-            for face in self.loaded_faces(p):
-                sel = g.surface_face == face
-                rhs[ni:][sel] = self._face_load(face, xs[sel], nrm[sel], p, c,
-                                                model.horizon, g)
-            u_ref_s = self.exact(xs, p)
-            for mask, k in self.surface_dirichlet(g, p):
-                nodes = np.flatnonzero(mask)
-                fixed.append(k * nu_ + ni + nodes)
-                values.append(u_ref_s[nodes, k])
-        fixed = np.concatenate(fixed)
-        values = np.concatenate(values)
-        order_idx = np.argsort(fixed)
-        fixed, values = fixed[order_idx], values[order_idx]
-        rhs = rhs.T.ravel()
-        if solver != "direct":   # zero rows of the nodal scalars (dilatations; PALS: two)
-            rhs = np.r_[rhs, np.zeros(K.shape[0] - rhs.size)]
-        return model, K, rhs, fixed, values, solver
-
-    def solve(self, method, p, timer):
-        order = p["order"] if method == "surface-nodes" else None
-        with timer.phase("setup"):
-            model, K, rhs, fixed, values, solver = self.assemble(method, p)
-            lengths, origin = self.box(p)
-            g = model.grid
-            d, ni, nu_ = g.dim, g.n_interior, model.n_unknown_nodes
-            x_int = g.x[g.interior_ids]
-        with timer.phase("solve"):
-            sol, info = solve_with_dirichlet(
-                K, rhs, fixed, values, where=f"{self.id}/{method}", solver=solver,
-                coords=None if solver == "direct" else model.unknown_coords())
-            sol = sol[:d * nu_]
-            if p["solver"] == "auto":
-                info["solver_choice"] = (f"auto: {solver} ({d * nu_} unknowns; nested "
-                                         f"dissection from {ND_FROM_UNKNOWNS} in 2D, "
-                                         f"{ND3D_FROM_UNKNOWNS} in 3D)")
-        U = sol.reshape(d, nu_).T
-        u = U[:ni]
+    # ----------------------------------------------------------------- measure
+    def measure(self, p, problem, system, x, info):
+        g = system.model.grid
+        lengths, origin = self.box(p)
+        d = g.dim
+        x_int = self.real_nodes(system)
+        u, u_extra = self.solution(system, x)
         u_ref = self.exact(x_int, p)
-        dist = g.distance_to_surface(x_int)
-        metrics, err = error_metrics(x_int, u, u_ref, dist, model.horizon, d)
-        if order is not None:
-            us_ref = self.exact(g.surface_x, p)
-            scale = np.max(np.abs(u_ref), axis=0)
-            metrics["surface_max_error_pct"] = float(
-                np.max(np.abs(U[ni:] - us_ref) / scale) * 100.0)
+        horizon = system.model.horizon
+        metrics, err = error_metrics(x_int, u, u_ref, g.distance_to_surface(x_int), horizon, d)
+        if u_extra is not None:
+            metrics["surface_max_error_pct"] = surface_error_pct(
+                u_extra, self.exact(system.extra_x, p), np.max(np.abs(u_ref), axis=0))
         fields = {"x": x_int, "u": u, "u_ref": u_ref, "error": err, "cells": np.asarray(g.cells),
                   "lengths": np.asarray(lengths), "origin": np.asarray(origin),
-                  "spacing": p["spacing"], "horizon": model.horizon}
-        size = model.size()
-        size["stiffness_nnz" if solver == "direct" else "augmented_nnz"] = int(K.nnz)
-        size.update(model.counts)
+                  "spacing": p["spacing"], "horizon": horizon}
+        size = self.size(system)
+        size["stiffness_nnz" if system.solver == "direct" else "augmented_nnz"] = int(system.K.nnz)
         return Outcome(metrics=metrics, size=size, fields=fields, diagnostics=info)
 
 
@@ -525,8 +332,6 @@ class Body3DTraction(Body3D):
     seed = "001 §4.1"
     reference = "analytic"
     params = BODY_PARAMS + (Param("traction", 10e6, "traction p on x = l_x [Pa]", positive),)
-    methods = (NONE, surface_method(1))
-    uniform_load = (1, 0)  # p along x on x = l_x
     published = (
         Published("max_error_pct", "> 30", "seed 001 §4.1, Fig. 9a", method="none",
                   where=PAPER_QUADRATURE),
@@ -542,14 +347,8 @@ class Body3DTraction(Body3D):
         return (1, 2, 3, 4, 5)
 
 
-    def surface_dirichlet(self, g, p):
-        f, cell = g.surface_face, g.surface_cell
-        return [(f == 0, 0), ((f == 2) & (cell[:, 0] == 0), 1), ((f == 4) & (cell[:, 0] == 0), 2)]
-
-    def interior_dirichlet(self, g, p):
-        cell = g.index[g.interior_ids]
-        first = cell[:, 0] == 0
-        return [(first, 0), (first & (cell[:, 1] == 0), 1), (first & (cell[:, 2] == 0), 2)]
+    def conditions(self, p):
+        return {"x-": ((0,), None), "y-": ((1,), _next_to_x0), "z-": ((2,), _next_to_x0)}
 
     def cases(self, quick=False):
         over = {"spacing": 0.1} if quick else {}
@@ -606,7 +405,7 @@ class Body3DManufactured(Body3D):
         "over the face (our choice) or its value at the face centre times A (a literal "
         "reading of p_i A_i in Eq. 36); they differ for the x^2 shear of Eq. (41)",
         choices=("face-mean", "centre")),)
-    methods = (NONE_LOAD_POINT, surface_method(3))
+    treatment_defaults = {"order": 3, "load_point": "node"}
     published = (
         Published("max_error_pct", "> 130", "seed 001 §4.2, Fig. 12a", method="none",
                   where=PAPER_QUADRATURE),
@@ -636,12 +435,8 @@ class Body3DManufactured(Body3D):
     def loaded_faces(self, p):
         return (1, 2, 3, 4, 5)
 
-    def surface_dirichlet(self, g, p):
-        return [(g.surface_face == 0, k) for k in range(3)]
-
-    def interior_dirichlet(self, g, p):
-        first = g.index[g.interior_ids][:, 0] == 0
-        return [(first, k) for k in range(3)]
+    def conditions(self, p):
+        return {"x-": ((0, 1, 2), None)}
 
     def cases(self, quick=False):
         over = {"spacing": 0.1} if quick else {}
@@ -724,10 +519,6 @@ class Plate2DPlaneStrain(SurfaceNodeScene):
         GEOMETRY,
         SOLVER,
     )
-    methods = (NONE, surface_method(1), MIRROR, MethodSpec("pddo"))
-    #: (face, component) prescribed for the mirror node and PDDO methods: u on x = 0,
-    #: v on y = 0
-    face_dirichlet = ((0, 0), (2, 1))
     uniform_load = (3, 1)  # p along y on y = l_y
 
     def constants(self, p):
@@ -744,13 +535,8 @@ class Plate2DPlaneStrain(SurfaceNodeScene):
         return (1, 3)
 
 
-    def surface_dirichlet(self, g, p):
-        f = g.surface_face
-        return [(f == 0, 0), (f == 2, 1)]
-
-    def interior_dirichlet(self, g, p):
-        cell = g.index[g.interior_ids]
-        return [(cell[:, 0] == 0, 0), (cell[:, 1] == 0, 1)]
+    def conditions(self, p):
+        return {"x-": ((0,), None), "y-": ((1,), None)}
 
     def cases(self, quick=False):
         if quick:

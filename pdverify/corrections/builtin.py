@@ -1,0 +1,172 @@
+"""The built-in treatments: those that assemble problem families (``static-state``) and
+the descriptions of those that their scenes still wire by hand."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Callable, Mapping
+
+from ..errors import InputError
+from ..params import Param, at_least
+from ..pd.problem import LOAD_POINTS
+from .mirror_nodes import MIRROR_POINTS, NEUMANN_READINGS
+from .surface_nodes import MAX_ORDER
+from .treatment import Treatment
+
+FAMILY = ("static-state",)
+
+
+@dataclass(frozen=True)
+class FamilyTreatment(Treatment):
+    """A treatment whose ``assemble`` is a function ``build(problem, params)`` and whose
+    parameter checks are ``checker(cells, params, where)``."""
+
+    build: Callable[[Any, Mapping[str, Any]], Any] | None = None
+    checker: Callable[[tuple, Mapping[str, Any], str], None] | None = None
+
+    def assemble(self, problem, params):
+        return self.build(problem, params)
+
+    def check(self, cells, params, where):
+        if self.checker is not None:
+            self.checker(cells, params, where)
+
+
+def _order_check(value):
+    return (None if 1 <= value <= MAX_ORDER
+            else f"must be 1, 2 or 3 (Taylor orders above {MAX_ORDER} are not supported)")
+
+
+def _check_taylor(cells, p, where):
+    """Seed 000 App. D: the extrapolation of order n needs more than 2 n nodes along
+    every axis."""
+    n = min(cells)
+    if n <= 2 * p["order"]:
+        raise InputError(f"{where}: order={p['order']} is too large for {n} nodes; "
+                         f"seed 000 App. D needs nodes > 2 * order (order <= {(n - 1) // 2})")
+
+
+def _check_surface(cells, p, where):
+    m = p["m_ratio"]
+    if abs(m - round(m)) > 1e-12:
+        raise InputError(f"{where}: m_ratio={m:g} must be a whole number for "
+                         "surface-nodes (the fictitious layer of thickness delta must "
+                         "be a whole number of cells)")
+    N = p["order"]
+    need = max(N + 1, 2 * ((N + 1) // 2) + 1)
+    for name, n in zip("xyz", cells):
+        if n < need:
+            raise InputError(f"{where}: l_{name} has {n} cells; order {N} needs at least "
+                             f"{need} for the Taylor stencils")
+
+
+def _check_mirror(cells, p, where):
+    m = p["m_ratio"]
+    if abs(m - round(m)) > 1e-12:
+        raise InputError(f"{where}: m_ratio={m:g} must be a whole number for the "
+                         "fictitious layer of whole cells")
+
+
+def _none(problem, p):
+    from .static_state import assemble_plain
+    return assemble_plain(problem)
+
+
+def _taylor(problem, p):
+    from .static_state import assemble_taylor
+    return assemble_taylor(problem, p["order"])
+
+
+def _surface(problem, p):
+    from .static_state import assemble_surface_nodes
+    return assemble_surface_nodes(problem, p["order"])
+
+
+def _mirror(problem, p):
+    from .static_state import assemble_mirror
+    return assemble_mirror(problem, p["neumann"], p["mirror_point"])
+
+
+def _pddo(problem, p):
+    from .static_state import assemble_pddo
+    return assemble_pddo(problem)
+
+
+LOAD_POINT = Param("load_point", "surface", "where the uncorrected model evaluates a "
+                   "surface load: at the node it is applied to (like its constraints) or "
+                   "at the face centre on the surface", choices=LOAD_POINTS)
+ORDER = Param("order", 1, "Taylor truncation order n", at_least(1))
+SURFACE_ORDER = Param("order", 1, "Taylor truncation order N (displacements N, "
+                      "dilatations N - 1)", _order_check)
+MIRROR_PARAMS = (
+    Param("neumann", "full-traction", "how a face's traction sets the gradient in the "
+          "mirror relation: the full traction condition with the tangential derivatives "
+          "at the mirror node (central differences), or the normal derivatives alone "
+          "(tangential terms dropped)", choices=NEUMANN_READINGS),
+    Param("mirror_point", "nearest", "mirror node: the real node nearest the mirror point "
+          "(the method), or that node with the mismatch corrected by its gradient "
+          "(our variant; exact for linear fields)", choices=MIRROR_POINTS))
+
+STATE = ("state-based",)
+
+
+def family_treatments() -> list[Treatment]:
+    return [
+        FamilyTreatment(
+            "none", "uncorrected PD: truncated neighbourhoods, BCs on the nodes nearest "
+            "the boundary", "the papers' baseline (seed 000 §5, seed 001 §4)",
+            params=(LOAD_POINT,), families=FAMILY, build=_none),
+        FamilyTreatment(
+            "taylor-fictitious", "seed 000: fictitious layer by nearest-node Taylor "
+            "extrapolation (1D series along the normal; corners by Eq. 69), Dirichlet and "
+            "Neumann conditions via Lagrange multipliers (Eqs. 58, 60, 63)",
+            "Scabbia, Zaccariotto, Galvanetto 2021 (seed 000)", params=(ORDER,),
+            theories=STATE, dims=(1, 2), families=FAMILY, footprint="fictitious",
+            scope="state-based 1D and 2D (3D: its Lagrange system of K has no "
+                  "nested-dissection path yet)",
+            build=_taylor, checker=_check_taylor),
+        FamilyTreatment(
+            "surface-nodes", "seeds 001/002: surface nodes carry the boundary conditions, "
+            "fictitious layer by Taylor extrapolation about the nearest surface node",
+            "Scabbia, Zaccariotto, Galvanetto 2023 (seed 001); seed 002",
+            params=(SURFACE_ORDER,), theories=STATE, families=FAMILY, footprint="surface",
+            build=_surface, checker=_check_surface),
+        FamilyTreatment(
+            "mirror-nodes", "seed 001 §5: a delta-thick fictitious layer whose nodes copy "
+            "mirror nodes inside the body (odd reflection for Dirichlet components, the "
+            "traction through the Neumann relation)",
+            "Zhao, Jafarzadeh, Chen, Bobaru 2020; seed 001 §5.2", params=MIRROR_PARAMS,
+            theories=STATE, families=FAMILY, footprint="fictitious", whole_faces_only=True,
+            scope="whole-face Dirichlet conditions (a mirror relation holds per face)",
+            build=_mirror, checker=_check_mirror),
+        FamilyTreatment(
+            "pddo", "seed 001 §5: peridynamic differential operator (moment matrices exact "
+            "for quadratics) for the boundary rows and the equilibrium within 2 delta, LPS "
+            "beyond", "Behera, Roy, Anicode, Madenci, Spencer 2022; seed 001 §5.3",
+            theories=STATE, families=FAMILY, whole_faces_only=True,
+            scope="whole-face Dirichlet conditions (boundary rows per face)", build=_pddo),
+    ]
+
+
+def hand_wired() -> list[Treatment]:
+    """Treatments only their own scenes implement; ``scope`` says where and why."""
+    return [
+        Treatment("homogenized", "seed 004: stiffness factors on the end bonds (1, 1+k), "
+                  "(N, N-k) so that a linear field satisfies every equilibrium equation "
+                  "(1D bond-based)", "Eriksson, Tulkki 2020 (seed 004)",
+                  theories=("bond-based",), dims=(1,),
+                  scope="1D bond-based bars only (seed 004 derives its factors for the "
+                        "triangular micromodulus in 1D)"),
+        Treatment("energy-directional", "seed 003: bond stiffness times (phi(x, e) + "
+                  "phi(x', -e))/2, phi the Eq. (14) ratio of the horizon's radial integral "
+                  "to its truncated part along the bond direction (bond-based)",
+                  "Ritter, Wohlmuth et al. (seed 003)", theories=("bond-based",),
+                  scope="2D bond-based scenes of seed 003 (Eq. 14's factor is derived for "
+                        "the 2D bond-based micromodulus)"),
+        Treatment("virtual-nodes", "seed 003 §4.1.2: buffer layers of thickness delta "
+                  "outside the clamped edges, displaced rigidly (bond-based)",
+                  "seed 003 §4.1.2", theories=("bond-based",),
+                  scope="the clamped sheet only (rigid buffers need a clamped edge, which "
+                        "no other bond-based scene has)"),
+        Treatment("fem", "classical-elasticity FEM reference (reference_fem)",
+                  "scikit-fem", scope="the reference of the scenes whose reference is FEM"),
+    ]

@@ -1,0 +1,361 @@
+"""The treatments of the ``static-state`` problem family: how each one turns a
+:class:`~pdverify.pd.problem.StaticProblem` (a state-based box with boundary conditions
+keyed by face and component) into a :class:`~pdverify.pd.problem.LinearSystem`.
+
+- ``none`` and every closure treatment (bond methods): truncated neighbourhoods; a
+  prescribed component is imposed on the real nodes nearest its face at the exact value
+  there (seed 000 and seed 001 §4: the uncorrected baseline), a face's traction as the
+  force of each boundary cell face on the node of that cell (evaluated at the node or on
+  the surface: ``load_point``).
+- ``surface-nodes`` (seeds 001, 002): surface-node unknowns carry the conditions, the
+  other surface-node equations are the force flux of Eq. (36).
+- ``taylor-fictitious`` (seed 000): the fictitious layer by Taylor extrapolation, the
+  conditions by Lagrange multipliers (Eq. 63): prescribed values at the boundary point of
+  every line perpendicular to a face (Eq. 58), tractions as the force flux through every
+  boundary cell face (Eq. 60 in 1D; the face-crossing bonds of seed 001 §3.4 in 2D/3D).
+- ``mirror-nodes`` and ``pddo`` (seed 001 §5): through the modules of the same name;
+  both need whole-face conditions.
+
+Each function returns the system; the scene solves it (``pdverify.solvers.front``) and
+measures it. Node counts and the budget's footprint come from :func:`footprint`.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..pd import BoxGrid, StateBasedModel
+from ..pd.bonds import bond_pairs
+from ..pd.closure import Closure
+from ..pd.problem import FACES, LinearSystem
+from ..solvers.policy import static_solver
+from .mirror_nodes import MirrorNodes
+from .pddo import pddo_system
+from .surface_nodes import face_crossings, flux_rows, surface_node_closure
+from .taylor_fictitious import boundary_value_rows, fictitious_closure
+
+
+# ------------------------------------------------------------------------------ helpers
+def _grid(problem, layers: int) -> BoxGrid:
+    return BoxGrid(problem.lengths, problem.origin, float(problem.spacing), layers)
+
+
+def _model(problem, grid, closure) -> StateBasedModel:
+    return StateBasedModel(grid, problem.stencil, problem.constants, problem.influence,
+                           closure, thickness=problem.thickness)
+
+
+def _side_sign(face: int) -> float:
+    return -1.0 if face % 2 == 0 else 1.0
+
+
+def _matrix(model, P, solver):
+    """K (direct) or the augmented system with the nodal scalars as unknowns."""
+    return model.stiffness(P) if solver == "direct" else model.augmented_stiffness(P)
+
+
+def _coords(model, nodes):
+    """Coordinates of the unknowns: d displacement components of ``nodes``, then the
+    closure's nodal scalars (dilatations; PALS: two per node) of the real nodes."""
+    g = model.grid
+    x_int = g.x[g.interior_ids]
+    scalars = model.A_theta.shape[0] // len(x_int)
+    return np.r_[np.tile(nodes, (g.dim, 1)), np.tile(x_int, (scalars, 1))]
+
+
+def _pad(rhs, K):
+    return np.r_[rhs, np.zeros(K.shape[0] - rhs.size)]
+
+
+def _residual_reaction(system_K, rhs_of):
+    """Reaction through a face from the residual R = K x - rhs of the prescribed
+    unknowns on it (normal component, tension positive)."""
+    def reaction(x, face, dofs_of):
+        R = system_K @ x - rhs_of
+        return float(_side_sign(face) * np.sum(R[dofs_of(face)]))
+    return reaction
+
+
+def _traction_of(problem):
+    """``traction(x, normal, face)`` of the mirror and PDDO modules: zero on free faces."""
+    def traction(x, n, face):
+        cond = problem.conditions.get(FACES[face])
+        if cond is None or cond.traction is None:
+            return np.zeros_like(x)
+        return cond.traction(x, n)
+    return traction
+
+
+def _face_dirichlet(problem):
+    return tuple((f, k) for f, k, _ in problem.prescribed())
+
+
+def footprint(kind: str, cells, m_ratio: float):
+    """``(extra unknown nodes, fictitious nodes)`` of a treatment kind on a box of
+    ``cells`` (the budget's estimate)."""
+    nodes = math.prod(cells)
+    fictitious = math.prod(c + 2 * m_ratio for c in cells) - nodes
+    if kind == "surface":
+        return 2 * sum(nodes / c for c in cells), fictitious
+    if kind == "fictitious":
+        return 0.0, fictitious
+    return 0.0, 0.0
+
+
+# ------------------------------------------------------------------------------ none
+def assemble_plain(problem, closure: Closure | None = None) -> LinearSystem:
+    """The uncorrected model (with a closure treatment's ``closure``), module docstring."""
+    g = _grid(problem, 0)
+    model = _model(problem, g, closure)
+    d, ni, nu_ = g.dim, g.n_interior, model.n_unknown_nodes
+    solver = static_solver(problem.solver, d, d * nu_)
+    P = model.equilibrium_rows()
+    K = _matrix(model, P, solver)
+    x_int = g.x[g.interior_ids]
+    cells = g.index[g.interior_ids]
+    rhs = np.zeros((nu_, d))
+    rhs[:ni] = problem.body_load(x_int, model.node_volume[g.interior_ids][:, None])
+    for face, _ in problem.loaded():
+        axis, side = divmod(face, 2)
+        on = cells[:, axis] == g.boundary_layer(face)
+        xs = x_int[on].copy()
+        if problem.load_point == "surface":
+            xs[:, axis] = g.face_coordinate(face)
+        nrm = np.zeros_like(xs)
+        nrm[:, axis] = _side_sign(face)
+        rhs[:ni][on] += problem.face_forces(face, xs, nrm, g.face_area)
+    u_ref = problem.exact(x_int)
+    fixed, values, by_face = [], [], {}
+    for face, k, where in problem.prescribed():
+        mask = cells[:, face // 2] == g.boundary_layer(face)
+        if where is not None:
+            mask &= where(cells)
+        nodes = np.flatnonzero(mask)
+        fixed.append(k * nu_ + nodes)
+        values.append(u_ref[nodes, k])
+        if k == face // 2:
+            by_face[face] = k * nu_ + nodes
+    fixed, values = _sorted(fixed, values)
+    rhs = rhs.T.ravel()
+    if solver != "direct":
+        rhs = _pad(rhs, K)
+    react = _residual_reaction(K, rhs)
+    return LinearSystem(model, K, rhs, fixed, values, nu_, solver=solver,
+                        coords=None if solver == "direct" else _coords(model, x_int),
+                        reaction=lambda x, face: react(x, face, by_face.__getitem__))
+
+
+def _sorted(fixed, values):
+    if not fixed:
+        return np.zeros(0, dtype=int), np.zeros(0)
+    fixed, values = np.concatenate(fixed), np.concatenate(values)
+    order = np.argsort(fixed)
+    return fixed[order], values[order]
+
+
+# ------------------------------------------------------------------------------ surface nodes
+def assemble_surface_nodes(problem, order: int) -> LinearSystem:
+    """Seed 001's surface node method (module docstring)."""
+    g = _grid(problem, problem.stencil.reach)
+    closure, flux = surface_node_closure(g, problem.stencil, order)
+    model = _model(problem, g, closure)
+    d, ni, nu_ = g.dim, g.n_interior, model.n_unknown_nodes
+    solver = static_solver(problem.solver, d, d * nu_)
+    P = (model.equilibrium_rows() + flux_rows(model, flux)).tocsr()
+    K = _matrix(model, P, solver)
+    x_int = g.x[g.interior_ids]
+    rhs = np.zeros((nu_, d))
+    rhs[:ni] = problem.body_load(x_int, model.node_volume[g.interior_ids][:, None])
+    xs, nrm = g.surface_x, g.surface_normal
+    for face, _ in problem.loaded():
+        sel = g.surface_face == face
+        rhs[ni:][sel] = problem.face_forces(face, xs[sel], nrm[sel], g.face_area)
+    us_ref = problem.exact(xs)
+    fixed, values, by_face = [], [], {}
+    for face, k, where in problem.prescribed():
+        mask = g.surface_face == face
+        if where is not None:
+            mask &= where(g.surface_cell)
+        nodes = np.flatnonzero(mask)
+        fixed.append(k * nu_ + ni + nodes)
+        values.append(us_ref[nodes, k])
+    for face in range(2 * d):
+        by_face[face] = (face // 2) * nu_ + ni + np.flatnonzero(g.surface_face == face)
+    fixed, values = _sorted(fixed, values)
+    rhs = rhs.T.ravel()
+    if solver != "direct":
+        rhs = _pad(rhs, K)
+    react = _residual_reaction(K, rhs)
+    return LinearSystem(model, K, rhs, fixed, values, nu_, solver=solver,
+                        coords=None if solver == "direct"
+                        else _coords(model, np.r_[x_int, xs]),
+                        extra_x=xs, reaction=lambda x, face: react(x, face, by_face.__getitem__),
+                        counts={"surface_nodes": int(g.n_surface),
+                                "fictitious_nodes": int(g.n_ext - g.n_interior)})
+
+
+# ------------------------------------------------------------------------------ Taylor
+def _crossing_keep(grid, stencil):
+    """Bonds of the Taylor closure: every stencil pair with a real end, plus the
+    fictitious-fictitious pairs that cross a boundary cell face (they carry part of the
+    force flux through that face near edges and corners; none exist in 1D). Returns
+    ``(keep, flux)`` as :func:`~pdverify.corrections.surface_nodes.surface_node_closure`."""
+    a, b, _ = bond_pairs(grid.ext_shape, stencil.half_offsets)
+    ia, ib = grid.is_interior[a], grid.is_interior[b]
+    keep = ia | ib
+    cand = np.flatnonzero(~(ia & ib))
+    s, bond, alpha, sign = face_crossings(grid, a[cand], b[cand])
+    keep[cand[bond]] = True
+    new_index = np.cumsum(keep) - 1
+    return keep, (s, new_index[cand[bond]], alpha, sign)
+
+
+def assemble_taylor(problem, order: int) -> LinearSystem:
+    """Seed 000's Taylor-extrapolated fictitious nodes with the conditions as constraint
+    rows by Lagrange multipliers (module docstring). A prescribed component takes the
+    rows of Eq. (58) on the lines of its face (``where``: on part of them); every other
+    component of a face with a traction, or of a free face, takes the force flux rows:
+    in 1D the bonds crossing the end plane (Eq. 60), in 2D/3D the face-crossing bonds of
+    each boundary cell face weighted by alpha (seed 001 Eq. 35, the same rule as the
+    surface nodes' flux)."""
+    g = _grid(problem, problem.stencil.reach)
+    d = g.dim
+    if d == 1:
+        closure = fictitious_closure(g, order)
+        flux = None
+    else:
+        keep, flux = _crossing_keep(g, problem.stencil)
+        base = fictitious_closure(g, order)
+        closure = Closure(keep=keep, weighted_volume="complete",
+                          displacement_map=base.displacement_map,
+                          dilatation_map=base.dilatation_map)
+    model = _model(problem, g, closure)
+    ni = g.n_interior
+    P = model.equilibrium_rows()
+    K = model.stiffness(P)
+    x_int = g.x[g.interior_ids]
+    rhs = problem.body_load(x_int, model.node_volume[g.interior_ids][:, None]).T.ravel()
+    K_b = model.bond_force_matrix()
+    rows, vals = [], []
+    if d > 1:   # force of each boundary cell face from the real displacements
+        Fs = (_surface_flux(model, flux, g.n_surface) @ K_b).tocsr()
+    for face in range(2 * d):
+        axis, side = divmod(face, 2)
+        cond = problem.conditions.get(FACES[face])
+        R, anchors = boundary_value_rows(g, order, face)
+        xb = g.x[g.ext_id(anchors)]
+        xb[:, axis] = g.face_coordinate(face)
+        exact = problem.exact(xb)
+        cells_face = anchors
+        if d > 1:
+            sel = np.flatnonzero(g.surface_face == face)
+            cells_s = g.surface_cell[sel]
+            nrm = g.surface_normal[sel]
+            load = (problem.face_forces(face, g.surface_x[sel], nrm, g.face_area)
+                    if cond is not None and cond.traction is not None
+                    else np.zeros((sel.size, d)))
+            # surface cells and anchors enumerate the same boundary cells: match them
+            order_s = _match(cells_s, cells_face, axis, g)
+        for k in range(d):
+            pres = np.zeros(anchors.shape[0], dtype=bool)
+            if cond is not None and k in cond.prescribed:
+                pres[:] = True if cond.where is None else cond.where(cells_face)
+            if np.any(pres):
+                Rk = sp.coo_matrix(R[np.flatnonzero(pres)])
+                rows.append(sp.csr_matrix((Rk.data, (Rk.row, Rk.col + k * ni)),
+                                          shape=(int(pres.sum()), d * ni)))
+                vals.append(exact[pres, k])
+            free = np.flatnonzero(~pres)
+            if free.size == 0:
+                continue
+            if d == 1:
+                sec = model.crossing_selector([g.face_coordinate(face)]) @ K_b
+                # tension positive through the plane; the force on the body at the
+                # face is the outward traction: + at x+, - at x-
+                rows.append(sp.csr_matrix(sec))
+                t = (cond.traction(xb, np.array([[_side_sign(face)]]))[0, 0]
+                     if cond is not None and cond.traction is not None else 0.0)
+                vals.append(np.array([_side_sign(face) * t * g.face_area
+                                      * problem.thickness]))
+            else:
+                idx = sel[order_s[free]]
+                rows.append(Fs[k * g.n_surface + idx])
+                vals.append(load[order_s[free], k])
+    B = sp.vstack(rows).tocsr()
+    c = np.concatenate(vals)
+
+    def reaction(x, face):
+        if d != 1:
+            raise ValueError("the Taylor reaction is defined for 1D bars only")
+        return float((model.crossing_selector([g.face_coordinate(face)]) @ K_b @ x[:ni])[0])
+    return LinearSystem(model, K, rhs, np.zeros(0, dtype=int), np.zeros(0), ni,
+                        B=B, c=c, reaction=reaction,
+                        counts={"fictitious_nodes": int(g.n_ext - g.n_interior),
+                                "constraints": int(B.shape[0])})
+
+
+def _surface_flux(model, flux, n_surface):
+    """Rows (d n_surface x bonds): the force of the face-crossing bonds of every boundary
+    cell face, component-major (sum alpha f_b sign n_b)."""
+    s, bond, alpha, sign = flux
+    d = model.dim
+    w = alpha * sign
+    rows = np.concatenate([k * n_surface + s for k in range(d)])
+    cols = np.tile(bond, d)
+    vals = np.concatenate([w * model.bond_n[bond, k] for k in range(d)])
+    return sp.csr_matrix((vals, (rows, cols)), shape=(d * n_surface, model.bond_a.size))
+
+
+def _match(cells_s, anchors, axis, g):
+    """Positions in ``cells_s`` (surface cells of a face) of each anchor's cell."""
+    key_s = np.ravel_multi_index(tuple(np.delete(cells_s, axis, axis=1).T),
+                                 tuple(np.delete(np.asarray(g.cells), axis)))
+    key_a = np.ravel_multi_index(tuple(np.delete(anchors, axis, axis=1).T),
+                                 tuple(np.delete(np.asarray(g.cells), axis)))
+    pos = np.argsort(key_s)
+    return pos[np.searchsorted(key_s[pos], key_a)]
+
+
+# ------------------------------------------------------------------------------ mirror, PDDO
+def assemble_mirror(problem, neumann: str, mirror_point: str) -> LinearSystem:
+    """Seed 001 §5's mirror node method (``corrections.mirror_nodes``): the loads and
+    constraints enter through the mirror relations only."""
+    g = _grid(problem, problem.stencil.reach)
+    mirror = MirrorNodes(g, problem.stencil, dirichlet=_face_dirichlet(problem),
+                         exact=problem.exact, traction=_traction_of(problem),
+                         moduli=problem.constants.moduli(), neumann=neumann,
+                         mirror_point=mirror_point)
+    model = _model(problem, g, mirror.closure())
+    d, ni, nu_ = g.dim, g.n_interior, model.n_unknown_nodes
+    solver = static_solver(problem.solver, d, d * nu_)
+    P = model.equilibrium_rows()
+    K = _matrix(model, P, solver)
+    x_int = g.x[g.interior_ids]
+    rhs = np.zeros((nu_, d))
+    rhs[:ni] = problem.body_load(x_int, model.node_volume[g.interior_ids][:, None])
+    U_c = mirror.constant_displacements()
+    e_c = model.A_e @ U_c.T.ravel()
+    rhs[:ni] -= model.rows_of_state(U_c, model.A_Theta @ (model.A_theta @ e_c),
+                                    P).reshape(d, nu_).T
+    rhs = rhs.T.ravel()
+    if solver != "direct":
+        rhs = _pad(rhs, K)
+    return LinearSystem(model, K, rhs, np.zeros(0, dtype=int), np.zeros(0), nu_,
+                        solver=solver,
+                        coords=None if solver == "direct" else _coords(model, x_int),
+                        counts={"fictitious_nodes": int(g.n_ext - g.n_interior)})
+
+
+def assemble_pddo(problem) -> LinearSystem:
+    """Seed 001 §5's PDDO boundary layer (``corrections.pddo``): its own square,
+    nonsymmetric system on the uncorrected model, solved by a direct LU."""
+    g = _grid(problem, 0)
+    model = _model(problem, g, None)
+    x_int = g.x[g.interior_ids]
+    body = problem.body_load(x_int, model.node_volume[g.interior_ids][:, None])
+    A, rhs, counts = pddo_system(model, _face_dirichlet(problem), problem.exact,
+                                 _traction_of(problem), problem.constants.moduli(), body)
+    return LinearSystem(model, A, rhs, np.zeros(0, dtype=int), np.zeros(0), g.n_interior,
+                        solver="direct", counts=counts)

@@ -1,0 +1,192 @@
+"""Problems as scenes state them once: a body, its material, boundary conditions keyed by
+face and component, loads, and the exact solution the errors are measured against.
+
+A scene of the ``static-state`` family describes a :class:`StaticProblem` (a box of
+cell-centred nodes, the linear state-based model, 1D to 3D) and never names a method; a
+boundary treatment (``pdverify.corrections``) turns the description into a
+:class:`LinearSystem` in its own way (eliminated unknowns, constraint rows, flux rows,
+extra nodes), and the scene measures the solution.
+
+Boundary conditions: ``conditions[face] = FaceCondition(prescribed=(k, ...), where=...,
+traction=...)`` with faces named ``x-``, ``x+``, ``y-``, ``y+``, ``z-``, ``z+``. The
+prescribed components take the exact solution's value (every scene here prescribes the
+value its reference has); ``where(cells) -> mask`` restricts them to part of the face
+(the boundary cells' integer indices; seed 001's edge constraints); ``traction(x,
+normal) -> (n, d)`` is the applied traction (the other components; ``None``: free).
+Faces not listed are traction-free. A treatment that cannot impose a condition as
+stated (e.g. part of a face) says so through :meth:`StaticProblem.whole_faces`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Mapping
+
+import numpy as np
+
+FACES = ("x-", "x+", "y-", "y+", "z-", "z+")
+
+#: Gauss-Legendre points per tangential axis of a face resultant (exact to degree 5).
+FACE_GAUSS = 3
+#: How a boundary cell face's load is computed: the traction's resultant over the face
+#: (``face-mean``, default) or its value at the face centre times the face area
+#: (``centre``).
+FACE_LOADS = ("face-mean", "centre")
+#: Where the uncorrected model evaluates a surface load: at the loaded node itself
+#: (``node``) or at the face centre on the surface (``surface``).
+LOAD_POINTS = ("node", "surface")
+
+
+def face_number(name: str) -> int:
+    """``x-`` -> 0, ``x+`` -> 1, ... (``2 * axis + side``, the grid's numbering)."""
+    return FACES.index(name)
+
+
+def face_resultant(traction, centres, normals, spacing):
+    """Mean of ``traction(x, n)`` over the square (2D: segment) cell face at each centre.
+
+    A surface node represents the area A of its cell face (seed 001 §3), so the load of
+    Eq. (36) is the resultant of the traction over that face: p_i A_i = int_(A_i) t dA.
+    For constant or linear tractions this is the value at the centre; for the quadratic
+    shear of Eq. (41) the centre value misses h^2/12 t'' and the flux equations see it.
+    Tensor Gauss-Legendre with 3 points per tangential axis (exact to degree 5).
+    """
+    centres = np.asarray(centres, dtype=float)
+    n, d = centres.shape
+    axis = np.argmax(np.abs(normals), axis=1)
+    t, w = np.polynomial.legendre.leggauss(FACE_GAUSS)
+    t, w = 0.5 * spacing * t, 0.5 * w
+    tangents = [(axis + k) % d for k in range(1, d)]
+    out = np.zeros_like(centres)
+    for combo in np.ndindex(*([FACE_GAUSS] * (d - 1))):
+        x = centres.copy()
+        weight = 1.0
+        for tang, q in zip(tangents, combo):
+            x[np.arange(n), tang] += t[q]
+            weight *= w[q]
+        out += weight * traction(x, normals)
+    return out
+
+
+@dataclass(frozen=True)
+class FaceCondition:
+    """What one face prescribes (module docstring)."""
+
+    prescribed: tuple[int, ...] = ()
+    where: Callable[[np.ndarray], np.ndarray] | None = None
+    traction: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
+
+
+@dataclass
+class StaticProblem:
+    """A static boundary-value problem of a state-based box (module docstring).
+
+    ``stencil``, ``constants`` and ``influence`` build the model (the scene chooses the
+    stencil's quadrature); ``thickness`` multiplies volumes and face areas (1D: the
+    cross-section, 2D: 1 per unit thickness). ``body_force(x) -> (n, d)`` per unit
+    volume; ``exact(x) -> (n, d)`` the reference solution (the prescribed values).
+    ``face_load``/``load_point``: :data:`FACE_LOADS`, :data:`LOAD_POINTS`. ``solver``:
+    ``auto``, ``direct`` or ``nested-dissection`` (``pdverify.solvers.policy``).
+    ``where``: how messages name the run.
+    """
+
+    lengths: tuple
+    origin: tuple
+    spacing: float
+    stencil: object
+    constants: object
+    influence: object
+    conditions: Mapping[str, FaceCondition]
+    exact: Callable[[np.ndarray], np.ndarray]
+    body_force: Callable[[np.ndarray], np.ndarray] | None = None
+    thickness: float = 1.0
+    face_load: str = "face-mean"
+    load_point: str = "surface"
+    solver: str = "auto"
+    where: str = "static problem"
+
+    def __post_init__(self):
+        bad = [f for f in self.conditions if f not in FACES[:2 * len(self.lengths)]]
+        if bad:
+            raise ValueError(f"faces {bad}: allowed {FACES[:2 * len(self.lengths)]}")
+        if self.face_load not in FACE_LOADS or self.load_point not in LOAD_POINTS:
+            raise ValueError(f"face_load={self.face_load!r}, load_point={self.load_point!r}")
+
+    @property
+    def dim(self) -> int:
+        return len(self.lengths)
+
+    def faces(self):
+        """``(face number, condition)`` of every listed face, in face order."""
+        return sorted((face_number(k), c) for k, c in self.conditions.items())
+
+    def prescribed(self):
+        """``[(face, component, where)]`` of every prescribed component."""
+        return [(f, k, c.where) for f, c in self.faces() for k in c.prescribed]
+
+    def loaded(self):
+        """``[(face, traction)]`` of every face with an applied traction."""
+        return [(f, c.traction) for f, c in self.faces() if c.traction is not None]
+
+    def whole_faces(self) -> bool:
+        """True when every prescribed component covers its whole face."""
+        return all(w is None for _, _, w in self.prescribed())
+
+    def body_load(self, x, volume) -> np.ndarray:
+        """b(x) times the node volume (zero without a body force)."""
+        if self.body_force is None:
+            return np.zeros((len(x), self.dim))
+        return self.body_force(x) * volume
+
+    def face_forces(self, face: int, centres, normals, face_area) -> np.ndarray:
+        """Force on each cell face of ``face`` at ``centres``: :attr:`face_load`'s rule
+        times the face area (and thickness)."""
+        traction = self.conditions[FACES[face]].traction
+        if self.face_load == "centre":
+            t = traction(centres, normals)
+        else:
+            t = face_resultant(traction, centres, normals, self.spacing)
+        return t * face_area * self.thickness
+
+
+@dataclass
+class LinearSystem:
+    """What a treatment makes of a :class:`StaticProblem`.
+
+    ``K x = rhs`` with ``x[fixed] = values`` eliminated and, if ``B`` is set, the
+    constraint rows ``B x = c`` by Lagrange multipliers (seed 000 Eq. 63). Unknowns:
+    ``dofs`` displacements, component-major over the ``n_unknown_nodes`` unknown nodes
+    (the real nodes first, then any extra nodes such as surface nodes), then any nodal
+    scalars of an augmented system. ``solver``/``coords``: the linear solver and the
+    unknowns' coordinates (nested dissection). ``model``: the PD model (its grid's real
+    nodes are the measured ones); ``extra_x``: positions of the extra unknown nodes
+    (surface nodes), measured too when the scene asks. ``reaction(x, face)``: the normal
+    force the face transmits, tension positive, as the treatment defines it (the force
+    flux through the face, or the reactions of its prescribed unknowns). ``counts``:
+    node counts the treatment reports beside the size.
+    """
+
+    model: object
+    K: object
+    rhs: np.ndarray
+    fixed: np.ndarray
+    values: np.ndarray
+    n_unknown_nodes: int
+    solver: str = "direct"
+    coords: np.ndarray | None = None
+    B: object | None = None
+    c: np.ndarray | None = None
+    extra_x: np.ndarray | None = None
+    reaction: Callable[[np.ndarray, int], float] | None = None
+    counts: dict = field(default_factory=dict)
+
+    @property
+    def dim(self) -> int:
+        return self.model.grid.dim
+
+    @property
+    def dofs(self) -> int:
+        return self.dim * self.n_unknown_nodes
+
+    def displacements(self, x: np.ndarray) -> np.ndarray:
+        """(n_unknown_nodes, d) displacements of the unknown nodes from a solution."""
+        return np.asarray(x[:self.dofs]).reshape(self.dim, self.n_unknown_nodes).T

@@ -1,0 +1,121 @@
+"""The ``static-state`` family: scenes that describe a static state-based problem and let
+every treatment of the family assemble it (``pdverify.corrections.static_state``).
+
+A scene of the family states its body, material, boundary conditions (keyed by face and
+component), loads and reference once in :meth:`StaticStateScene.problem`, and measures a
+solution in :meth:`StaticStateScene.measure`; it never names a method outside its
+``cases`` and published numbers. Which treatments run on it, with which parameters, and
+why a treatment does not, comes from the registry (``list`` shows it).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .. import budget
+from ..solvers.front import solve as solve_system
+from ..solvers.policy import auto_note
+from .base import Outcome, Scene, whole_cells
+
+
+class StaticStateScene(Scene):
+    """Base of the family. Subclasses set ``id`` etc. and implement :meth:`box`,
+    :meth:`problem` and :meth:`measure` (and may refine :meth:`check`/:meth:`estimate`)."""
+
+    family = "static-state"
+    theory = "state-based"
+    methods = ()
+
+    # ----------------------------------------------------------------- description
+    def box(self, p):
+        """``(lengths, origin)`` of the body."""
+        raise NotImplementedError
+
+    def problem(self, p, where: str):
+        """The :class:`~pdverify.pd.problem.StaticProblem` of the params ``p``."""
+        raise NotImplementedError
+
+    def measure(self, p, problem, system, x, info) -> Outcome:
+        """Metrics, fields and size of a solved system."""
+        raise NotImplementedError
+
+    def family_refusal(self, treatment) -> str | None:
+        if treatment.whole_faces_only:
+            p = {q.name: q.default for q in self.params}
+            if not self.problem(p, self.id).whole_faces():
+                return (f"{treatment.scope or 'whole-face conditions only'}; this scene "
+                        "prescribes a component on part of a face")
+        return None
+
+    # ----------------------------------------------------------------- checks
+    def treatment(self, method: str):
+        return self.offered()[method]
+
+    def cells(self, p) -> list[int]:
+        lengths, _ = self.box(p)
+        return whole_cells(f"{self.id}", p["spacing"],
+                           [(f"l_{name}", L) for name, L in zip("xyz", lengths)])
+
+    def check(self, method, p):
+        where = f"{self.id} --method {method}"
+        lengths, _ = self.box(p)
+        cells = whole_cells(where, p["spacing"],
+                            [(f"l_{name}", L) for name, L in zip("xyz", lengths)])
+        self.treatment(method).check(tuple(cells), p, where)
+
+    def estimate(self, method, p):
+        """Unknowns on the cell-centred nodes, and what the treatment adds (a fictitious
+        layer m deep folds into the unknowns through its stored extrapolation rows;
+        surface nodes are unknowns); the dilatation couples nodes 2m spacings apart (m
+        in the augmented system of the nested-dissection solve)."""
+        from ..corrections.static_state import footprint
+        from ..solvers.policy import static_solver
+        lengths, _ = self.box(p)
+        m, d = p["m_ratio"], len(lengths)
+        cells = [L / p["spacing"] for L in lengths]
+        extra, fictitious = footprint(self.treatment(method).footprint, cells, m)
+        nodes = math.prod(cells) + extra
+        rows = budget.BYTES_PER_NONZERO * fictitious * d * d * budget.lattice_neighbours(d, m)
+        solver = static_solver(p.get("solver", "direct"), d, d * nodes)
+        if d == 3 and solver == "nested-dissection":
+            return budget.nested_dissection_3d(nodes, d + 1, m, extra_bytes=rows)
+        return budget.linear_system(nodes, d, d, 2 * m, dense_allowed=True, extra_bytes=rows)
+
+    # ----------------------------------------------------------------- solve
+    def solve(self, method, p, timer):
+        where = f"{self.id}/{method}"
+        with timer.phase("setup"):
+            problem = self.problem(p, where)
+            system = self.treatment(method).assemble(problem, p)
+        with timer.phase("solve"):
+            x, info = solve_system(system, where=where)
+            if p.get("solver") == "auto":
+                info["solver_choice"] = auto_note(system.solver, system.dofs)
+        return self.measure(p, problem, system, x, info)
+
+    @staticmethod
+    def size(system) -> dict:
+        """Node, unknown and bond counts of a system, and the treatment's own counts."""
+        g = system.model.grid
+        out = {"interior_nodes": int(g.n_interior), "bonds": int(system.model.bond_a.size),
+               "dofs": int(system.dofs)}
+        out.update(system.counts)
+        return out
+
+    @staticmethod
+    def real_nodes(system):
+        g = system.model.grid
+        return g.x[g.interior_ids]
+
+    @staticmethod
+    def solution(system, x):
+        """``(u of the real nodes, u of the extra nodes or None)``."""
+        U = system.displacements(x)
+        ni = system.model.grid.n_interior
+        return U[:ni], (U[ni:] if system.extra_x is not None else None)
+
+
+def surface_error_pct(u_extra, u_ref_extra, scale) -> float:
+    """Largest component error of the extra (surface) nodes, in % of ``scale``."""
+    return float(np.max(np.abs(u_extra - u_ref_extra) / scale) * 100.0)
