@@ -165,15 +165,16 @@ def bench_state(args, out, scene_id, spacing, key):
     systems = {}
     for solver in ("direct", "nested-dissection"):
         p = scene.resolve("surface-nodes", {"spacing": spacing, "solver": solver})
-        t_setup, (model, A, rhs, fixed, values, _) = timed(lambda: scene.assemble("surface-nodes", p))
-        systems[solver] = (model, A, rhs, fixed, values, t_setup)
+        t_setup, system = timed(lambda: scene.treatment("surface-nodes").assemble(
+            scene.problem(p, "bench"), p))
+        systems[solver] = (system, system.K, system.rhs, system.fixed, system.values, t_setup)
     model = systems["direct"][0]
     n_disp = systems["direct"][1].shape[0]
     print(f"\n[{key}] {scene_id}, surface nodes, h = {spacing}: {n_disp} unknowns; K "
           f"{systems['direct'][1].nnz} non-zeros, augmented {systems['nested-dissection'][1].nnz}")
     alts = {}
     for solver, (model, A, rhs, fixed, values, _) in systems.items():
-        coords = None if solver == "direct" else model.unknown_coords()
+        coords = None if solver == "direct" else model.coords
         label = ("today: direct (K multiplied out)" if solver == "direct"
                  else "ours: nested dissection (augmented)")
         alts[label] = (lambda A=A, rhs=rhs, fixed=fixed, values=values, solver=solver,
@@ -185,7 +186,7 @@ def bench_state(args, out, scene_id, spacing, key):
                 lambda Af=Af, bf=bf: pardiso_factor_solve(Af, bf))
     model, A, rhs, fixed, values, _ = systems["nested-dissection"]
     Af, bf, free, u_fixed = eliminate_dirichlet(A, rhs, fixed, values)
-    coords_free = np.asarray(model.unknown_coords())[free]
+    coords_free = np.asarray(model.coords)[free]
     if args.with_double:
         alts["ours before: nested dissection, float64 LU"] = (
             lambda: solve_nested(Af, bf, coords_free, where="bench", mixed=False))

@@ -160,6 +160,16 @@ def assemble_surface_nodes(problem, order: int) -> LinearSystem:
     """Seed 001's surface node method (module docstring)."""
     g = _grid(problem, problem.stencil.reach)
     closure, flux = surface_node_closure(g, problem.stencil, order)
+    return impose_on_surface_nodes(problem, g, closure, flux)
+
+
+def impose_on_surface_nodes(problem, g, closure, flux) -> LinearSystem:
+    """The system of a closure whose unknowns are the real nodes, then one surface node
+    per boundary cell face (``closure.n_unknown_nodes``): a prescribed component is set
+    on the surface nodes of its face (elimination), every other surface-node equation is
+    its force flux (``flux``, seed 001 Eq. 36) equal to the face's load (zero on a free
+    face). Shared by ``surface-nodes`` and any treatment that carries the conditions on
+    surface nodes (a plugin's, e.g.)."""
     model = _model(problem, g, closure)
     d, ni, nu_ = g.dim, g.n_interior, model.n_unknown_nodes
     solver = static_solver(problem.solver, d, d * nu_)

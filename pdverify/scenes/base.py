@@ -189,8 +189,8 @@ class Scene:
         allowed = [m.name for m in self.all_methods]
         close = difflib.get_close_matches(name, allowed, n=3)
         hint = f"; did you mean {' or '.join(close)}?" if close else ""
-        raise InputError(f"{self.id}: method {name!r} is not supported by this scene{hint}; "
-                         f"allowed: {', '.join(allowed)}")
+        raise InputError(f"{self.id}: method {name!r} is not supported by this scene; "
+                         f"allowed: {', '.join(allowed)}{hint}")
 
     def bond_closure(self, method: str, params: Mapping[str, Any]) -> Closure:
         """The :class:`~pdverify.pd.closure.Closure` of a bond method; the uncorrected

@@ -332,6 +332,7 @@ class Body3DTraction(Body3D):
     seed = "001 §4.1"
     reference = "analytic"
     params = BODY_PARAMS + (Param("traction", 10e6, "traction p on x = l_x [Pa]", positive),)
+    uniform_load = (1, 0)  # p along x on x = l_x
     published = (
         Published("max_error_pct", "> 30", "seed 001 §4.1, Fig. 9a", method="none",
                   where=PAPER_QUADRATURE),

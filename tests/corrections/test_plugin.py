@@ -13,21 +13,24 @@ import pytest
 PLUGIN = Path(__file__).resolve().parents[1] / "plugins" / "demo_plugin"
 
 
-def _install(target: Path) -> str:
+TREATMENT_PLUGIN = Path(__file__).resolve().parents[1] / "plugins" / "demo_treatment_plugin"
+
+
+def _install(target: Path, plugin: Path = PLUGIN, package: str = "pdverify_demo_plugin",
+             entry: str = "demo-uniform = pdverify_demo_plugin:METHOD") -> str:
     """pip install --target (the user's way); offline, where pip cannot fetch the build
     backend, lay out what that install writes: the package and its dist-info with the
     entry points."""
     r = subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--no-deps",
-                        "--target", str(target), str(PLUGIN)], capture_output=True, text=True)
+                        "--target", str(target), str(plugin)], capture_output=True, text=True)
     if r.returncode == 0:
         return "pip"
-    shutil.copytree(PLUGIN / "pdverify_demo_plugin", target / "pdverify_demo_plugin")
-    info = target / "pdverify_demo_plugin-0.1.0.dist-info"
+    shutil.copytree(plugin / package, target / package)
+    info = target / f"{package}-0.1.0.dist-info"
     info.mkdir()
-    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: pdverify-demo-plugin\n"
+    (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {package}\n"
                                    "Version: 0.1.0\n")
-    (info / "entry_points.txt").write_text(
-        "[pdverify.methods]\ndemo-uniform = pdverify_demo_plugin:METHOD\n")
+    (info / "entry_points.txt").write_text(f"[pdverify.methods]\n{entry}\n")
     return "dist-info"
 
 
@@ -101,3 +104,59 @@ def test_broken_plugin_is_listed_not_fatal(monkeypatch):
     finally:
         monkeypatch.undo()
         registry.reload()
+
+
+# ------------------------------------------------------------ a treatment with nodes and rows
+@pytest.fixture(scope="module")
+def treatment_env(tmp_path_factory):
+    """The plugin tests/plugins/demo_treatment_plugin: a mirror-node variant with
+    surface-node unknowns (extra nodes) and their force-flux equations (extra rows),
+    installed like a user's package; pdverify itself is unchanged."""
+    target = tmp_path_factory.mktemp("site-treatment")
+    _install(target, TREATMENT_PLUGIN, "pdverify_image_nodes",
+             "image-nodes = pdverify_image_nodes:METHOD")
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([str(target), env.get("PYTHONPATH", "")])
+    return env
+
+
+def test_treatment_plugin_serves_every_scene_of_its_family(treatment_env):
+    """``list`` offers it on every static-state scene (the seed-000 bars and the seed-001
+    boxes and plate) and says why not elsewhere."""
+    import pdverify.scenes as scenes
+    family = sorted(s.id for s in scenes.all_scenes() if s.family == "static-state")
+    assert len(family) == 7
+    r = cli(treatment_env, "list")
+    assert r.returncode == 0, r.stderr
+    matrix = r.stdout.split("method x scene:\n", 1)[1].splitlines()
+    i = matrix[0].index("image-nodes")
+    served = sorted(line.split()[0] for line in matrix[1:]
+                    if line[:1].strip() and line[i:i + len("image-nodes")].strip() == "x")
+    assert served == family
+
+
+def test_treatment_plugin_runs_and_is_exact_for_a_linear_field(treatment_env):
+    """The traction bar's solution is linear, and odd images about the surface nodes
+    reproduce a linear field exactly: round-off (Eq. 64 relative to the largest
+    displacement, times 1e3 eps per node row summed over ~40 bonds)."""
+    r = cli(treatment_env, "run", "bar1d-traction", "--method", "image-nodes", "--json",
+            os.devnull)
+    assert r.returncode == 0, r.stderr
+    err = float(r.stdout.split("max_error_pct", 1)[1].split()[0])
+    assert err < 1e-9
+    r = cli(treatment_env, "run", "plate2d-plane-strain", "--method", "image-nodes",
+            "--set", "spacing=0.05")
+    assert r.returncode == 0, r.stderr
+    assert "surface_max_error_pct" in r.stdout
+
+
+def test_treatment_plugin_in_report_and_overview(treatment_env, tmp_path):
+    out = tmp_path / "rep"
+    r = cli(treatment_env, "report", "--quick", "--only", "bar1d-traction", "--out", str(out))
+    assert r.returncode == 0, r.stderr
+    runs = json.loads((out / "results.json").read_text())["runs"]
+    mine = [x for x in runs if x["method"] == "image-nodes"]
+    assert mine and all(x["status"] == "ok" for x in mine)
+    html = (out / "index.html").read_text()
+    overview = html.split("</table>", 1)[0]          # the matrix is the page's first table
+    assert "<th>image-<wbr>nodes</th>" in overview    # its column head (breaks at hyphens)

@@ -7,7 +7,8 @@ import scipy.sparse.linalg as spla
 from pdverify.errors import NumericalError
 from pdverify.pd import StateBasedConstants
 from pdverify.scenes import get_scene
-from pdverify.scenes.surface_nodes import ND3D_FROM_UNKNOWNS, ND_FROM_UNKNOWNS, StateBox
+from pdverify.scenes.surface_nodes import StateBox
+from pdverify.solvers.policy import ND3D_FROM_UNKNOWNS, ND_FROM_UNKNOWNS, static_solver
 from pdverify.solvers.ordering import nested_dissection
 from pdverify.solvers.static import solve_nested
 
@@ -143,14 +144,13 @@ def test_plate_nested_dissection_agrees_with_direct(monkeypatch, mixed_from):
 
 
 def test_auto_picks_nested_dissection_for_large_systems():
-    scene = get_scene("plate2d-plane-strain")
-    p = scene.resolve("surface-nodes")
-    assert scene.solver_for(p, 2, ND_FROM_UNKNOWNS) == "nested-dissection"
-    assert scene.solver_for(p, 2, ND_FROM_UNKNOWNS - 1) == "direct"
-    assert scene.solver_for(p, 3, ND3D_FROM_UNKNOWNS) == "nested-dissection"
-    assert scene.solver_for(p, 3, ND3D_FROM_UNKNOWNS - 1) == "direct"
-    assert scene.solver_for({**p, "solver": "direct"}, 2, 10 ** 6) == "direct"
-    assert scene.solver_for({**p, "solver": "direct"}, 3, 10 ** 6) == "direct"
+    p = get_scene("plate2d-plane-strain").resolve("surface-nodes")
+    assert static_solver(p["solver"], 2, ND_FROM_UNKNOWNS) == "nested-dissection"
+    assert static_solver(p["solver"], 2, ND_FROM_UNKNOWNS - 1) == "direct"
+    assert static_solver(p["solver"], 3, ND3D_FROM_UNKNOWNS) == "nested-dissection"
+    assert static_solver(p["solver"], 3, ND3D_FROM_UNKNOWNS - 1) == "direct"
+    assert static_solver("direct", 2, 10 ** 6) == "direct"
+    assert static_solver("direct", 3, 10 ** 6) == "direct"
 
 
 @pytest.mark.parametrize("scene_id", ["body3d-traction", "body3d-manufactured"])
@@ -161,9 +161,8 @@ def test_3d_auto_nested_dissection_agrees_with_the_dense_lu(monkeypatch, scene_i
     compare gate's 1e-8 (issue 12: metrics unchanged at --rtol 1e-8). Both are direct
     solves (condition ~1e6 after equilibration): the solutions agree to ~1e-12, and an
     error metric ~1e-3 of the solution (max_error_pct 0.077 %) to ~1e-9 relative."""
-    from pdverify.scenes import surface_nodes
-    from pdverify.solvers import static
-    monkeypatch.setattr(surface_nodes, "ND3D_FROM_UNKNOWNS", 1000)
+    from pdverify.solvers import policy, static
+    monkeypatch.setattr(policy, "ND3D_FROM_UNKNOWNS", 1000)
     monkeypatch.setattr(static, "MIXED_FROM_UNKNOWNS", 0)
     scene = get_scene(scene_id)
     a = scene.run("surface-nodes", {"spacing": 0.1})

@@ -4,7 +4,7 @@ import pytest
 
 from pdverify.pd.bonds import (fourth_moment_anisotropy, moment_corrected_volumes,
                                partial_volumes, stencil_offsets)
-from pdverify.scenes.surface_nodes import face_resultant
+from pdverify.pd.problem import face_resultant
 from pdverify.pd import StateBasedConstants
 from pdverify.scenes.surface_nodes import StateBox
 
