@@ -46,11 +46,13 @@ def connect(address: str):
                          f"{CONNECT_TIMEOUT_S} s ({type(exc).__name__})") from None
 
 
-def run_cases_on(client, cases, note) -> list:
-    """Submit every case, collect as they finish; ``note(k, result)`` per finished run."""
+def run_cases_on(client, cases, note, run_case, died_on_cluster) -> list:
+    """Submit every case, collect as they finish; ``note(k, result)`` per finished run.
+    ``run_case(case)`` is the task, ``died_on_cluster(case, exc)`` the failed run of a
+    task whose worker died (the runner's; passed in, so this module does not import
+    the runner)."""
     from distributed import as_completed
 
-    from .runner import died_on_cluster, run_case
     futures = [client.submit(run_case, case, pure=False, retries=0) for case in cases]
     index = {f.key: k for k, f in enumerate(futures)}
     results = [None] * len(cases)

@@ -184,7 +184,7 @@ def run_cases(cases, *, jobs: int = 1, progress=None, client=None) -> list[RunRe
         with RunProgress(cases, workers, progress, auto_refresh=True, line=line) as shown:
             for k in range(len(cases)):
                 shown.started(k, timed=False)   # queued on the cluster
-            return run_cases_on(client, cases, shown.finished)
+            return run_cases_on(client, cases, shown.finished, run_case, died_on_cluster)
 
     with RunProgress(cases, min(jobs, len(cases)), progress, line=line) as shown:
         return _run_local(cases, jobs, shown)

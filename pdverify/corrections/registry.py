@@ -20,9 +20,11 @@ pdverify. A method whose optional dependency is missing says so in ``unavailable
 """
 from __future__ import annotations
 
+import difflib
 from dataclasses import dataclass, replace
 from typing import Any, Callable, Mapping
 
+from ..errors import InputError
 from ..params import Param
 from ..pd.closure import Closure
 from .treatment import ENTRY_POINT_GROUP, THEORIES, Treatment  # noqa: F401  (re-exported)
@@ -134,3 +136,14 @@ def reload() -> None:
     global _METHODS
     _METHODS = None
     BROKEN.clear()
+
+
+def from_name(name: str) -> Treatment:
+    """The registered treatment ``name``; unknown names are bad input with the close
+    matches and the full list."""
+    known = treatments()
+    if name in known:
+        return known[name]
+    close = difflib.get_close_matches(name, list(known), n=3)
+    hint = f"; did you mean {' or '.join(close)}?" if close else ""
+    raise InputError(f"unknown method {name!r}{hint} (allowed: {', '.join(known)})")

@@ -25,18 +25,17 @@ list of them), e.g. in the plugin's ``pyproject.toml``::
     [project.entry-points."pdverify.methods"]
     my-method = "my_package.pdverify_plugin:METHOD"
 
-:func:`from_name` looks a treatment up by name with a helpful error (close matches);
+:func:`~pdverify.corrections.registry.from_name` looks a treatment up by name with a
+helpful error (close matches);
 :meth:`Treatment.info` is its dictionary of facts for ``list --json`` and the report;
 :meth:`Treatment.why_not` is the one-line reason an empty cell of the method x scene
 matrix is empty.
 """
 from __future__ import annotations
 
-import difflib
 from dataclasses import dataclass
 from typing import Any, Mapping
 
-from ..errors import InputError
 from ..params import Param
 
 THEORIES = ("bond-based", "state-based")
@@ -87,6 +86,8 @@ class Treatment:
         """``None`` when this treatment runs on ``scene``, else a one-line reason."""
         if self.name in {m.name for m in scene.methods}:
             return None                                  # the scene implements it itself
+        if getattr(scene, "closed_to_treatments", None):
+            return scene.closed_to_treatments
         if self.scenes is not None and scene.id not in self.scenes:
             return self.scope or f"only on {', '.join(self.scenes)}"
         theory = getattr(scene, "model_theory", None)
@@ -128,15 +129,3 @@ class Treatment:
                 "scenes": None if self.scenes is None else list(self.scenes),
                 "scope": self.scope, "params": {p.name: p.default for p in self.params},
                 "unavailable": self.unavailable, "origin": self.origin}
-
-
-def from_name(name: str) -> Treatment:
-    """The registered treatment ``name``; unknown names are bad input with the close
-    matches and the full list."""
-    from .registry import treatments
-    known = treatments()
-    if name in known:
-        return known[name]
-    close = difflib.get_close_matches(name, list(known), n=3)
-    hint = f"; did you mean {' or '.join(close)}?" if close else ""
-    raise InputError(f"unknown method {name!r}{hint} (allowed: {', '.join(known)})")

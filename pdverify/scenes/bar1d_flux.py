@@ -5,11 +5,15 @@ import numpy as np
 
 from manufactured import bar1d as closed
 
+from ..corrections.builtin import ORDER
+from ..corrections.registry import from_name
 from ..params import Param, positive
-from . import Outcome, Published, Scene, register, require_influence
-from .bar1d import BAR_PARAMS, NONE, TAYLOR, StateBar, bar_estimate, check_bar_grid
+from . import MethodSpec, Outcome, Published, Scene, register, require_influence
+from .bar1d import BAR_PARAMS, StateBar, bar_estimate, check_bar_grid
 
 _FEATURES = closed.flux_features()  # (1.26285..., 0.77160..., 0.39403...)
+NONE = MethodSpec("none")
+TAYLOR = MethodSpec("taylor-fictitious", (ORDER,))
 
 
 @register
@@ -49,11 +53,15 @@ class ForceFlux(Scene):
         Published("flux_max_ratio", 1.0, "seed 000 Eq. (33)", method="taylor-fictitious"),
     )
     headline = "flux_table_error"  # the report overview's error for this scene
+    closed_to_treatments = ("its reference is the uncorrected model's own flux table "
+                            "(Table 2), so another correction has nothing to be compared with")
     horizon_default = 0.15
     report_m_ratios = (3, 6, 12, 24, 48)
 
     def check(self, method, p):
-        check_bar_grid(self.id, method, p, min_horizons=4.0)
+        n = check_bar_grid(self.id, method, p, min_horizons=4.0)
+        if method == TAYLOR.name:
+            from_name(method).check((n,), p, f"{self.id} --method {method}")
         if method == NONE.name:
             require_influence(self.id, method, p, "hyperbolic", "the closed forms of Tables 1, 2 "
                               "and B1 are derived for seed 000's delta / |xi|")

@@ -134,6 +134,9 @@ class Scene:
     quick_overrides: Mapping[str, Any] = {}
     #: the scene's defaults of treatment parameters (e.g. a Taylor order), by name
     treatment_defaults: Mapping[str, Any] = {}
+    #: why no treatment beyond the scene's own ``methods`` applies (one line), e.g. a
+    #: reference that is the uncorrected model's own; None: the registry decides
+    closed_to_treatments: str | None = None
 
     # -- methods ----------------------------------------------------------------------
     @property

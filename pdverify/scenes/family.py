@@ -52,11 +52,6 @@ class StaticStateScene(Scene):
     def treatment(self, method: str):
         return self.offered()[method]
 
-    def cells(self, p) -> list[int]:
-        lengths, _ = self.box(p)
-        return whole_cells(f"{self.id}", p["spacing"],
-                           [(f"l_{name}", L) for name, L in zip("xyz", lengths)])
-
     def check(self, method, p):
         where = f"{self.id} --method {method}"
         lengths, _ = self.box(p)

@@ -188,7 +188,7 @@ class SurfaceNodeScene(StaticStateScene):
     imposes them (``pdverify.corrections.static_state``)."""
 
     seed = "001"
-    figure = "surface-nodes"
+    figure = "seed001-boxes"
     kind = "3d"
 
     # ----------------------------------------------------------------- hooks

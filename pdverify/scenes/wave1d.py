@@ -204,6 +204,9 @@ class Wave1DSurfaceNodes(Scene):
     seed = "002"
     reference = "analytic"
     figure = "wave1d"
+    closed_to_treatments = ("bond-based 1D waves whose reference is the PD series of the "
+                            "same model at the same delta: only the seed-002 treatments "
+                            "are wired to its explicit time stepping")
     dim = 1
     params = (
         Param("length", 1.0, "bar length l [m]", positive),

@@ -21,9 +21,16 @@ WINDOW = (1400, 600)
 MM = 1e3  # displacements are in m, shown in mm
 
 
+def _grid_values(f, values):
+    """Nodal values of a box's cell-centred nodes on its cell grid (NaN where none)."""
+    idx = np.rint((f["x"] - f["origin"]) / f["spacing"] - 0.5).astype(int)
+    out = np.full(tuple(int(n) for n in f["cells"]), np.nan)
+    out[tuple(idx.T)] = values
+    return out
+
+
 def _cell_values(f, values):
     """Nodal values as cell data of the box's ImageData (x fastest, VTK's order)."""
-    from .surface_nodes import _grid_values
     return _grid_values(f, values).ravel(order="F")
 
 

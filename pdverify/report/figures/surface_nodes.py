@@ -7,6 +7,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from . import family, label, save as _save
+from .fields3d import _grid_values
 
 
 def _label(r) -> str:
@@ -23,16 +24,6 @@ def _map_name(scene, r, i) -> str:
     return f"{scene.id}-{r.method}-{r.params.get('order', 0)}-{i}.png"
 
 
-def _cells(f):
-    idx = np.rint((f["x"] - f["origin"]) / f["spacing"] - 0.5).astype(int)
-    return idx, tuple(int(n) for n in f["cells"])
-
-
-def _grid_values(f, values):
-    idx, shape = _cells(f)
-    out = np.full(shape, np.nan)
-    out[tuple(idx.T)] = values
-    return out
 
 
 def _maps_2d(scene, results, folder):
@@ -157,7 +148,7 @@ def _renderings_3d(scene, results, folder):
         return []
 
 
-@family("surface-nodes")
+@family("seed001-boxes")
 def surface_node_figures(scene, results, folder):
     dim = results[0].fields["x"].shape[1]
     maps = (_maps_3d(scene, results, folder) + _renderings_3d(scene, results, folder)

@@ -1,0 +1,176 @@
+"""The treatment contract: scenes of a problem family never name a method outside their
+``cases`` and published numbers, every empty cell of the method x scene matrix has its
+one-line reason, and the package's import graph runs one way."""
+import ast
+import inspect
+from pathlib import Path
+
+import pytest
+
+import pdverify
+from pdverify.corrections.registry import treatments
+from pdverify.corrections.registry import from_name
+from pdverify.errors import InputError
+from pdverify.scenes import all_scenes
+
+PACKAGE = Path(pdverify.__file__).parent
+
+
+def _family_modules():
+    mods = {inspect.getsourcefile(type(s)) for s in all_scenes() if s.family is not None}
+    return sorted(mods)
+
+
+def _allowed_nodes(tree):
+    """Nodes under a ``cases`` method or a ``published = (...)`` assignment."""
+    allowed = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.FunctionDef) and node.name == "cases":
+            allowed |= {id(n) for n in ast.walk(node)}
+        if isinstance(node, ast.Assign) and any(
+                isinstance(t, ast.Name) and t.id == "published" for t in node.targets):
+            allowed |= {id(n) for n in ast.walk(node)}
+    return allowed
+
+
+def test_family_scenes_name_no_method_outside_cases_and_published():
+    names = set(treatments())
+    mods = _family_modules()
+    assert {Path(m).name for m in mods} >= {"bar1d.py", "surface_nodes.py"}
+    offenders = []
+    for path in mods:
+        tree = ast.parse(Path(path).read_text())
+        allowed = _allowed_nodes(tree)
+        for node in ast.walk(tree):
+            if (isinstance(node, ast.Constant) and node.value in names
+                    and id(node) not in allowed):
+                offenders.append(f"{Path(path).name}:{node.lineno} {node.value!r}")
+    assert not offenders, offenders
+
+
+def test_the_grep_can_fail():
+    """A literal method name in a scene body is found (the test above can fail)."""
+    tree = ast.parse("class S:\n    def solve(self, method):\n"
+                     "        return method == 'surface-nodes'\n")
+    hits = [n for n in ast.walk(tree) if isinstance(n, ast.Constant)
+            and n.value in set(treatments()) and id(n) not in _allowed_nodes(tree)]
+    assert len(hits) == 1
+
+
+def test_every_empty_cell_has_a_reason():
+    for scene in all_scenes():
+        offered = {m.name for m in scene.all_methods}
+        for name, t in treatments().items():
+            reason = t.why_not(scene)
+            if name in offered:
+                assert reason is None, (scene.id, name, reason)
+            else:
+                assert reason, (scene.id, name)
+                assert "\n" not in reason
+
+
+def test_list_prints_the_reasons_and_the_counts():
+    from pdverify.listing import format_matrix
+    text = format_matrix()
+    assert "why a cell is empty" in text
+    assert "seed 004 derives its factors for the triangular micromodulus" in text
+    assert "taylor-fictitious" in text.split("why a cell is empty", 1)[1]
+
+
+def test_from_name_suggests_close_matches():
+    with pytest.raises(InputError, match="did you mean surface-nodes"):
+        from_name("surface-node")
+    assert from_name("pddo").info()["kind"] == "family"
+
+
+def _imports(module_path: Path, module: str):
+    """The pdverify modules ``module`` imports (absolute and relative, at any depth)."""
+    tree = ast.parse(module_path.read_text())
+    pkg = module if module_path.name == "__init__.py" else module.rsplit(".", 1)[0]
+    out = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = pkg.split(".")
+                base = base[:len(base) - node.level + 1]
+                target = ".".join(base + ([node.module] if node.module else []))
+            else:
+                target = node.module or ""
+            if target.startswith("pdverify"):
+                out.add(target)
+                out |= {f"{target}.{a.name}" for a in node.names}
+        elif isinstance(node, ast.Import):
+            out |= {a.name for a in node.names if a.name.startswith("pdverify")}
+    return out
+
+
+def _graph():
+    mods = {}
+    for path in PACKAGE.rglob("*.py"):
+        rel = path.relative_to(PACKAGE.parent).with_suffix("")
+        name = ".".join(rel.parts[:-1] if rel.name == "__init__" else rel.parts)
+        mods[name] = path
+    graph = {m: {t for t in _imports(p, m) if t in mods and t != m} for m, p in mods.items()}
+    return graph
+
+
+def _cycles(graph):
+    index, low, stack, on, out = {}, {}, [], set(), []
+
+    def visit(v):
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in graph[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                out.append(sorted(comp))
+    for v in graph:
+        if v not in index:
+            visit(v)
+    return out
+
+
+#: the packages each layer may not import (the issue's one-way graph: scenes ->
+#: corrections -> pd; solvers below scenes; report on top)
+FORBIDDEN = {
+    "pdverify.pd": ("pdverify.corrections", "pdverify.scenes", "pdverify.solvers",
+                    "pdverify.report", "pdverify.runner", "pdverify.cli"),
+    "pdverify.solvers": ("pdverify.corrections", "pdverify.scenes", "pdverify.report",
+                         "pdverify.runner", "pdverify.cli"),
+    "pdverify.corrections": ("pdverify.scenes", "pdverify.report", "pdverify.runner",
+                             "pdverify.cli"),
+    "pdverify.scenes": ("pdverify.report", "pdverify.runner", "pdverify.cli"),
+}
+
+
+def test_import_graph_has_no_cycle_between_modules():
+    """Package __init__ modules that only re-export are left out (a package imports its
+    own modules by design); imports inside functions count."""
+    graph = _graph()
+    inits = {m for m in graph if (PACKAGE.parent / Path(*m.split("."))).is_dir()}
+    g = {m: {t for t in ts if t not in inits} for m, ts in graph.items() if m not in inits}
+    assert _cycles(g) == []
+
+
+def test_import_graph_runs_one_way():
+    graph = _graph()
+    wrong = [(m, t) for m, ts in graph.items() for layer, bad in FORBIDDEN.items()
+             if m.startswith(layer) for t in ts if t.startswith(bad)]
+    assert wrong == []
+
+
+def test_cycle_finder_can_fail():
+    assert _cycles({"a": {"b"}, "b": {"a"}, "c": set()}) == [["a", "b"]]
