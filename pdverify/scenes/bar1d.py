@@ -12,7 +12,7 @@ from ..metrics import max_relative_error_pct, nodal_relative_error_pct, rel_l2_e
 from ..params import Param, at_least, open_interval, positive
 from ..pd import BoxGrid, StateBasedConstants, StateBasedModel, build_stencil, get_influence
 from ..solvers.static import solve_constrained
-from . import MethodSpec, Outcome, Published, Scene, influence_param, register
+from . import MethodSpec, Outcome, Published, Scene, cell_count, influence_param, register
 
 #: Table 3 of seed 000.
 BAR_PARAMS = (
@@ -75,7 +75,7 @@ class StateBar:
 def check_bar_grid(scene_id: str, method: str, p: dict, min_horizons: float = 0.0) -> int:
     """Common checks: the spacing divides the length, enough nodes for the Taylor order."""
     where = f"{scene_id} --method {method}"
-    n = p["length"] / p["spacing"]
+    n = cell_count(where, p["spacing"], "length", p["length"])
     if abs(n - round(n)) > 1e-9 * max(n, 1.0) or round(n) < 2:
         raise InputError(f"{where}: spacing={p['spacing']} must divide length={p['length']} "
                          f"into a whole number (>= 2) of cells")

@@ -1,7 +1,6 @@
 """Seed 004: 1D bond-based bars, triangular micromodulus: homogenisation, constraints, vibration."""
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Callable
 
@@ -544,8 +543,8 @@ class Vibration(BondBarScene):
     STEPS_PER_PERIOD_AND_SPACING = 4.0
 
     def estimate(self, method, p):
-        steps = math.ceil(self.STEPS_PER_PERIOD_AND_SPACING * p["periods"] * (p["nodes"] - 1)
-                          / p["dt_factor"])
+        steps = budget.step_count(self.STEPS_PER_PERIOD_AND_SPACING * p["periods"]
+                                  * (p["nodes"] - 1) / p["dt_factor"])
         history = budget.Estimate(48.0 * steps, f"~{steps:.3g} time steps", steps)
         return super().estimate(method, p) + history
 

@@ -60,12 +60,29 @@ def require_influence(scene_id: str, method: str, p: dict, allowed: str, why: st
                          f"supported here; allowed: {allowed} ({why})")
 
 
+#: more cells than this along one axis are refused before any other check: beyond 2^53 a
+#: double no longer tells whole numbers apart, and no such grid fits any memory
+MAX_CELLS_PER_AXIS = 1e15
+
+
+def cell_count(where: str, spacing: float, name: str, length: float,
+               label: str = "spacing") -> float:
+    """length / spacing, refused (one line, exit 2) when it is not a finite count of at most
+    :data:`MAX_CELLS_PER_AXIS` (a subnormal spacing or a huge length overflows it)."""
+    n = length / spacing
+    if not n <= MAX_CELLS_PER_AXIS:      # inf, and NaN from 0/0, too
+        raise InputError(f"{where}: {label}={spacing:g} and {name}={length:g} give "
+                         f"{name}/{label} = {n:g} cells; allowed: at most "
+                         f"{MAX_CELLS_PER_AXIS:.0e} cells along an axis")
+    return n
+
+
 def whole_cells(where: str, spacing: float, lengths, label: str = "spacing") -> list[int]:
     """Cells along each of ``lengths`` ((name, L) pairs); refuse (one line, exit 2) a
     ``spacing`` that does not divide every L into a whole number (>= 2) of cells."""
     counts = []
     for name, L in lengths:
-        n = L / spacing
+        n = cell_count(where, spacing, name, L, label)
         if abs(n - round(n)) > 1e-9 * max(n, 1.0) or round(n) < 2:
             raise InputError(f"{where}: {label}={spacing:g} must divide {name}={L:g} into a "
                              "whole number (>= 2) of cells")
@@ -170,8 +187,22 @@ class Scene:
         spec = self.method(method)
         where = f"{self.id} --method {method}"
         values = resolve(self.params + spec.params, dict(overrides or {}), where)
-        self.check(method, values)
-        budget.check(where, self.estimate(method, values))
+        try:
+            self.check(method, values)
+            estimate = self.estimate(method, values)
+        except InputError:
+            raise
+        except (ArithmeticError, ValueError, TypeError) as exc:
+            # the last guard of the class of bug "an extreme value overflows a size": a
+            # one-line refusal naming the values given, never a traceback
+            given = ", ".join(f"{k}={v}" for k, v in (overrides or {}).items()) or "defaults"
+            raise InputError(f"{where}: {given} is outside what this scene can size "
+                             f"({type(exc).__name__}: {exc})") from None
+        if estimate is not None and not estimate.memory < float("inf"):
+            given = ", ".join(f"{k}={v}" for k, v in (overrides or {}).items()) or "defaults"
+            raise InputError(f"{where}: {given} makes the run's size overflow "
+                             f"({estimate.detail}); no run of this size fits any memory")
+        budget.check(where, estimate)
         return values
 
     def check(self, method: str, params: dict) -> None:

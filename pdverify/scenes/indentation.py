@@ -172,6 +172,18 @@ class Indentation(FemAndPD):
             raise InputError(f"{where}: n_steps * substeps = {p['n_steps'] * p['substeps']} "
                              "depth increments; allowed at most 2000")
 
+    def estimate(self, method, p):
+        """The memory of :class:`FemAndPD`, and the FEM study's load increments (each at
+        least one solve): n_steps x substeps at every level, and twice that again at the
+        finest one (its stepping check), held to ``budget.MAX_LOAD_INCREMENTS``; a PD run
+        computes the study first unless it is cached."""
+        est = super().estimate(method, p)
+        ref = p if method == "fem" else self.reference_params(p)
+        increments = ref["n_steps"] * ref["substeps"] * (ref["levels"] + 2)
+        return est + budget.Estimate(0.0, f"FEM study: {increments:.3g} load increments "
+                                          f"(n_steps x substeps x (levels + 2))",
+                                     increments=increments)
+
     def estimate_pd(self, method, p):
         h = p["spacing"]
         nodes = (p["width"] / h + 1) * (p["height"] / h + 1)

@@ -1,7 +1,6 @@
 """Seed 002: a Gaussian pulse in a fixed-fixed PD bar, surface nodes against the analytic PD series."""
 from __future__ import annotations
 
-import math
 
 import numpy as np
 
@@ -17,7 +16,7 @@ from ..params import Param, at_least, positive
 from ..pd import BondBasedModel, BoxGrid, Closure, bond_micromodulus, build_stencil, get_influence
 from ..pd.closure import real_identity, with_rows
 from ..solvers.explicit import central_difference
-from . import MethodSpec, Outcome, Published, Scene, register
+from . import MethodSpec, Outcome, Published, Scene, cell_count, register
 
 #: The instants of Fig. 5 at which the error is measured [s].
 SAMPLE_TIMES = (0.05e-3, 0.10e-3, 0.15e-3, 0.20e-3)
@@ -223,7 +222,7 @@ class Wave1DSurfaceNodes(Scene):
     def estimate(self, method, p):
         m = p["m_ratio"]
         nodes = p["length"] * m / p["horizon"] + 1 + 2 * m
-        steps = math.ceil(SAMPLE_TIMES[-1] / p["dt"])
+        steps = budget.step_count(SAMPLE_TIMES[-1] / p["dt"])
         series = 8.0 * p["n_terms"] * nodes * (len(SAMPLE_TIMES) + 1)
         return budget.linear_system(nodes, 1, 1, m, extra_bytes=series) + budget.Estimate(
             0.0, f"{steps:.3g} time steps, {p['n_terms']} series terms", steps)
@@ -233,7 +232,8 @@ class Wave1DSurfaceNodes(Scene):
         if p["horizon"] > p["length"] / 2:
             raise InputError(f"{where}: horizon={p['horizon']} must be <= length/2 = "
                              f"{p['length'] / 2:g}")
-        n = p["length"] * p["m_ratio"] / p["horizon"]
+        n = cell_count(where, p["horizon"] / p["m_ratio"], "length", p["length"],
+                       "horizon/m_ratio")
         if abs(n - round(n)) > 1e-9 * n:
             raise InputError(f"{where}: m_ratio={p['m_ratio']} gives spacing "
                              f"{p['horizon'] / p['m_ratio']:g} m, which must divide "
