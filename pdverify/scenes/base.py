@@ -16,6 +16,11 @@ from ..results import RunResult, Timer
 from ..solvers.iterative import solver_error_warnings
 
 
+def what_it_did(exc: BaseException) -> str:
+    from ..corrections.registry import what_it_did as phrase
+    return phrase(exc)
+
+
 def conditioning_warnings(diagnostics: Mapping) -> list[str]:
     """One warning for the worst ``*condition_estimate`` in ``diagnostics`` (nested
     included) above :data:`~pdverify.solvers.static.WARN_CONDITION`."""
@@ -168,6 +173,12 @@ class Scene:
                     raise InputError(f"{self.id}: method {name} is unavailable here: "
                                      f"{bm.unavailable}")
                 return m
+        if self.closure_theory is not None:
+            from ..corrections.registry import broken_method
+            why = broken_method(name)
+            if why:
+                raise InputError(f"{self.id}: method {name!r} is a plugin that failed to "
+                                 f"load ({why})")
         allowed = ", ".join(m.name for m in self.all_methods)
         raise InputError(f"{self.id}: method {name!r} is not supported by this scene; "
                          f"allowed: {allowed}")
@@ -176,7 +187,7 @@ class Scene:
         """The :class:`~pdverify.pd.closure.Closure` of a bond method; the uncorrected
         ``Closure()`` for the scene's own methods."""
         bm = self.bond_methods().get(method)
-        return Closure() if bm is None else bm.closure(params)
+        return Closure() if bm is None else bm.make_closure(params)
 
     @property
     def default_method(self) -> str:
@@ -259,6 +270,13 @@ class Scene:
         except (FloatingPointError, ArithmeticError, np.linalg.LinAlgError) as exc:
             result.status = "failed"
             result.message = f"numerical error: {type(exc).__name__}: {exc}"
+        except SystemExit as exc:  # code outside the plugin guards that exits: a failed
+            # run, never the end of the process (nor of a report's worker)
+            result.status = "failed"
+            result.message = (f"{self.id}/{method}: the run tried to end the process "
+                              f"({what_it_did(exc)})" + (
+                                  f" in {self.bond_methods()[method].origin}"
+                                  if method in self.bond_methods() else ""))
         except Exception as exc:  # never crash a whole report on one run
             frame = traceback.extract_tb(exc.__traceback__)[-1]
             result.status = "failed"
