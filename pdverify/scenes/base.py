@@ -95,6 +95,26 @@ def whole_cells(where: str, spacing: float, lengths, label: str = "spacing") -> 
     return counts
 
 
+#: a series or iterative reference's own truncation error must stay below this share of
+#: every error it is used to measure (issue 31): else the "error" is partly the
+#: reference's, and the run fails saying so
+TRUNCATION_SHARE = 1e-3
+
+
+def truncation_problem(what: str, estimate: float, errors: Mapping[str, float],
+                       hint: str) -> str | None:
+    """None when the reference's truncation ``estimate`` is below :data:`TRUNCATION_SHARE`
+    of each of ``errors`` (metric name -> the error, in the estimate's unit), else the
+    one-line reason for a failed run (``what``: the reference and its setting, ``hint``:
+    how to make it finer)."""
+    for name, err in errors.items():
+        if not estimate < TRUNCATION_SHARE * abs(err):
+            return (f"{what}: its truncation error estimate {estimate:.3g} is not below "
+                    f"{TRUNCATION_SHARE:g} of the {name} {abs(err):.4g} it measures, so that "
+                    f"error is partly the reference's own; {hint}")
+    return None
+
+
 @dataclass
 class Outcome:
     """What a scene's ``solve`` returns: numbers for JSON and arrays for figures."""
