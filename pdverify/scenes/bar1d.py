@@ -13,6 +13,7 @@ from ..params import Param, at_least, open_interval, positive
 from ..pd import BoxGrid, StateBasedConstants, StateBasedModel, build_stencil, get_influence
 from ..solvers.static import solve_constrained
 from . import MethodSpec, Outcome, Published, Scene, cell_count, influence_param, register
+from .base import check_load_scale
 
 #: Table 3 of seed 000.
 BAR_PARAMS = (
@@ -144,6 +145,12 @@ class StaticBar(Scene):
     # -------------------------------------------------------------------------------
     def check(self, method, p):
         check_bar_grid(self.id, method, p, min_horizons=2.0)
+        name = self.load_param.name
+        unit = abs(self.total_load({**p, name: 1.0}))   # linear: the load of a unit value
+        if unit > 0:
+            # strain ~ total load / (E A): the load value of a unit strain is E A / unit
+            check_load_scale(f"{self.id} --method {method}", name, p[name],
+                             p["E"] * p["area"] / unit)
 
     def estimate(self, method, p):
         return bar_estimate(p)

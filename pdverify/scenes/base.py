@@ -95,6 +95,27 @@ def whole_cells(where: str, spacing: float, lengths, label: str = "spacing") -> 
     return counts
 
 
+#: the strains a linear scene's load may cause: below 1e-150 the squares of displacements in
+#: the error norms fall under the smallest normal double (2.2e-308) and underflow; above
+#: 1e150 they overflow. The model is linear, so every load in between gives the same
+#: relative errors.
+STRAIN_RANGE = (1e-150, 1e150)
+
+
+def check_load_scale(where: str, name: str, value: float, per_unit_strain: float) -> None:
+    """Refuse (one line, exit 2) a load ``name`` whose strain ``value / per_unit_strain``
+    lies outside :data:`STRAIN_RANGE`, naming the smallest and largest load allowed;
+    ``per_unit_strain``: the load that causes a unit strain (E A for an end force).
+    Zero is left to the scene (it has its own reason to refuse it)."""
+    lo, hi = STRAIN_RANGE
+    if value == 0 or lo * per_unit_strain <= abs(value) <= hi * per_unit_strain:
+        return
+    raise InputError(f"{where}: {name}={value:g} is outside |{name}| from "
+                     f"{lo * per_unit_strain:.3g} to {hi * per_unit_strain:.3g}, the loads "
+                     f"whose strain lies in {lo:.0e}..{hi:.0e} (beyond, the squares of the "
+                     "displacements in the error norms underflow or overflow a double)")
+
+
 #: a series or iterative reference's own truncation error must stay below this share of
 #: every error it is used to measure (issue 31): else the "error" is partly the
 #: reference's, and the run fails saying so

@@ -27,6 +27,8 @@ SKIP_OUTPUT_STEPS = 1
 #: A free surface node is caught when it lies this fraction of R inside the indenter (the
 #: FEM reference's rule).
 CATCH_TOLERANCE = 1e-9
+#: the smallest first output depth as a fraction of R: 1000 x CATCH_TOLERANCE
+MIN_OUTPUT_DEPTH = 1e-6
 KINEMATICS = ("nonlinear", "linear")
 #: ``solver=auto`` uses CG from this many unknowns: on the quick grid (41 x 41 nodes, m = 6,
 #: 3,362 unknowns) a sparse LU per Newton step made the corrected curve 13 s, CG 2.6 s.
@@ -152,6 +154,18 @@ class Indentation(FemAndPD):
         fields.update(depths=np.asarray(res.depths), forces=np.asarray(res.forces),
                       contact_widths=np.asarray(res.contact_widths))
         return fields
+
+    def check(self, method, p):
+        """The depth first (FEM and PD): at least n_steps x :data:`MIN_OUTPUT_DEPTH` R."""
+        smallest = p["n_steps"] * MIN_OUTPUT_DEPTH * p["radius"]
+        if not p["depth"] >= smallest:
+            raise InputError(f"{self.id} --method {method}: depth={p['depth']:g} is below "
+                             f"the smallest allowed, {smallest:.3g} m = n_steps x "
+                             f"{MIN_OUTPUT_DEPTH:g} R (the first output depth must be 1000 "
+                             f"times the contact rule's penetration tolerance "
+                             f"{CATCH_TOLERANCE:g} R, so that it moves no force by more than "
+                             "~0.1 %; below it no node is caught and there is no force)")
+        super().check(method, p)
 
     def check_pd(self, where, method, p):
         rf = _reference_module()
