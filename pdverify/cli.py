@@ -135,6 +135,11 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("pdverify: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # the reader of stdout went away (| head): stop quietly, and
+        # point stdout at /dev/null so that the interpreter's final flush cannot fail too
+        import os
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141  # 128 + SIGPIPE, as a shell reports a pipe's writer
     finally:
         budget.set_limit(None)  # --max-memory holds for this command only
 

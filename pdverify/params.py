@@ -85,8 +85,29 @@ class Param:
         return value
 
 
+#: the magnitudes a positive physical parameter may take: beyond them the products and
+#: squares a run forms (E x area x strain, displacements squared in the error norms)
+#: under- or overflow a double (5e-324 or 1e308 would; no SI value here comes near)
+POSITIVE_RANGE = (1e-100, 1e100)
+
+
 def positive(value) -> str | None:
-    return None if value > 0 and value != float("inf") else "must be a finite number > 0"
+    lo, hi = POSITIVE_RANGE
+    if not value > 0:
+        return "must be a finite number > 0"
+    if not lo <= value <= hi:
+        return (f"must lie in {lo:g}..{hi:g} (a positive physical value; beyond, the "
+                "products and squares of a run under- or overflow a double)")
+    return None
+
+
+def magnitude(value) -> str | None:
+    """Any sign, zero included, but no magnitude outside :data:`POSITIVE_RANGE`."""
+    lo, hi = POSITIVE_RANGE
+    if value == 0 or lo <= abs(value) <= hi:
+        return None
+    return (f"must be 0 or of magnitude {lo:g}..{hi:g} (beyond, the products and squares "
+            "of a run under- or overflow a double)")
 
 
 def at_least(bound) -> Check:

@@ -156,7 +156,11 @@ class Indentation(FemAndPD):
         return fields
 
     def check(self, method, p):
-        """The depth first (FEM and PD): at least n_steps x :data:`MIN_OUTPUT_DEPTH` R."""
+        """The params as the base checks them, the step budget (a huge n_steps is refused
+        for its cost, before its depth rule), then the depth: at least n_steps x
+        :data:`MIN_OUTPUT_DEPTH` R (FEM and PD)."""
+        super().check(method, p)
+        budget.check(f"{self.id} --method {method}", self.estimate(method, p))
         smallest = p["n_steps"] * MIN_OUTPUT_DEPTH * p["radius"]
         if not p["depth"] >= smallest:
             raise InputError(f"{self.id} --method {method}: depth={p['depth']:g} is below "
@@ -165,7 +169,6 @@ class Indentation(FemAndPD):
                              f"times the contact rule's penetration tolerance "
                              f"{CATCH_TOLERANCE:g} R, so that it moves no force by more than "
                              "~0.1 %; below it no node is caught and there is no force)")
-        super().check(method, p)
 
     def check_pd(self, where, method, p):
         rf = _reference_module()

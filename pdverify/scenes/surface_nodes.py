@@ -12,7 +12,7 @@ from .. import budget
 from ..corrections.mirror_nodes import MIRROR_POINTS, NEUMANN_READINGS, MirrorNodes
 from ..corrections.pddo import pddo_system
 from ..corrections.surface_nodes import MAX_ORDER, flux_rows, surface_node_closure
-from ..errors import InputError
+from ..errors import InputError, NumericalError
 from ..metrics import rel_l2_error
 from ..params import Param, at_least, open_interval, positive
 from ..pd import (QUADRATURES, BoxGrid, StateBasedConstants, StateBasedModel, get_influence,
@@ -190,6 +190,13 @@ def error_metrics(x, u, u_ref, dist, horizon, dim) -> tuple[dict, np.ndarray]:
     metrics are over nodes within one horizon of the surface, ``interior_`` over the rest.
     """
     scale = np.max(np.abs(u_ref), axis=0)
+    tiny = np.flatnonzero(~(scale > np.finfo(float).tiny))
+    if tiny.size:
+        raise NumericalError(f"Eq. ({38 if dim == 3 else 44}) divides each component's "
+                             f"error by its largest reference value, and component "
+                             f"{'xyz'[tiny[0]]} of the reference is {scale[tiny[0]]:.3g} "
+                             "everywhere (e.g. nu = 0 gives no lateral displacement): the "
+                             "error is undefined")
     comp = np.abs(u - u_ref) / scale * 100.0        # (n, d) per-component percent
     mag = np.sqrt(np.sum(comp ** 2, axis=1))         # Eq. (38)
     near = dist <= horizon
@@ -322,7 +329,12 @@ class SurfaceNodeScene(Scene):
         where = f"{self.id} --method {method}"
         lengths, _ = self.box(p)
         h = p["spacing"]
-        whole_cells(where, h, [(f"l_{name}", L) for name, L in zip("xyz", lengths)])
+        cells = whole_cells(where, h, [(f"l_{name}", L) for name, L in zip("xyz", lengths)])
+        if p["m_ratio"] > max(cells):
+            # a horizon past the whole body (and a stencil of ~m^d offsets to build)
+            raise InputError(f"{where}: m_ratio={p['m_ratio']:g} gives a horizon of "
+                             f"{p['m_ratio'] * h:g} m, longer than the body "
+                             f"({max(lengths):g} m); allowed: m_ratio <= {max(cells)}")
         if method == "surface-nodes":
             m = p["m_ratio"]
             if abs(m - round(m)) > 1e-12:
