@@ -95,7 +95,10 @@ def parse_size(text: str, what: str) -> int:
         raise InputError(f"{what}={text!r} must be a size such as 4G, 512M, 1.5GB or a "
                          "number of bytes")
     value = float(m.group(1)) * _UNITS[unit]
-    if not (math.isfinite(value) and value >= 2 ** 20):
+    if not math.isfinite(value):
+        raise InputError(f"{what}={text!r} is not a finite size (a double holds up to 1.8e308 "
+                         "bytes)")
+    if not value >= 2 ** 20:
         raise InputError(f"{what}={text!r} must be at least 1M")
     return int(value)
 
