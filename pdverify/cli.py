@@ -23,7 +23,8 @@ from .errors import STOP_REQUESTED, InputError
 
 
 MAX_MEMORY_HELP = ("refuse (exit 2) any run whose memory estimate exceeds SIZE, e.g. 4G, "
-                   "512M (default: $PDVERIFY_MAX_MEMORY, else half the available memory)")
+                   "512M (default: $PDVERIFY_MAX_MEMORY, else half of the smallest of total "
+                   "memory, the cgroup limit and RLIMIT_AS)")
 
 
 class _Parser(argparse.ArgumentParser):
