@@ -20,8 +20,9 @@ functions that closure hands the model, its parameters' checks) catches any exce
   :class:`BondMethod`, whose parameter's default fails its own check, or whose parameter
   shares a name with a parameter of a scene it serves (it would replace that scene's
   default), is listed as broken with its error (``list``: ``plugin NAME: failed to load
-  (SystemExit(3) at import)``) and left out; the built-in methods run as before, and
-  ``run --method NAME`` is refused (exit 2) with that error;
+  (SystemExit(3) at import)``) and left out of reports; the built-in methods run as
+  before, and ``run --method NAME`` on a scene that takes bond methods is a failed run
+  giving that error;
 - a plugin whose code raises during a run (``SystemExit(0)`` in its closure included)
   makes that run a failed run whose message names the plugin and what it did.
 

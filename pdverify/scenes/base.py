@@ -214,15 +214,22 @@ class Scene:
                     raise InputError(f"{self.id}: method {name} is unavailable here: "
                                      f"{bm.unavailable}")
                 return m
-        if self.closure_theory is not None:
-            from ..corrections.registry import broken_method
-            why = broken_method(name)
-            if why:
-                raise InputError(f"{self.id}: method {name!r} is a plugin that failed to "
-                                 f"load ({why})")
+        if self._broken_plugin(name):
+            # accepted as a bond method (the params of ``none``): its run is a failed run
+            # naming the plugin and what it did (see :meth:`run`)
+            base = next((m.params for m in self.methods if m.name == "none"), ())
+            return MethodSpec(name, base)
         allowed = ", ".join(m.name for m in self.all_methods)
         raise InputError(f"{self.id}: method {name!r} is not supported by this scene; "
                          f"allowed: {allowed}")
+
+    def _broken_plugin(self, name: str) -> str | None:
+        """Why the plugin method ``name`` failed to load, for a scene that takes bond
+        methods; None otherwise."""
+        if self.closure_theory is None:
+            return None
+        from ..corrections.registry import broken_method
+        return broken_method(name)
 
     def bond_closure(self, method: str, params: Mapping[str, Any]) -> Closure:
         """The :class:`~pdverify.pd.closure.Closure` of a bond method; the uncorrected
@@ -290,6 +297,12 @@ class Scene:
         params = self.resolve(method, overrides)
         result = RunResult(scene=self.id, method=method, params=params, reference=self.reference)
         timer = Timer()
+        broken = self._broken_plugin(method)
+        if broken:
+            result.status = "failed"
+            result.message = f"{self.id}/{method}: the plugin failed to load: {broken}"
+            result.timings = timer.as_dict()
+            return result
         try:
             out = self.solve(method, params, timer)
             bad = [k for k, v in out.metrics.items()

@@ -81,11 +81,21 @@ def test_built_in_methods_run_beside_broken_plugins(plugin_env):
     assert ": ok" in r.stdout.splitlines()[0]
 
 
+@pytest.mark.parametrize("method, needle", [
+    ("exit-at-import", "stiffness2d-sheet/exit-at-import: the plugin failed to load: "
+                       "pdverify_exit_at_import:METHOD: SystemExit(3) at import"),
+    ("spacing-clash", "stiffness2d-sheet/spacing-clash: the plugin failed to load: plugin "
+                      "pdverify_misbehaving:SPACING_CLASH: its parameter 'spacing' is a "
+                      "parameter of scene"),
+])
+def test_a_run_of_a_broken_plugin_is_a_failed_run_naming_it(plugin_env, method, needle):
+    r = cli(plugin_env, "run", "stiffness2d-sheet", "--method", method)
+    assert r.returncode == 1, (r.stdout, r.stderr)
+    first = r.stdout.splitlines()[0]
+    assert ": failed (" in first and needle in first, first
+
+
 @pytest.mark.parametrize("argv, needle", [
-    (["--method", "exit-at-import"], "method 'exit-at-import' is a plugin that failed to "
-                                     "load (pdverify_exit_at_import:METHOD: SystemExit(3) "
-                                     "at import)"),
-    (["--method", "spacing-clash"], "its parameter 'spacing' is a parameter of scene"),
     (["--method", "check-exit", "--set", "gain=2"],
      "plugin method check-exit (pdverify_misbehaving:CHECK_EXIT): the check of its "
      "parameter gain raised SystemExit(5)"),
