@@ -85,10 +85,11 @@ class Param:
         return value
 
 
-#: the magnitudes a positive physical parameter may take: beyond them the products and
-#: squares a run forms (E x area x strain, displacements squared in the error norms)
-#: under- or overflow a double (5e-324 or 1e308 would; no SI value here comes near)
-POSITIVE_RANGE = (1e-100, 1e100)
+#: the magnitudes a positive physical parameter may take: from the smallest normal double
+#: (a subnormal such as 5e-324 keeps a few digits or none, and what it scales underflows to
+#: zero) to 1e300 (a product with any factor above ~1.8e8 overflows). Linear problems
+#: scaled by 1e+-300 give the default metrics (tests/reliability/test_hard_numerics.py).
+POSITIVE_RANGE = (2.2250738585072014e-308, 1e300)
 
 
 def positive(value) -> str | None:
@@ -96,8 +97,8 @@ def positive(value) -> str | None:
     if not value > 0:
         return "must be a finite number > 0"
     if not lo <= value <= hi:
-        return (f"must lie in {lo:g}..{hi:g} (a positive physical value; beyond, the "
-                "products and squares of a run under- or overflow a double)")
+        return (f"must lie in {lo:.3g}..{hi:g} (from the smallest normal double: a "
+                "subnormal keeps too few digits; to 1e300: products of it overflow)")
     return None
 
 
@@ -106,8 +107,8 @@ def magnitude(value) -> str | None:
     lo, hi = POSITIVE_RANGE
     if value == 0 or lo <= abs(value) <= hi:
         return None
-    return (f"must be 0 or of magnitude {lo:g}..{hi:g} (beyond, the products and squares "
-            "of a run under- or overflow a double)")
+    return (f"must be 0 or of magnitude {lo:.3g}..{hi:g} (from the smallest normal double: "
+            "a subnormal keeps too few digits; to 1e300: products of it overflow)")
 
 
 def at_least(bound) -> Check:
