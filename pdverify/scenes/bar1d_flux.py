@@ -7,7 +7,6 @@ from manufactured import bar1d as closed
 
 from ..params import Param, positive
 from . import Outcome, Published, Scene, register, require_influence
-from .base import check_load_scale
 from .bar1d import BAR_PARAMS, NONE, TAYLOR, StateBar, bar_estimate, check_bar_grid
 
 _FEATURES = closed.flux_features()  # (1.26285..., 0.77160..., 0.39403...)
@@ -55,7 +54,6 @@ class ForceFlux(Scene):
 
     def check(self, method, p):
         check_bar_grid(self.id, method, p, min_horizons=4.0)
-        check_load_scale(f"{self.id} --method {method}", "strain", p["strain"], 1.0)
         if method == NONE.name:
             require_influence(self.id, method, p, "hyperbolic", "the closed forms of Tables 1, 2 "
                               "and B1 are derived for seed 000's delta / |xi|")
