@@ -61,3 +61,21 @@ def rao_displacement(x, t, *, strain: float, length: float, wave_speed: float):
     ct = wave_speed * t[:, None]
     return 0.5 * (_quarter_wave_extension(x[None, :] - ct, strain, length)
                   + _quarter_wave_extension(x[None, :] + ct, strain, length))
+
+
+def exact_sum_error_bound(*, strain: float, length: float, wave_speed: float,
+                          t_max: float) -> float:
+    """A bound on |rao_displacement - Eq. (105)| for 0 <= t <= t_max, 0 <= x <= L: the
+    exact sum has no truncation, only the rounding of its few operations.
+
+    With s = x -+ c t (|s| <= L + c t_max =: S, two roundings), r = mod(s + L, 4L) - L
+    (the addition and the subtraction round, the modulo of doubles is exact or rounds
+    once when it adds 4L), every rounding at most eps times a quantity below S + 4L, so
+    |r - r_exact| <= 5 eps (S + 4L); the triangle wave has slope +-strain, and the
+    product, 2L - r and the mean add 3 eps |u| <= 3 eps strain L. In all:
+    strain eps (5 S + 23 L), with eps the double's unit roundoff 2^-53 doubled (2.2e-16)
+    for margin.
+    """
+    eps = float(np.finfo(float).eps)
+    S = length + abs(wave_speed) * t_max
+    return strain * eps * (5.0 * S + 23.0 * length)

@@ -4,8 +4,12 @@ checked against a limit before any allocation (issue 18).
 A run above the limit is bad input: exit 2 with one line that names the run, the
 estimate, what it is made of and the limit. The limit is ``--max-memory`` (``run`` and
 ``report``), else the environment variable ``PDVERIFY_MAX_MEMORY``, else half of the
-memory available when the command starts. Time-stepping runs are also held to
-:data:`MAX_TIME_STEPS`.
+machine's memory ceiling: the smallest of the physical memory (MemTotal), the cgroup's
+memory limit (v2 ``memory.max`` or v1 ``memory.limit_in_bytes``) and ``RLIMIT_AS``. That
+ceiling does not move with what else runs, so the same run is admitted or refused the
+same way every time (the momentary MemAvailable did move, by 10 % within an hour).
+Time-stepping runs are also held to :data:`MAX_TIME_STEPS`, implicit load-stepping runs
+(each increment at least one linear solve) to :data:`MAX_LOAD_INCREMENTS`.
 
 The memory model (:func:`linear_system`) counts what dominates a static PD or FEM solve:
 
@@ -33,10 +37,14 @@ from dataclasses import dataclass
 from .errors import InputError
 
 MEMORY_ENV = "PDVERIFY_MAX_MEMORY"
-#: share of the available memory one run may plan to use when no limit is given
+#: share of the memory ceiling (:func:`memory_ceiling`) one run may plan to use when no
+#: limit is given
 DEFAULT_FRACTION = 0.5
 #: ceiling on explicit time steps of one run (~ minutes of 1D stepping on this machine)
 MAX_TIME_STEPS = 20_000_000
+#: ceiling on implicit load increments of one run, each at least one linear solve: the FEM
+#: indentation study (800 increments over its levels) took 5 s, so this is ~2 minutes there
+MAX_LOAD_INCREMENTS = 20_000
 #: matrix and assembly arrays per stored non-zero: measured 61 B on the 3D boxes (dense
 #: path: 6000 unknowns, 13.1 M non-zeros, 1.37 GB; 9000 unknowns, 24.0 M, 2.75 GB)
 BYTES_PER_NONZERO = 64.0
@@ -59,17 +67,24 @@ class Estimate:
     memory: float
     detail: str
     time_steps: int = 0
+    increments: int = 0
 
     def __add__(self, other: "Estimate") -> "Estimate":
         return Estimate(self.memory + other.memory, f"{self.detail}; {other.detail}",
-                        self.time_steps + other.time_steps)
+                        self.time_steps + other.time_steps, self.increments + other.increments)
+
+
+def step_count(steps: float) -> float:
+    """ceil(steps), or inf when it overflows (a subnormal dt): :func:`check` refuses it."""
+    return math.ceil(steps) if math.isfinite(steps) else math.inf
 
 
 def larger(first: Estimate, then: Estimate) -> Estimate:
     """Two phases run one after the other: the peak is the larger of the two."""
     big = first if first.memory >= then.memory else then
     return Estimate(big.memory, f"{big.detail} (the larger phase)",
-                    max(first.time_steps, then.time_steps))
+                    max(first.time_steps, then.time_steps),
+                    max(first.increments, then.increments))
 
 
 def parse_size(text: str, what: str) -> int:
@@ -80,7 +95,10 @@ def parse_size(text: str, what: str) -> int:
         raise InputError(f"{what}={text!r} must be a size such as 4G, 512M, 1.5GB or a "
                          "number of bytes")
     value = float(m.group(1)) * _UNITS[unit]
-    if not (math.isfinite(value) and value >= 2 ** 20):
+    if not math.isfinite(value):
+        raise InputError(f"{what}={text!r} is not a finite size (a double holds up to 1.8e308 "
+                         "bytes)")
+    if not value >= 2 ** 20:
         raise InputError(f"{what}={text!r} must be at least 1M")
     return int(value)
 
@@ -91,16 +109,40 @@ def set_limit(text: str | None) -> None:
     _limit_override = None if text is None else parse_size(text, "--max-memory")
 
 
-def available_memory() -> int:
-    """MemAvailable of /proc/meminfo (Linux); else physical pages x page size."""
+_CGROUP_LIMITS = ("/sys/fs/cgroup/memory.max",                     # cgroup v2
+                  "/sys/fs/cgroup/memory/memory.limit_in_bytes")     # cgroup v1
+
+
+def _read_limit(path: str) -> int | None:
+    """A cgroup memory limit in bytes, None when absent or unlimited ("max", or v1's
+    page-rounded 2^63)."""
     try:
-        with open("/proc/meminfo") as fh:
-            for line in fh:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
+        with open(path) as fh:
+            text = fh.read().strip()
     except OSError:
+        return None
+    if not text.isdigit():
+        return None
+    value = int(text)
+    return value if value < 2 ** 62 else None
+
+
+def memory_ceiling() -> tuple[int, str]:
+    """The smallest of the physical memory, the cgroup limit and ``RLIMIT_AS`` (bytes),
+    and which one it is. None of them depends on what else runs at the moment."""
+    found = [(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"), "total memory")]
+    for path in _CGROUP_LIMITS:
+        value = _read_limit(path)
+        if value is not None:
+            found.append((value, "the cgroup's memory limit"))
+    try:
+        import resource
+        soft = resource.getrlimit(resource.RLIMIT_AS)[0]
+        if soft != resource.RLIM_INFINITY and soft > 0:
+            found.append((soft, "RLIMIT_AS"))
+    except (ImportError, OSError, ValueError):
         pass
-    return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    return min(found)
 
 
 def memory_limit() -> tuple[int, str]:
@@ -110,8 +152,9 @@ def memory_limit() -> tuple[int, str]:
     env = os.environ.get(MEMORY_ENV)
     if env:
         return parse_size(env, MEMORY_ENV), MEMORY_ENV
-    return int(DEFAULT_FRACTION * available_memory()), (
-        f"default: {DEFAULT_FRACTION:.0%} of available memory; change with --max-memory "
+    ceiling, what = memory_ceiling()
+    return int(DEFAULT_FRACTION * ceiling), (
+        f"default: {DEFAULT_FRACTION:.0%} of {what}; change with --max-memory "
         f"or {MEMORY_ENV}")
 
 
@@ -130,6 +173,12 @@ def check(where: str, estimate: Estimate | None) -> None:
     if estimate.time_steps > MAX_TIME_STEPS:
         raise InputError(f"{where}: needs ~{estimate.time_steps:.3g} time steps "
                          f"({estimate.detail}), above the ceiling of {MAX_TIME_STEPS:.3g}")
+    if estimate.increments > MAX_LOAD_INCREMENTS:
+        raise InputError(f"{where}: needs ~{estimate.increments:.3g} load increments "
+                         f"({estimate.detail}), above the ceiling of {MAX_LOAD_INCREMENTS}")
+    if not math.isfinite(estimate.memory):
+        raise InputError(f"{where}: the size overflows ({estimate.detail}); no run of this "
+                         "size fits any memory")
     limit, source = memory_limit()
     if estimate.memory > limit:
         raise InputError(f"{where}: needs ~{format_bytes(estimate.memory)} of memory "
@@ -160,8 +209,11 @@ def measured_peak(args, env=None) -> float:
 def lattice_neighbours(dim: int, reach: float) -> float:
     """Lattice points within ``reach`` spacings of a node (itself included), ~ the ball."""
     r = float(reach)
+    if not math.isfinite(r):       # a reach that overflowed: so does the count (refused)
+        return math.inf
+    # products, not powers: r ** 3 raises OverflowError where r * r * r becomes inf
     return {1: 2 * math.floor(r) + 1, 2: math.pi * r * r + 1,
-            3: 4.0 / 3.0 * math.pi * r ** 3 + 1}[dim]
+            3: 4.0 / 3.0 * math.pi * r * r * r + 1}[dim]
 
 
 def _unknowns_and_nonzeros(nodes: float, dim: int, dofs_per_node: int, reach: float):

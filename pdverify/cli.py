@@ -23,7 +23,8 @@ from .errors import STOP_REQUESTED, InputError
 
 
 MAX_MEMORY_HELP = ("refuse (exit 2) any run whose memory estimate exceeds SIZE, e.g. 4G, "
-                   "512M (default: $PDVERIFY_MAX_MEMORY, else half the available memory)")
+                   "512M (default: $PDVERIFY_MAX_MEMORY, else half of the smallest of total "
+                   "memory, the cgroup limit and RLIMIT_AS)")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -135,6 +136,11 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("pdverify: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # the reader of stdout went away (| head): stop quietly, and
+        # point stdout at /dev/null so that the interpreter's final flush cannot fail too
+        import os
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141  # 128 + SIGPIPE, as a shell reports a pipe's writer
     finally:
         budget.set_limit(None)  # --max-memory holds for this command only
 

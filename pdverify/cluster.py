@@ -17,6 +17,9 @@ from .errors import InputError
 ENV = "PDVERIFY_SCHEDULER"
 #: how long to wait for the scheduler before giving up (exit 2)
 CONNECT_TIMEOUT_S = 10
+#: the address schemes a separate scheduler process can be reached by with a plain
+#: ``distributed`` install
+SCHEMES = ("tcp", "tls", "ws", "wss")
 _ADDRESS = re.compile(r"^(tcp|tls|inproc|ucx|ws|wss)://[^\s/]+$|^[A-Za-z0-9.\-\[\]:]+:\d+$")
 
 
@@ -30,6 +33,11 @@ def scheduler_address(flag: str | None) -> str | None:
     if not _ADDRESS.match(value):
         raise InputError(f"{where}={value!r}: expected a Dask scheduler address such as "
                          "tcp://10.0.0.5:8786 or 10.0.0.5:8786")
+    scheme = value.split("://", 1)[0] if "://" in value else "tcp"
+    if scheme not in SCHEMES:
+        raise InputError(f"{where}={value!r}: the scheme {scheme}:// is not supported; "
+                         f"allowed: {', '.join(s + '://' for s in SCHEMES)} (inproc:// reaches "
+                         "only a scheduler inside this process, ucx:// needs UCX-Py)")
     if importlib.util.find_spec("distributed") is None:
         raise InputError(f"{where}: running on a Dask cluster needs the 'distributed' package "
                          "(python -m pip install \"pdverify[cluster]\")")
@@ -41,7 +49,8 @@ def connect(address: str):
     from distributed import Client
     try:
         return Client(address, timeout=f"{CONNECT_TIMEOUT_S}s", set_as_default=False)
-    except (OSError, TimeoutError) as exc:
+    except (OSError, TimeoutError, ValueError) as exc:  # ValueError: a scheme or address
+        # distributed refuses only when it tries it
         raise InputError(f"--scheduler: cannot reach a Dask scheduler at {address} within "
                          f"{CONNECT_TIMEOUT_S} s ({type(exc).__name__})") from None
 

@@ -2,12 +2,16 @@
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 from typing import Any, Callable, Mapping
 
 from .errors import InputError
 
 Check = Callable[[Any], "str | None"]
+#: what an integer parameter may be written as: decimal digits, an optional fraction that is
+#: zero and an exponent (200, 2e2, 200.0); not 0x2, 0b10, 1_000
+_DECIMAL = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
 
 
 @dataclass(frozen=True)
@@ -43,9 +47,13 @@ class Param:
                         raise ValueError(raw)
                     value = low in ("true", "1", "yes")
                 elif kind is int:
+                    if not _DECIMAL.fullmatch(raw.strip()):   # 0x2, 1_000, 0b1, "two"
+                        raise InputError(f"{where}: {self.name}={raw!r} is not a decimal "
+                                         "integer (digits, optionally with an exponent: "
+                                         "200, 2e2)")
                     as_float = float(raw)
                     if as_float != int(as_float):
-                        raise ValueError(raw)
+                        raise InputError(f"{where}: {self.name}={raw!r} is not a whole number")
                     value = int(as_float)
                 else:
                     value = kind(raw)
@@ -57,9 +65,14 @@ class Param:
                 value = raw
             if not isinstance(value, kind):
                 raise ValueError(raw)
-        except (TypeError, ValueError, OverflowError):
+        except InputError:
+            raise
+        except OverflowError:
+            raise InputError(f"{where}: {self.name}={raw!r} is out of range for "
+                             + ("an integer" if kind is int else f"a {kind.__name__}")) from None
+        except (TypeError, ValueError):
             raise InputError(f"{where}: {self.name}={raw!r} is not a valid {kind.__name__}"
-                             + (" (out of range)" if kind is int else "")) from None
+                             ) from None
         if kind is float and not math.isfinite(value):  # NaN, inf, and overflow such as 1e400
             raise InputError(f"{where}: {self.name}={raw!r} must be a finite number")
         if self.choices is not None and value not in self.choices:
@@ -72,8 +85,30 @@ class Param:
         return value
 
 
+#: the magnitudes a positive physical parameter may take: from the smallest normal double
+#: (a subnormal such as 5e-324 keeps a few digits or none, and what it scales underflows to
+#: zero) to 1e300 (a product with any factor above ~1.8e8 overflows). Linear problems
+#: scaled by 1e+-300 give the default metrics (tests/reliability/test_hard_numerics.py).
+POSITIVE_RANGE = (2.2250738585072014e-308, 1e300)
+
+
 def positive(value) -> str | None:
-    return None if value > 0 and value != float("inf") else "must be a finite number > 0"
+    lo, hi = POSITIVE_RANGE
+    if not value > 0:
+        return "must be a finite number > 0"
+    if not lo <= value <= hi:
+        return (f"must lie in {lo:.3g}..{hi:g} (from the smallest normal double: a "
+                "subnormal keeps too few digits; to 1e300: products of it overflow)")
+    return None
+
+
+def magnitude(value) -> str | None:
+    """Any sign, zero included, but no magnitude outside :data:`POSITIVE_RANGE`."""
+    lo, hi = POSITIVE_RANGE
+    if value == 0 or lo <= abs(value) <= hi:
+        return None
+    return (f"must be 0 or of magnitude {lo:.3g}..{hi:g} (from the smallest normal double: "
+            "a subnormal keeps too few digits; to 1e300: products of it overflow)")
 
 
 def at_least(bound) -> Check:

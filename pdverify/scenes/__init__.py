@@ -5,8 +5,8 @@ import importlib
 import pkgutil
 
 from ..errors import InputError
-from .base import (MethodSpec, Outcome, Published, Scene, influence_param, require_influence,
-                   whole_cells)
+from .base import (MethodSpec, Outcome, Published, Scene, cell_count, influence_param,
+                   require_influence, whole_cells)
 
 _REGISTRY: dict[str, Scene] = {}
 _LOADED = False
@@ -46,4 +46,4 @@ def get_scene(scene_id: str) -> Scene:
 
 
 __all__ = ["MethodSpec", "Outcome", "Published", "Scene", "influence_param", "register",
-           "require_influence", "whole_cells", "all_scenes", "get_scene"]
+           "require_influence", "whole_cells", "cell_count", "all_scenes", "get_scene"]

@@ -12,7 +12,8 @@ from ..metrics import max_relative_error_pct, nodal_relative_error_pct, rel_l2_e
 from ..params import Param, at_least, open_interval, positive
 from ..pd import BoxGrid, StateBasedConstants, StateBasedModel, build_stencil, get_influence
 from ..pd.problem import FaceCondition, StaticProblem
-from . import Outcome, Published, influence_param, register
+from . import Outcome, Published, cell_count, influence_param, register
+from .base import check_load_scale
 from .family import StaticStateScene
 
 #: Table 3 of seed 000.
@@ -75,7 +76,7 @@ def check_bar_grid(scene_id: str, method: str, p: dict, min_horizons: float = 0.
     """Common checks: the spacing divides the length into whole cells, and the bar is at
     least ``min_horizons`` horizons long; returns the number of cells."""
     where = f"{scene_id} --method {method}"
-    n = p["length"] / p["spacing"]
+    n = cell_count(where, p["spacing"], "length", p["length"])
     if abs(n - round(n)) > 1e-9 * max(n, 1.0) or round(n) < 2:
         raise InputError(f"{where}: spacing={p['spacing']} must divide length={p['length']} "
                          f"into a whole number (>= 2) of cells")
@@ -167,6 +168,12 @@ class StaticBar(StaticStateScene):
 
     def check(self, method, p):
         check_bar_grid(self.id, method, p, min_horizons=2.0)
+        name = self.load_param.name
+        unit = abs(self.total_load({**p, name: 1.0}))   # linear: the load of a unit value
+        if unit > 0:
+            # strain ~ total load / (E A): the load value of a unit strain is E A / unit
+            check_load_scale(f"{self.id} --method {method}", name, p[name],
+                             p["E"] * p["area"] / unit)
         super().check(method, p)
 
     def estimate(self, method, p):

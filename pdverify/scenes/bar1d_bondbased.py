@@ -1,7 +1,6 @@
 """Seed 004: 1D bond-based bars, triangular micromodulus: homogenisation, constraints, vibration."""
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Callable
 
@@ -22,6 +21,7 @@ from ..solvers.explicit import central_difference
 from ..solvers.modal import exact_stability_limit, min_angular_frequency
 from ..solvers.static import solve_constrained
 from . import MethodSpec, Outcome, Published, Scene, register
+from .base import truncation_problem
 
 NONE = MethodSpec("none")
 HOMOGENIZED = MethodSpec("homogenized")
@@ -544,8 +544,8 @@ class Vibration(BondBarScene):
     STEPS_PER_PERIOD_AND_SPACING = 4.0
 
     def estimate(self, method, p):
-        steps = math.ceil(self.STEPS_PER_PERIOD_AND_SPACING * p["periods"] * (p["nodes"] - 1)
-                          / p["dt_factor"])
+        steps = budget.step_count(self.STEPS_PER_PERIOD_AND_SPACING * p["periods"]
+                                  * (p["nodes"] - 1) / p["dt_factor"])
         history = budget.Estimate(48.0 * steps, f"~{steps:.3g} time steps", steps)
         return super().estimate(method, p) + history
 
@@ -584,5 +584,19 @@ class Vibration(BondBarScene):
                   "u_next": run.history[:, 0], "u_next_ref": ref[:, 0],
                   "amplitude": eps * L, "period": 1.0 / f1}
         size = {**bar.size(), "steps": steps}
-        diagnostics = {**run.info, "end_factors": list(bar.end_factors)}
-        return Outcome(metrics=metrics, size=size, fields=fields, diagnostics=diagnostics)
+        # Rao's series is summed exactly (d'Alembert), so its only error is rounding
+        # (manufactured.vibration1d.exact_sum_error_bound), in % of eps L like the error
+        bound_pct = 100.0 * rao.exact_sum_error_bound(
+            strain=eps, length=L, wave_speed=c,
+            t_max=float(run.history_times[-1])) / (eps * L)
+        diagnostics = {**run.info, "end_factors": list(bar.end_factors),
+                       "reference_error_bound_pct": bound_pct}
+        out = Outcome(metrics=metrics, size=size, fields=fields, diagnostics=diagnostics)
+        problem = truncation_problem(
+            "Rao's series (summed exactly; rounding bound "
+            f"{bound_pct:.3g} % of eps L)", bound_pct,
+            {"max_error_pct": metrics["max_error_pct"]},
+            "the PD run agrees with it to round-off, below what it can measure")
+        if problem:
+            raise NumericalError(problem, partial=out)
+        return out

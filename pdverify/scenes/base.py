@@ -17,6 +17,11 @@ from ..results import RunResult, Timer
 from ..solvers.iterative import solver_error_warnings
 
 
+def what_it_did(exc: BaseException) -> str:
+    from ..corrections.registry import what_it_did as phrase
+    return phrase(exc)
+
+
 def conditioning_warnings(diagnostics: Mapping) -> list[str]:
     """One warning for the worst ``*condition_estimate`` in ``diagnostics`` (nested
     included) above :data:`~pdverify.solvers.static.WARN_CONDITION`."""
@@ -61,17 +66,76 @@ def require_influence(scene_id: str, method: str, p: dict, allowed: str, why: st
                          f"supported here; allowed: {allowed} ({why})")
 
 
+#: more cells than this along one axis are refused before any other check: beyond 2^53 a
+#: double no longer tells whole numbers apart, and no such grid fits any memory
+MAX_CELLS_PER_AXIS = 1e15
+
+
+def cell_count(where: str, spacing: float, name: str, length: float,
+               label: str = "spacing") -> float:
+    """length / spacing, refused (one line, exit 2) when it is not a finite count of at most
+    :data:`MAX_CELLS_PER_AXIS` (a subnormal spacing or a huge length overflows it)."""
+    n = length / spacing
+    if not n <= MAX_CELLS_PER_AXIS:      # inf, and NaN from 0/0, too
+        raise InputError(f"{where}: {label}={spacing:g} and {name}={length:g} give "
+                         f"{name}/{label} = {n:g} cells; allowed: at most "
+                         f"{MAX_CELLS_PER_AXIS:.0e} cells along an axis")
+    return n
+
+
 def whole_cells(where: str, spacing: float, lengths, label: str = "spacing") -> list[int]:
     """Cells along each of ``lengths`` ((name, L) pairs); refuse (one line, exit 2) a
     ``spacing`` that does not divide every L into a whole number (>= 2) of cells."""
     counts = []
     for name, L in lengths:
-        n = L / spacing
+        n = cell_count(where, spacing, name, L, label)
         if abs(n - round(n)) > 1e-9 * max(n, 1.0) or round(n) < 2:
             raise InputError(f"{where}: {label}={spacing:g} must divide {name}={L:g} into a "
                              "whole number (>= 2) of cells")
         counts.append(int(round(n)))
     return counts
+
+
+#: the strains a linear scene's load may cause: at least 5e-314 = 1e10 x the spacing of the
+#: subnormal doubles (4.9e-324), so that the displacements keep 10 significant digits
+#: (force=1e-320 gave strains of 1e-327: every displacement 0). Large strains stay
+#: allowed: the model is linear and a load scaled by 1e300 gives the default metrics, and
+#: what overflows beyond is a failed run naming it (tests/reliability/test_hard_numerics.py:
+#: E = 1e-300 under the default force is a near-singular failed run, not bad input).
+STRAIN_RANGE = (5e-314, float("inf"))
+
+
+def check_load_scale(where: str, name: str, value: float, per_unit_strain: float) -> None:
+    """Refuse (one line, exit 2) a load ``name`` whose strain ``value / per_unit_strain``
+    lies below :data:`STRAIN_RANGE`, naming the smallest load allowed;
+    ``per_unit_strain``: the load that causes a unit strain (E A for an end force).
+    Zero is left to the scene (it has its own reason to refuse it)."""
+    lo, hi = STRAIN_RANGE
+    if value == 0 or lo * per_unit_strain <= abs(value) <= hi * per_unit_strain:
+        return
+    raise InputError(f"{where}: {name}={value:.3g} is below the smallest |{name}| allowed, "
+                     f"{lo * per_unit_strain:.3g}: the load of a strain of {lo:.3g} (below, "
+                     "the displacements keep fewer than 10 digits in a double)")
+
+
+#: a series or iterative reference's own truncation error must stay below this share of
+#: every error it is used to measure (issue 31): else the "error" is partly the
+#: reference's, and the run fails saying so
+TRUNCATION_SHARE = 1e-3
+
+
+def truncation_problem(what: str, estimate: float, errors: Mapping[str, float],
+                       hint: str) -> str | None:
+    """None when the reference's truncation ``estimate`` is below :data:`TRUNCATION_SHARE`
+    of each of ``errors`` (metric name -> the error, in the estimate's unit), else the
+    one-line reason for a failed run (``what``: the reference and its setting, ``hint``:
+    how to make it finer)."""
+    for name, err in errors.items():
+        if not estimate < TRUNCATION_SHARE * abs(err):
+            return (f"{what}: its truncation error estimate {estimate:.3g} is not below "
+                    f"{TRUNCATION_SHARE:g} of the {name} {abs(err):.4g} it measures, so that "
+                    f"error is partly the reference's own; {hint}")
+    return None
 
 
 @dataclass
@@ -189,17 +253,30 @@ class Scene:
                     raise InputError(f"{self.id}: method {name} is unavailable here: "
                                      f"{t.unavailable}")
                 return m
+        if self._broken_plugin(name):
+            # accepted as a bond method (the params of ``none``): its run is a failed run
+            # naming the plugin and what it did (see :meth:`run`)
+            base = next((m.params for m in self.all_methods if m.name == "none"), ())
+            return MethodSpec(name, base)
         allowed = [m.name for m in self.all_methods]
         close = difflib.get_close_matches(name, allowed, n=3)
         hint = f"; did you mean {' or '.join(close)}?" if close else ""
         raise InputError(f"{self.id}: method {name!r} is not supported by this scene; "
                          f"allowed: {', '.join(allowed)}{hint}")
 
+    def _broken_plugin(self, name: str) -> str | None:
+        """Why the plugin method ``name`` failed to load, for a scene that takes bond
+        methods; None otherwise."""
+        if self.closure_theory is None:
+            return None
+        from ..corrections.registry import broken_method
+        return broken_method(name)
+
     def bond_closure(self, method: str, params: Mapping[str, Any]) -> Closure:
         """The :class:`~pdverify.pd.closure.Closure` of a bond method; the uncorrected
         ``Closure()`` for the scene's own methods."""
         bm = self.bond_methods().get(method)
-        return Closure() if bm is None else bm.closure(params)
+        return Closure() if bm is None else bm.make_closure(params)
 
     @property
     def default_method(self) -> str:
@@ -210,8 +287,22 @@ class Scene:
         spec = self.method(method)
         where = f"{self.id} --method {method}"
         values = resolve(self.params + spec.params, dict(overrides or {}), where)
-        self.check(method, values)
-        budget.check(where, self.estimate(method, values))
+        try:
+            self.check(method, values)
+            estimate = self.estimate(method, values)
+        except InputError:
+            raise
+        except (ArithmeticError, ValueError, TypeError) as exc:
+            # the last guard of the class of bug "an extreme value overflows a size": a
+            # one-line refusal naming the values given, never a traceback
+            given = ", ".join(f"{k}={v}" for k, v in (overrides or {}).items()) or "defaults"
+            raise InputError(f"{where}: {given} is outside what this scene can size "
+                             f"({type(exc).__name__}: {exc})") from None
+        if estimate is not None and not estimate.memory < float("inf"):
+            given = ", ".join(f"{k}={v}" for k, v in (overrides or {}).items()) or "defaults"
+            raise InputError(f"{where}: {given} makes the run's size overflow "
+                             f"({estimate.detail}); no run of this size fits any memory")
+        budget.check(where, estimate)
         return values
 
     def check(self, method: str, params: dict) -> None:
@@ -247,6 +338,12 @@ class Scene:
         params = self.resolve(method, overrides)
         result = RunResult(scene=self.id, method=method, params=params, reference=self.reference)
         timer = Timer()
+        broken = self._broken_plugin(method)
+        if broken:
+            result.status = "failed"
+            result.message = f"{self.id}/{method}: the plugin failed to load: {broken}"
+            result.timings = timer.as_dict()
+            return result
         try:
             out = self.solve(method, params, timer)
             bad = [k for k, v in out.metrics.items()
@@ -268,6 +365,13 @@ class Scene:
         except (FloatingPointError, ArithmeticError, np.linalg.LinAlgError) as exc:
             result.status = "failed"
             result.message = f"numerical error: {type(exc).__name__}: {exc}"
+        except SystemExit as exc:  # code outside the plugin guards that exits: a failed
+            # run, never the end of the process (nor of a report's worker)
+            result.status = "failed"
+            result.message = (f"{self.id}/{method}: the run tried to end the process "
+                              f"({what_it_did(exc)})" + (
+                                  f" in {self.bond_methods()[method].origin}"
+                                  if method in self.bond_methods() else ""))
         except Exception as exc:  # never crash a whole report on one run
             frame = traceback.extract_tb(exc.__traceback__)[-1]
             result.status = "failed"

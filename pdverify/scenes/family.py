@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from .. import budget
+from ..errors import InputError
 from ..solvers.front import solve as solve_system
 from ..solvers.policy import auto_note
 from .base import Outcome, Scene, whole_cells
@@ -53,11 +54,18 @@ class StaticStateScene(Scene):
         return self.offered()[method]
 
     def check(self, method, p):
+        from ..corrections.registry import plugin_call
         where = f"{self.id} --method {method}"
         lengths, _ = self.box(p)
-        cells = whole_cells(where, p["spacing"],
-                            [(f"l_{name}", L) for name, L in zip("xyz", lengths)])
-        self.treatment(method).check(tuple(cells), p, where)
+        h = p["spacing"]
+        cells = whole_cells(where, h, [(f"l_{name}", L) for name, L in zip("xyz", lengths)])
+        if p["m_ratio"] > max(cells):
+            # a horizon past the whole body (and a stencil of ~m^d offsets to build)
+            raise InputError(f"{where}: m_ratio={p['m_ratio']:g} gives a horizon of "
+                             f"{p['m_ratio'] * h:g} m, longer than the body "
+                             f"({max(lengths):g} m); allowed: m_ratio <= {max(cells)}")
+        t = self.treatment(method)
+        plugin_call(t, "check", t.check, tuple(cells), p, where)
 
     def estimate(self, method, p):
         """Unknowns on the cell-centred nodes, and what the treatment adds (a fictitious
@@ -79,10 +87,12 @@ class StaticStateScene(Scene):
 
     # ----------------------------------------------------------------- solve
     def solve(self, method, p, timer):
+        from ..corrections.registry import plugin_call
         where = f"{self.id}/{method}"
         with timer.phase("setup"):
             problem = self.problem(p, where)
-            system = self.treatment(method).assemble(problem, p)
+            t = self.treatment(method)
+            system = plugin_call(t, "assemble", t.assemble, problem, p)
         with timer.phase("solve"):
             x, info = solve_system(system, where=where)
             if p.get("solver") == "auto":

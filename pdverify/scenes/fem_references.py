@@ -7,10 +7,16 @@ import dataclasses
 
 from .. import budget
 from ..errors import InputError
-from ..params import Param
+from ..params import Param, magnitude
 from . import MethodSpec, Outcome, Scene
 
 FEM = MethodSpec("fem")
+
+
+def _float_check(default):
+    """Float fields of a reference's dataclass: no magnitude a double cannot carry through
+    the run (:func:`pdverify.params.magnitude`); the dataclass checks the rest."""
+    return magnitude if isinstance(default, float) else None
 
 
 def _reference_module():
@@ -41,7 +47,8 @@ class FemReference(Scene):
     @property
     def params(self):
         # Mirrors the dataclass fields (names, defaults); the dataclass validates values.
-        return tuple(Param(f.name, f.default, "") for f in dataclasses.fields(self._cls()))
+        return tuple(Param(f.name, f.default, "", _float_check(f.default))
+                     for f in dataclasses.fields(self._cls()))
 
     def check(self, method, p):
         try:
@@ -92,11 +99,12 @@ class FemAndPD(FemReference):
 
     @property
     def params(self):
-        return tuple(Param(n, f.default, "") for n, f in self._fields().items() if n in self.shared)
+        return tuple(Param(n, f.default, "", _float_check(f.default))
+                     for n, f in self._fields().items() if n in self.shared)
 
     @property
     def methods(self):
-        fem = MethodSpec(FEM.name, tuple(Param(n, f.default, "")
+        fem = MethodSpec(FEM.name, tuple(Param(n, f.default, "", _float_check(f.default))
                                          for n, f in self._fields().items()
                                          if n not in self.shared))
         return (fem,) + tuple(MethodSpec(name, self.pd_params + extra)

@@ -27,6 +27,8 @@ SKIP_OUTPUT_STEPS = 1
 #: A free surface node is caught when it lies this fraction of R inside the indenter (the
 #: FEM reference's rule).
 CATCH_TOLERANCE = 1e-9
+#: the smallest first output depth as a fraction of R: 1000 x CATCH_TOLERANCE
+MIN_OUTPUT_DEPTH = 1e-6
 KINEMATICS = ("nonlinear", "linear")
 #: ``solver=auto`` uses CG from this many unknowns: on the quick grid (41 x 41 nodes, m = 6,
 #: 3,362 unknowns) a sparse LU per Newton step made the corrected curve 13 s, CG 2.6 s.
@@ -153,6 +155,21 @@ class Indentation(FemAndPD):
                       contact_widths=np.asarray(res.contact_widths))
         return fields
 
+    def check(self, method, p):
+        """The params as the base checks them, the step budget (a huge n_steps is refused
+        for its cost, before its depth rule), then the depth: at least n_steps x
+        :data:`MIN_OUTPUT_DEPTH` R (FEM and PD)."""
+        super().check(method, p)
+        budget.check(f"{self.id} --method {method}", self.estimate(method, p))
+        smallest = p["n_steps"] * MIN_OUTPUT_DEPTH * p["radius"]
+        if not p["depth"] >= smallest:
+            raise InputError(f"{self.id} --method {method}: depth={p['depth']:g} is below "
+                             f"the smallest allowed, {smallest:.3g} m = n_steps x "
+                             f"{MIN_OUTPUT_DEPTH:g} R (the first output depth must be 1000 "
+                             f"times the contact rule's penetration tolerance "
+                             f"{CATCH_TOLERANCE:g} R, so that it moves no force by more than "
+                             "~0.1 %; below it no node is caught and there is no force)")
+
     def check_pd(self, where, method, p):
         rf = _reference_module()
         try:
@@ -171,6 +188,18 @@ class Indentation(FemAndPD):
         if p["n_steps"] * p["substeps"] > 2000:
             raise InputError(f"{where}: n_steps * substeps = {p['n_steps'] * p['substeps']} "
                              "depth increments; allowed at most 2000")
+
+    def estimate(self, method, p):
+        """The memory of :class:`FemAndPD`, and the FEM study's load increments (each at
+        least one solve): n_steps x substeps at every level, and twice that again at the
+        finest one (its stepping check), held to ``budget.MAX_LOAD_INCREMENTS``; a PD run
+        computes the study first unless it is cached."""
+        est = super().estimate(method, p)
+        ref = p if method == "fem" else self.reference_params(p)
+        increments = ref["n_steps"] * ref["substeps"] * (ref["levels"] + 2)
+        return est + budget.Estimate(0.0, f"FEM study: {increments:.3g} load increments "
+                                          f"(n_steps x substeps x (levels + 2))",
+                                     increments=increments)
 
     def estimate_pd(self, method, p):
         h = p["spacing"]

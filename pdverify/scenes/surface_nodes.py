@@ -8,6 +8,7 @@ import numpy as np
 from manufactured import surface3d as closed
 
 from ..corrections.surface_nodes import flux_rows, surface_node_closure
+from ..errors import NumericalError
 from ..metrics import rel_l2_error
 from ..params import Param, at_least, open_interval, positive
 from ..pd import (QUADRATURES, BoxGrid, StateBasedConstants, StateBasedModel, get_influence,
@@ -124,6 +125,13 @@ def error_metrics(x, u, u_ref, dist, horizon, dim) -> tuple[dict, np.ndarray]:
     metrics are over nodes within one horizon of the surface, ``interior_`` over the rest.
     """
     scale = np.max(np.abs(u_ref), axis=0)
+    tiny = np.flatnonzero(~(scale > np.finfo(float).tiny))
+    if tiny.size:
+        raise NumericalError(f"Eq. ({38 if dim == 3 else 44}) divides each component's "
+                             f"error by its largest reference value, and component "
+                             f"{'xyz'[tiny[0]]} of the reference is {scale[tiny[0]]:.3g} "
+                             "everywhere (e.g. nu = 0 gives no lateral displacement): the "
+                             "error is undefined")
     comp = np.abs(u - u_ref) / scale * 100.0        # (n, d) per-component percent
     mag = np.sqrt(np.sum(comp ** 2, axis=1))         # Eq. (38)
     near = dist <= horizon

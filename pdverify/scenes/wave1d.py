@@ -1,7 +1,6 @@
 """Seed 002: a Gaussian pulse in a fixed-fixed PD bar, surface nodes against the analytic PD series."""
 from __future__ import annotations
 
-import math
 
 import numpy as np
 
@@ -11,13 +10,14 @@ import scipy.sparse as sp
 
 from .. import budget
 from ..corrections.surface_nodes import surface_node_displacement_map
-from ..errors import InputError
+from ..errors import InputError, NumericalError
 from ..metrics import max_error_of_peak_pct, rel_l2_error
 from ..params import Param, at_least, positive
 from ..pd import BondBasedModel, BoxGrid, Closure, bond_micromodulus, build_stencil, get_influence
 from ..pd.closure import real_identity, with_rows
 from ..solvers.explicit import central_difference
-from . import MethodSpec, Outcome, Published, Scene, register
+from . import MethodSpec, Outcome, Published, Scene, cell_count, register
+from .base import truncation_problem
 
 #: The instants of Fig. 5 at which the error is measured [s].
 SAMPLE_TIMES = (0.05e-3, 0.10e-3, 0.15e-3, 0.20e-3)
@@ -226,7 +226,7 @@ class Wave1DSurfaceNodes(Scene):
     def estimate(self, method, p):
         m = p["m_ratio"]
         nodes = p["length"] * m / p["horizon"] + 1 + 2 * m
-        steps = math.ceil(SAMPLE_TIMES[-1] / p["dt"])
+        steps = budget.step_count(SAMPLE_TIMES[-1] / p["dt"])
         series = 8.0 * p["n_terms"] * nodes * (len(SAMPLE_TIMES) + 1)
         return budget.linear_system(nodes, 1, 1, m, extra_bytes=series) + budget.Estimate(
             0.0, f"{steps:.3g} time steps, {p['n_terms']} series terms", steps)
@@ -236,7 +236,8 @@ class Wave1DSurfaceNodes(Scene):
         if p["horizon"] > p["length"] / 2:
             raise InputError(f"{where}: horizon={p['horizon']} must be <= length/2 = "
                              f"{p['length'] / 2:g}")
-        n = p["length"] * p["m_ratio"] / p["horizon"]
+        n = cell_count(where, p["horizon"] / p["m_ratio"], "length", p["length"],
+                       "horizon/m_ratio")
         if abs(n - round(n)) > 1e-9 * n:
             raise InputError(f"{where}: m_ratio={p['m_ratio']} gives spacing "
                              f"{p['horizon'] / p['m_ratio']:g} m, which must divide "
@@ -284,11 +285,25 @@ class Wave1DSurfaceNodes(Scene):
             "rel_l2_error": rel_l2_error(u, u_ref),
             "classical_gap_pct": max_error_of_peak_pct(u_cl, u_ref, peak),
         }
+        # the series' own truncation (manufactured.wave1d.truncation_estimate), in % of the
+        # peak like the errors; the classical gap subtracts two series, so twice it
+        tail_pct = 100.0 * pd.tail / peak
         diagnostics = dict(run.info)
         diagnostics.update({"sample_times": run.times, "wave_speed": wave_speed,
                             "spacing": bar.spacing, "series_tail": pd.tail,
+                            "series_truncation_pct": tail_pct,
                             "boundary_nodes": int(near.sum())})
         fields = {"x": x, "times": run.times, "u": u, "u_ref": u_ref, "u_classical": u_cl,
                   "horizon": horizon, "length": length, "peak": peak,
                   "wave_speed": wave_speed, "n_terms": p["n_terms"]}
-        return Outcome(metrics=metrics, size=bar.size(), fields=fields, diagnostics=diagnostics)
+        out = Outcome(metrics=metrics, size=bar.size(), fields=fields, diagnostics=diagnostics)
+        problem = truncation_problem(
+            f"the reference series (n_terms={p['n_terms']}; omitted modes ~{tail_pct:.3g} % "
+            "of the peak)", tail_pct,
+            {"max_error_pct": metrics["max_error_pct"],
+             "boundary_error_pct": metrics["boundary_error_pct"],
+             "classical_gap_pct / 2": metrics["classical_gap_pct"] / 2},
+            "raise n_terms (40 is below 1e-8 %)")
+        if problem:
+            raise NumericalError(problem, partial=out)
+        return out

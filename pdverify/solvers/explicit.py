@@ -31,6 +31,16 @@ class StabilityLimit:
     real_part: float = 0.0
 
 
+
+def ratio_above_one(ratio: float) -> str:
+    """``ratio`` (> 1) with the fewest significant digits (3 at least) that still show it
+    above 1: 1.0003 is "1.0003", not "1"."""
+    for digits in range(3, 18):
+        text = f"{ratio:.{digits}g}"
+        if float(text) > 1.0:
+            return text
+    return repr(ratio)
+
 def _scaled(stiffness, mass):
     K = sp.csr_matrix(stiffness)
     if mass is None:
@@ -166,7 +176,7 @@ def central_difference(stiffness, u0, v0, dt: float, n_steps: int, *, mass=None,
     if dt > limit.dt_limit:
         raise NumericalError(f"{where}: time step dt={dt:.6g} s exceeds the stability limit "
                              f"2/sqrt(lambda_max) = {limit.dt_limit:.6g} s of central differences "
-                             f"(ratio {dt / limit.dt_limit:.3g} > 1; lambda_max = "
+                             f"(ratio {ratio_above_one(dt / limit.dt_limit)} > 1; lambda_max = "
                              f"{limit.lambda_max:.6g} 1/s^2, {limit.estimate})")
 
     inv_m = np.ones(n) if mass is None else 1.0 / np.asarray(mass, dtype=float)

@@ -139,8 +139,7 @@ def test_treatment_plugin_runs_and_is_exact_for_a_linear_field(treatment_env):
     """The traction bar's solution is linear, and odd images about the surface nodes
     reproduce a linear field exactly: round-off (Eq. 64 relative to the largest
     displacement, times 1e3 eps per node row summed over ~40 bonds)."""
-    r = cli(treatment_env, "run", "bar1d-traction", "--method", "image-nodes", "--json",
-            os.devnull)
+    r = cli(treatment_env, "run", "bar1d-traction", "--method", "image-nodes")
     assert r.returncode == 0, r.stderr
     err = float(r.stdout.split("max_error_pct", 1)[1].split()[0])
     assert err < 1e-9

@@ -225,3 +225,78 @@ def test_bad_input(name, argv, files, needle, tmp_path, monkeypatch, capsys):
     assert "Traceback" not in err
     assert needle in err, err
     assert _snapshot(tmp_path) == before          # nothing written, nothing created
+
+
+# ==================================================================== issue 31: robustness
+# (extreme values, the step budget of every stepping loop, messages that name the cause;
+# appended as one block, the outputs/compare cases of issue 31 sit in their own block)
+ROBUST_CASES = [
+    ("spacing-subnormal", ["run", "bar1d-traction", "--set", "spacing=5e-324"], {},
+     "spacing='5e-324' must lie in 2.23e-308..1e+300 (from the smallest normal double"),
+    ("length-huge", ["run", "bar1d-traction", "--set", "length=1e308"], {},
+     "length='1e308' must lie in 2.23e-308..1e+300"),
+    ("cells-overflow", ["run", "bar1d-traction", "--set", "spacing=1e-90", "--set",
+                        "length=1e90"], {},
+     "spacing=1e-90 and length=1e+90 give length/spacing = 1e+180 cells; allowed: at most "
+     "1e+15 cells along an axis"),
+    ("m-ratio-3d-huge", ["run", "stiffness3d-box", "--set", "m_ratio=1e300"], {},
+     "m_ratio=1e300 makes the run's size overflow"),
+    ("m-ratio-2d-huge", ["run", "plate2d-plane-strain", "--set", "m_ratio=1e308"], {},
+     "m_ratio=1e+308 gives a horizon of 2e+306 m, longer than the body (1 m)"),
+    ("scheduler-inproc", ["report", "--scheduler", "inproc://x"], {},
+     "--scheduler='inproc://x': the scheme inproc:// is not supported; allowed: tcp://"),
+    ("scheduler-ucx", ["report", "--scheduler", "ucx://10.0.0.5:8786"], {},
+     "the scheme ucx:// is not supported"),
+    ("force-subnormal", ["run", "bar1d-traction", "--set", "force=1e-320"], {},
+     "force=1e-320 is below the smallest |force| allowed, 5e-307: the load of a strain of "
+     "5e-314 (below, the displacements keep fewer than 10 digits in a double)"),
+    ("body-load-tiny", ["run", "bar1d-uniform-load", "--set", "b0=1e-315"], {},
+     "b0=1e-315 is below the smallest |b0| allowed"),
+    ("indent-depth-tiny", ["run", "block2d-indentation", "--set", "depth=1e-12"], {},
+     "depth=1e-12 is below the smallest allowed, 3e-07 m = n_steps x 1e-06 R"),
+    ("indent-depth-tiny-pd", ["run", "block2d-indentation", "--method", "none", "--set",
+                              "depth=1e-12"], {}, "depth=1e-12 is below the smallest allowed"),
+    ("order-hex", ["run", "bar1d-traction", "--method", "taylor-fictitious", "--set",
+                   "order=0x2"], {}, "order='0x2' is not a decimal integer"),
+    ("order-underscore", ["run", "bar1d-traction", "--method", "taylor-fictitious", "--set",
+                          "order=1_0"], {}, "order='1_0' is not a decimal integer"),
+    ("order-fraction-named", ["run", "bar1d-traction", "--method", "taylor-fictitious",
+                              "--set", "order=2.5"], {}, "order='2.5' is not a whole number"),
+    ("order-overflow-named", ["run", "bar1d-traction", "--method", "taylor-fictitious",
+                              "--set", "order=1e400"], {},
+     "order='1e400' is out of range for an integer"),
+    ("fem-indent-steps", ["run", "block2d-indentation", "--set", "n_steps=100000000"], {},
+     "load increments"),
+    ("fem-indent-substeps", ["run", "block2d-indentation", "--set", "substeps=100000"], {},
+     "above the ceiling of 20000"),
+    ("wave-dt-subnormal", ["run", "wave1d-surface-nodes", "--set", "dt=5e-324"], {},
+     "dt='5e-324' must lie in 2.23e-308..1e+300"),
+    ("vibration-periods-huge", ["run", "bar1d-vibration", "--set", "periods=1e308"], {},
+     "inf time steps"),
+    ("vibration-nodes-huge", ["run", "bar1d-vibration", "--set", "nodes=1e308"], {},
+     "nodes=1e308"),
+    ("E-subnormal", ["run", "bar1d-traction", "--set", "E=5e-324"], {},
+     "E='5e-324' must lie in 2.23e-308..1e+300"),
+    ("area-huge", ["run", "bar1d-traction", "--set", "area=1e308"], {}, "area='1e308'"),
+    ("fem-E-huge", ["run", "sheet2d-tension", "--set", "E=1e308"], {},
+     "E='1e308' must be 0 or of magnitude 2.23e-308..1e+300"),
+    ("fem-thickness-subnormal", ["run", "plate2d-clamped", "--set", "thickness=5e-324"], {},
+     "thickness='5e-324'"),
+    ("fem-elements-huge", ["run", "sheet2d-clamped", "--set", "elements=1e308"], {},
+     "elements=1e308 is outside what this scene can size"),
+    ("wave-horizon-subnormal", ["run", "wave1d-surface-nodes", "--set", "horizon=5e-324"],
+     {}, "horizon='5e-324'"),
+    ("sheet-spacing-subnormal", ["run", "stiffness2d-sheet", "--set", "spacing=5e-324"], {},
+     "spacing='5e-324'"),
+]
+
+
+def test_robust_case_names_are_new():
+    names = [c[0] for c in CASES + ROBUST_CASES]
+    assert len(set(names)) == len(names)
+
+
+@pytest.mark.parametrize("name, argv, files, needle", ROBUST_CASES,
+                         ids=[c[0] for c in ROBUST_CASES])
+def test_bad_input_robust(name, argv, files, needle, tmp_path, monkeypatch, capsys):
+    test_bad_input(name, argv, files, needle, tmp_path, monkeypatch, capsys)
