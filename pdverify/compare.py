@@ -112,8 +112,8 @@ def compare_docs(base: dict, new: dict, *, rtol=None, atol=None, defaults=curren
             if ov == nv:
                 continue  # equal, the same infinity included (inf - inf would be NaN)
             r, a = thresholds(name, rtol, atol)
-            if abs(nv - ov) <= a + r * abs(ov):
-                continue
+            if math.isfinite(ov) and math.isfinite(nv) and abs(nv - ov) <= a + r * abs(ov):
+                continue  # (an infinite baseline would make every threshold infinite)
             if is_error_metric(name) and nv < ov:
                 verdict = "improved"
             else:

@@ -165,13 +165,17 @@ def _locked(cases, out, parent, name, jobs, progress, client, quick=False) -> in
     _clean_stale(parent, name)
     try:
         staging = tempfile.mkdtemp(prefix=f".{name}.staging-", dir=parent)
-        os.chmod(staging, umask_mode(0o777))  # mkdtemp gives 0700
-        outputs.write_marker(staging, complete=False)
     except OSError as exc:
         raise OutputError(f"report: cannot create its staging folder in {parent!r} "
                           f"({exc.strerror or exc}); nothing was run") from None
     keep = False
     try:
+        try:
+            os.chmod(staging, umask_mode(0o777))  # mkdtemp gives 0700
+            outputs.write_marker(staging, complete=False)
+        except OSError as exc:
+            raise OutputError(f"report: cannot write into its staging folder {staging!r} "
+                              f"({exc.strerror or exc}); nothing was run") from None
         try:
             code = _build(cases, staging, out, jobs, progress, client, quick)
             _write_marker(staging)
