@@ -37,12 +37,16 @@ def output_lock(out: str):
     """Hold ``<parent>/.<name>.lock`` for the whole report: a second report into the same
     folder exits 2 naming the holder instead of interleaving with this one."""
     parent, name = os.path.split(os.path.abspath(out))
-    os.makedirs(parent, exist_ok=True)
     path = os.path.join(parent, f".{name}.lock")
     if os.path.lexists(path) and not _own_lock(path):
         raise InputError(f"--out {out!r}: {path!r} exists and is not pdverify's lock file; "
                          "move it away or choose another folder")
-    fh = open(path, "a+")
+    try:
+        os.makedirs(parent, exist_ok=True)
+        fh = open(path, "a+")
+    except OSError as exc:
+        raise InputError(f"--out {out!r}: cannot create its lock file {path!r} "
+                         f"({exc.strerror or exc})") from None
     try:
         fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except BlockingIOError:
@@ -116,7 +120,10 @@ def build_report(*, out=None, quick=False, only=None, jobs=1, progress=None,
     Figures, results.json and index.html are written into a staging folder next to
     ``out`` and swapped in as a whole at the end, under a lock on ``out``: a report that
     is killed or fails leaves the previous one intact (its staging folder is removed now,
-    or by the next report into the same folder if the process was killed outright).
+    or by the next report into the same folder if the process was killed outright). One
+    that cannot be written whole (disk full, ...) raises :class:`OutputError` and keeps
+    its staging folder. ``out`` must be new, empty or a previous report, and its disk and
+    the cache must take the output (:mod:`pdverify.outputs`; InputError before work).
     ``scheduler``: a Dask scheduler address; the runs then go to that cluster
     (:mod:`pdverify.cluster`), which is reached before any work starts.
     """

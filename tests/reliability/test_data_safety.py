@@ -169,6 +169,9 @@ def test_a_previous_report_is_replaced_but_not_with_a_file_the_user_added(tmp_pa
     rep = tmp_path / "rep"
     assert _report(rep) == 0
     capsys.readouterr()
+    from pdverify.report import estimate_bytes
+    size = sum(os.path.getsize(os.path.join(d, f)) for d, _, fs in os.walk(rep) for f in fs)
+    assert size < estimate_bytes(range(4))       # the free-space estimate covers it
     marker = json.loads((rep / outputs.MARKER).read_text())
     assert marker["schema"] == outputs.MARKER_SCHEMA and marker["complete"] is True
     assert {"results.json", "index.html", "figures/", outputs.MARKER} <= set(marker["entries"])
