@@ -216,17 +216,24 @@ def folder_state(folder: str) -> tuple[str, str]:
 
 
 def is_own_leftover(path: str) -> bool:
-    """A staging or set-aside folder of an earlier, killed report: pdverify's to remove
-    (marked, empty, or holding only what a report writes)."""
+    """A staging or set-aside folder of an earlier, killed report: pdverify's to remove.
+
+    That is a complete report (its marker lists everything in it), an empty folder, or a
+    folder whose top level holds only what a report writes while it runs (results.json,
+    index.html, figures/, fields/, atomic writes' .tmp-* files and the marker, which a
+    staging folder gets first and which lists its files only at the end)."""
     if os.path.islink(path) or not os.path.isdir(path):
         return False
     state, _ = folder_state(path)
     if state in ("report", "empty"):
         return True
-    try:   # a staging folder from before the marker existed
-        return all(e in _LEGACY_TOP or e.startswith(".tmp-") for e in os.listdir(path))
+    try:
+        entries = os.listdir(path)
     except OSError:
         return False
+    if MARKER in entries and read_marker(path) is None:
+        return False
+    return all(e in _LEGACY_TOP or e == MARKER or e.startswith(".tmp-") for e in entries)
 
 
 def check_out_dir(path, flag: str = "--out", inputs=()) -> str:

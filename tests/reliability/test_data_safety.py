@@ -6,6 +6,7 @@ import errno
 import hashlib
 import json
 import os
+import shutil
 import stat
 import subprocess
 import sys
@@ -65,6 +66,22 @@ def _one_error_line(err):
 
 def _report(out, *extra):
     return main(["report", "--quick", "--only", SCENE, "--out", str(out), *extra])
+
+
+@pytest.fixture(scope="module")
+def made_report(tmp_path_factory):
+    """One real report, made once; tests copy it as their previous report."""
+    root = tmp_path_factory.mktemp("made")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("PDVERIFY_CACHE_DIR", str(root / "cache"))
+        mp.chdir(root)
+        assert _report(root / "rep") == 0
+    return root / "rep"
+
+
+def _previous(made_report, rep):
+    shutil.copytree(made_report, rep, symlinks=True)
+    assert outputs.folder_state(str(rep)) == ("report", "")
 
 
 # ------------------------------------------------------------------------------ --out
@@ -142,7 +159,8 @@ def test_the_default_cache_folder_is_protected_too(tmp_path, monkeypatch, capsys
     assert outputs.cache_root() == str(fem_cache()) == str(manufactured_cache())
 
 
-def test_a_link_as_out_is_resolved_and_leaves_nothing_behind(tmp_path, env, capsys):
+def test_a_link_as_out_is_resolved_and_leaves_nothing_behind(made_report, tmp_path, env,
+                                                             capsys):
     proj = tmp_path / "proj"
     _foreign_project(proj)
     os.symlink(proj, tmp_path / "to-proj")
@@ -154,7 +172,7 @@ def test_a_link_as_out_is_resolved_and_leaves_nothing_behind(tmp_path, env, caps
     # a link to a previous report: the report is written at the link's target, the link
     # stays a link, and no '.link.old-*' or staging folder is left
     rep = tmp_path / "rep"
-    assert _report(rep) == 0
+    _previous(made_report, rep)
     os.symlink(rep, tmp_path / "link")
     (rep / "results.json").write_text('{\n "schema": "pdverify.results/1", "runs": []}')
     assert _report(tmp_path / "link") == 0
@@ -164,10 +182,10 @@ def test_a_link_as_out_is_resolved_and_leaves_nothing_behind(tmp_path, env, caps
     assert [e for e in os.listdir(tmp_path) if ".old-" in e or ".staging-" in e] == []
 
 
-def test_a_previous_report_is_replaced_but_not_with_a_file_the_user_added(tmp_path, env,
-                                                                         capsys):
+def test_a_previous_report_is_replaced_but_not_with_a_file_the_user_added(
+        made_report, tmp_path, env, capsys):
     rep = tmp_path / "rep"
-    assert _report(rep) == 0
+    _previous(made_report, rep)
     capsys.readouterr()
     from pdverify.report import estimate_bytes
     size = sum(os.path.getsize(os.path.join(d, f)) for d, _, fs in os.walk(rep) for f in fs)
@@ -226,11 +244,18 @@ def test_leftovers_that_are_not_pdverify_s_are_kept(tmp_path, env):
     mine = tmp_path / ".rep.staging-mine"
     mine.mkdir()
     (mine / "thesis.tex").write_text("mine")
-    stale = tmp_path / ".rep.staging-abc123"
+    stale = tmp_path / ".rep.staging-abc123"     # what a SIGKILL during the figures leaves
     stale.mkdir()
     outputs.write_marker(str(stale), complete=False)
+    (stale / "figures").mkdir()
+    (stale / "figures" / "half.png").write_bytes(b"\x89PNG")
+    (stale / ".tmp-abc").write_text("{")
+    fake = tmp_path / ".rep.old-fake"              # someone else's marker: not ours
+    fake.mkdir()
+    (fake / outputs.MARKER).write_text("not json")
     assert _report(rep) == 0
     assert (mine / "thesis.tex").read_text() == "mine"
+    assert (fake / outputs.MARKER).read_text() == "not json"
     assert not stale.exists()
 
 
@@ -241,12 +266,13 @@ def test_a_foreign_lock_file_is_not_overwritten(tmp_path, env, capsys):
     assert (tmp_path / ".rep.lock").read_text() == "my file that happens to have this name"
 
 
-def test_files_added_while_the_report_runs_are_kept(tmp_path, env, monkeypatch, capsys):
+def test_files_added_while_the_report_runs_are_kept(made_report, tmp_path, env, monkeypatch,
+                                                    capsys):
     """A file put into the previous report while the new one runs makes it the user's: the
     new report stays in its staging folder (exit 1)."""
     from pdverify.report import figures
     rep = tmp_path / "rep"
-    assert _report(rep) == 0
+    _previous(made_report, rep)
     real = figures.draw
 
     def draw_and_meddle(*args):
@@ -383,9 +409,9 @@ def _fill(disk, leave: int) -> None:
     assert outputs.free_bytes(str(disk)) <= leave
 
 
-def test_a_full_disk_is_refused_before_work(small_disk, tmp_path, env, capsys):
+def test_a_full_disk_is_refused_before_work(made_report, small_disk, tmp_path, env, capsys):
     rep = small_disk / "rep"
-    assert _report(rep) == 0
+    _previous(made_report, rep)
     capsys.readouterr()
     before = _tree_hash(rep)
     _fill(small_disk, 100_000)
@@ -409,16 +435,15 @@ def test_a_full_disk_is_refused_before_work(small_disk, tmp_path, env, capsys):
     assert _tree_hash(rep) == before and sorted(os.listdir(small_disk)) == listing
 
 
-def test_a_disk_that_fills_during_the_figures_keeps_the_previous_report(small_disk, tmp_path,
-                                                                       env, monkeypatch,
-                                                                       capsys):
+def test_a_disk_that_fills_during_the_figures_keeps_the_previous_report(
+        made_report, small_disk, tmp_path, env, monkeypatch, capsys):
     """The disk has room at the check before work, then fills up (another process) while
     the figures are drawn: matplotlib's write fails with ENOSPC, the report is incomplete,
     the previous report stays byte-identical, the partial one stays in its staging folder,
     exit 1 with one line naming both."""
     from pdverify.report import figures
     rep = small_disk / "rep"
-    assert _report(rep) == 0
+    _previous(made_report, rep)
     before = _tree_hash(rep)
     real = figures.draw
 
