@@ -3,14 +3,17 @@
 usage:
   python -m pdverify list                                   scenes and their methods
   python -m pdverify run SCENE [--method M] [--set KEY=VALUE ...] [--json FILE]
-                          [--vtu FILE] [--max-memory SIZE]
+                          [--vtu FILE] [--force] [--max-memory SIZE]
   python -m pdverify report [--out DIR] [--quick] [--only SCENE ...] [--jobs N]
                           [--scheduler ADDRESS] [--max-memory SIZE]
   python -m pdverify compare BASELINE.json NEW.json [--rtol R] [--atol A] [--summary FILE]
+                          [--force]
 
-Exit codes: 0 success; 1 a run failed numerically or a regression was found;
-2 bad input (one line naming the input and what is allowed), a run above the memory
-budget (its estimate and the limit) included; 130 interrupted.
+Exit codes: 0 success; 1 a run failed numerically, a regression was found, or an output
+could not be written after the work (one line naming it; a report stays in its staging
+folder); 2 bad input (one line naming the input and what is allowed), a run above the
+memory budget (its estimate and the limit), an output pdverify may not replace and a
+cache or disk that cannot take the output included, all before any work; 130 interrupted.
 """
 from __future__ import annotations
 
@@ -19,12 +22,16 @@ import signal
 import sys
 
 from . import __version__, budget
-from .errors import STOP_REQUESTED, InputError
+from .errors import STOP_REQUESTED, InputError, OutputError
 
 
 MAX_MEMORY_HELP = ("refuse (exit 2) any run whose memory estimate exceeds SIZE, e.g. 4G, "
                    "512M (default: $PDVERIFY_MAX_MEMORY, else half of the smallest of total "
                    "memory, the cgroup limit and RLIMIT_AS)")
+
+
+FORCE_HELP = ("replace an existing output file that pdverify did not write (never an input "
+              "of the command)")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -50,10 +57,12 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--vtu", default=None, metavar="FILE",
                      help="also write the run's fields as VTU for ParaView (FILE.vtu; a run "
                           "with several node sets or a FEM grid adds a suffix per file)")
+    run.add_argument("--force", action="store_true", help=FORCE_HELP)
     run.add_argument("--max-memory", default=None, metavar="SIZE", help=MAX_MEMORY_HELP)
     rep = sub.add_parser("report", help="run every scene and method, write the HTML report")
     rep.add_argument("--out", default=None, metavar="DIR",
-                     help="output folder, replaced as a whole (default: reports/latest; "
+                     help="output folder, replaced as a whole; it must be new, empty or a "
+                          "previous pdverify report (default: reports/latest; "
                           "reports/quick with --quick; reports/[quick-]only-SCENE with "
                           "--only, so that neither replaces the full report)")
     rep.add_argument("--quick", action="store_true",
@@ -76,6 +85,7 @@ def build_parser() -> argparse.ArgumentParser:
                       help="absolute threshold (default 1e-9; 1e-6 points for *_pct metrics)")
     cmp_.add_argument("--summary", default=None, metavar="FILE",
                       help="also write the changes as JSON (FILE.json) or Markdown (else)")
+    cmp_.add_argument("--force", action="store_true", help=FORCE_HELP)
     return parser
 
 
@@ -133,6 +143,9 @@ def main(argv=None) -> int:
     except InputError as exc:
         print(f"pdverify: error: {exc}", file=sys.stderr)
         return 2
+    except OutputError as exc:
+        print(f"pdverify: error: {exc}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print("pdverify: interrupted", file=sys.stderr)
         return 130
@@ -158,8 +171,12 @@ def _dispatch(args) -> int:
     if args.command == "run":
         from .params import parse_assignments
         from .runner import run_one
-        json_path = validate.output_file(args.json) if args.json is not None else None
-        vtu_path = validate.vtu_file(args.vtu) if args.vtu is not None else None
+        json_path = (validate.output_file(args.json, force=args.force)
+                     if args.json is not None else None)
+        vtu_path = (validate.vtu_file(args.vtu, force=args.force, json_path=json_path)
+                    if args.vtu is not None else None)
+        from .outputs import check_cache
+        check_cache()
         return run_one(args.scene, method=args.method, overrides=parse_assignments(args.set),
                        json_path=json_path, vtu_path=vtu_path)
     if args.command == "report":
@@ -175,8 +192,10 @@ def _dispatch(args) -> int:
         from .compare import compare_files
         for path, what in ((args.baseline, "baseline"), (args.new, "new results")):
             validate.input_file(path, what)
-        summary = (validate.output_file(args.summary, "--summary") if args.summary is not None
-                   else None)
+        summary = (validate.output_file(args.summary, "--summary", force=args.force,
+                                        inputs=((args.baseline, "baseline"),
+                                                (args.new, "new results file")))
+                   if args.summary is not None else None)
         return compare_files(args.baseline, args.new, rtol=args.rtol, atol=args.atol,
                              summary=summary)
     raise InputError(f"unknown command {args.command!r}")

@@ -14,6 +14,9 @@ from .results import load_results, run_key
 #: between machines (BLAS, LU pivoting) out while catching any change of substance;
 #: atol absorbs metrics that sit at round-off level (e.g. 1e-12 % for an exact method),
 #: whose relative change is meaningless. Per-metric overrides below.
+#: The schema of ``--summary FILE.json``; it marks the file as pdverify's, so that the next
+#: compare may replace it.
+SUMMARY_SCHEMA = "pdverify.compare/1"
 DEFAULT_RTOL = 1e-3
 DEFAULT_ATOL = 1e-9
 METRIC_ATOL = {
@@ -96,6 +99,7 @@ def compare_docs(base: dict, new: dict, *, rtol=None, atol=None, defaults=curren
             out.append(Change(scene, method, params, "(status)", "failed", "ok", "improved"))
         for name, ov in old.get("metrics", {}).items():
             nv = cur.get("metrics", {}).get(name)
+            ov, nv = _number(ov), _number(nv)
             if nv is None:
                 out.append(Change(scene, method, params, name, ov, "missing", "regression"))
                 continue
@@ -105,9 +109,11 @@ def compare_docs(base: dict, new: dict, *, rtol=None, atol=None, defaults=curren
                 if ov != nv:
                     out.append(Change(scene, method, params, name, ov, nv, "regression"))
                 continue
+            if ov == nv:
+                continue  # equal, the same infinity included (inf - inf would be NaN)
             r, a = thresholds(name, rtol, atol)
-            if abs(nv - ov) <= a + r * abs(ov):
-                continue
+            if math.isfinite(ov) and math.isfinite(nv) and abs(nv - ov) <= a + r * abs(ov):
+                continue  # (an infinite baseline would make every threshold infinite)
             if is_error_metric(name) and nv < ov:
                 verdict = "improved"
             else:
@@ -117,6 +123,18 @@ def compare_docs(base: dict, new: dict, *, rtol=None, atol=None, defaults=curren
         scene, method, params = key
         out.append(Change(scene, method, params, "(run)", "absent", "new", "new"))
     return out
+
+
+_NON_FINITE = {"inf": math.inf, "+inf": math.inf, "infinity": math.inf, "+infinity": math.inf,
+               "-inf": -math.inf, "-infinity": -math.inf}
+
+
+def _number(v):
+    """pdverify writes a non-finite metric as the string 'inf' or '-inf' (JSON has no
+    infinity); such a string compares as the float, so 'inf' against Infinity is equal."""
+    if isinstance(v, str):
+        return _NON_FINITE.get(v.strip().lower(), v)
+    return v
 
 
 def _is_nan(v) -> bool:
@@ -146,7 +164,8 @@ def summary_text(changes: list[Change], path: str, baseline: str, new: str) -> s
     """The changes as JSON (``path`` ending in .json) or a Markdown table (else), for CI."""
     n_reg = sum(c.is_regression for c in changes)
     if path.endswith(".json"):
-        return json.dumps({"baseline": baseline, "new": new, "regressions": n_reg,
+        return json.dumps({"schema": SUMMARY_SCHEMA, "baseline": baseline, "new": new,
+                           "regressions": n_reg,
                            "changes": [{"verdict": c.verdict, "scene": c.scene,
                                         "method": c.method, "params": json.loads(c.params),
                                         "metric": c.metric, "baseline": c.old, "new": c.new}
@@ -175,7 +194,7 @@ def compare_files(baseline: str, new: str, *, rtol=None, atol=None, stream=None,
         if value is not None and not (value >= 0 and math.isfinite(value)):
             raise InputError(f"{flag}={value} must be a finite number >= 0")
     docs = []
-    for path in (baseline, new):
+    for path, what in ((baseline, "baseline"), (new, "new results")):
         try:
             docs.append(load_results(path))
         except FileNotFoundError:
@@ -186,6 +205,7 @@ def compare_files(baseline: str, new: str, *, rtol=None, atol=None, stream=None,
             raise InputError(f"results file {path!r} cannot be read (permission denied)") from None
         except ValueError as exc:
             raise InputError(str(exc)) from None
+        check_unique(docs[-1], path, what)
     matched: list = []
     changes = compare_docs(docs[0], docs[1], rtol=rtol, atol=atol, matched=matched)
     print(format_changes(changes), file=stream)
@@ -196,6 +216,24 @@ def compare_files(baseline: str, new: str, *, rtol=None, atol=None, stream=None,
     n_reg = sum(c.is_regression for c in changes)
     print(f"compare: {n_reg} regression(s), {len(changes) - n_reg} other change(s)", file=stream)
     if summary is not None:
+        from .errors import OutputError
         from .results import atomic_write_text
-        atomic_write_text(summary, summary_text(changes, summary, baseline, new))
+        try:
+            atomic_write_text(summary, summary_text(changes, summary, baseline, new))
+        except OSError as exc:
+            raise OutputError(f"--summary {summary!r}: cannot write it ({exc.strerror or exc})"
+                              "; the comparison above is complete") from None
     return 1 if n_reg else 0
+
+
+def check_unique(doc: dict, path: str, what: str) -> None:
+    """InputError naming the first (scene, method, params) that ``doc`` holds twice: two
+    copies would collapse into one and the comparison would silently use the last."""
+    first = {}
+    for k, r in enumerate(doc["runs"]):
+        key = run_key(r["scene"], r["method"], r["params"])
+        if key in first:
+            raise InputError(f"{what} {path!r}: runs[{k}] repeats runs[{first[key]}] (scene "
+                             f"{r['scene']!r}, method {r['method']!r}, params {key[2]}); a "
+                             "results file holds each run once")
+        first[key] = k

@@ -28,3 +28,12 @@ class NumericalError(RuntimeError):
 #: Set when the process was asked to stop (SIGTERM, Ctrl-C): a step that finishes after a
 #: library swallowed the interrupt checks it before publishing anything.
 STOP_REQUESTED = {"flag": False}
+
+
+class OutputError(RuntimeError):
+    """An output could not be written after the work started (disk full, read-only, ...).
+
+    The message is one line naming the file or folder and the cause; the CLI prints it and
+    exits with code 1. Nothing is published half-written: a report stays in its staging
+    folder, a results file keeps its previous content.
+    """

@@ -128,24 +128,33 @@ def _grid_mesh(grid: dict, field_data: dict):
 
 
 def write_run_fields(result, stem: str) -> list[str]:
-    """Write ``stem<suffix>.vtu`` for each mesh of the run; returns the paths written."""
+    """Write ``stem<suffix>.vtu`` for each mesh of the run; returns the paths written.
+
+    A file that cannot be written (disk full, read-only) raises
+    :class:`~pdverify.errors.OutputError` naming it."""
     import meshio
     paths = []
-    os.makedirs(os.path.dirname(os.path.abspath(stem)), exist_ok=True)
-    for suffix, mesh in meshes(result):
-        path = f"{stem}{suffix}.vtu"
-        meshio.write(path, mesh, file_format="vtu")
-        _add_field_data(path, mesh.field_data)
-        os.chmod(path, umask_mode(0o666))
-        paths.append(path)
+    path = stem
+    try:
+        os.makedirs(os.path.dirname(os.path.abspath(stem)), exist_ok=True)
+        for suffix, mesh in meshes(result):
+            path = f"{stem}{suffix}.vtu"
+            meshio.write(path, mesh, file_format="vtu")
+            _add_field_data(path, mesh.field_data)
+            os.chmod(path, umask_mode(0o666))
+            paths.append(path)
+    except OSError as exc:
+        from .errors import OutputError
+        raise OutputError(f"cannot write {path!r} ({exc.strerror or exc})") from exc
     return paths
 
 
 def _add_field_data(path: str, field_data: dict) -> None:
     """meshio 5 reads a VTU's ``<FieldData>`` but does not write it: add the block after
-    ``<UnstructuredGrid>``, as ASCII Float64 with 17 significant digits (exact)."""
-    if not field_data:
-        return
+    ``<UnstructuredGrid>``, as ASCII Float64 with 17 significant digits (exact). The
+    comment :data:`pdverify.outputs.VTU_MARK` goes first, so that a later ``--vtu`` may
+    replace the file as pdverify's own."""
+    from .outputs import VTU_MARK
     arrays = "".join(
         f'<DataArray type="Float64" Name="{escape(name, {chr(34): "&quot;"})}" '
         f'NumberOfTuples="{len(v)}" format="ascii">'
@@ -156,5 +165,10 @@ def _add_field_data(path: str, field_data: dict) -> None:
     tag = "<UnstructuredGrid>"
     if text.count(tag) != 1:
         raise ValueError(f"{path}: unexpected VTU layout from meshio (no single {tag})")
+    if arrays:
+        text = text.replace(tag, f"{tag}\n<FieldData>\n{arrays}</FieldData>", 1)
+    decl, sep, rest = text.partition("\n")
+    if not decl.startswith("<?xml"):
+        raise ValueError(f"{path}: unexpected VTU layout from meshio (no XML declaration)")
     with open(path, "w", encoding="utf-8") as fh:
-        fh.write(text.replace(tag, f"{tag}\n<FieldData>\n{arrays}</FieldData>", 1))
+        fh.write(f"{decl}\n{VTU_MARK} -->\n{rest}")

@@ -152,8 +152,15 @@ def atomic_write_text(path: str | os.PathLike, text: str) -> None:
 
 
 def write_results(path, runs: list[RunResult], extra: dict | None = None) -> dict:
+    """Write the results document atomically; a file that cannot be written (disk full,
+    read-only) raises :class:`~pdverify.errors.OutputError` naming it, the old file kept."""
     doc = document(runs, extra)
-    atomic_write_text(path, json.dumps(doc, indent=1, allow_nan=False) + "\n")
+    text = json.dumps(doc, indent=1, allow_nan=False) + "\n"
+    try:
+        atomic_write_text(path, text)
+    except OSError as exc:
+        from .errors import OutputError
+        raise OutputError(f"cannot write {os.fspath(path)!r} ({exc.strerror or exc})") from exc
     return doc
 
 
@@ -186,10 +193,48 @@ def check_schema(doc, path) -> None:
         if run["status"] not in ("ok", "failed"):
             raise ValueError(f"{path}: runs[{k}].status must be 'ok' or 'failed', "
                              f"got {run['status']!r}")
+        _check_values(run, f"{path}: runs[{k}]")
         for name, v in run["metrics"].items():
             if isinstance(v, bool) or not isinstance(v, (int, float, str)):
                 raise ValueError(f"{path}: runs[{k}].metrics.{name} must be a number or a "
                                  f"string, got {type(v).__name__}")
+            if isinstance(v, int) and abs(v) > _FLOAT_MAX:
+                raise ValueError(f"{path}: runs[{k}].metrics.{name} is an integer of "
+                                 f"{len(str(abs(v)))} digits, beyond the range of a float")
+
+
+_FLOAT_MAX = 1.7976931348623157e308
+#: How deep a run's values may nest (pdverify writes at most a few levels).
+MAX_DEPTH = 32
+
+
+def _check_values(run: dict, where: str) -> None:
+    """Every string of ``run`` (keys included) is valid Unicode (no lone surrogate, which
+    no file can be printed or written with) and nothing nests deeper than MAX_DEPTH."""
+    stack = [(run, 0, "")]
+    while stack:
+        value, depth, at = stack.pop()
+        if depth > MAX_DEPTH:
+            raise ValueError(f"{where}{at} nests deeper than {MAX_DEPTH} levels")
+        items = (value.items() if isinstance(value, dict)
+                 else enumerate(value) if isinstance(value, list) else None)
+        if items is None:
+            if isinstance(value, str):
+                _check_text(value, f"{where}{at}")
+            continue
+        for key, v in items:
+            if isinstance(key, str):
+                _check_text(key, f"{where}{at}: a key")
+            stack.append((v, depth + 1, f"{at}.{key}" if isinstance(key, str)
+                          else f"{at}[{key}]"))
+
+
+def _check_text(text: str, where: str) -> None:
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError as exc:
+        raise ValueError(f"{where.encode('utf-8', 'backslashreplace').decode()} holds a lone "
+                         f"surrogate {text[exc.start]!r} (not valid Unicode)") from None
 
 
 def load_results(path) -> dict:
@@ -201,5 +246,10 @@ def load_results(path) -> dict:
         raise ValueError(f"{path}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
     except UnicodeDecodeError:
         raise ValueError(f"{path}: not a text (UTF-8) file") from None
+    except RecursionError:
+        raise ValueError(f"{path}: JSON nested too deeply to read (a results file nests "
+                         f"at most a few levels)") from None
+    except ValueError as exc:  # e.g. an integer of more than 4300 digits
+        raise ValueError(f"{path}: not a results file ({str(exc).splitlines()[0]})") from None
     check_schema(doc, path)
     return doc

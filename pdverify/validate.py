@@ -8,6 +8,7 @@ from __future__ import annotations
 import os
 import tempfile
 
+from . import outputs
 from .errors import InputError
 
 
@@ -31,15 +32,16 @@ def _probe_folder(folder: str, flag: str, shown: str) -> None:
         raise InputError(f"{flag} {shown!r}: cannot write there ({reason})") from None
 
 
-def output_dir(path, flag: str = "--out") -> str:
+def output_dir(path, flag: str = "--out", inputs=()) -> str:
     """A report folder: a non-empty path that is not a file, whose ``results.json`` and
     ``index.html`` are not folders and whose ``figures`` is not a file, in a writable
-    parent. Returns the absolute path."""
+    parent, and that pdverify may replace (:func:`pdverify.outputs.check_out_dir`: new,
+    empty or a previous report). Returns the path with links resolved."""
     if path is None:
         raise InputError(f"{flag}: a folder is required")
     if not str(path).strip():
         raise InputError(f"{flag} {path!r}: empty path; give a folder")
-    full = os.path.abspath(os.path.expanduser(str(path)))
+    full = os.path.realpath(os.path.abspath(os.path.expanduser(str(path))))
     if os.path.exists(full) and not os.path.isdir(full):
         raise InputError(f"{flag} {path!r} is a file; give a folder")
     for name, want_dir in (("results.json", False), ("index.html", False), ("figures", True)):
@@ -48,35 +50,53 @@ def output_dir(path, flag: str = "--out") -> str:
             kind = "a folder" if not want_dir else "a file"
             raise InputError(f"{flag} {path!r}: {name} there is {kind}; remove it or choose "
                              "another folder")
+    full = outputs.check_out_dir(path, flag, inputs)
     _probe_folder(os.path.dirname(full), flag, str(path))
     return full
 
 
-def output_file(path, flag: str = "--json") -> str:
-    """A file to write: non-empty, not a folder, in a writable folder. Returns it absolute."""
+def output_file(path, flag: str = "--json", *, force: bool = False, inputs=()) -> str:
+    """A file to write: non-empty, not a folder, in a writable folder with room, never an
+    input (``inputs``: (path, what) pairs) and, if it exists, a file pdverify wrote unless
+    ``force`` (:func:`pdverify.outputs.check_out_file`). Returns it with links resolved."""
     if not str(path).strip():
         raise InputError(f"{flag} {path!r}: empty path; give a file name")
     full = os.path.abspath(os.path.expanduser(str(path)))
     if os.path.isdir(full) or str(path).endswith(os.sep):
         raise InputError(f"{flag} {path!r} is a folder; give a file name")
     _probe_folder(os.path.dirname(full), flag, str(path))
+    full = outputs.check_out_file(path, flag, force=force, inputs=inputs)
+    outputs.check_free(os.path.dirname(full), outputs.MIN_FREE_FILE, f"{flag} {str(path)!r}")
     return full
 
 
-def vtu_file(path) -> str:
-    """``run --vtu``: a writable file name ending in ``.vtu``."""
+def vtu_file(path, *, force: bool = False, json_path=None) -> str:
+    """``run --vtu``: a writable file name ending in ``.vtu``; none of the files it may
+    write (:func:`pdverify.outputs.vtu_files`) is the ``--json`` file or, unless
+    ``force``, an existing file pdverify did not write."""
     if not str(path).endswith(".vtu"):
         raise InputError(f"--vtu {path!r}: the file name must end in .vtu")
-    return output_file(path, "--vtu")
+    full = output_file(path, "--vtu", force=force)
+    for target in outputs.vtu_files(full):
+        if json_path is not None and os.path.realpath(target) == json_path:
+            raise InputError(f"--vtu {path!r} would write {target!r}, the --json file; give "
+                             "them different names")
+        outputs.check_out_file(target, "--vtu", force=force)
+    if json_path is not None and full == json_path:
+        raise InputError(f"--vtu {path!r} is also the --json file; give them different names")
+    return full
 
 
 def input_file(path, what: str) -> str:
-    """A file to read: exists and is a regular file."""
+    """A file to read: exists and is a regular file (not a folder, FIFO or device)."""
     if not str(path).strip():
         raise InputError(f"{what} {path!r}: empty path")
     if os.path.isdir(path):
         raise InputError(f"{what} {path!r} is a folder, not a results file")
     if not os.path.isfile(path):
+        if os.path.exists(path):
+            kind = outputs.file_kind(os.stat(path).st_mode)
+            raise InputError(f"{what} {path!r} is {kind}, not a file; give a results file")
         raise InputError(f"{what} {path!r} does not exist")
     return path
 

@@ -1,6 +1,7 @@
 """The main job: run every scene and method, write results.json, figures and index.html."""
 from __future__ import annotations
 
+import errno
 import fcntl
 import hashlib
 import os
@@ -10,7 +11,8 @@ import tempfile
 import time
 from contextlib import contextmanager
 
-from ..errors import STOP_REQUESTED, InputError
+from .. import outputs
+from ..errors import STOP_REQUESTED, InputError, OutputError
 from ..results import atomic_write_text, run_key, umask_mode, write_results
 from ..runner import plan, run_cases
 from ..scenes import get_scene
@@ -35,9 +37,16 @@ def output_lock(out: str):
     """Hold ``<parent>/.<name>.lock`` for the whole report: a second report into the same
     folder exits 2 naming the holder instead of interleaving with this one."""
     parent, name = os.path.split(os.path.abspath(out))
-    os.makedirs(parent, exist_ok=True)
     path = os.path.join(parent, f".{name}.lock")
-    fh = open(path, "a+")
+    if os.path.lexists(path) and not _own_lock(path):
+        raise InputError(f"--out {out!r}: {path!r} exists and is not pdverify's lock file; "
+                         "move it away or choose another folder")
+    try:
+        os.makedirs(parent, exist_ok=True)
+        fh = open(path, "a+")
+    except OSError as exc:
+        raise InputError(f"--out {out!r}: cannot create its lock file {path!r} "
+                         f"({exc.strerror or exc})") from None
     try:
         fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except BlockingIOError:
@@ -46,22 +55,43 @@ def output_lock(out: str):
         fh.close()
         raise InputError(f"--out {out!r} is being written by {holder}; wait for it or "
                          "choose another folder") from None
-    fh.seek(0)
-    fh.truncate()
-    fh.write(f"pdverify report (pid {os.getpid()})")
-    fh.flush()
+    try:  # who holds it, for the message of a second report; a full disk costs only that
+        fh.seek(0)
+        fh.truncate()
+        fh.write(f"{_LOCK_TEXT} (pid {os.getpid()})")
+        fh.flush()
+    except OSError:
+        pass
     try:
         yield
     finally:
         fh.close()  # releases the lock; the empty lock file may stay
 
 
+_LOCK_TEXT = "pdverify report"
+
+
+def _own_lock(path: str) -> bool:
+    """The lock file is pdverify's: a regular file, empty or holding our holder text."""
+    try:
+        if os.path.islink(path) or not os.path.isfile(path) or os.path.getsize(path) > 200:
+            return False
+        with open(path, "rb") as fh:
+            text = fh.read()
+    except OSError:
+        return False
+    return text == b"" or text.startswith(_LOCK_TEXT.encode())
+
+
 def _clean_stale(parent: str, name: str) -> None:
     """Remove staging folders that earlier, killed reports into ``name`` left behind (only
-    while holding the lock, so none of them belongs to a live report)."""
+    while holding the lock, so none of them belongs to a live report), and only those
+    that are pdverify's (:func:`pdverify.outputs.is_own_leftover`)."""
     for entry in os.listdir(parent):
         if entry.startswith(f".{name}.staging-") or entry.startswith(f".{name}.old-"):
-            shutil.rmtree(os.path.join(parent, entry), ignore_errors=True)
+            path = os.path.join(parent, entry)
+            if outputs.is_own_leftover(path):
+                shutil.rmtree(path, ignore_errors=True)
 
 
 def _swap_in(staging: str, out: str) -> None:
@@ -90,13 +120,17 @@ def build_report(*, out=None, quick=False, only=None, jobs=1, progress=None,
     Figures, results.json and index.html are written into a staging folder next to
     ``out`` and swapped in as a whole at the end, under a lock on ``out``: a report that
     is killed or fails leaves the previous one intact (its staging folder is removed now,
-    or by the next report into the same folder if the process was killed outright).
+    or by the next report into the same folder if the process was killed outright). One
+    that cannot be written whole (disk full, ...) raises :class:`OutputError` and keeps
+    its staging folder. ``out`` must be new, empty or a previous report, and its disk and
+    the cache must take the output (:mod:`pdverify.outputs`; InputError before work).
     ``scheduler``: a Dask scheduler address; the runs then go to that cluster
     (:mod:`pdverify.cluster`), which is reached before any work starts.
     """
     progress = progress or sys.stderr
-    out = os.path.abspath(out or default_out(only, quick))
+    out = outputs.check_out_dir(out or default_out(only, quick))  # links resolved
     cases = plan(only=only, quick=quick)  # raises InputError on unknown scenes
+    check_storage(cases, out)
     parent, name = os.path.split(out)
     client = None
     if scheduler is not None:
@@ -110,20 +144,74 @@ def build_report(*, out=None, quick=False, only=None, jobs=1, progress=None,
             client.close()
 
 
+#: Bytes a report needs on disk, per run and once (figures of the overview, pages), from
+#: the largest --quick --only SCENE report per run measured: see the README's "Storage".
+REPORT_BYTES_PER_RUN = 256_000
+REPORT_BYTES_FIXED = 2_000_000
+
+
+def estimate_bytes(cases) -> int:
+    """A generous estimate of a report's size on disk (see :data:`REPORT_BYTES_PER_RUN`)."""
+    return REPORT_BYTES_FIXED + REPORT_BYTES_PER_RUN * len(cases)
+
+
+def check_storage(cases, out: str) -> None:
+    """Before any work: the cache takes files, and ``out``'s disk has room for the new
+    report next to the previous one (which stays until the new one is complete)."""
+    outputs.check_cache()
+    outputs.check_free(os.path.dirname(out), estimate_bytes(cases),
+                       f"--out {out!r} (a report of {len(cases)} runs)")
+
+
 def _locked(cases, out, parent, name, jobs, progress, client, quick=False) -> int:
-    """The report's body, under the output lock: stage, build, swap in."""
+    """The report's body, under the output lock: stage, build, swap in.
+
+    A report that could not be written whole (:class:`OutputError`: a figure, a VTU file,
+    a page or results.json failed to write) is not swapped in: the previous report stays,
+    the partial one stays in its staging folder, and OutputError names both."""
     _clean_stale(parent, name)
-    staging = tempfile.mkdtemp(prefix=f".{name}.staging-", dir=parent)
-    os.chmod(staging, umask_mode(0o777))  # mkdtemp gives 0700
     try:
-        code = _build(cases, staging, out, jobs, progress, client, quick)
+        staging = tempfile.mkdtemp(prefix=f".{name}.staging-", dir=parent)
+    except OSError as exc:
+        raise OutputError(f"report: cannot create its staging folder in {parent!r} "
+                          f"({exc.strerror or exc}); nothing was run") from None
+    keep = False
+    try:
+        try:
+            os.chmod(staging, umask_mode(0o777))  # mkdtemp gives 0700
+            outputs.write_marker(staging, complete=False)
+        except OSError as exc:
+            raise OutputError(f"report: cannot write into its staging folder {staging!r} "
+                              f"({exc.strerror or exc}); nothing was run") from None
+        try:
+            code = _build(cases, staging, out, jobs, progress, client, quick)
+            _write_marker(staging)
+        except OutputError as exc:
+            keep = True
+            previous = ("the previous report in " + repr(out) + " is unchanged"
+                        if os.path.exists(out) else "nothing was published at " + repr(out))
+            raise OutputError(f"report incomplete: {exc}; {previous}; the partial report is "
+                              f"in {staging!r}") from None
         if STOP_REQUESTED["flag"]:  # an interrupt some library swallowed: publish nothing
             raise KeyboardInterrupt
+        state, why = outputs.folder_state(out)
+        if state == "foreign":  # someone put files there while the report ran
+            keep = True
+            raise OutputError(f"report: {out!r} changed while the report ran ({why}); it was "
+                              f"left as it is; the new report is in {staging!r}")
         _swap_in(staging, out)
     finally:
-        if os.path.exists(staging):
+        if not keep and os.path.exists(staging):
             shutil.rmtree(staging, ignore_errors=True)
     return code
+
+
+def _write_marker(folder: str) -> None:
+    try:
+        outputs.write_marker(folder, complete=True)
+    except OSError as exc:
+        raise OutputError(f"writing its marker {outputs.MARKER} failed "
+                          f"({exc.strerror or exc})") from None
 
 
 def export_fields(results, out) -> None:
@@ -138,23 +226,58 @@ def export_fields(results, out) -> None:
 
 
 class _Phases(dict):
-    """Wall time of each phase of the report, seconds by name (summed over re-entries)."""
+    """Wall time of each phase of the report, seconds by name (summed over re-entries).
+
+    A write that fails in a writing phase (an OSError: disk full, read-only, ...) becomes
+    an :class:`OutputError` naming the phase and the file."""
+
+    WRITES = {"figures_s": "figures", "fields_s": "the VTU fields",
+              "pages_s": "the pages (index.html, results.json)"}
 
     @contextmanager
     def __call__(self, name):
         t0 = time.perf_counter()
         try:
             yield
+        except OSError as exc:
+            if name not in self.WRITES:
+                raise
+            raise OutputError(f"writing {self.WRITES[name]} failed ({_describe(exc)})") from exc
         finally:
             self[name] = self.get(name, 0.0) + time.perf_counter() - t0
 
 
+#: errno values of a storage failure: the disk, not the plotting code, is at fault
+STORAGE_ERRNOS = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS, errno.EIO}
+
+
+def storage_failure(exc: BaseException) -> OSError | None:
+    """The OSError of a storage failure (:data:`STORAGE_ERRNOS`) in ``exc`` or the
+    exceptions it was raised from or during, if any."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        seen.add(id(exc))
+        if isinstance(exc, OSError) and exc.errno in STORAGE_ERRNOS:
+            return exc
+        exc = exc.__cause__ or exc.__context__
+    return None
+
+
+def _describe(exc: OSError) -> str:
+    text = exc.strerror or str(exc) or type(exc).__name__
+    return f"{text}: {exc.filename!r}" if exc.filename else text
+
+
 def _drawn(what, draw, args, empty, progress):
-    """``draw(*args)``, or ``empty`` and a note if it raises: a broken figure must not
-    lose the numbers."""
+    """``draw(*args)``, or ``empty`` and a note if the plotting code raises: a broken
+    figure must not lose the numbers. A storage failure (disk full, read-only, I/O error;
+    :func:`storage_failure`) is not a broken figure: it makes the report incomplete."""
     try:
         return draw(*args)
     except Exception as exc:
+        failure = storage_failure(exc)
+        if failure is not None:
+            raise OutputError(f"writing the {what} failed ({_describe(failure)})") from exc
         print(f"{what} failed: {type(exc).__name__}: {exc}", file=progress)
         return empty
 
@@ -165,7 +288,8 @@ def _build(cases, out, final, jobs, progress, client=None, quick=False) -> int:
     with phase("runs_s"):
         results = run_cases(cases, jobs=jobs, progress=progress, client=client)
     figdir = os.path.join(out, "figures")
-    os.makedirs(figdir, exist_ok=True)
+    with phase("figures_s"):
+        os.makedirs(figdir, exist_ok=True)
     from . import figures, html
     from .figures import convergence, overview
     sections = []

@@ -95,3 +95,26 @@ def test_a_parameter_added_off_its_default_does_not_match(tmp_path, baseline, ca
     assert main(["compare", write(tmp_path, "a.json", old), write(tmp_path, "b.json", new)]) == 1
     out = capsys.readouterr().out
     assert "missing" in out and "1 regression(s)" in out
+
+
+def test_the_same_infinity_is_no_change(tmp_path, capsys):
+    """Infinity against Infinity is equal (inf - inf is NaN, which passed no threshold);
+    pdverify's own spelling of a non-finite metric, the string 'inf', counts as the float;
+    infinity against the other infinity, or against a number, is a change (issue 31)."""
+    from pdverify.compare import compare_docs
+
+    def doc(value):
+        return {"schema": "pdverify.results/1", "runs": [
+            {"scene": "bar1d-traction", "method": "none", "params": {}, "status": "ok",
+             "metrics": {"condition": value, "max_error_pct": 1.0}}]}
+    inf = float("inf")
+    assert compare_docs(doc(inf), doc(inf)) == []
+    assert compare_docs(doc(-inf), doc(-inf)) == []
+    assert compare_docs(doc("inf"), doc(inf)) == []
+    assert [c.verdict for c in compare_docs(doc(inf), doc(-inf))] == ["regression"]
+    assert [c.verdict for c in compare_docs(doc(inf), doc(5.0))] == ["regression"]
+    a = tmp_path / "a.json"
+    a.write_text(json.dumps(doc(inf)))           # written as the JSON literal Infinity
+    assert "Infinity" in a.read_text()
+    assert main(["compare", str(a), str(a)]) == 0
+    assert "no changes beyond the thresholds" in capsys.readouterr().out

@@ -15,6 +15,17 @@ def _doc(runs, schema="pdverify.results/1"):
     return {"schema": schema, "runs": runs}
 
 
+FIFO = "<a FIFO>"   # files: create a named pipe there
+DEEP = 200_000      # nesting that Python's JSON reader cannot follow (issue 31)
+
+
+def _nested(depth):
+    value = 1
+    for _ in range(depth):
+        value = [value]
+    return value
+
+
 #: (id, argv, files to create first {name: content or None for a folder}, text expected)
 CASES = [
     # ---------------------------------------------------------------- run: scene, method
@@ -189,6 +200,78 @@ CASES = [
      {"a.json": json.dumps(_doc([GOOD_RUN]))}, "--summary ''"),
     ("cmp-summary-folder", ["compare", "a.json", "a.json", "--summary", "adir"],
      {"a.json": json.dumps(_doc([GOOD_RUN])), "adir": None}, "is a folder"),
+    # ---------------------------------------------------------------- compare (issue 31)
+    ("cmp-duplicate-run", ["compare", "a.json", "b.json"],
+     {"a.json": json.dumps(_doc([{**GOOD_RUN, "metrics": {"max_error_pct": 9.0}}, GOOD_RUN])),
+      "b.json": json.dumps(_doc([GOOD_RUN]))},
+     "baseline 'a.json': runs[1] repeats runs[0] (scene 'bar1d-traction', method 'none'"),
+    ("cmp-duplicate-run-new", ["compare", "a.json", "b.json"],
+     {"a.json": json.dumps(_doc([GOOD_RUN])),
+      "b.json": json.dumps(_doc([GOOD_RUN, {**GOOD_RUN, "status": "failed"}]))},
+     "new results 'b.json': runs[1] repeats runs[0]"),
+    ("cmp-int-401-digits", ["compare", "a.json", "b.json"],
+     {"a.json": json.dumps(_doc([{**GOOD_RUN, "metrics": {"n": 10 ** 400}}])),
+      "b.json": json.dumps(_doc([GOOD_RUN]))},
+     "a.json: runs[0].metrics.n is an integer of 401 digits, beyond the range of a float"),
+    ("cmp-int-5000-digits", ["compare", "a.json", "b.json"],
+     {"a.json": '{"schema": "pdverify.results/1", "runs": [{"metrics": {"n": 1' + "0" * 5000
+      + "}}]}", "b.json": json.dumps(_doc([GOOD_RUN]))},
+     "a.json: not a results file (Exceeds the limit (4300 digits)"),
+    ("cmp-surrogate-scene", ["compare", "a.json", "b.json"],
+     {"a.json": json.dumps(_doc([{**GOOD_RUN, "scene": "bar\ud800"}])),
+      "b.json": json.dumps(_doc([GOOD_RUN]))},
+     "a.json: runs[0].scene holds a lone surrogate '\\ud800' (not valid Unicode)"),
+    ("cmp-surrogate-key", ["compare", "a.json", "b.json"],
+     {"a.json": json.dumps(_doc([GOOD_RUN])),
+      "b.json": json.dumps(_doc([{**GOOD_RUN, "metrics": {"e\udfff": 1.0}}]))},
+     "b.json: runs[0].metrics: a key holds a lone surrogate"),
+    ("cmp-deep-array", ["compare", "a.json", "b.json"],
+     {"a.json": '{"schema": "pdverify.results/1", "runs": ' + "[" * DEEP + "]" * DEEP + "}",
+      "b.json": json.dumps(_doc([GOOD_RUN]))}, "a.json: JSON nested too deeply to read"),
+    ("cmp-deep-params", ["compare", "a.json", "b.json"],
+     {"a.json": json.dumps(_doc([{**GOOD_RUN, "params": {"p": _nested(40)}}])),
+      "b.json": json.dumps(_doc([GOOD_RUN]))}, "nests deeper than 32 levels"),
+    ("cmp-fifo", ["compare", "pipe", "b.json"], {"pipe": FIFO, "b.json": json.dumps(_doc([]))},
+     "baseline 'pipe' is a FIFO, not a file"),
+    ("cmp-device", ["compare", "a.json", "/dev/null"], {"a.json": json.dumps(_doc([]))},
+     "new results '/dev/null' is a character device, not a file"),
+    ("cmp-summary-is-baseline", ["compare", "a.json", "b.json", "--summary", "a.json"],
+     {"a.json": json.dumps(_doc([GOOD_RUN])), "b.json": json.dumps(_doc([GOOD_RUN]))},
+     "--summary 'a.json' is the baseline of this command"),
+    ("cmp-summary-is-new-forced", ["compare", "a.json", "b.json", "--summary", "b.json",
+                                   "--force"],
+     {"a.json": json.dumps(_doc([GOOD_RUN])), "b.json": json.dumps(_doc([GOOD_RUN]))},
+     "--summary 'b.json' is the new results file of this command"),
+    ("cmp-summary-foreign", ["compare", "a.json", "a.json", "--summary", "notes.md"],
+     {"a.json": json.dumps(_doc([GOOD_RUN])), "notes.md": "# my notes"},
+     "--summary 'notes.md' exists and was not written by pdverify"),
+    ("cmp-summary-fifo", ["compare", "a.json", "a.json", "--summary", "pipe", "--force"],
+     {"a.json": json.dumps(_doc([GOOD_RUN])), "pipe": FIFO}, "is a FIFO, not a file"),
+    # ---------------------------------------------------------------- outputs (issue 31)
+    ("json-foreign", ["run", "bar1d-traction", "--json", "mine.json"], {"mine.json": "{}"},
+     "--json 'mine.json' exists and was not written by pdverify"),
+    ("json-device", ["run", "bar1d-traction", "--json", "/dev/null"], {},
+     "--json '/dev/null' is a character device, not a file"),
+    ("vtu-foreign", ["run", "bar1d-traction", "--vtu", "f.vtu"], {"f.vtu": "<?xml?>"},
+     "--vtu 'f.vtu' exists and was not written by pdverify"),
+    ("vtu-foreign-suffix", ["run", "bar1d-traction", "--vtu", "f.vtu"], {"f_a.vtu": "x"},
+     "f_a.vtu' exists and was not written by pdverify"),
+    ("vtu-is-json", ["run", "bar1d-traction", "--json", "f.vtu", "--vtu", "f.vtu"], {},
+     "--vtu 'f.vtu' is also the --json file"),
+    ("out-foreign", ["report", "--out", "proj"], {"proj": None, "proj/a.py": "x"},
+     "--out 'proj' is a folder pdverify did not create (it holds 'a.py' and no "
+     ".pdverify-report marker)"),
+    # (the table's cache folder is inside the current folder; test_data_safety covers
+    # the current folder alone)
+    ("out-current", ["report", "--out", "."], {}, "--out '.' contains the cache folder"),
+    ("out-in-cache", ["report", "--out", ".cache-unused/r"], {},
+     "is inside the cache folder"),
+    ("out-report-with-stray", ["report", "--out", "r"],
+     {"r": None, "r/.pdverify-report": json.dumps(
+         {"schema": "pdverify.report-folder/1", "entries": [".pdverify-report"]}),
+      "r/mine.txt": "x"}, "is a pdverify report, but it holds 'mine.txt'"),
+    ("cache-is-file", ["run", "bar1d-traction"], {".cache-unused": "x"},
+     ".cache-unused' is a file, not a folder"),
 ]
 
 
@@ -213,6 +296,8 @@ def test_bad_input(name, argv, files, needle, tmp_path, monkeypatch, capsys):
         p = tmp_path / rel
         if content is None:
             p.mkdir(parents=True, exist_ok=True)
+        elif content is FIFO:
+            os.mkfifo(p)
         elif isinstance(content, bytes):
             p.write_bytes(content)
         else:
