@@ -266,12 +266,17 @@ def _plugins():
         yield from methods
 
 
+#: the registered scenes, set by ``pdverify.scenes`` when it loads (the registry sits
+#: below the scenes and does not import them): the plugins' parameters are checked
+#: against those of the scenes they serve
+SCENES: Callable[[], list] | None = None
+
+
 def _scene_param_clash(method: Treatment) -> str | None:
     """The first parameter of ``method`` named like a parameter of a scene it serves (its
     own or those of that scene's ``none``, which a bond method takes), as a phrase."""
-    from ..scenes import all_scenes
     mine = {p.name for p in method.params}
-    for scene in all_scenes():
+    for scene in (SCENES() if SCENES is not None else ()):
         try:
             served = method.serves(scene)
         except KeyboardInterrupt:

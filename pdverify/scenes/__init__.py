@@ -45,5 +45,14 @@ def get_scene(scene_id: str) -> Scene:
         raise InputError(f"unknown scene {scene_id!r}; allowed: {allowed}") from None
 
 
+def _tell_the_registry() -> None:
+    """The treatment registry checks plugins' parameters against the scenes' (it sits
+    below this package and does not import it)."""
+    from ..corrections import registry
+    registry.SCENES = all_scenes
+
+
+_tell_the_registry()
+
 __all__ = ["MethodSpec", "Outcome", "Published", "Scene", "influence_param", "register",
            "require_influence", "whole_cells", "cell_count", "all_scenes", "get_scene"]
