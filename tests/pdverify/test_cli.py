@@ -89,11 +89,11 @@ def test_list_names_every_scene_and_method():
 
 def test_numerical_failure_is_exit_1(monkeypatch, capsys):
     # numerical trouble is a failed run (exit 1) with a message saying what and where
-    import pdverify.scenes.bar1d as mod
+    import pdverify.solvers.front as mod
     from pdverify.errors import NumericalError
 
     def boom(*a, **k):
         raise NumericalError("static solve: singular system of size 22")
-    monkeypatch.setattr(mod, "solve_constrained", boom)
+    monkeypatch.setattr(mod, "solve_with_dirichlet", boom)   # the bar's none: elimination
     assert main(["run", "bar1d-traction"]) == 1
     assert "singular system" in capsys.readouterr().out
