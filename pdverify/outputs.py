@@ -337,7 +337,7 @@ def vtu_files(path: str) -> list[str]:
 
 # ------------------------------------------------------------------------------ storage
 
-def _existing(folder: str) -> str:
+def existing_ancestor(folder: str) -> str:
     """``folder`` or its nearest existing ancestor."""
     probe = folder
     while not os.path.exists(probe):
@@ -370,7 +370,7 @@ def _probe(folder: str, nbytes: int) -> str | None:
 
 def free_bytes(folder: str) -> int:
     """Bytes an unprivileged user may still write on ``folder``'s file system."""
-    st = os.statvfs(_existing(folder))
+    st = os.statvfs(existing_ancestor(folder))
     return st.f_bavail * st.f_frsize
 
 
@@ -397,7 +397,7 @@ def check_cache() -> None:
     folders = [root] + [os.path.join(root, s) for s in ("reference_fem", "manufactured")
                         if not os.environ.get(CACHE_ENV) or s == "manufactured"]
     for folder in folders:
-        probe = _existing(folder)
+        probe = existing_ancestor(folder)
         if not os.path.isdir(probe):
             raise InputError(f"{what}: {probe!r} is a file, not a folder{fix}")
         if probe != folder and folder != root:

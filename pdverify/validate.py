@@ -15,12 +15,7 @@ from .errors import InputError
 def _probe_folder(folder: str, flag: str, shown: str) -> None:
     """Prove that ``folder`` could be created (if missing) and take a file, without leaving
     anything behind: its nearest existing ancestor must be a folder that takes a file."""
-    probe = folder
-    while not os.path.exists(probe):
-        parent = os.path.dirname(probe)
-        if parent == probe:
-            break
-        probe = parent
+    probe = outputs.existing_ancestor(folder)
     if not os.path.isdir(probe):
         raise InputError(f"{flag} {shown!r}: {probe!r} is a file, not a folder")
     try:

@@ -45,12 +45,17 @@ def _check_taylor(cells, p, where):
                          f"seed 000 App. D needs nodes > 2 * order (order <= {(n - 1) // 2})")
 
 
-def _check_surface(cells, p, where):
+def _whole_layer(p, where, method):
+    """A fictitious layer of thickness delta must be a whole number of cells."""
     m = p["m_ratio"]
     if abs(m - round(m)) > 1e-12:
-        raise InputError(f"{where}: m_ratio={m:g} must be a whole number for "
-                         "surface-nodes (the fictitious layer of thickness delta must "
-                         "be a whole number of cells)")
+        raise InputError(f"{where}: m_ratio={m:g} must be a whole number for {method} "
+                         "(the fictitious layer of thickness delta must be a whole number "
+                         "of cells)")
+
+
+def _check_surface(cells, p, where):
+    _whole_layer(p, where, "surface-nodes")
     N = p["order"]
     need = max(N + 1, 2 * ((N + 1) // 2) + 1)
     for name, n in zip("xyz", cells):
@@ -60,10 +65,7 @@ def _check_surface(cells, p, where):
 
 
 def _check_mirror(cells, p, where):
-    m = p["m_ratio"]
-    if abs(m - round(m)) > 1e-12:
-        raise InputError(f"{where}: m_ratio={m:g} must be a whole number for the "
-                         "fictitious layer of whole cells")
+    _whole_layer(p, where, "mirror-nodes")
 
 
 def _none(problem, p):

@@ -27,13 +27,12 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..pd import BoxGrid, StateBasedModel
-from ..pd.bonds import bond_pairs
 from ..pd.closure import Closure
 from ..pd.problem import FACES, LinearSystem
 from ..solvers.policy import static_solver
 from .mirror_nodes import MirrorNodes
 from .pddo import pddo_system
-from .surface_nodes import face_crossings, flux_rows, surface_node_closure
+from .surface_nodes import crossing_bonds, flux_rows, surface_node_closure
 from .taylor_fictitious import boundary_value_rows, fictitious_closure
 
 
@@ -137,14 +136,23 @@ def assemble_plain(problem, closure: Closure | None = None) -> LinearSystem:
         values.append(u_ref[nodes, k])
         if k == face // 2:
             by_face[face] = k * nu_ + nodes
+    return _eliminated(model, K, rhs, fixed, values, solver, x_int, by_face)
+
+
+def _eliminated(model, K, rhs, fixed, values, solver, nodes, by_face, **extra):
+    """The system of prescribed unknowns ``fixed`` (lists per condition) eliminated:
+    the right-hand side (n_unknown_nodes, d) flattened component-major and padded for the
+    augmented system's nodal scalars, the unknowns' coordinates (``nodes``: the unknown
+    nodes' positions) for nested dissection, and the reaction of each face's prescribed
+    normal components (``by_face``: face -> their unknowns)."""
     fixed, values = _sorted(fixed, values)
     rhs = rhs.T.ravel()
     if solver != "direct":
         rhs = _pad(rhs, K)
     react = _residual_reaction(K, rhs)
-    return LinearSystem(model, K, rhs, fixed, values, nu_, solver=solver,
-                        coords=None if solver == "direct" else _coords(model, x_int),
-                        reaction=lambda x, face: react(x, face, by_face.__getitem__))
+    return LinearSystem(model, K, rhs, fixed, values, model.n_unknown_nodes, solver=solver,
+                        coords=None if solver == "direct" else _coords(model, nodes),
+                        reaction=lambda x, face: react(x, face, by_face.__getitem__), **extra)
 
 
 def _sorted(fixed, values):
@@ -193,35 +201,12 @@ def impose_on_surface_nodes(problem, g, closure, flux) -> LinearSystem:
         values.append(us_ref[nodes, k])
     for face in range(2 * d):
         by_face[face] = (face // 2) * nu_ + ni + np.flatnonzero(g.surface_face == face)
-    fixed, values = _sorted(fixed, values)
-    rhs = rhs.T.ravel()
-    if solver != "direct":
-        rhs = _pad(rhs, K)
-    react = _residual_reaction(K, rhs)
-    return LinearSystem(model, K, rhs, fixed, values, nu_, solver=solver,
-                        coords=None if solver == "direct"
-                        else _coords(model, np.r_[x_int, xs]),
-                        extra_x=xs, reaction=lambda x, face: react(x, face, by_face.__getitem__),
-                        counts={"surface_nodes": int(g.n_surface),
-                                "fictitious_nodes": int(g.n_ext - g.n_interior)})
+    return _eliminated(model, K, rhs, fixed, values, solver, np.r_[x_int, xs], by_face,
+                       extra_x=xs, counts={"surface_nodes": int(g.n_surface),
+                                           "fictitious_nodes": int(g.n_ext - g.n_interior)})
 
 
 # ------------------------------------------------------------------------------ Taylor
-def _crossing_keep(grid, stencil):
-    """Bonds of the Taylor closure: every stencil pair with a real end, plus the
-    fictitious-fictitious pairs that cross a boundary cell face (they carry part of the
-    force flux through that face near edges and corners; none exist in 1D). Returns
-    ``(keep, flux)`` as :func:`~pdverify.corrections.surface_nodes.surface_node_closure`."""
-    a, b, _ = bond_pairs(grid.ext_shape, stencil.half_offsets)
-    ia, ib = grid.is_interior[a], grid.is_interior[b]
-    keep = ia | ib
-    cand = np.flatnonzero(~(ia & ib))
-    s, bond, alpha, sign = face_crossings(grid, a[cand], b[cand])
-    keep[cand[bond]] = True
-    new_index = np.cumsum(keep) - 1
-    return keep, (s, new_index[cand[bond]], alpha, sign)
-
-
 def assemble_taylor(problem, order: int) -> LinearSystem:
     """Seed 000's Taylor-extrapolated fictitious nodes with the conditions as constraint
     rows by Lagrange multipliers (module docstring). A prescribed component takes the
@@ -236,7 +221,7 @@ def assemble_taylor(problem, order: int) -> LinearSystem:
         closure = fictitious_closure(g, order)
         flux = None
     else:
-        keep, flux = _crossing_keep(g, problem.stencil)
+        keep, flux = crossing_bonds(g, problem.stencil)
         base = fictitious_closure(g, order)
         closure = Closure(keep=keep, weighted_volume="complete",
                           displacement_map=base.displacement_map,

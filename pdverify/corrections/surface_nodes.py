@@ -182,6 +182,21 @@ def face_crossings(grid, a, b):
 
 
 # --------------------------------------------------------------------------- the closure
+def crossing_bonds(grid, stencil):
+    """``(keep, flux)``: the bonds of a fictitious-layer closure whose conditions act
+    through face fluxes (every stencil pair with an interior end, plus the
+    fictitious-fictitious pairs that cross a surface node's face: they enter Eq. 36), and
+    the crossings ``(surface node, bond, alpha, sign)`` in that bond numbering."""
+    a, b, _ = bond_pairs(grid.ext_shape, stencil.half_offsets)
+    ia, ib = grid.is_interior[a], grid.is_interior[b]
+    keep = ia | ib
+    cand = np.flatnonzero(~(ia & ib))
+    s, bond, alpha, sign = face_crossings(grid, a[cand], b[cand])
+    keep[cand[bond]] = True
+    new_index = np.cumsum(keep) - 1
+    return keep, (s, new_index[cand[bond]], alpha, sign)
+
+
 def surface_node_closure(grid, stencil, order: int, *, dilatations: bool = True):
     """The surface node method's :class:`~pdverify.pd.closure.Closure` and its flux data.
 
@@ -197,15 +212,7 @@ def surface_node_closure(grid, stencil, order: int, *, dilatations: bool = True)
     model's bond numbering (see :func:`face_crossings`); :func:`flux_rows` turns it into
     the force-flux equations of Eq. (36).
     """
-    a, b, _ = bond_pairs(grid.ext_shape, stencil.half_offsets)
-    ia, ib = grid.is_interior[a], grid.is_interior[b]
-    keep = ia | ib
-    cand = np.flatnonzero(~(ia & ib))
-    s, bond, alpha, sign = face_crossings(grid, a[cand], b[cand])
-    keep[cand[bond]] = True
-    new_index = np.cumsum(keep) - 1
-    flux = (s, new_index[cand[bond]], alpha, sign)
-
+    keep, flux = crossing_bonds(grid, stencil)
     fict = np.flatnonzero(~grid.is_interior)
     A_Theta = real_identity(grid)
     if fict.size and dilatations:
