@@ -34,10 +34,26 @@ class RunResult:
     fields: dict = field(default_factory=dict, repr=False)
     #: files written from ``fields`` (VTU, relative to the report folder), if any
     files: list = field(default_factory=list)
+    #: why this run is expected to fail (a documented finding, like pytest's strict
+    #: xfail); empty when it is expected to succeed
+    expected_failure: str = ""
 
     @property
     def key(self) -> tuple:
         return run_key(self.scene, self.method, self.params)
+
+    @property
+    def outcome(self) -> str:
+        """``ok``, ``failed``, ``expected-failure`` (failed, as documented) or
+        ``unexpected-pass`` (ok although a failure is documented: the finding is out of
+        date, strict like pytest's xfail)."""
+        return outcome(self.status, self.expected_failure)
+
+    @property
+    def counts_as_failure(self) -> bool:
+        """What makes ``run`` and ``report`` exit 1: an unexpected failure, or an expected
+        failure that did not happen."""
+        return self.outcome in ("failed", "unexpected-pass")
 
     def to_json(self) -> dict:
         return {
@@ -53,7 +69,18 @@ class RunResult:
             "diagnostics": _plain(self.diagnostics),
             "warnings": list(self.warnings),
             **({"files": list(self.files)} if self.files else {}),
+            **({"expected_failure": self.expected_failure} if self.expected_failure else {}),
         }
+
+
+OUTCOMES = ("ok", "failed", "expected-failure", "unexpected-pass")
+
+
+def outcome(status: str, expected_failure: str) -> str:
+    """The outcome of a run from its status and its documented expectation."""
+    if not expected_failure:
+        return status
+    return "expected-failure" if status == "failed" else "unexpected-pass"
 
 
 def run_key(scene: str, method: str, params: dict) -> tuple:
@@ -169,7 +196,7 @@ _RUN_FIELDS = {"scene": (str,), "method": (str,), "params": (dict,), "status": (
                "metrics": (dict,)}
 _OPTIONAL_RUN_FIELDS = {"reference": (str,), "message": (str,), "timings": (dict,),
                         "size": (dict,), "diagnostics": (dict,), "warnings": (list,),
-                        "files": (list,)}
+                        "files": (list,), "expected_failure": (str,)}
 _TYPE_NAMES = {str: "a string", dict: "an object", list: "a list"}
 
 

@@ -90,6 +90,7 @@ def _row(scene, r, metrics) -> dict:
     paper = scene.published_for(r.method, r.params)
     return {
         "ok": r.status == "ok", "method": r.method, "params": _params(r, scene),
+        "outcome": r.outcome, "expected": r.expected_failure,
         "message": r.message, "warnings": list(r.warnings),
         "cells": [{"value": _num(r.metrics.get(m, "")),
                    "paper": _num(paper[m].value) if m in paper else None,
@@ -179,6 +180,8 @@ def _colour(value: float) -> str:
 def _overview_cell(scene, m, r, metric, best) -> dict | None:
     if r is None:
         return None
+    if r.outcome == "expected-failure":
+        return {"kind": "expected", "message": f"expected ({r.expected_failure}): {r.message}"}
     if r.status != "ok":
         return {"kind": "failed", "message": r.message}
     time = f"{r.timings.get('total_s', 0):.2g}"
@@ -227,7 +230,8 @@ def page(doc: dict, sections: list[tuple], total_time: float, results=None,
     scenes = [s for s, _ in sections]
     return _render(
         "page.html", doc=doc, n_runs=len(runs),
-        n_failed=sum(1 for r in runs if r["status"] != "ok"),
+        n_failed=sum(1 for r in runs if r["status"] != "ok" and not r.get("expected_failure")),
+        n_expected=sum(1 for r in runs if r["status"] != "ok" and r.get("expected_failure")),
         n_warned=sum(1 for r in runs if r.get("warnings")), total_time=total_time,
         overview=overview(scenes, results) if results is not None else "",
         front_figures=front_figures, papers=papers(scenes),

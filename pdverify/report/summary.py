@@ -56,7 +56,7 @@ def summarise(scene, runs) -> SceneSummary:
         scene=scene.id, metric=headline(scene), best=best,
         best_error=values.get(best), runs=len(runs),
         best_time_s=picked[best].timings.get("total_s") if best else None,
-        failed=[(r.method, r.message) for r in runs if r.status != "ok"])
+        failed=[(r.method, r.message) for r in runs if r.counts_as_failure])
 
 
 # -- the end-of-report summary (one row per scene) -----------------------------------------

@@ -148,6 +148,13 @@ class Outcome:
     diagnostics: dict = field(default_factory=dict)
 
 
+def _applies(method_of, where, method: str, params: Mapping[str, Any]) -> bool:
+    """A method (None: any) and a subset of the params (None: any) match a run."""
+    if method_of is not None and method_of != method:
+        return False
+    return all(params.get(k) == v for k, v in (where or {}).items())
+
+
 @dataclass(frozen=True)
 class Published:
     """A number a paper prints, for the report's 'paper' column."""
@@ -159,9 +166,21 @@ class Published:
     where: Mapping[str, Any] | None = None
 
     def applies(self, method: str, params: Mapping[str, Any]) -> bool:
-        if self.method is not None and self.method != method:
-            return False
-        return all(params.get(k) == v for k, v in (self.where or {}).items())
+        return _applies(self.method, self.where, method, params)
+
+
+@dataclass(frozen=True)
+class ExpectedFailure:
+    """A documented finding that makes a run fail (the paper's own failure, a collapse
+    the paper predicts): the run's failure is expected, shown as such and not counted in
+    the exit code; if the run stops failing, that is reported (strict)."""
+
+    reason: str
+    method: str | None = None
+    where: Mapping[str, Any] | None = None
+
+    def applies(self, method: str, params: Mapping[str, Any]) -> bool:
+        return _applies(self.method, self.where, method, params)
 
 
 class Scene:
@@ -180,6 +199,8 @@ class Scene:
     params: tuple[Param, ...] = ()
     methods: tuple[MethodSpec, ...] = ()
     published: tuple[Published, ...] = ()
+    #: documented findings that make runs fail (:class:`ExpectedFailure`)
+    expected_failures: tuple = ()
     figure: str = ""  # name of the report figure family that draws this scene's runs
     #: the theory of the scene's plain-grid model ("bond-based" or "state-based") when
     #: it takes the closure treatments (bond methods) of ``pdverify.corrections.registry``
@@ -336,7 +357,9 @@ class Scene:
         Bad input raises :class:`InputError` before any work starts.
         """
         params = self.resolve(method, overrides)
-        result = RunResult(scene=self.id, method=method, params=params, reference=self.reference)
+        result = RunResult(scene=self.id, method=method, params=params, reference=self.reference,
+                           expected_failure=next((e.reason for e in self.expected_failures
+                                                  if e.applies(method, params)), ""))
         timer = Timer()
         broken = self._broken_plugin(method)
         if broken:

@@ -17,6 +17,7 @@ from ..solvers.dense import SPD_LATTICE_SOLVERS
 from ..solvers.iterative import Lattice
 from ..solvers.newton import DirichletLinearSolver, newton
 from . import Outcome, Published, register
+from .base import ExpectedFailure
 from .fem_references import FemAndPD, _reference_module
 from .sheets import PAPER, PD_COMMON, SheetScene, _grid_check
 
@@ -140,6 +141,22 @@ class Indentation(FemAndPD):
                   where=NONLINEAR),
         Published("failure_depth_mm", 0.4, "seed 003 §4.2 (about 0.4 mm)", method="none",
                   where=NONLINEAR),
+    )
+
+    #: the documented collapses (deviations: seed 003 findings): failures, as expected
+    expected_failures = (
+        ExpectedFailure("the uncorrected lattice stalls under the indenter (seed 003 §4.2: "
+                        "the paper's fails at about 0.4 mm; ours at 0.7 mm at the paper's "
+                        "grid, 1.8 mm at the quick grid)", method="none",
+                        where={**PAPER, "kinematics": "nonlinear"}),
+        ExpectedFailure("the linear lattice folds under the indenter at 1 mm (a bond "
+                        "inverted), as seed 003 §4.2 expects of small-displacement PD",
+                        method="none", where={"kinematics": "linear", "spacing": 0.00025}),
+        *(ExpectedFailure("the peers' bond corrections stall at 1.0-1.1 mm at the paper's "
+                          "grid, the bond under the indenter at 15 % of its length (our "
+                          "finding, deviations)", method=m,
+                          where=NONLINEAR)
+          for m in ("energy", "volume", "perifit")),
     )
 
     def reference_params(self, p) -> dict:
