@@ -123,7 +123,11 @@ def test_format_summary_lists_every_scene_with_its_best_method():
         assert row.split()[1] == s.best
         assert f"{100 * s.best_error:.3g} %" in row
         assert row.split()[-2:] == [str(s.runs), "0"]
-    assert [s.best for s in summaries] == ["taylor-fictitious", "energy-directional"]
+    # on the traction bar four treatments reproduce the linear field to round-off, so the
+    # best is whichever round-off is smallest; it must be one of them, at round-off
+    exact = {"taylor-fictitious", "surface-nodes", "mirror-nodes", "pddo"}
+    assert summaries[0].best in exact and summaries[0].best_error < 1e-12
+    assert summaries[1].best == "energy-directional"
 
 
 def test_format_summary_shortens_the_first_failure():
