@@ -83,8 +83,8 @@ def _swap_in(staging: str, out: str) -> None:
         shutil.rmtree(old, ignore_errors=True)
 
 
-def build_report(*, out=None, quick=False, only=None, jobs=1, progress=None,
-                 scheduler=None) -> int:
+def build_report(*, out=None, quick=False, only=None, jobs=None, progress=None,
+                 scheduler=None, run_timeout=None) -> int:
     """Run the report; returns 0, or 1 if any run failed. Bad input raises before work.
 
     Figures, results.json and index.html are written into a staging folder next to
@@ -92,7 +92,9 @@ def build_report(*, out=None, quick=False, only=None, jobs=1, progress=None,
     is killed or fails leaves the previous one intact (its staging folder is removed now,
     or by the next report into the same folder if the process was killed outright).
     ``scheduler``: a Dask scheduler address; the runs then go to that cluster
-    (:mod:`pdverify.cluster`), which is reached before any work starts.
+    (:mod:`pdverify.cluster`), which is reached before any work starts. ``jobs``: local
+    worker processes (None: the cores available to this process); ``run_timeout``: the
+    seconds after which a run is killed and recorded as failed (None: no limit).
     """
     progress = progress or sys.stderr
     out = os.path.abspath(out or default_out(only, quick))
@@ -104,19 +106,21 @@ def build_report(*, out=None, quick=False, only=None, jobs=1, progress=None,
         client = connect(scheduler)
     try:
         with output_lock(out):
-            return _locked(cases, out, parent, name, jobs, progress, client, quick)
+            return _locked(cases, out, parent, name, jobs, progress, client, quick,
+                           run_timeout)
     finally:
         if client is not None:
             client.close()
 
 
-def _locked(cases, out, parent, name, jobs, progress, client, quick=False) -> int:
+def _locked(cases, out, parent, name, jobs, progress, client, quick=False,
+            run_timeout=None) -> int:
     """The report's body, under the output lock: stage, build, swap in."""
     _clean_stale(parent, name)
     staging = tempfile.mkdtemp(prefix=f".{name}.staging-", dir=parent)
     os.chmod(staging, umask_mode(0o777))  # mkdtemp gives 0700
     try:
-        code = _build(cases, staging, out, jobs, progress, client, quick)
+        code = _build(cases, staging, out, jobs, progress, client, quick, run_timeout)
         if STOP_REQUESTED["flag"]:  # an interrupt some library swallowed: publish nothing
             raise KeyboardInterrupt
         _swap_in(staging, out)
@@ -159,11 +163,17 @@ def _drawn(what, draw, args, empty, progress):
         return empty
 
 
-def _build(cases, out, final, jobs, progress, client=None, quick=False) -> int:
+def _build(cases, out, final, jobs, progress, client=None, quick=False,
+           run_timeout=None) -> int:
+    from ..schedule import critical_path, previous_times
     t0 = time.perf_counter()
     phase = _Phases()
+    slots = []
     with phase("runs_s"):
-        results = run_cases(cases, jobs=jobs, progress=progress, client=client)
+        # the previous report in this folder times each run, for the longest-first order
+        known = previous_times(os.path.join(final, "results.json"))
+        results = run_cases(cases, jobs=jobs, progress=progress, client=client,
+                            run_timeout=run_timeout, known=known, schedule=slots)
     figdir = os.path.join(out, "figures")
     os.makedirs(figdir, exist_ok=True)
     from . import figures, html
@@ -205,6 +215,8 @@ def _build(cases, out, final, jobs, progress, client=None, quick=False) -> int:
     failed = sum(r.status != "ok" for r in results)
     from .summary import print_summary
     print_summary(scenes, results, progress)  # one row per scene, before the last line
+    if slots:                                 # the local pool (not a Dask cluster)
+        print(critical_path(slots, cases), file=progress)
     print(f"report: {len(results)} runs, {failed} failed, "
           f"{time.perf_counter() - t0:.1f} s -> {os.path.join(final, 'index.html')}",
           file=progress)
