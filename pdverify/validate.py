@@ -1,7 +1,7 @@
 """Checks of the command line's paths and flags, before any work (bad input: exit 2).
 
 Parameters are checked by ``pdverify.params`` and each scene's ``check``; this module
-covers what is not a parameter: output paths, ``--jobs`` and ``--only``.
+covers what is not a parameter: output paths, ``--jobs``, ``--run-timeout`` and ``--only``.
 """
 from __future__ import annotations
 

@@ -100,6 +100,9 @@ def build_report(*, out=None, quick=False, only=None, jobs=None, progress=None,
     out = os.path.abspath(out or default_out(only, quick))
     cases = plan(only=only, quick=quick)  # raises InputError on unknown scenes
     parent, name = os.path.split(out)
+    if scheduler is not None and run_timeout is not None:
+        raise InputError("--run-timeout applies to the local worker processes; it cannot be "
+                         "combined with --scheduler (or $PDVERIFY_SCHEDULER)")
     client = None
     if scheduler is not None:
         from ..cluster import connect

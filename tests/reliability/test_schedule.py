@@ -123,3 +123,11 @@ def test_critical_path_names_the_last_workers_runs():
     assert text.startswith("critical path: worker 2 of 2 finished last, at 5.5 s (2 runs")
     assert "finished at 4.0, 5.5 s" in text
     assert text.index("volume") < text.index("energy")   # the longest run first
+
+
+def test_run_timeout_with_a_scheduler_is_bad_input(tmp_path):
+    from pdverify.errors import InputError
+    with pytest.raises(InputError, match="--run-timeout .* --scheduler"):
+        build_report(out=str(tmp_path / "r"), only=["bar1d-traction"], run_timeout=5.0,
+                     scheduler="tcp://127.0.0.1:1")
+    assert not (tmp_path / "r").exists()          # refused before any work
