@@ -233,7 +233,7 @@ def _run_local(cases, jobs, shown, run_timeout=None, known=None, slots=None):
     ctx = mp.get_context("fork")
     memory = memory_estimates(cases)
     limit = memory_limit()[0]
-    pending = longest_first(cases, memory, known)
+    pending = longest_first(cases, known)
     workers = {}          # connection -> [process, case index or None, slot, start time]
     slots = slots if slots is not None else []
     slots.extend(Slot() for _ in range(min(jobs, total)))

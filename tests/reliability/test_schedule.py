@@ -56,17 +56,16 @@ def test_jobs_default_to_the_cores_available_to_the_process():
     assert validate.jobs(1) == 1
 
 
-def test_longest_first_unknown_by_memory_then_known_by_time():
+def test_longest_first_unknown_in_plan_order_then_known_by_time():
     cases = [("bar1d-traction", "none", {}), ("bar1d-traction", "energy", {}),
              ("bar1d-traction", "volume", {}), ("bar1d-traction", "none", {"spacing": 0.025})]
     from pdverify.results import run_key
     from pdverify.scenes import get_scene
     scene = get_scene("bar1d-traction")
     key = [run_key(s, m, scene.resolve(m, o)) for s, m, o in cases]
-    memory = [1.0, 5.0, 3.0, 2.0]
-    assert longest_first(cases, memory) == [1, 2, 3, 0]
-    known = {key[1]: 0.5, key[2]: 9.0}
-    assert longest_first(cases, memory, known) == [3, 0, 2, 1]
+    assert longest_first(cases) == [0, 1, 2, 3]
+    known = {key[0]: 0.5, key[1]: 9.0, key[3]: 2.0}
+    assert longest_first(cases, known) == [2, 1, 3, 0]
 
 
 def test_the_memory_budget_holds_for_the_runs_in_flight_together(timed_scene):
@@ -80,8 +79,8 @@ def test_the_memory_budget_holds_for_the_runs_in_flight_together(timed_scene):
     spans = {k: (s, e) for slot in slots for k, s, e in slot.runs}
     (s1, e1), (s3, e3) = spans[1], spans[3]
     assert e1 <= s3 or e3 <= s1
-    # longest (here: largest) first: the big runs are the first two to start
-    assert sorted(spans, key=lambda k: spans[k][0])[:2] == [1, 3]
+    # the cases start in the plan's order (no earlier times known)
+    assert sorted(spans, key=lambda k: spans[k][0]) == [0, 1, 2, 3, 4]
     smalls = [spans[k] for k in (0, 2, 4)]
     assert any(s < e1 and e > s1 or s < e3 and e > s3 for s, e in smalls)
 
