@@ -3,9 +3,9 @@
 usage:
   python -m pdverify list                                   scenes and their methods
   python -m pdverify run SCENE [--method M] [--set KEY=VALUE ...] [--json FILE]
-                          [--vtu FILE] [--force] [--max-memory SIZE]
+                          [--vtu FILE] [--force] [--max-memory SIZE] [--run-timeout SECONDS]
   python -m pdverify report [--out DIR] [--quick] [--only SCENE ...] [--jobs N]
-                          [--scheduler ADDRESS] [--max-memory SIZE]
+                          [--scheduler ADDRESS] [--max-memory SIZE] [--run-timeout SECONDS]
   python -m pdverify compare BASELINE.json NEW.json [--rtol R] [--atol A] [--summary FILE]
                           [--force]
 
@@ -25,6 +25,8 @@ from . import __version__, budget
 from .errors import STOP_REQUESTED, InputError, OutputError
 
 
+RUN_TIMEOUT_HELP = ("kill a run that takes longer than SECONDS and record it as failed "
+                    "('timed out after N s'); the report goes on (default: no limit)")
 MAX_MEMORY_HELP = ("refuse (exit 2) any run whose memory estimate exceeds SIZE, e.g. 4G, "
                    "512M (default: $PDVERIFY_MAX_MEMORY, else half of the smallest of total "
                    "memory, the cgroup limit and RLIMIT_AS)")
@@ -59,6 +61,8 @@ def build_parser() -> argparse.ArgumentParser:
                           "with several node sets or a FEM grid adds a suffix per file)")
     run.add_argument("--force", action="store_true", help=FORCE_HELP)
     run.add_argument("--max-memory", default=None, metavar="SIZE", help=MAX_MEMORY_HELP)
+    run.add_argument("--run-timeout", type=float, default=None, metavar="SECONDS",
+                     help=RUN_TIMEOUT_HELP)
     rep = sub.add_parser("report", help="run every scene and method, write the HTML report")
     rep.add_argument("--out", default=None, metavar="DIR",
                      help="output folder, replaced as a whole; it must be new, empty or a "
@@ -69,13 +73,16 @@ def build_parser() -> argparse.ArgumentParser:
                      help="smaller sweeps of the expensive scenes")
     rep.add_argument("--only", nargs="+", default=None, metavar="SCENE",
                      help="run only these scenes (each once)")
-    rep.add_argument("--jobs", type=int, default=1,
-                     help="worker processes, 1 to the number of CPUs (default 1)")
+    rep.add_argument("--jobs", type=int, default=None,
+                     help="worker processes, 1 to the number of CPUs (default: the cores "
+                          "available to this process)")
     rep.add_argument("--scheduler", default=None, metavar="ADDRESS",
                      help="run the cases on the Dask cluster of this scheduler, e.g. "
                           "tcp://10.0.0.5:8786 (default: $PDVERIFY_SCHEDULER, else the "
                           "local processes of --jobs; needs the extra 'cluster')")
     rep.add_argument("--max-memory", default=None, metavar="SIZE", help=MAX_MEMORY_HELP)
+    rep.add_argument("--run-timeout", type=float, default=None, metavar="SECONDS",
+                     help=RUN_TIMEOUT_HELP)
     cmp_ = sub.add_parser("compare", help="compare a results file against a baseline")
     cmp_.add_argument("baseline", help="the stored results.json")
     cmp_.add_argument("new", help="the new results.json")
@@ -178,7 +185,8 @@ def _dispatch(args) -> int:
         from .outputs import check_cache
         check_cache()
         return run_one(args.scene, method=args.method, overrides=parse_assignments(args.set),
-                       json_path=json_path, vtu_path=vtu_path)
+                       json_path=json_path, vtu_path=vtu_path,
+                       run_timeout=validate.run_timeout(args.run_timeout))
     if args.command == "report":
         from .report import build_report, default_out
         only = validate.only(args.only)
@@ -187,6 +195,7 @@ def _dispatch(args) -> int:
         from .cluster import scheduler_address
         return build_report(out=out, quick=args.quick, only=only,
                             jobs=validate.jobs(args.jobs),
+                            run_timeout=validate.run_timeout(args.run_timeout),
                             scheduler=scheduler_address(args.scheduler))
     if args.command == "compare":
         from .compare import compare_files

@@ -19,13 +19,19 @@ def _paper_value(value) -> str:
 
 
 def run_one(scene_id: str, *, method=None, overrides=None, json_path=None, vtu_path=None,
-            stream=None) -> int:
-    """``pdverify run``: resolve (exit 2 on bad input), run, print, optionally write JSON."""
+            stream=None, run_timeout=None) -> int:
+    """``pdverify run``: resolve (exit 2 on bad input), run, print, optionally write JSON.
+    ``run_timeout``: seconds; the run then goes to a supervised worker process that is
+    killed past it (a failed run, exit 1)."""
     stream = stream or sys.stdout
     scene = get_scene(scene_id)
     method = method or scene.default_method
     scene.resolve(method, overrides)  # bad input fails here, before any work
-    result = scene.run(method, overrides)
+    if run_timeout is None:
+        result = scene.run(method, overrides)
+    else:
+        result = run_cases([(scene_id, method, dict(overrides or {}))], jobs=1,
+                           run_timeout=run_timeout)[0]
     print(f"{scene.id} --method {method} (reference: {scene.reference}): {result.status}"
           + (f" ({result.message})" if result.message else ""), file=stream)
     paper = scene.published_for(method, result.params)
@@ -160,22 +166,33 @@ def run_line(case, res) -> str:
             f"({res.timings.get('total_s', 0):.2f} s) {format_metrics(res.metrics, 2)}")
 
 
-def run_cases(cases, *, jobs: int = 1, progress=None, client=None) -> list[RunResult]:
-    """Run ``cases`` in ``jobs`` supervised worker processes, showing their progress on the
-    stream ``progress`` (:class:`pdverify.progress.RunProgress`: a live display on a
-    terminal, one line per finished run otherwise; None: silent).
+def run_cases(cases, *, jobs: int | None = None, progress=None, client=None,
+              run_timeout: float | None = None, known=None, schedule=None) -> list[RunResult]:
+    """Run ``cases`` in ``jobs`` supervised worker processes (default: the cores available
+    to this process), showing their progress on the stream ``progress``
+    (:class:`pdverify.progress.RunProgress`: a live display on a terminal, one line per
+    finished run otherwise; None: silent).
 
     With a Dask ``client`` (``report --scheduler``), the cases run as tasks on its
     cluster instead (:mod:`pdverify.cluster`); ``jobs`` is then unused.
 
     Every case runs in a worker process, so a run that dies in native code (segfault,
     abort, out-of-memory kill) becomes a failed run naming the signal, a new worker takes
-    over, and the other runs go on. Results come back in the order of ``cases``.
+    over, and the other runs go on; so does a run that takes longer than ``run_timeout``
+    seconds (killed by the supervisor; None: no limit). The cases start longest first and
+    only while the memory estimates of the runs in flight fit the budget
+    (:mod:`pdverify.schedule`; ``known``: earlier run times by run key). ``schedule``: a
+    list that receives each worker's :class:`~pdverify.schedule.Slot`. Results come back
+    in the order of ``cases``, the same numbers whatever ``jobs`` and the order they ran in.
     """
     from .progress import RunProgress
+    from .schedule import default_jobs
 
+    jobs = default_jobs() if jobs is None else jobs
     if jobs < 1:
         raise InputError(f"--jobs={jobs} must be >= 1")
+    if run_timeout is not None and not run_timeout > 0:
+        raise InputError(f"--run-timeout={run_timeout} must be a positive number of seconds")
 
     def line(k, res):
         return run_line(cases[k], res)
@@ -192,51 +209,94 @@ def run_cases(cases, *, jobs: int = 1, progress=None, client=None) -> list[RunRe
             return run_cases_on(client, cases, shown.finished, run_case, died_on_cluster)
 
     with RunProgress(cases, min(jobs, len(cases)), progress, line=line) as shown:
-        return _run_local(cases, jobs, shown)
+        return _run_local(cases, jobs, shown, run_timeout, known,
+                          schedule if schedule is not None else [])
 
 
-def _run_local(cases, jobs, shown) -> list[RunResult]:
+def _timed_out(case, seconds) -> RunResult:
+    """The failed record of a case its supervisor killed for taking too long."""
+    res = _failed(case, f"timed out after {seconds:g} s (--run-timeout); the supervisor "
+                        "killed the run's process")
+    res.timings = {"setup_s": 0.0, "solve_s": float(seconds), "total_s": float(seconds)}
+    return res
+
+
+def _run_local(cases, jobs, shown, run_timeout=None, known=None, slots=None):
     """The supervised local pool of :func:`run_cases`; ``shown`` (a
     :class:`~pdverify.progress.RunProgress`) hears of every start and finish here, in the
     main process, and is redrawn every ``shown.tick_s`` while no run finishes."""
     import multiprocessing as mp
+    import time
     from multiprocessing.connection import wait
+
+    from .budget import memory_limit
+    from .schedule import Slot, longest_first, memory_estimates
 
     total = len(cases)
     results: list[RunResult | None] = [None] * total
     done = 0
     ctx = mp.get_context("fork")
-    workers = {}          # connection -> [process, index of the case it runs or None]
-    pending = list(range(total))
+    memory = memory_estimates(cases)
+    limit = memory_limit()[0]
+    pending = longest_first(cases, known)
+    workers = {}          # connection -> [process, case index or None, slot, start time]
+    slots = slots if slots is not None else []
+    slots.extend(Slot() for _ in range(min(jobs, total)))
+    t0 = time.monotonic()
 
-    def start():
+    def start(slot):
         parent, child = ctx.Pipe()
         proc = ctx.Process(target=_worker, args=(child, [parent, *workers], os.getpid()),
                            daemon=True)
         proc.start()
         child.close()
-        workers[parent] = [proc, None]
+        workers[parent] = [proc, None, slot, None]
         return parent
 
-    def give(conn):
-        if pending:
+    def in_flight_memory():
+        return sum(memory[w[1]] for w in workers.values() if w[1] is not None)
+
+    def give_all():
+        """Idle workers take the head of the queue while it fits the memory budget."""
+        for conn, w in workers.items():
+            if w[1] is not None or not pending:
+                continue
+            running = any(x[1] is not None for x in workers.values())
+            if running and in_flight_memory() + memory[pending[0]] > limit:
+                return                   # the head waits for memory; nothing overtakes it
             k = pending.pop(0)
-            workers[conn][1] = k
+            w[1], w[3] = k, time.monotonic()
             conn.send(cases[k])
             shown.started(k)
-        else:
-            workers[conn][1] = None
+
+    def finish(conn, k, res):
+        nonlocal done
+        proc, _, slot, began = workers[conn]
+        slots[slot].runs.append((k, began - t0, time.monotonic() - t0))
+        workers[conn][1] = None
+        results[k] = res
+        done += 1
+        shown.finished(k, res)
+
+    def replace(conn):
+        """The worker of ``conn`` is dead or killed: a new one takes its slot."""
+        proc, _, slot, _ = workers.pop(conn)
+        conn.close()
+        start(slot)
 
     try:
-        for _ in range(min(jobs, total)):
-            start()
-        for conn in list(workers):
-            give(conn)
+        for slot in range(min(jobs, total)):
+            start(slot)
+        give_all()
         while done < total:
             busy = {c: w for c, w in workers.items() if w[1] is not None}
+            timeout = shown.tick_s
+            if run_timeout is not None:
+                left = min(w[3] + run_timeout for w in busy.values()) - time.monotonic()
+                timeout = max(0.0, left) if timeout is None else min(timeout, max(0.0, left))
             ready = wait(list(busy) + [w[0].sentinel for w in busy.values()],
-                         timeout=shown.tick_s)
-            for conn, (proc, k) in list(busy.items()):
+                         timeout=timeout)
+            for conn, (proc, k, slot, began) in list(busy.items()):
                 res = None
                 if conn in ready or proc.sentinel in ready:
                     try:
@@ -244,27 +304,28 @@ def _run_local(cases, jobs, shown) -> list[RunResult]:
                             res = conn.recv()
                     except (EOFError, OSError):
                         res = None
-                    if res is None and proc.is_alive():
-                        continue
-                    if res is None:           # the worker died: record it, replace it
+                    if res is None and not proc.is_alive():   # died: record, replace
                         proc.join()
-                        res = _died(cases[k], proc.exitcode)
-                        conn.close()
-                        del workers[conn]
-                        conn = start()
-                    results[k] = res
-                    done += 1
-                    shown.finished(k, res)
-                    give(conn)
+                        finish(conn, k, _died(cases[k], proc.exitcode))
+                        replace(conn)
+                        continue
+                if res is not None:
+                    finish(conn, k, res)
+                elif run_timeout is not None and time.monotonic() - began > run_timeout:
+                    proc.kill()
+                    proc.join()
+                    finish(conn, k, _timed_out(cases[k], run_timeout))
+                    replace(conn)
+            give_all()
             shown.tick()
     finally:
-        for conn, (proc, _) in workers.items():
+        for conn, (proc, *_) in workers.items():
             try:
                 conn.send(None)
             except OSError:  # the worker is gone (BrokenPipeError)
                 pass
             conn.close()
-        for conn, (proc, _) in workers.items():
+        for conn, (proc, *_) in workers.items():
             proc.join(timeout=1)
             if proc.is_alive():
                 proc.kill()

@@ -1,7 +1,7 @@
 """Checks of the command line's paths and flags, before any work (bad input: exit 2).
 
 Parameters are checked by ``pdverify.params`` and each scene's ``check``; this module
-covers what is not a parameter: output paths, ``--jobs`` and ``--only``.
+covers what is not a parameter: output paths, ``--jobs``, ``--run-timeout`` and ``--only``.
 """
 from __future__ import annotations
 
@@ -96,11 +96,22 @@ def input_file(path, what: str) -> str:
     return path
 
 
-def jobs(value: int) -> int:
-    """``--jobs``: 1 .. the number of CPUs."""
+def jobs(value: int | None) -> int:
+    """``--jobs``: 1 .. the number of CPUs; None: the cores available to this process."""
+    if value is None:
+        from .schedule import default_jobs
+        return default_jobs()
     cpus = os.cpu_count() or 1
     if not 1 <= value <= cpus:
         raise InputError(f"--jobs={value} must be between 1 and {cpus} (the CPUs of this machine)")
+    return value
+
+
+def run_timeout(value: float | None) -> float | None:
+    """``--run-timeout``: a positive, finite number of seconds, or None (no limit)."""
+    import math
+    if value is not None and not (math.isfinite(value) and value > 0):
+        raise InputError(f"--run-timeout={value:g} must be a positive number of seconds")
     return value
 
 

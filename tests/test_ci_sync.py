@@ -24,9 +24,47 @@ def test_ci_runs_the_readme_test_command_verbatim():
     assert test_cmd in ci.splitlines()
 
 
+def test_ci_then_runs_the_slow_tier():
+    # the README's command runs the fast tier; CI adds the tests marked slow after it,
+    # as the README says, so that every test runs in CI
+    lines = [x for x in (ROOT / ".ci" / "run").read_text().splitlines()
+             if x.strip() and not x.startswith("#")]
+    test_cmd = readme_commands()[1].strip()
+    slow = "python -m pytest -q --runslow -m slow"
+    assert lines.index(test_cmd) + 1 == lines.index(next(x for x in lines if x.startswith(slow)))
+    assert lines[-1].startswith(slow)
+    readme = (ROOT / "README.md").read_text()
+    assert "`.ci/run`" in readme and slow in readme
+    conftest = (ROOT / "tests" / "conftest.py").read_text()
+    assert '"--runslow"' in conftest
+
+
 def test_every_dependency_imported_is_declared():
     # a missing install step would pass here (same machine) but fail on a fresh one
     toml = (ROOT / "pyproject.toml").read_text()
     for pkg in ("numpy", "scipy", "scikit-fem", "meshio", "pyvista", "matplotlib", "sympy",
                 "rich"):
         assert f'"{pkg}' in toml, pkg
+
+
+def test_slow_tests_run_only_with_runslow(tmp_path):
+    import shutil
+    import subprocess
+    import sys
+    shutil.copy(ROOT / "tests" / "conftest.py", tmp_path / "conftest.py")
+    (tmp_path / "test_tiers.py").write_text(
+        "import pytest\n\n\ndef test_fast():\n    pass\n\n\n"
+        "@pytest.mark.slow\ndef test_slow():\n    pass\n")
+
+    def outcome(*args):
+        run = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
+                              "-W", "ignore::pytest.PytestUnknownMarkWarning", *args],
+                             cwd=tmp_path, capture_output=True, text=True)
+        return run.returncode, run.stdout.strip().splitlines()[-1]
+
+    code, last = outcome()
+    assert code == 0 and "1 passed, 1 skipped" in last, last
+    code, last = outcome("--runslow")
+    assert code == 0 and "2 passed" in last and "skipped" not in last, last
+    code, last = outcome("--runslow", "-m", "slow")
+    assert code == 0 and "1 passed, 1 deselected" in last, last

@@ -113,8 +113,8 @@ def _swap_in(staging: str, out: str) -> None:
         shutil.rmtree(old, ignore_errors=True)
 
 
-def build_report(*, out=None, quick=False, only=None, jobs=1, progress=None,
-                 scheduler=None) -> int:
+def build_report(*, out=None, quick=False, only=None, jobs=None, progress=None,
+                 scheduler=None, run_timeout=None) -> int:
     """Run the report; returns 0, or 1 if any run failed. Bad input raises before work.
 
     Figures, results.json and index.html are written into a staging folder next to
@@ -125,20 +125,26 @@ def build_report(*, out=None, quick=False, only=None, jobs=1, progress=None,
     its staging folder. ``out`` must be new, empty or a previous report, and its disk and
     the cache must take the output (:mod:`pdverify.outputs`; InputError before work).
     ``scheduler``: a Dask scheduler address; the runs then go to that cluster
-    (:mod:`pdverify.cluster`), which is reached before any work starts.
+    (:mod:`pdverify.cluster`), which is reached before any work starts. ``jobs``: local
+    worker processes (None: the cores available to this process); ``run_timeout``: the
+    seconds after which a run is killed and recorded as failed (None: no limit).
     """
     progress = progress or sys.stderr
     out = outputs.check_out_dir(out or default_out(only, quick))  # links resolved
     cases = plan(only=only, quick=quick)  # raises InputError on unknown scenes
     check_storage(cases, out)
     parent, name = os.path.split(out)
+    if scheduler is not None and run_timeout is not None:
+        raise InputError("--run-timeout applies to the local worker processes; it cannot be "
+                         "combined with --scheduler (or $PDVERIFY_SCHEDULER)")
     client = None
     if scheduler is not None:
         from ..cluster import connect
         client = connect(scheduler)
     try:
         with output_lock(out):
-            return _locked(cases, out, parent, name, jobs, progress, client, quick)
+            return _locked(cases, out, parent, name, jobs, progress, client, quick,
+                           run_timeout)
     finally:
         if client is not None:
             client.close()
@@ -163,7 +169,8 @@ def check_storage(cases, out: str) -> None:
                        f"--out {out!r} (a report of {len(cases)} runs)")
 
 
-def _locked(cases, out, parent, name, jobs, progress, client, quick=False) -> int:
+def _locked(cases, out, parent, name, jobs, progress, client, quick=False,
+            run_timeout=None) -> int:
     """The report's body, under the output lock: stage, build, swap in.
 
     A report that could not be written whole (:class:`OutputError`: a figure, a VTU file,
@@ -184,7 +191,7 @@ def _locked(cases, out, parent, name, jobs, progress, client, quick=False) -> in
             raise OutputError(f"report: cannot write into its staging folder {staging!r} "
                               f"({exc.strerror or exc}); nothing was run") from None
         try:
-            code = _build(cases, staging, out, jobs, progress, client, quick)
+            code = _build(cases, staging, out, jobs, progress, client, quick, run_timeout)
             _write_marker(staging)
         except OutputError as exc:
             keep = True
@@ -282,11 +289,17 @@ def _drawn(what, draw, args, empty, progress):
         return empty
 
 
-def _build(cases, out, final, jobs, progress, client=None, quick=False) -> int:
+def _build(cases, out, final, jobs, progress, client=None, quick=False,
+           run_timeout=None) -> int:
+    from ..schedule import critical_path, previous_times
     t0 = time.perf_counter()
     phase = _Phases()
+    slots = []
     with phase("runs_s"):
-        results = run_cases(cases, jobs=jobs, progress=progress, client=client)
+        # the previous report in this folder times each run, for the longest-first order
+        known = previous_times(os.path.join(final, "results.json"))
+        results = run_cases(cases, jobs=jobs, progress=progress, client=client,
+                            run_timeout=run_timeout, known=known, schedule=slots)
     figdir = os.path.join(out, "figures")
     with phase("figures_s"):
         os.makedirs(figdir, exist_ok=True)
@@ -332,6 +345,8 @@ def _build(cases, out, final, jobs, progress, client=None, quick=False) -> int:
     passed = [r for r in results if r.outcome == "unexpected-pass"]
     from .summary import print_summary
     print_summary(scenes, results, progress)  # one row per scene, before the last line
+    if slots:                                 # the local pool (not a Dask cluster)
+        print(critical_path(slots, cases), file=progress)
     for r in passed:   # strict: a documented failure that no longer happens
         print(f"unexpected pass: {r.scene}/{r.method} is ok, but it is documented to fail "
               f"({r.expected_failure}); update the finding", file=progress)

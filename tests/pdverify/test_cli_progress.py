@@ -151,8 +151,10 @@ def test_report_prints_the_summary_before_its_last_line(tmp_path):
                         only=["bar1d-traction", "sheet2d-clamped"], progress=stream) == 0
     lines = stream.getvalue().splitlines()
     assert lines[-1].startswith("report: ")
+    # the critical path: the last worker's runs, the longest of them named
+    assert lines[-2].startswith("critical path: worker ") and "sheet2d-clamped" in lines[-2]
     head = next(k for k, line in enumerate(lines) if line.startswith("scene "))
-    rows = lines[head + 1:-1]
+    rows = lines[head + 1:-2]
     assert [r.split()[:2] for r in rows] == [["bar1d-traction", "taylor-fictitious"],
                                              ["sheet2d-clamped", "energy-directional"]]
     assert all(LINE.match(line) for line in lines[:head])

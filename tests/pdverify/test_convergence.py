@@ -50,6 +50,7 @@ def quick_report(tmp_path_factory):
         return out, json.load(fh)
 
 
+@pytest.mark.slow  # slow tier (issue 32): its quick report 526 s of the suite's 3811 s (loaded machine)
 def test_every_method_has_a_rate_or_is_exact_in_1d_2d_3d(quick_report):
     out, doc = quick_report
     entries = doc["convergence"]
@@ -75,6 +76,7 @@ def test_every_method_has_a_rate_or_is_exact_in_1d_2d_3d(quick_report):
                        and all(p[k] == v for k, v in level.items()) for sc, m, p in runs), lv
 
 
+@pytest.mark.slow  # slow tier (issue 32): shares the 526 s quick report (loaded machine)
 def test_every_corrected_method_has_a_study(quick_report):
     """Every method of every scene (the FEM reference and missing extras aside) is refined
     in some study, with a rate or as exact: issue 17's 'a fitted rate for every corrected
@@ -86,6 +88,7 @@ def test_every_corrected_method_has_a_study(quick_report):
     assert offered == studied, offered ^ studied
 
 
+@pytest.mark.slow  # slow tier (issue 32): shares the 526 s quick report (loaded machine)
 def test_rates_and_figures_are_in_the_report(quick_report):
     out, doc = quick_report
     page = (out / "index.html").read_text()
