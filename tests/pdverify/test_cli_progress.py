@@ -155,8 +155,11 @@ def test_report_prints_the_summary_before_its_last_line(tmp_path):
     assert lines[-2].startswith("critical path: worker ") and "sheet2d-clamped" in lines[-2]
     head = next(k for k, line in enumerate(lines) if line.startswith("scene "))
     rows = lines[head + 1:-2]
-    assert [r.split()[:2] for r in rows] == [["bar1d-traction", "taylor-fictitious"],
-                                             ["sheet2d-clamped", "energy-directional"]]
+    # the traction bar's best is one of the four treatments exact for its linear field
+    # (their errors are round-off, so which one is smallest is not a property)
+    assert [r.split()[0] for r in rows] == ["bar1d-traction", "sheet2d-clamped"]
+    assert rows[0].split()[1] in {"taylor-fictitious", "surface-nodes", "mirror-nodes", "pddo"}
+    assert rows[1].split()[1] == "energy-directional"
     assert all(LINE.match(line) for line in lines[:head])
 
 

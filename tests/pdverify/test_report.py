@@ -48,9 +48,9 @@ def test_interrupted_write_keeps_the_old_results(tmp_path, monkeypatch):
 
 
 def test_a_failed_run_is_recorded_and_the_report_goes_on(tmp_path, monkeypatch):
-    import pdverify.scenes.bar1d as mod
+    import pdverify.solvers.front as mod      # the bars' none: elimination, its first solve
     from pdverify.errors import NumericalError
-    real = mod.solve_constrained
+    real = mod.solve_with_dirichlet
     calls = {"n": 0}
 
     def sometimes(*a, **k):
@@ -59,7 +59,7 @@ def test_a_failed_run_is_recorded_and_the_report_goes_on(tmp_path, monkeypatch):
             raise NumericalError("bar1d-traction/none: near-singular system")
         return real(*a, **k)
 
-    monkeypatch.setattr(mod, "solve_constrained", sometimes)
+    monkeypatch.setattr(mod, "solve_with_dirichlet", sometimes)
     out = tmp_path / "rep"
     # one worker: the call count lives in the worker process, so only its first run fails
     assert build_report(out=str(out), only=["bar1d-traction"], jobs=1) == 1
