@@ -234,9 +234,15 @@ class Scene:
         if self.closure_theory is None and self.family is None:
             return {}
         from ..corrections.registry import treatments
+        known = treatments()
+        cached = self.__dict__.get("_offered_cache")
+        if cached is not None and cached[0] is known:    # the same registry: same answer
+            return cached[1]
         own = {m.name for m in self.methods}
-        return {k: t for k, t in treatments().items()
-                if k not in own and t.kind != "hand-wired" and t.serves(self)}
+        out = {k: t for k, t in known.items()
+               if k not in own and t.kind != "hand-wired" and t.serves(self)}
+        self.__dict__["_offered_cache"] = (known, out)
+        return out
 
     def bond_methods(self) -> dict:
         """The registry's closure treatments (bond methods) this scene offers."""

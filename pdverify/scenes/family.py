@@ -42,12 +42,19 @@ class StaticStateScene(Scene):
         raise NotImplementedError
 
     def family_refusal(self, treatment) -> str | None:
-        if treatment.whole_faces_only:
-            p = {q.name: q.default for q in self.params}
-            if not self.problem(p, self.id).whole_faces():
-                return (f"{treatment.scope or 'whole-face conditions only'}; this scene "
-                        "prescribes a component on part of a face")
+        if treatment.whole_faces_only and not self._whole_faces():
+            return (f"{treatment.scope or 'whole-face conditions only'}; this scene "
+                    "prescribes a component on part of a face")
         return None
+
+    def _whole_faces(self) -> bool:
+        """Whether the scene's conditions cover whole faces (a property of the scene,
+        not of its params: computed once, from the defaults)."""
+        cached = self.__dict__.get("_whole_faces_cache")
+        if cached is None:
+            p = {q.name: q.default for q in self.params}
+            cached = self.__dict__["_whole_faces_cache"] = self.problem(p, self.id).whole_faces()
+        return cached
 
     # ----------------------------------------------------------------- checks
     def treatment(self, method: str):
