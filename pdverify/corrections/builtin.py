@@ -161,12 +161,6 @@ def hand_wired() -> list[Treatment]:
                   theories=("bond-based",), dims=(1,),
                   scope="1D bond-based bars only (seed 004 derives its factors for the "
                         "triangular micromodulus in 1D)"),
-        Treatment("energy-directional", "seed 003: bond stiffness times (phi(x, e) + "
-                  "phi(x', -e))/2, phi the Eq. (14) ratio of the horizon's radial integral "
-                  "to its truncated part along the bond direction (bond-based)",
-                  "Ritter, Wohlmuth et al. (seed 003)", theories=("bond-based",),
-                  scope="2D bond-based scenes of seed 003 (Eq. 14's factor is derived for "
-                        "the 2D bond-based micromodulus)"),
         Treatment("virtual-nodes", "seed 003 §4.1.2: buffer layers of thickness delta "
                   "outside the clamped edges, displaced rigidly (bond-based)",
                   "seed 003 §4.1.2", theories=("bond-based",),

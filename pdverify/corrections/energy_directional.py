@@ -53,6 +53,32 @@ def directional_closure(grid, lower, upper, horizon, influence, axes=None) -> Cl
     return Closure(bond_factor=bond_factor)
 
 
+def box_factors(model) -> np.ndarray:
+    """The bond factors of :func:`directional_closure` on the model's own box (the grid's
+    ``origin + [0, lengths]``, every face counted), from the built model's bonds: the
+    ``energy-directional`` bond method of the registry on any bond-based box scene.
+
+    The ratio of Eq. (14) is taken with xi^D in D dimensions: a bond-based node's energy
+    under a homogeneous strain is (1/4) s^2 int c(xi) xi^D dxi per direction (the bond
+    energy c s^2 |xi| / 2, halved to each end, times the shell xi^(D-1)), which is the
+    paper's 2D ratio for D = 2 and the same argument in 1D and 3D (our extension).
+    """
+    g = model.grid
+    lower = np.asarray(g.origin, dtype=float)
+    upper = lower + np.asarray(g.lengths, dtype=float)
+    x, n = g.x, model.bond_n
+    fa = directional_factor(x[model.bond_a], n, lower, upper, model.horizon,
+                            model.influence, g.dim)
+    fb = directional_factor(x[model.bond_b], -n, lower, upper, model.horizon,
+                            model.influence, g.dim)
+    return 0.5 * (fa + fb)
+
+
+def energy_directional_closure(params=None) -> Closure:
+    """The registry's ``energy-directional``: :func:`box_factors` on the bond weights."""
+    return Closure(weight_factor=box_factors)
+
+
 def own_factor_energy_density(model, u, lower, upper, horizon, axes=None) -> np.ndarray:
     """W(x_i) of Eq. (5) with c(x_i, xi) = c_b phi(x_i, e) (Eq. 13): each node's energy from
     its own directional factors, W_i = 1/4 sum_j c_b phi(x_i, e_ij) omega beta V_j e^2 / |xi|.

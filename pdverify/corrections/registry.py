@@ -79,6 +79,7 @@ class BondMethod(Treatment):
 def _builtin() -> list[Treatment]:
     from .builtin import family_treatments, hand_wired
     from .energy import energy_closure
+    from .energy_directional import energy_directional_closure
     from .pals import pals_closure
     from .perifit_weights import INSTALL, SCENES, installed_version, perifit_closure
     from .volume import volume_closure
@@ -89,6 +90,14 @@ def _builtin() -> list[Treatment]:
                    "their ends' mean factors, applied to the bond force",
                    "Le and Bobaru, Comput. Mech. 61 (2018) 499-518; Peridynamics.jl",
                    closure=energy_closure),
+        BondMethod("energy-directional", "seed 003: bond stiffness times (phi(x, e) + "
+                   "phi(x', -e))/2, phi the Eq. (14) ratio of the horizon's radial integral "
+                   "to its truncated part along the bond direction, on the scene's box "
+                   "(bond-based; the seed-003 scenes wire it to their own boxes)",
+                   "Ritter, Wohlmuth et al. (seed 003), Eqs. 2, 12-14",
+                   closure=energy_directional_closure, theories=("bond-based",),
+                   scope="bond-based box scenes (Eq. 14's ratio with xi^D: the paper's 2D, "
+                         "our 1D and 3D)"),
         BondMethod("volume", "volume correction 2 V0 / (V_i + V_j) on the bond force (V the "
                    "discrete horizon volume of each end)",
                    "Le and Bobaru 2018; PeriLab, PeriPy, pypd", closure=volume_closure),
