@@ -5,10 +5,11 @@ import numpy as np
 
 from .. import budget
 from ..corrections.energy_directional import directional_closure
+from ..corrections.virtual_nodes import buffered_grid, virtual_nodes_closure
 from ..errors import InputError
 from ..metrics import rel_l2_error
 from ..params import Param, at_least, positive
-from ..pd import BondBasedModel, BoxGrid, Closure, bond_micromodulus, build_stencil, get_influence
+from ..pd import BondBasedModel, BoxGrid, bond_micromodulus, build_stencil, get_influence
 from ..pd.influence import bond_based_nu
 from ..solvers.dense import AUTO_ITERATIVE_UNKNOWNS, SPD_LATTICE_SOLVERS, solve_with_dirichlet
 from ..solvers.iterative import Lattice
@@ -343,11 +344,9 @@ class ClampedSheet(SheetScene):
         with timer.phase("setup"):
             inf = get_influence(p["micromodulus"])
             if method == "virtual-nodes":
-                grid = BoxGrid((L, L + 2 * delta), (-L / 2, -L / 2 - delta), h)
-                y = grid.x[:, 1]
-                top, bottom = np.flatnonzero(y > L / 2), np.flatnonzero(y < -L / 2)
-                closure = (directional_closure(grid, lo, hi, delta, inf, axes=(0,))
-                           if p["correct_sides"] else Closure())
+                grid, bottom, top = buffered_grid(lo, hi, h, delta, axis=1)
+                closure = virtual_nodes_closure(grid, lo, hi, delta, inf, 1,
+                                                p["correct_sides"])
             else:
                 grid = BoxGrid((L, L), lo, h, placement="on-surface",
                                boundary_volume=p["node_volumes"])
