@@ -143,7 +143,7 @@ def published_rows(scene, results) -> list[dict]:
             ours = r.metrics.get(p.metric)
             check = {"equal": "=", "below": "<", "above": ">", "none": ""}[entry["check"]]
             if entry["check"] != "none":
-                check = (f"{check} {_num(entry['target'])}"
+                check = (f"{check} {entry['target']:.7g}"
                          + (f" &plusmn; {entry['tolerance']:.2g}" if entry["tolerance"] else ""))
             rows.append({"method": r.method, "params": _params(r, scene), "metric": p.metric,
                          "ours": _ours(ours, p) if ours is not None else "(none)",
