@@ -209,7 +209,7 @@ def _dispatch(args) -> int:
             raise InputError(f"compare --against-published takes one results file and no "
                              f"{', '.join(extra)}")
         validate.input_file(args.against_published, "results file")
-        from .published import compare_published
+        from .compare import compare_published
         return compare_published(args.against_published)
     if args.command == "compare":
         if args.new is None:
