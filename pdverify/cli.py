@@ -8,6 +8,7 @@ usage:
                           [--scheduler ADDRESS] [--max-memory SIZE] [--run-timeout SECONDS]
   python -m pdverify compare BASELINE.json NEW.json [--rtol R] [--atol A] [--summary FILE]
                           [--force]
+  python -m pdverify compare --against-published RESULTS.json
 
 Exit codes: 0 success; 1 a run failed numerically, a regression was found, or an output
 could not be written after the work (one line naming it; a report stays in its staging
@@ -84,8 +85,11 @@ def build_parser() -> argparse.ArgumentParser:
     rep.add_argument("--run-timeout", type=float, default=None, metavar="SECONDS",
                      help=RUN_TIMEOUT_HELP)
     cmp_ = sub.add_parser("compare", help="compare a results file against a baseline")
-    cmp_.add_argument("baseline", help="the stored results.json")
-    cmp_.add_argument("new", help="the new results.json")
+    cmp_.add_argument("baseline", nargs="?", help="the stored results.json")
+    cmp_.add_argument("new", nargs="?", help="the new results.json")
+    cmp_.add_argument("--against-published", default=None, metavar="RESULTS",
+                      help="instead: check every published entry of RESULTS.json (the "
+                           "papers' numbers, each with its tolerance); exit 1 if one fails")
     cmp_.add_argument("--rtol", type=float, default=None,
                       help="relative threshold of a change (default 1e-3)")
     cmp_.add_argument("--atol", type=float, default=None,
@@ -197,7 +201,20 @@ def _dispatch(args) -> int:
                             jobs=validate.jobs(args.jobs),
                             run_timeout=validate.run_timeout(args.run_timeout),
                             scheduler=scheduler_address(args.scheduler))
+    if args.command == "compare" and args.against_published is not None:
+        extra = [f for f, v in (("BASELINE", args.baseline), ("NEW", args.new),
+                                ("--rtol", args.rtol), ("--atol", args.atol),
+                                ("--summary", args.summary)) if v is not None]
+        if extra:
+            raise InputError(f"compare --against-published takes one results file and no "
+                             f"{', '.join(extra)}")
+        validate.input_file(args.against_published, "results file")
+        from .compare import compare_published
+        return compare_published(args.against_published)
     if args.command == "compare":
+        if args.new is None:
+            raise InputError("compare needs BASELINE.json and NEW.json (or "
+                             "--against-published RESULTS.json)")
         from .compare import compare_files
         for path, what in ((args.baseline, "baseline"), (args.new, "new results")):
             validate.input_file(path, what)

@@ -6,6 +6,7 @@ import math
 import sys
 from dataclasses import dataclass
 
+from . import published
 from .errors import InputError
 from .results import load_results, run_key
 
@@ -237,3 +238,77 @@ def check_unique(doc: dict, path: str, what: str) -> None:
                              f"{r['scene']!r}, method {r['method']!r}, params {key[2]}); a "
                              "results file holds each run once")
         first[key] = k
+
+
+def _pub_fmt(v) -> str:
+    if isinstance(v, bool) or v is None:
+        return "-" if v is None else str(v)
+    if isinstance(v, float):
+        return f"{v:.6g}"
+    return str(v)
+
+
+def _pub_params(params: dict) -> str:
+    return ",".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}"
+                    for k, v in params.items())
+
+
+def format_published(rows: list[dict]) -> str:
+    """The checked entries as a fixed-width table, one line per entry."""
+    table = [("verdict", "scene", "method", "metric", "ours", "paper", "check", "tolerance",
+              "source", "params")]
+    for r in rows:
+        e = r["entry"]
+        check = {"equal": "=", "below": "<", "above": ">", "none": "-"}[e["check"]]
+        if e["check"] != "none" and e.get("target") is not None and "deviation" in e \
+                and not e.get("known_difference"):
+            check += f" {_pub_fmt(e['target'])} ({e['deviation']})"
+        elif e.get("known_difference"):
+            check += f" (known: {e['deviation']})"
+        table.append((r["verdict"], r["scene"], r["method"], e["metric"], _pub_fmt(r["ours"]),
+                      _pub_fmt(e["value"])
+                      + (" [figure]" if e["kind"] == published.FIGURE else ""),
+                      check, _pub_fmt(e.get("tolerance")), e["source"][:50],
+                      _pub_params(r["params"])[:70]))
+    widths = [max(len(row[i]) for row in table) for i in range(len(table[0]))]
+    return "\n".join("  ".join(c.ljust(w) for c, w in zip(row, widths)).rstrip()
+                     for row in table)
+
+
+def compare_published(path: str, *, stream=None) -> int:
+    """``pdverify compare --against-published RESULTS.json``: check every published entry
+    of every run; 0 when all hold (known differences and statements without a number are
+    listed, not failed), 1 when one fails (listed again at the end), bad input (exit 2,
+    :class:`~pdverify.errors.InputError`): a file that is not a results file or holds no
+    published entry."""
+    stream = stream or sys.stdout
+    try:
+        doc = load_results(path)
+    except FileNotFoundError:
+        raise InputError(f"results file {path!r} does not exist") from None
+    except IsADirectoryError:
+        raise InputError(f"results file {path!r} is a folder") from None
+    except PermissionError:
+        raise InputError(f"results file {path!r} cannot be read (permission denied)") from None
+    except ValueError as exc:
+        raise InputError(str(exc)) from None
+    check_unique(doc, path, "results file")
+    rows = [row for run in doc["runs"] for row in published.check_run(run)]
+    if not rows:
+        raise InputError(f"--against-published {path!r}: no run holds a 'published' entry "
+                         "(a results file of a pdverify before published values, or of runs "
+                         "the papers print nothing for)")
+    print(format_published(rows), file=stream)
+    counts = {v: sum(r["verdict"] == v for r in rows)
+              for v in ("holds", "known difference", "not numeric", "fails")}
+    failed = [r for r in rows if r["verdict"] == "fails"]
+    for r in failed:
+        e = r["entry"]
+        print(f"fails: {r['scene']} {r['method']} {_pub_params(r['params'])}: {e['metric']} "
+              f"= {_pub_fmt(r['ours'])}, paper {_pub_fmt(e['value'])} ({e['source']}; check "
+              f"{e['check']} {_pub_fmt(e['target'])} within {_pub_fmt(e['tolerance'])}: "
+              f"{e['tolerance_source']})", file=stream)
+    print(f"compare --against-published: {len(rows)} entries, {counts['holds']} hold, "
+          f"{counts['known difference']} known differences, {counts['not numeric']} not "
+          f"numeric, {counts['fails']} fail", file=stream)
+    return 1 if failed else 0

@@ -37,6 +37,8 @@ class RunResult:
     #: why this run is expected to fail (a documented finding, like pytest's strict
     #: xfail); empty when it is expected to succeed
     expected_failure: str = ""
+    #: the papers' numbers for this method and these params (:mod:`pdverify.published`)
+    published: list = field(default_factory=list)
 
     @property
     def key(self) -> tuple:
@@ -70,6 +72,7 @@ class RunResult:
             "warnings": list(self.warnings),
             **({"files": list(self.files)} if self.files else {}),
             **({"expected_failure": self.expected_failure} if self.expected_failure else {}),
+            **({"published": _plain(self.published)} if self.published else {}),
         }
 
 
@@ -196,7 +199,7 @@ _RUN_FIELDS = {"scene": (str,), "method": (str,), "params": (dict,), "status": (
                "metrics": (dict,)}
 _OPTIONAL_RUN_FIELDS = {"reference": (str,), "message": (str,), "timings": (dict,),
                         "size": (dict,), "diagnostics": (dict,), "warnings": (list,),
-                        "files": (list,), "expected_failure": (str,)}
+                        "files": (list,), "expected_failure": (str,), "published": (list,)}
 _TYPE_NAMES = {str: "a string", dict: "an object", list: "a list"}
 
 
@@ -221,6 +224,10 @@ def check_schema(doc, path) -> None:
             raise ValueError(f"{path}: runs[{k}].status must be 'ok' or 'failed', "
                              f"got {run['status']!r}")
         _check_values(run, f"{path}: runs[{k}]")
+        if "published" in run:
+            from .published import check_entry
+            for j, entry in enumerate(run["published"]):
+                check_entry(entry, f"{path}: runs[{k}].published[{j}]")
         for name, v in run["metrics"].items():
             if isinstance(v, bool) or not isinstance(v, (int, float, str)):
                 raise ValueError(f"{path}: runs[{k}].metrics.{name} must be a number or a "

@@ -84,7 +84,9 @@ def _failed(case, message) -> RunResult:
         params = dict(overrides)
     return RunResult(scene=scene_id, method=method, params=params, reference=scene.reference,
                      status="failed", message=message,
-                     timings={"setup_s": 0.0, "solve_s": 0.0, "total_s": 0.0})
+                     timings={"setup_s": 0.0, "solve_s": 0.0, "total_s": 0.0},
+                     published=[p.entry() for p in
+                                scene.published_for(method, params).values()])
 
 
 def plan(only=None, quick=False) -> list[tuple[str, str, dict]]:

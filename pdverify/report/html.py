@@ -4,6 +4,7 @@ paper's values), the templates hold the markup, and every value is escaped on ou
 from __future__ import annotations
 
 import math
+import re
 
 import jinja2
 from markupsafe import Markup
@@ -12,6 +13,7 @@ from ..convergence import LEVEL_RESULTS
 from ..corrections import describe
 from ..errors import InputError
 from ..papers import PAPERS, seed_of
+from ..published import FIGURE, verdict
 from .summary import default_run, headline, headline_value, summarise
 
 _ENV = jinja2.Environment(
@@ -84,6 +86,24 @@ def _solver_note(diagnostics) -> Markup:
     return _ENV.get_template("macros.html").module.solver_note(_solver(diagnostics))
 
 
+def _ours(value, paper=None) -> str:
+    """Our value with at least one digit more than the paper prints (4.17 -> 4.137,
+    1.0125 -> 1.01250), else 4 significant digits."""
+    if not isinstance(value, float) or paper is None:
+        return _num(value)
+    text = str(paper.value).strip()
+    if re.fullmatch(r"-?\d+\.\d+", text):
+        decimals = len(text.split(".")[1]) + 1
+        if f"{value:.{decimals}f}" != f"{value:.4g}" and abs(value) < 1e6:
+            return f"{value:.{decimals}f}"
+    return _num(value)
+
+
+def _paper_text(p) -> str:
+    """The paper's value as the tables show it: as printed, marked when read off a figure."""
+    return _num(p.value) + (" (read off a figure)" if p.kind == FIGURE else "")
+
+
 def _row(scene, r, metrics) -> dict:
     """What the compact and the full table show of one run."""
     t = r.timings
@@ -92,8 +112,8 @@ def _row(scene, r, metrics) -> dict:
         "ok": r.status == "ok", "method": r.method, "params": _params(r, scene),
         "outcome": r.outcome, "expected": r.expected_failure,
         "message": r.message, "warnings": list(r.warnings),
-        "cells": [{"value": _num(r.metrics.get(m, "")),
-                   "paper": _num(paper[m].value) if m in paper else None,
+        "cells": [{"value": _ours(r.metrics.get(m, ""), paper.get(m)),
+                   "paper": _paper_text(paper[m]) if m in paper else None,
                    "source": paper[m].source if m in paper else ""} for m in metrics],
         "all_metrics": [(k, _num(v)) for k, v in r.metrics.items()],
         "setup": f"{t.get('setup_s', 0):.3g}", "solve": f"{t.get('solve_s', 0):.3g}",
@@ -113,6 +133,42 @@ def _refinement(result) -> dict:
                      + [_num(row.get("extra", {}).get(k, "")) for k in extra] for row in rows]}
 
 
+def published_rows(scene, results) -> list[dict]:
+    """One row per published value of every run that has one: ours beside the paper's,
+    the check and its verdict (:mod:`pdverify.published`), the source and any deviation."""
+    rows = []
+    for r in results:
+        for p in scene.published_for(r.method, r.params).values():
+            entry = p.entry()
+            ours = r.metrics.get(p.metric)
+            check = {"equal": "=", "below": "<", "above": ">", "none": ""}[entry["check"]]
+            if entry["check"] != "none":
+                check = (f"{check} {entry['target']:.7g}"
+                         + (f" &plusmn; {entry['tolerance']:.2g}" if entry["tolerance"] else ""))
+            rows.append({"method": r.method, "params": _params(r, scene), "metric": p.metric,
+                         "ours": _ours(ours, p) if ours is not None else "(none)",
+                         "paper": _num(p.value), "figure": p.kind == FIGURE,
+                         "check": Markup(check), "tolerance_source": entry["tolerance_source"],
+                         "verdict": verdict(entry, ours), "source": p.source,
+                         "deviation": p.deviation, "note": p.note})
+    return rows
+
+
+def missing_published(scene, results) -> list[str]:
+    """The published values that stand beside no run of this report (e.g. at the paper's
+    grid, which the quick report does not run): one phrase each, the runs they need."""
+    out = []
+    for p in scene.published:
+        if any(p.applies(r.method, r.params) for r in results):
+            continue
+        mine = [r for r in results if p.method in (None, r.method)]
+        where = ", ".join(f"{k}={_num(v)}" for k, v in (p.where or {}).items()
+                          if not any(r.params.get(k) == v for r in mine))
+        out.append(f"{p.metric} = {_num(p.value)} ({p.source}; {p.method or 'any method'}"
+                   + (f" at {where}" if where else "") + ")")
+    return list(dict.fromkeys(out))
+
+
 def scene_section(scene, results, figures, deviations=None) -> Markup:
     """A scene's section: the deviations box (default: those of
     :mod:`pdverify.deviations`), the docstring folded, the compact table (at most
@@ -130,7 +186,9 @@ def scene_section(scene, results, figures, deviations=None) -> Markup:
         doc=(type(scene).__doc__ or "").strip(), metrics=metrics,
         rows=[_row(scene, r, metrics) for r in results],
         refinements=[_refinement(r) for r in results if r.fields.get("refinement")],
-        sources=sorted({p.source for p in scene.published}), figures=figures)
+        sources=sorted({p.source for p in scene.published}), figures=figures,
+        published=published_rows(scene, results),
+        missing=missing_published(scene, results) if results else [])
 
 
 def convergence_section(studies, figures) -> Markup:

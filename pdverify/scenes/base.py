@@ -157,16 +157,65 @@ def _applies(method_of, where, method: str, params: Mapping[str, Any]) -> bool:
 
 @dataclass(frozen=True)
 class Published:
-    """A number a paper prints, for the report's 'paper' column."""
+    """A number a paper prints (or that is read off a figure), for the report's 'paper'
+    column and the ``published`` entries of a results file (:mod:`pdverify.published`).
+
+    ``value`` as printed (a number, a fraction "3/2", a bound "< 1", or words); ``kind``
+    ``printed`` or ``read off a figure``. The check: a decimal is equal within half a unit
+    in its last printed digit unless ``tolerance`` (with ``tolerance_source``) says
+    otherwise; ``exact`` values (fractions, closed forms) to round-off; ``bound`` turns
+    words ("machine precision", "non-zero") into a bound (``check``: ``below`` or
+    ``above``), named in ``tolerance_source``. ``deviation``: the key of the
+    :mod:`pdverify.deviations` entry that explains why ours differs; the check then uses
+    ``expected`` (the value that deviation predicts) or, without it, is a known
+    difference (shown, not failed)."""
 
     metric: str
     value: Any
     source: str
     method: str | None = None
     where: Mapping[str, Any] | None = None
+    kind: str = "printed"
+    tolerance: float | None = None
+    tolerance_source: str = ""
+    exact: bool = False
+    bound: float | None = None
+    check: str | None = None
+    deviation: str = ""
+    expected: float | None = None
+    note: str = ""
 
     def applies(self, method: str, params: Mapping[str, Any]) -> bool:
         return _applies(self.method, self.where, method, params)
+
+    def entry(self) -> dict:
+        """The run record's ``published`` entry (:mod:`pdverify.published`)."""
+        from .. import published as pub
+        check, number, tol = pub.parse(self.value)
+        source = pub.DIGITS_SOURCE if check == "equal" else pub.BOUND_SOURCE
+        if self.bound is not None:
+            check, number, tol = self.check or "below", float(self.bound), 0.0
+            source = self.tolerance_source or pub.BOUND_SOURCE
+        if self.expected is not None:
+            number = float(self.expected)
+        if self.exact:
+            tol, source = pub.exact_tolerance(number), pub.EXACT_SOURCE
+        if self.tolerance is not None:
+            tol, source = float(self.tolerance), self.tolerance_source
+        if check == "none":
+            number, tol, source = None, None, "a statement without a number: shown, not checked"
+        elif tol is None:
+            raise ValueError(f"{self.source}: {self.value!r} is exact; say exact=True")
+        value = self.value if isinstance(self.value, (str, int, float)) else str(self.value)
+        out = {"metric": self.metric, "value": value, "source": self.source,
+               "kind": self.kind, "check": check, "target": number, "tolerance": tol,
+               "tolerance_source": source}
+        if self.deviation:
+            out["deviation"] = self.deviation
+            out["known_difference"] = self.expected is None
+        if self.note:
+            out["note"] = self.note
+        return out
 
 
 @dataclass(frozen=True)
@@ -365,7 +414,9 @@ class Scene:
         params = self.resolve(method, overrides)
         result = RunResult(scene=self.id, method=method, params=params, reference=self.reference,
                            expected_failure=next((e.reason for e in self.expected_failures
-                                                  if e.applies(method, params)), ""))
+                                                  if e.applies(method, params)), ""),
+                           published=[p.entry() for p in
+                                      self.published_for(method, params).values()])
         timer = Timer()
         broken = self._broken_plugin(method)
         if broken:

@@ -135,12 +135,15 @@ class Indentation(FemAndPD):
     )
     pd_methods = (("none", ()), ("energy-directional", ()))
     published = (
+        # "about 6 %", "about 30 %": one significant digit, so half a unit in that digit
         Published("force_error_pct", 6, "seed 003 §4.2 (about 6 %)", method="energy-directional",
                   where=NONLINEAR),
         Published("force_bias_pct", -30, "seed 003 §4.2 (about 30 % too soft)", method="none",
-                  where=NONLINEAR),
+                  where=NONLINEAR, tolerance=5.0,
+                  tolerance_source="half a unit in the one printed significant digit "
+                                   "('about 30 %')"),
         Published("failure_depth_mm", 0.4, "seed 003 §4.2 (about 0.4 mm)", method="none",
-                  where=NONLINEAR),
+                  where=NONLINEAR, deviation="003-indentation-failure"),
     )
 
     #: the documented collapses (deviations: seed 003 findings): failures, as expected

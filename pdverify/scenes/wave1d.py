@@ -220,7 +220,7 @@ class Wave1DSurfaceNodes(Scene):
     methods = (SURFACE_NODES, NONE)
     published = (
         Published("max_error_pct", "decreases with m, no number printed", "seed 002 Fig. 5",
-                  method="surface-nodes"),
+                  method="surface-nodes", kind="read off a figure"),
     )
 
     def estimate(self, method, p):

@@ -57,7 +57,8 @@ def test_table12_cells_run_and_carry_the_printed_value(key):
 def test_erratum_cell_reports_five_thirds():
     r = ok(HOMOG.run("none", {"horizon_ratio": 3.0, "end_weight": "half", "nodes": 7}))
     assert r.metrics["strain_factor"] == pytest.approx(5 / 3, abs=1e-12)  # (N+3)/(N-1)
-    assert "5/3" in HOMOG.published_for("none", r.params)["strain_factor"].value
+    pub = HOMOG.published_for("none", r.params)["strain_factor"]
+    assert pub.value == "1.043" and "5/3" in pub.source and pub.expected == pytest.approx(5 / 3)
 
 
 def test_homogenized_at_1001_points_is_classical():

@@ -33,11 +33,23 @@ def _label(r):
     return base
 
 
+def fem_label(fem_kinematics: str) -> str:
+    """The name of a FEM reference curve by its kinematics (a run's ``fem_kinematics``:
+    nonlinear PD is measured against the finite-strain St Venant-Kirchhoff FEM, linear PD
+    against the small-strain FEM)."""
+    if fem_kinematics == "finite":
+        return "FEM, finite strain, St Venant-Kirchhoff"
+    return "FEM, small strain"
+
+
 def _curves(ax, fem, runs, inset=False):
     crossed = inset
     if fem is not None:
         ax.plot(fem["depths"] * 1e3, fem["forces"] / 1e3, "k-", lw=2,
-                label="FEM, small strain (reference)")
+                label=f"{fem['label']} (reference)")
+        if fem.get("small") is not None:
+            ax.plot(fem["depths"] * 1e3, fem["small"] / 1e3, "k--", lw=1,
+                    label=None if inset else "FEM, small strain")
     for r in runs:
         f = r.fields
         color, ls, marker = _style(r)
@@ -58,7 +70,10 @@ def indentation_figures(scene, results, folder):
     runs = [r for r in pd_runs if _paper_grid(r)] or pd_runs
     if not runs:
         return out
-    fem = {"depths": runs[0].fields["fem_depths"], "forces": runs[0].fields["fem_forces"]}
+    kin = runs[0].fields.get("fem_kinematics", "linear")
+    fem = {"depths": runs[0].fields["fem_depths"], "forces": runs[0].fields["fem_forces"],
+           "label": fem_label(kin),
+           "small": runs[0].fields.get("fem_small_forces") if kin == "finite" else None}
     fig, (ax, ax2) = plt.subplots(1, 2, figsize=(13, 5), layout="constrained")
     _curves(ax, fem, runs)
     ax.set_xlabel("indentation depth [mm]")
@@ -86,7 +101,9 @@ def indentation_figures(scene, results, folder):
     ax2.legend(fontsize=8)
     out.append((save(fig, folder, f"{scene.id}-fig4.png"),
                 "Fig. 4 of seed 003: indentation force against depth at the paper's grid "
-                "(161 x 161 nodes, m = 6), FEM (small strain) and PD without correction, with "
+                f"(161 x 161 nodes, m = 6), {fem_label(kin)} (the reference"
+                + ("; dashed: the small-strain FEM" if kin == "finite" else "")
+                + ") and PD without correction, with "
                 "the directional correction and with the energy, volume (and perifit) "
                 "corrections, nonlinear (solid) and linear (dotted) kinematics; "
                 "green crosses: where a run fails (the curve stops at its last equilibrium). "
@@ -115,6 +132,7 @@ def _fig5(scene, r, folder):
         a_ref.set_ylabel("y [mm]")
         fig.colorbar(im, ax=[a_ref, a_pd], shrink=0.8)
     return (save(fig, folder, f"{scene.id}-fig5.png"),
-            "Fig. 5 of seed 003 at 2 mm depth: u_y, u_x and strain-energy density, FEM (left, "
-            "small strain, evaluated at the PD nodes) beside corrected nonlinear PD (right), "
-            "one colour scale per row.")
+            "Fig. 5 of seed 003 at 2 mm depth: u_y, u_x and strain-energy density, "
+            f"{fem_label(f.get('fem_kinematics', 'linear'))} (left, evaluated at the PD "
+            "nodes) beside "
+            "corrected nonlinear PD (right), one colour scale per row.")

@@ -1,0 +1,143 @@
+"""The papers' published numbers in a results file, and the check of each run against them.
+
+A scene's :class:`~pdverify.scenes.base.Published` entries that apply to a run are written
+into its record (``published``, one object per metric): the paper's value as printed, its
+source, whether the paper prints it or it is read off a figure, what is checked (``equal``
+within ``tolerance``, ``below`` or ``above`` a bound, or ``none`` for a statement without
+a number) and where the tolerance comes from. Where our number differs for a recorded
+reason, the entry names the deviation (:mod:`pdverify.deviations`) and either checks the
+value that deviation predicts (``target``) or is a ``known_difference``, shown and not
+failed. ``python -m pdverify compare --against-published RESULTS.json`` checks them all.
+"""
+from __future__ import annotations
+
+import math
+import re
+from fractions import Fraction
+
+PRINTED = "printed"
+FIGURE = "read off a figure"
+KINDS = (PRINTED, FIGURE)
+CHECKS = ("equal", "below", "above", "none")
+
+#: an exact printed value (a fraction, an integer of an exact table, a closed-form 0 or 1)
+#: is checked to round-off: 1e-9 relative (at least 1e-12 absolute) lies far above the
+#: double round-off of these small solves (~1e-15) and far below any real difference
+EXACT_RTOL = 1e-9
+EXACT_ATOL = 1e-12
+EXACT_SOURCE = ("an exact value (fraction or closed form): round-off only, 1e-9 relative "
+                "(at least 1e-12)")
+DIGITS_SOURCE = "half a unit in the last printed digit"
+BOUND_SOURCE = "a bound as printed"
+
+_NUMBER = r"-?\d+(?:\.\d+)?"
+
+
+def printed_text(value) -> str:
+    """The value as the paper prints it (a float by its shortest repr: 4.17, 0.06)."""
+    return repr(value) if isinstance(value, float) else str(value)
+
+
+def _half_unit(text: str) -> float:
+    """Half a unit in the last printed digit of a decimal number's text."""
+    decimals = len(text.split(".", 1)[1]) if "." in text else 0
+    return 0.5 * 10.0 ** -decimals
+
+
+def parse(value) -> tuple[str, float | None, float | None]:
+    """(check, number, tolerance from the printed digits) of a printed value: a decimal
+    number is ``equal`` within half a unit of its last digit, a fraction ``a/b`` is exact
+    (tolerance None: the entry must say so), ``< x`` / ``> x`` are bounds, any other text
+    has no number (``none``). A leading number followed by words in brackets ("0 (u_b =
+    u_a)") is that number."""
+    if isinstance(value, bool):
+        return "none", None, None
+    if isinstance(value, (int, float)):
+        text = printed_text(value)
+        return "equal", float(value), _half_unit(text)
+    text = str(value).strip()
+    m = re.fullmatch(r"([<>])\s*(" + _NUMBER + r")", text)
+    if m:
+        return ("below" if m.group(1) == "<" else "above"), float(m.group(2)), 0.0
+    m = re.fullmatch(r"(-?\d+)/(\d+)", text)
+    if m:
+        return "equal", float(Fraction(int(m.group(1)), int(m.group(2)))), None
+    m = re.fullmatch(r"(" + _NUMBER + r")(?:\s*\(.*\))?", text)
+    if m:
+        return "equal", float(m.group(1)), _half_unit(m.group(1))
+    return "none", None, None
+
+
+def exact_tolerance(value: float) -> float:
+    return max(EXACT_RTOL * abs(value), EXACT_ATOL)
+
+
+def verdict(entry: dict, ours) -> str:
+    """``holds``, ``fails``, ``known difference`` (a named deviation, not failed) or
+    ``not numeric`` (a statement without a number: shown, not checked)."""
+    check = entry.get("check")
+    if check == "none":
+        return "not numeric"
+    number = _number(ours)
+    target = entry.get("target")
+    tol = entry.get("tolerance") or 0.0
+    if number is None or target is None:
+        ok = False
+    elif check == "equal":
+        ok = abs(number - target) <= tol
+    elif check == "below":
+        ok = number < target + tol
+    elif check == "above":
+        ok = number > target - tol
+    else:
+        ok = False
+    if ok:
+        return "holds"
+    return "known difference" if entry.get("known_difference") else "fails"
+
+
+def _number(value) -> float | None:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return None
+    v = float(value)
+    return v if math.isfinite(v) else None
+
+
+#: what a published entry of a results file must hold (key -> allowed types)
+ENTRY_FIELDS = {"metric": (str,), "value": (str, int, float), "source": (str,), "kind": (str,),
+                "check": (str,)}
+OPTIONAL_ENTRY_FIELDS = {"target": (int, float, type(None)), "tolerance": (int, float, type(None)),
+                         "tolerance_source": (str,), "deviation": (str,),
+                         "known_difference": (bool,), "note": (str,)}
+
+
+def check_entry(entry, where: str) -> None:
+    """Raise ValueError naming ``where`` and the first field of a published entry that
+    breaks the results schema."""
+    if not isinstance(entry, dict):
+        raise ValueError(f"{where} must be an object, got {type(entry).__name__}")
+    for name in ENTRY_FIELDS:
+        if name not in entry:
+            raise ValueError(f"{where} has no {name!r}")
+    for name, types in {**ENTRY_FIELDS, **OPTIONAL_ENTRY_FIELDS}.items():
+        if name in entry and (not isinstance(entry[name], types)
+                              or (isinstance(entry[name], bool) and bool not in types)):
+            raise ValueError(f"{where}.{name} has the wrong type ({type(entry[name]).__name__})")
+    if entry["kind"] not in KINDS:
+        raise ValueError(f"{where}.kind must be one of {', '.join(KINDS)}, got {entry['kind']!r}")
+    if entry["check"] not in CHECKS:
+        raise ValueError(f"{where}.check must be one of {', '.join(CHECKS)}, "
+                         f"got {entry['check']!r}")
+    if entry["check"] != "none" and not isinstance(entry.get("target"), (int, float)):
+        raise ValueError(f"{where}: check {entry['check']!r} needs a numeric 'target'")
+
+
+def check_run(run: dict) -> list[dict]:
+    """One row per published entry of a results-file run: the entry, ours and the verdict."""
+    rows = []
+    for entry in run.get("published", []):
+        ours = run.get("metrics", {}).get(entry["metric"])
+        rows.append({"scene": run["scene"], "method": run["method"], "params": run["params"],
+                     "entry": entry, "ours": ours, "verdict": verdict(entry, ours)})
+    return rows
+
