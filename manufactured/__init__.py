@@ -9,6 +9,7 @@ for importing sympy.
 
 def __getattr__(name):
     if name in ("solution", "engine"):
-        from . import engine
+        import importlib
+        engine = importlib.import_module(f"{__name__}.engine")
         return engine.solution if name == "solution" else engine
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

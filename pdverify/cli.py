@@ -4,7 +4,8 @@ usage:
   python -m pdverify list [SCENE] [--json]                  scenes, their methods, parameters
   python -m pdverify run SCENE [--method M] [--set KEY=VALUE ...] [--json FILE]
                           [--vtu FILE] [--force] [--max-memory SIZE] [--run-timeout SECONDS]
-  python -m pdverify report [--out DIR] [--quick] [--only SCENE ...] [--jobs N]
+  python -m pdverify report [--out DIR] [--quick] [--only SCENE ...] [--method M ...]
+                          [--failed] [--jobs N]
                           [--scheduler ADDRESS] [--max-memory SIZE] [--run-timeout SECONDS]
   python -m pdverify compare BASELINE.json NEW.json [--rtol R] [--atol A] [--summary FILE]
                           [--force]
@@ -100,6 +101,12 @@ def build_parser() -> argparse.ArgumentParser:
                      help="smaller sweeps of the expensive scenes")
     rep.add_argument("--only", nargs="+", default=None, metavar="SCENE",
                      help="run only these scenes (each once)")
+    rep.add_argument("--method", nargs="+", default=None, metavar="M", dest="methods",
+                     help="run only these methods (on the selected scenes)")
+    rep.add_argument("--failed", action="store_true",
+                     help="rerun only the runs that failed or were missing in the previous "
+                          "report in the output folder, and merge them into it (exit 2 if "
+                          "there is no previous report there)")
     rep.add_argument("--jobs", type=int, default=None,
                      help="worker processes, 1 to the number of CPUs (default: the cores "
                           "available to this process)")
@@ -227,10 +234,12 @@ def _dispatch(args) -> int:
     if args.command == "report":
         from .report import build_report, default_out
         only = validate.only(args.only)
-        out = validate.output_dir(default_out(only, args.quick) if args.out is None
+        methods = validate.methods(args.methods)
+        out = validate.output_dir(default_out(only, args.quick, methods) if args.out is None
                                   else args.out)
         from .cluster import scheduler_address
-        return build_report(out=out, quick=args.quick, only=only,
+        return build_report(out=out, quick=args.quick, only=only, methods=methods,
+                            failed=args.failed,
                             jobs=validate.jobs(args.jobs),
                             run_timeout=validate.run_timeout(args.run_timeout),
                             scheduler=scheduler_address(args.scheduler))
