@@ -132,25 +132,34 @@ class RunProgress:
         return time.monotonic() - self.t0
 
     def predicted(self) -> list[float | None]:
-        """Each case's predicted seconds: its cost (:attr:`costs`) times the seconds per
-        unit of cost that the finished runs of the same kind took (ratio of the sums, so
-        the long runs weigh most; 1 for previous times before any of them finished); a
-        case without a cost, or whose kind has no finished run yet, the mean run time
-        of the finished runs; None before any run finished."""
-        scale = {}
-        for kind in ("known", "size"):
-            pairs = [(self._took[k], c) for k, (kd, c) in enumerate(self.costs)
-                     if kd == kind and k in self._took and c]
-            total = sum(c for _, c in pairs)
-            if total > 0:
-                scale[kind] = sum(t for t, _ in pairs) / total
-            elif kind == "known":
-                scale[kind] = 1.0
+        """Each case's predicted seconds from its cost (:attr:`costs`), calibrated by the
+        finished runs (ratios of sums, so the long runs weigh most):
+
+        - a previous time: times the ratio of this report's to the previous report's
+          times over the finished runs that have one (1 before any finished);
+        - a size (the budget's model, in its own unit): times the seconds per unit of
+          the finished runs of the same scene (a size is comparable within a scene only:
+          across scenes, fixed costs that the model does not see dominate small runs);
+        - otherwise, or before a run of that scene finished: the mean finished run time;
+          None before any run finished."""
+        known = [(self._took[k], c) for k, (kd, c) in enumerate(self.costs)
+                 if kd == "known" and k in self._took and c]
+        total = sum(c for _, c in known)
+        speed = sum(t for t, _ in known) / total if total > 0 else 1.0
+        per_scene: dict[str, list[float]] = {}
+        for k, (kind, cost) in enumerate(self.costs):
+            if kind == "size" and k in self._took and cost:
+                acc = per_scene.setdefault(self.cases[k][0], [0.0, 0.0])
+                acc[0] += self._took[k]
+                acc[1] += cost
         mean = sum(self.durations) / len(self.durations) if self.durations else None
         out = []
-        for kind, cost in self.costs:
-            if kind in scale and cost is not None:
-                out.append(cost * scale[kind])
+        for k, (kind, cost) in enumerate(self.costs):
+            acc = per_scene.get(self.cases[k][0])
+            if kind == "known" and cost is not None:
+                out.append(cost * speed)
+            elif kind == "size" and cost and acc and acc[1] > 0:
+                out.append(cost * acc[0] / acc[1])
             else:
                 out.append(mean)
         return out
