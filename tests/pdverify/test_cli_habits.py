@@ -322,8 +322,11 @@ def test_the_schema_file_is_package_data():
 
 # ------------------------------------------------------------------ sympy only when used
 
-@pytest.mark.parametrize("args", [["--version"], ["list"], ["run", "bar1d-traction"]])
-def test_sympy_is_not_imported_by_the_commands(args):
+@pytest.mark.parametrize("args", [["--version"], ["list"], ["run", "bar1d-traction"],
+                                  ["report", "--quick", "--only", "bar1d-traction", "--out",
+                                   "TMP"]])
+def test_sympy_is_not_imported_by_the_commands(args, tmp_path):
+    args = [str(tmp_path / "rep") if a == "TMP" else a for a in args]
     code = ("import sys, contextlib, io\nfrom pdverify.cli import main\n"
             "with contextlib.redirect_stdout(io.StringIO()):\n"
             f"    try: main({args!r})\n    except SystemExit: pass\n"
@@ -410,3 +413,21 @@ def test_case_costs_use_the_previous_times_then_the_size_model():
     costs = case_costs(cases, {key: 3.5})
     assert costs[0] == ("known", 3.5)
     assert costs[1][0] in ("size", None)
+
+
+def test_eta_calibrates_a_size_within_its_scene_only(monkeypatch):
+    from pdverify import progress
+    clock = {"t": 0.0}
+    monkeypatch.setattr(progress.time, "monotonic", lambda: clock["t"])
+    cases = [("bar", "a", {}), ("sheet", "b", {}), ("sheet", "c", {}), ("bar", "d", {})]
+    costs = [("size", 1.0), ("size", 1000.0), ("size", 4000.0), ("size", 2.0)]
+    shown = progress.RunProgress(cases, 1, None, costs=costs)
+    shown.started(0)
+    clock["t"] = 0.5                        # a small bar run: 0.5 s per unit of size
+    shown.finished(0, _Res())
+    # d: 2 units x 0.5 s; b and c: no sheet run done, the mean (0.5 s), not 500 s / 2000 s
+    assert shown.eta() == pytest.approx(0.5 + 0.5 + 2 * 0.5)
+    shown.started(1)
+    clock["t"] = 10.5                       # b, 1000 units, took 10 s: c is 4x that
+    shown.finished(1, _Res())
+    assert shown.eta() == pytest.approx(40.0 + 1.0)
