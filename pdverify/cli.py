@@ -1,10 +1,11 @@
 """pdverify: verification suite for peridynamic boundary corrections.
 
 usage:
-  python -m pdverify list                                   scenes and their methods
+  python -m pdverify list [SCENE] [--json]                  scenes, their methods, parameters
   python -m pdverify run SCENE [--method M] [--set KEY=VALUE ...] [--json FILE]
                           [--vtu FILE] [--force] [--max-memory SIZE] [--run-timeout SECONDS]
-  python -m pdverify report [--out DIR] [--quick] [--only SCENE ...] [--jobs N]
+  python -m pdverify report [--out DIR] [--quick] [--only SCENE ...] [--method M ...]
+                          [--failed] [--jobs N]
                           [--scheduler ADDRESS] [--max-memory SIZE] [--run-timeout SECONDS]
   python -m pdverify compare BASELINE.json NEW.json [--rtol R] [--atol A] [--summary FILE]
                           [--force]
@@ -39,7 +40,29 @@ FORCE_HELP = ("replace an existing output file that pdverify did not write (neve
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message):  # argparse's own usage errors: one line, exit 2
-        raise InputError(message)
+        raise InputError(message + _suggestion(self, message))
+
+
+def _suggestion(parser, message) -> str:
+    """Close matches of a mistyped command (``invalid choice: 'reprot'``) or flag
+    (``unrecognized arguments: --metod``) among the commands or every flag."""
+    import re
+    from .errors import did_you_mean
+    choice = re.search(r"invalid choice: '([^']*)' \(choose from (.*)\)", message)
+    if choice:
+        return did_you_mean(choice.group(1), re.findall(r"'([^']*)'", choice.group(2)))
+    flags = re.match(r"unrecognized arguments: (\S+)", message)
+    if flags and flags.group(1).startswith("--"):
+        known = set()
+        for action in parser._actions:
+            known.update(action.option_strings)
+            for sub in (getattr(action, "choices", None) or {}).values():
+                if isinstance(sub, argparse.ArgumentParser):
+                    for a in sub._actions:
+                        known.update(a.option_strings)
+        flag = flags.group(1).split("=")[0]
+        return "" if flag in known else did_you_mean(flag, sorted(known))
+    return ""
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -47,8 +70,13 @@ def build_parser() -> argparse.ArgumentParser:
                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"pdverify {__version__}")
     sub = parser.add_subparsers(dest="command", parser_class=_Parser)
-    sub.add_parser("list", help="list scenes, methods and parameters "
-                                "(name=default {allowed values})")
+    lst = sub.add_parser("list", help="list scenes, methods and parameters "
+                                      "(name=default unit {allowed values})")
+    lst.add_argument("scene", nargs="?", default=None,
+                     help="show this scene only: its parameters with units and meaning, its "
+                          "methods, and why the others are not offered")
+    lst.add_argument("--json", action="store_true",
+                     help="print the listing as JSON (schema pdverify.list/1)")
     run = sub.add_parser("run", help="run one scene with one method")
     run.add_argument("scene", help="scene id (see: python -m pdverify list)")
     run.add_argument("--method", default=None,
@@ -74,6 +102,12 @@ def build_parser() -> argparse.ArgumentParser:
                      help="smaller sweeps of the expensive scenes")
     rep.add_argument("--only", nargs="+", default=None, metavar="SCENE",
                      help="run only these scenes (each once)")
+    rep.add_argument("--method", nargs="+", default=None, metavar="M", dest="methods",
+                     help="run only these methods (on the selected scenes)")
+    rep.add_argument("--failed", action="store_true",
+                     help="rerun only the runs that failed or were missing in the previous "
+                          "report in the output folder, and merge them into it (exit 2 if "
+                          "there is no previous report there)")
     rep.add_argument("--jobs", type=int, default=None,
                      help="worker processes, 1 to the number of CPUs (default: the cores "
                           "available to this process)")
@@ -171,10 +205,20 @@ def main(argv=None) -> int:
 
 def _dispatch(args) -> int:
     if args.command == "list":
-        from .listing import format_listing, format_matrix
-        print(format_listing())
-        print()
-        print(format_matrix())
+        from .listing import format_listing, format_matrix, format_scene, listing_json
+        scenes = None
+        if args.scene is not None:
+            from .scenes import get_scene
+            scenes = [get_scene(args.scene)]      # an unknown scene: exit 2, close matches
+        if args.json:
+            import json
+            print(json.dumps(listing_json(scenes), indent=1))
+        elif scenes:
+            print(format_scene(scenes[0]))
+        else:
+            print(format_listing())
+            print()
+            print(format_matrix())
         return 0
     from . import validate
     if args.command in ("run", "report"):
@@ -194,10 +238,12 @@ def _dispatch(args) -> int:
     if args.command == "report":
         from .report import build_report, default_out
         only = validate.only(args.only)
-        out = validate.output_dir(default_out(only, args.quick) if args.out is None
+        methods = validate.methods(args.methods)
+        out = validate.output_dir(default_out(only, args.quick, methods) if args.out is None
                                   else args.out)
         from .cluster import scheduler_address
-        return build_report(out=out, quick=args.quick, only=only,
+        return build_report(out=out, quick=args.quick, only=only, methods=methods,
+                            failed=args.failed,
                             jobs=validate.jobs(args.jobs),
                             run_timeout=validate.run_timeout(args.run_timeout),
                             scheduler=scheduler_address(args.scheduler))

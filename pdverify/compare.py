@@ -144,21 +144,43 @@ def _is_nan(v) -> bool:
     return isinstance(v, float) and math.isnan(v)
 
 
-def _short_params(params_json: str) -> str:
+def _short_params(params_json: str, scene: str | None = None, method: str | None = None,
+                  defaults=current_defaults) -> str:
+    """The run's parameters that differ from the current defaults of (scene, method)
+    (``defaults``; every parameter when the scene or method is gone), ``defaults`` when
+    none differs: the parameter that tells two runs apart stays visible."""
     params = json.loads(params_json)
+    if scene is not None:
+        base = {k: v for k, v in _plain_defaults(defaults(scene, method)).items()}
+        if base:
+            params = {k: v for k, v in params.items() if k not in base or base[k] != v}
+            if not params:
+                return "defaults"
     return ",".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in params.items())
 
 
-def format_changes(changes: list[Change]) -> str:
+def _plain_defaults(values: dict) -> dict:
+    """Defaults as results.json writes them (so that 1e9 compares with 1000000000.0)."""
+    from .results import _plain
+    return _plain(values)
+
+
+def format_changes(changes: list[Change], defaults=current_defaults) -> str:
+    """The changes as a text table; ``params`` shows each run's parameters that differ
+    from the defaults (:func:`_short_params`)."""
     if not changes:
         return "no changes beyond the thresholds"
-    rows = [("verdict", "scene", "method", "params", "metric", "baseline", "new")]
+    rows = [("verdict", "scene", "method", "params (not default)", "metric", "baseline", "new")]
     for c in changes:
         fmt = (lambda v: f"{v:.6g}" if isinstance(v, float) else str(v))
-        rows.append((c.verdict, c.scene, c.method, _short_params(c.params), c.metric,
+        rows.append((c.verdict, c.scene, c.method,
+                     _short_params(c.params, c.scene, c.method, defaults), c.metric,
                      fmt(c.old), fmt(c.new)))
-    widths = [min(max(len(r[i]) for r in rows), 90) for i in range(len(rows[0]))]
-    return "\n".join("  ".join(cell[:90].ljust(w) for cell, w in zip(row, widths)) for row in rows)
+    # the params column is never cut: it shows only what differs from the defaults
+    widths = [max(len(r[i]) for r in rows) if i == 3 else min(max(len(r[i]) for r in rows), 90)
+              for i in range(len(rows[0]))]
+    return "\n".join("  ".join((cell if i == 3 else cell[:90]).ljust(w)
+                                for i, (cell, w) in enumerate(zip(row, widths))) for row in rows)
 
 
 def summary_text(changes: list[Change], path: str, baseline: str, new: str) -> str:
@@ -174,11 +196,12 @@ def summary_text(changes: list[Change], path: str, baseline: str, new: str) -> s
     lines = [f"# pdverify compare: {n_reg} regression(s), {len(changes) - n_reg} other change(s)",
              "", f"baseline `{baseline}`, new `{new}`", ""]
     if changes:
-        lines += ["| verdict | scene | method | params | metric | baseline | new |",
+        lines += ["| verdict | scene | method | params (not default) | metric | baseline | new |",
                   "|---|---|---|---|---|---|---|"]
         for c in changes:
             fmt = (lambda v: f"{v:.6g}" if isinstance(v, float) else str(v))
-            lines.append(f"| {c.verdict} | {c.scene} | {c.method} | {_short_params(c.params)} "
+            lines.append(f"| {c.verdict} | {c.scene} | {c.method} "
+                         f"| {_short_params(c.params, c.scene, c.method)} "
                          f"| {c.metric} | {fmt(c.old)} | {fmt(c.new)} |")
     return "\n".join(lines) + "\n"
 

@@ -37,3 +37,16 @@ class OutputError(RuntimeError):
     exits with code 1. Nothing is published half-written: a report stays in its staging
     folder, a results file keeps its previous content.
     """
+
+
+def did_you_mean(name, allowed) -> str:
+    """``" (did you mean a or b?)"`` naming the close matches of a mistyped ``name`` among
+    ``allowed`` (difflib's similarity ratio >= 0.75, case ignored, at most three, best
+    first), else ``""``: put right after the mistyped name in a one-line bad-input
+    message."""
+    import difflib
+    by_lower = {}
+    for a in allowed:
+        by_lower.setdefault(str(a).lower(), str(a))
+    close = difflib.get_close_matches(str(name).lower(), list(by_lower), n=3, cutoff=0.75)
+    return f" (did you mean {' or '.join(by_lower[c] for c in close)}?)" if close else ""

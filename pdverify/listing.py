@@ -10,9 +10,9 @@ def _fmt(value) -> str:
 
 
 def format_param(p) -> str:
-    """``name=default``, and the allowed values of a choice param: ``plane=strain
-    {strain|stress}``."""
-    text = f"{p.name}={_fmt(p.default)}"
+    """``name=default``, its unit if physical (``E=1e+09 Pa``), and the allowed values of
+    a choice param: ``plane=strain {strain|stress}``."""
+    text = f"{p.name}={_fmt(p.default)}" + (f" {p.unit}" if p.unit else "")
     if p.choices:
         text += " {" + "|".join(_fmt(c) for c in p.choices) + "}"
     return text
@@ -86,3 +86,58 @@ def format_matrix() -> str:
     for name, why in BROKEN.items():
         lines.append(f"plugin {name}: failed to load ({why})")
     return "\n".join(lines)
+
+
+def format_scene(scene) -> str:
+    """``pdverify list SCENE``: one scene's parameters (default, unit, allowed values and
+    meaning), its methods with their own parameters, and why each registered method it
+    does not offer is missing."""
+    lines = [f"{scene.id}: {scene.title}",
+             f"  seed {scene.seed}; reference: {scene.reference}"
+             + (f"; {scene.dim}D" if scene.dim else ""),
+             "  params (name=default unit {allowed}: meaning):"]
+    lines += [f"    {format_param(p)}: {p.doc}" for p in scene.params]
+    lines.append("  methods:")
+    for m in scene.all_methods:
+        tag = " (default)" if m.name == scene.default_method else ""
+        lines.append(f"    {m.name}{tag}" + (f"  - {describe(m.name)}" if describe(m.name)
+                                               else ""))
+        own = {p.name for p in scene.params}
+        lines += [f"        {format_param(p)}: {p.doc}" for p in m.params if p.name not in own]
+    missing = [(name, why) for (name, why), ids in empty_cells([scene]).items()]
+    if missing:
+        lines.append("  not offered here (method: reason):")
+        lines += [f"    {name}: {why}" for name, why in missing]
+    return "\n".join(lines)
+
+
+#: the schema of ``pdverify list --json``
+LIST_SCHEMA = "pdverify.list/1"
+
+
+def _param_json(p) -> dict:
+    from .results import _plain
+    return {"name": p.name, "default": _plain(p.default), "type": p.kind.__name__,
+            "unit": p.unit or None, "choices": None if p.choices is None else _plain(
+                list(p.choices)), "doc": p.doc}
+
+
+def listing_json(scenes=None) -> dict:
+    """``pdverify list [SCENE] --json``: the scenes (all, or ``scenes``), each with its
+    parameters, methods (with their own parameters) and the methods it does not offer
+    with the reason, for another program to read."""
+    scenes = all_scenes() if scenes is None else scenes
+    out = []
+    for scene in scenes:
+        own = {p.name for p in scene.params}
+        out.append({
+            "id": scene.id, "title": scene.title, "seed": scene.seed,
+            "reference": scene.reference, "dim": scene.dim,
+            "default_method": scene.default_method,
+            "params": [_param_json(p) for p in scene.params],
+            "methods": [{"name": m.name, "description": describe(m.name) or None,
+                         "params": [_param_json(p) for p in m.params if p.name not in own]}
+                        for m in scene.all_methods],
+            "not_offered": {name: why for (name, why) in empty_cells([scene])},
+        })
+    return {"schema": LIST_SCHEMA, "scenes": out}

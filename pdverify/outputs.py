@@ -39,6 +39,10 @@ CACHE_ENV = "PDVERIFY_CACHE_DIR"
 #: figures/ and fields/ hold only files with these endings.
 _LEGACY_TOP = {"results.json", "index.html", "figures", "fields"}
 _LEGACY_EXT = {"figures": (".png", ".svg", ".gif", ".html"), "fields": (".vtu",)}
+#: What a report writes at its top level beyond the legacy shape (issue 34): the CSV of
+#: each scene's runs and the log of the progress lines. A staging folder of a killed
+#: report may hold them (:func:`is_own_leftover`).
+REPORT_EXTRA = {"tables", "report.log"}
 _RESULTS_HEAD = '{\n "schema": "pdverify.results/1"'
 _COMPARE_HEAD = '{\n "schema": "pdverify.compare/1"'
 #: a compare --summary JSON written before it carried a schema
@@ -221,7 +225,8 @@ def is_own_leftover(path: str) -> bool:
     That is a complete report (its marker lists everything in it), an empty folder, or a
     folder whose top level holds only what a report writes while it runs (results.json,
     index.html, figures/, fields/, atomic writes' .tmp-* files and the marker, which a
-    staging folder gets first and which lists its files only at the end)."""
+    staging folder gets first and which lists its files only at the end, and the
+    :data:`REPORT_EXTRA` tables/ and report.log)."""
     if os.path.islink(path) or not os.path.isdir(path):
         return False
     state, _ = folder_state(path)
@@ -233,7 +238,8 @@ def is_own_leftover(path: str) -> bool:
         return False
     if MARKER in entries and read_marker(path) is None:
         return False
-    return all(e in _LEGACY_TOP or e == MARKER or e.startswith(".tmp-") for e in entries)
+    return all(e in _LEGACY_TOP or e in REPORT_EXTRA or e == MARKER or e.startswith(".tmp-")
+               for e in entries)
 
 
 def check_out_dir(path, flag: str = "--out", inputs=()) -> str:

@@ -6,12 +6,14 @@ import re
 from dataclasses import dataclass
 from typing import Any, Callable, Mapping
 
-from .errors import InputError
+from .errors import InputError, did_you_mean
 
 Check = Callable[[Any], "str | None"]
 #: what an integer parameter may be written as: decimal digits, an optional fraction that is
 #: zero and an exponent (200, 2e2, 200.0); not 0x2, 0b10, 1_000
 _DECIMAL = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
+#: a unit in a parameter's doc: ``[m]``, ``[Pa]``, ``[kg/m^3]``, ``[N/m^4]``
+_UNIT = re.compile(r"\[([A-Za-z][A-Za-z0-9^/*. -]{0,15})\]")
 
 
 @dataclass(frozen=True)
@@ -31,6 +33,16 @@ class Param:
     @property
     def kind(self) -> type:
         return type(self.default)
+
+    @property
+    def unit(self) -> str:
+        """The physical unit the declaration names in its ``doc`` (its first ``[...]``,
+        e.g. ``"Pa"`` for ``"Young's modulus [Pa]"``); ``""`` for a dimensionless or
+        non-numeric parameter."""
+        if self.kind not in (int, float):
+            return ""
+        found = _UNIT.search(self.doc)
+        return found.group(1) if found else ""
 
     def convert(self, raw: Any, where: str) -> Any:
         kind = self.kind
@@ -77,7 +89,9 @@ class Param:
             raise InputError(f"{where}: {self.name}={raw!r} must be a finite number")
         if self.choices is not None and value not in self.choices:
             allowed = ", ".join(str(c) for c in self.choices)
-            raise InputError(f"{where}: {self.name}={raw!r} is not allowed; allowed: {allowed}")
+            hint = did_you_mean(raw, self.choices) if isinstance(raw, str) else ""
+            raise InputError(f"{where}: {self.name}={raw!r} is not allowed{hint}; "
+                             f"allowed: {allowed}")
         if self.check is not None:
             problem = self.check(value)
             if problem:
@@ -132,7 +146,8 @@ def resolve(specs: tuple[Param, ...], overrides: Mapping[str, Any], where: str) 
     unknown = [k for k in overrides if k not in by_name]
     if unknown:
         allowed = ", ".join(sorted(by_name)) or "(none)"
-        raise InputError(f"{where}: unknown key {unknown[0]!r}; allowed: {allowed}")
+        raise InputError(f"{where}: unknown key {unknown[0]!r}"
+                         f"{did_you_mean(unknown[0], by_name)}; allowed: {allowed}")
     values = {p.name: p.default for p in specs}
     for key, raw in overrides.items():
         values[key] = by_name[key].convert(raw, where)

@@ -6,6 +6,7 @@ Display only: nothing here computes a result. :func:`pdverify.runner.run_cases` 
 """
 from __future__ import annotations
 
+import os
 import threading
 import time
 
@@ -13,6 +14,41 @@ import time
 SHOWN_IN_FLIGHT = 8
 #: how often the local pool wakes to refresh the live display's clock [s]
 TICK_S = 0.25
+#: on a non-terminal, a heartbeat line names the runs in flight at least this often [s]
+#: while no run finishes (CI kills a job silent for 10 minutes; a log should show life)
+HEARTBEAT_S = 60.0
+#: the environment variable that sets another heartbeat interval in seconds (tests)
+HEARTBEAT_ENV = "PDVERIFY_HEARTBEAT_S"
+
+
+def heartbeat_interval() -> float:
+    """:data:`HEARTBEAT_S`, or ``$PDVERIFY_HEARTBEAT_S`` when it is a positive number."""
+    try:
+        value = float(os.environ.get(HEARTBEAT_ENV, ""))
+    except ValueError:
+        return HEARTBEAT_S
+    return value if value > 0 and value == value else HEARTBEAT_S
+
+
+class Tee:
+    """A text stream that writes to ``stream`` and to the report's log file ``log``; a
+    terminal when ``stream`` is (the live display draws on ``stream`` only, and the log
+    gets the plain lines)."""
+
+    def __init__(self, stream, log):
+        self.stream, self.log = stream, log
+
+    def write(self, text):
+        self.stream.write(text)
+        self.log.write(text)
+        return len(text)
+
+    def flush(self):
+        self.stream.flush()
+        self.log.flush()
+
+    def isatty(self):
+        return is_terminal(self.stream)
 
 
 def is_terminal(stream) -> bool:
@@ -64,12 +100,22 @@ class RunProgress:
     """
 
     def __init__(self, cases, workers: int, stream, *, auto_refresh: bool = False,
-                 line=None):
+                 line=None, costs=None, heartbeat_s=None):
         self.cases = list(cases)
         self.total = len(self.cases)
         self.workers = max(1, int(workers or 1))
         self.stream = stream
         self.live = stream is not None and is_terminal(stream)
+        #: the report's log (a :class:`Tee`'s file): the plain lines, also under the live
+        #: display
+        self.log = getattr(stream, "log", None)
+        #: each case's predicted cost (:func:`pdverify.schedule.case_costs`): ("known",
+        #: its seconds in the previous report), ("size", the budget's size model in its
+        #: own unit) or (None, None)
+        self.costs = list(costs) if costs is not None else [(None, None)] * self.total
+        self.heartbeat_s = heartbeat_interval() if heartbeat_s is None else heartbeat_s
+        self._next_beat = time.monotonic() + self.heartbeat_s
+        self._beats = None      # the heartbeat thread of the cluster path
         self.auto_refresh = auto_refresh
         self.line = line or (lambda k, res: describe(self.cases[k]))
         self.t0 = time.monotonic()
@@ -77,6 +123,7 @@ class RunProgress:
         self.failed = 0
         self.in_flight: dict[int, float | None] = {}  # case index -> start time, if known
         self.durations: list[float] = []
+        self._took: dict[int, float] = {}     # case index -> its run time
         self._lock = threading.Lock()
         self._live = None
 
@@ -84,14 +131,54 @@ class RunProgress:
     def elapsed(self) -> float:
         return time.monotonic() - self.t0
 
+    def predicted(self) -> list[float | None]:
+        """Each case's predicted seconds from its cost (:attr:`costs`), calibrated by the
+        finished runs (ratios of sums, so the long runs weigh most):
+
+        - a previous time: times the ratio of this report's to the previous report's
+          times over the finished runs that have one (1 before any finished);
+        - a size (the budget's model, in its own unit): times the seconds per unit of
+          the finished runs of the same scene (a size is comparable within a scene only:
+          across scenes, fixed costs that the model does not see dominate small runs);
+        - otherwise, or before a run of that scene finished: the mean finished run time;
+          None before any run finished."""
+        known = [(self._took[k], c) for k, (kd, c) in enumerate(self.costs)
+                 if kd == "known" and k in self._took and c]
+        total = sum(c for _, c in known)
+        speed = sum(t for t, _ in known) / total if total > 0 else 1.0
+        per_scene: dict[str, list[float]] = {}
+        for k, (kind, cost) in enumerate(self.costs):
+            if kind == "size" and k in self._took and cost:
+                acc = per_scene.setdefault(self.cases[k][0], [0.0, 0.0])
+                acc[0] += self._took[k]
+                acc[1] += cost
+        mean = sum(self.durations) / len(self.durations) if self.durations else None
+        out = []
+        for k, (kind, cost) in enumerate(self.costs):
+            acc = per_scene.get(self.cases[k][0])
+            if kind == "known" and cost is not None:
+                out.append(cost * speed)
+            elif kind == "size" and cost and acc and acc[1] > 0:
+                out.append(cost * acc[0] / acc[1])
+            else:
+                out.append(mean)
+        return out
+
     def eta(self) -> float | None:
-        """Seconds left, estimated as the mean time per finished run x the runs left /
-        the worker count (so it assumes the runs left cost what the finished ones did on
-        average, and that every worker stays busy); None before the first run is done."""
-        if not self.durations:
-            return None
-        left = self.total - self.done
-        return sum(self.durations) / len(self.durations) * left / self.workers
+        """Seconds left: the predicted times (:meth:`predicted`) of the runs not started
+        and what is left of those in flight, over the worker count (so it assumes that
+        every worker stays busy); None while nothing predicts the runs left."""
+        pred = self.predicted()
+        now = time.monotonic()
+        left = 0.0
+        for k in range(self.total):
+            if k in self._took:
+                continue
+            if pred[k] is None:
+                return None
+            start = self.in_flight.get(k)
+            left += max(pred[k] - (now - start if start is not None else 0.0), 0.0)
+        return left / self.workers
 
     # -- events (main process only) -------------------------------------------------------
     def started(self, k: int, timed: bool = True) -> None:
@@ -105,30 +192,63 @@ class RunProgress:
             start = self.in_flight.pop(k, None)
             self.done += 1
             self.failed += res.status != "ok"
-            self.durations.append(time.monotonic() - start if start is not None
-                                  else float(res.timings.get("total_s", 0.0) or 0.0))
+            took = (time.monotonic() - start if start is not None
+                    else float(res.timings.get("total_s", 0.0) or 0.0))
+            self.durations.append(took)
+            self._took[k] = took
+            self._next_beat = time.monotonic() + self.heartbeat_s
             done, eta, elapsed = self.done, self.eta(), self.elapsed()
         if self.stream is None:
             return
         text = f"[{done}/{self.total}] {self.line(k, res)}"
+        plain = f"{text.rstrip()} | elapsed {clock(elapsed)}, ETA {clock(eta)}"
         if self._live is not None:
             from rich.text import Text
             self._live.console.print(Text(text, style=None if res.status == "ok" else "red"),
                                      soft_wrap=True)
             self._live.refresh()
+            if self.log is not None:
+                print(plain, file=self.log, flush=True)
         else:
-            print(f"{text.rstrip()} | elapsed {clock(elapsed)}, ETA {clock(eta)}",
-                  file=self.stream, flush=True)
+            print(plain, file=self.stream, flush=True)
+
+    def heartbeat(self) -> str:
+        """``... running: scene method params 1:02, ... | 3/10 done, elapsed 2:00, ETA
+        1:00``: the runs in flight and their time so far."""
+        now = time.monotonic()
+        with self._lock:
+            flight = sorted(self.in_flight.items(), key=lambda kv: kv[1] or now)
+            done, eta, elapsed = self.done, self.eta(), self.elapsed()
+        runs = "; ".join(f"{describe(self.cases[k])} {clock(now - t)}" if t is not None
+                         else f"{describe(self.cases[k])} (submitted)" for k, t in flight)
+        return (f"... running: {runs or 'nothing'} | {done}/{self.total} done, elapsed "
+                f"{clock(elapsed)}, ETA {clock(eta)}")
+
+    def _beat_if_due(self) -> None:
+        """Print a heartbeat on a non-terminal when :attr:`heartbeat_s` passed since the
+        last line (a finished run or a heartbeat) and runs are in flight."""
+        if self.stream is None or self.live or time.monotonic() < self._next_beat:
+            return
+        if self.in_flight:
+            print(self.heartbeat(), file=self.stream, flush=True)
+        self._next_beat = time.monotonic() + self.heartbeat_s
 
     def tick(self) -> None:
-        """Redraw the live display (its clock moves even while no run finishes)."""
+        """Redraw the live display (its clock moves even while no run finishes), or print
+        a heartbeat line on a non-terminal when one is due."""
         if self._live is not None and not self.auto_refresh:
             self._live.refresh()
+        elif not self.auto_refresh:
+            self._beat_if_due()
 
     @property
     def tick_s(self) -> float | None:
         """How long the caller may block before calling :meth:`tick` (None: forever)."""
-        return TICK_S if self._live is not None and not self.auto_refresh else None
+        if self._live is not None and not self.auto_refresh:
+            return TICK_S
+        if self.stream is not None and not self.live and not self.auto_refresh:
+            return max(0.0, self._next_beat - time.monotonic())
+        return None
 
     # -- the live display ---------------------------------------------------------------
     def __rich__(self):
@@ -167,9 +287,25 @@ class RunProgress:
                               refresh_per_second=4, transient=False,
                               redirect_stdout=False, redirect_stderr=False)
             self._live.start(refresh=True)
+        elif self.stream is not None and self.auto_refresh:
+            # the cluster path blocks its main thread on the cluster: a thread beats
+            stop = threading.Event()
+
+            def beat():
+                while not stop.wait(min(self.heartbeat_s, max(0.05, self._next_beat
+                                                                - time.monotonic()))):
+                    self._beat_if_due()
+            thread = threading.Thread(target=beat, daemon=True, name="pdverify-heartbeat")
+            self._beats = (stop, thread)
+            thread.start()
         return self
 
     def __exit__(self, *exc):
+        if self._beats is not None:
+            stop, thread = self._beats
+            stop.set()
+            thread.join(timeout=1)
+            self._beats = None
         live, self._live = self._live, None
         if live is not None:
             live.stop()  # also on Ctrl-C / SIGTERM: the final state, the cursor back

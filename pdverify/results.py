@@ -14,6 +14,8 @@ from typing import Any
 import numpy as np
 
 SCHEMA = "pdverify.results/1"
+#: the JSON Schema of :data:`SCHEMA`, published with the package for other tools
+SCHEMA_FILE = os.path.join(os.path.dirname(__file__), "schema", "results-1.schema.json")
 
 
 @dataclass
@@ -75,6 +77,17 @@ class RunResult:
             **({"published": _plain(self.published)} if self.published else {}),
         }
 
+    @classmethod
+    def from_json(cls, run: dict) -> "RunResult":
+        """A run as results.json holds it (no ``fields``: those are never written)."""
+        return cls(scene=run["scene"], method=run["method"], params=dict(run["params"]),
+                   reference=run.get("reference", ""), status=run["status"],
+                   message=run.get("message", ""), metrics=dict(run["metrics"]),
+                   timings=dict(run.get("timings", {})), size=dict(run.get("size", {})),
+                   diagnostics=dict(run.get("diagnostics", {})),
+                   warnings=list(run.get("warnings", [])), files=list(run.get("files", [])),
+                   expected_failure=run.get("expected_failure", ""))
+
 
 OUTCOMES = ("ok", "failed", "expected-failure", "unexpected-pass")
 
@@ -134,9 +147,53 @@ def _plain(value: Any) -> Any:
     return value
 
 
+#: the libraries whose versions decide whether two machines' numbers agree bit for bit
+#: (recorded in ``machine.libraries``; a missing one is "not installed")
+LIBRARIES = ("numpy", "scipy", "scikit-fem", "meshio", "pyvista")
+
+
+def library_versions() -> dict:
+    """The installed versions of :data:`LIBRARIES` (package metadata: no import)."""
+    from importlib.metadata import PackageNotFoundError, version
+    out = {}
+    for name in LIBRARIES:
+        try:
+            out[name] = version(name)
+        except PackageNotFoundError:
+            out[name] = "not installed"
+    return out
+
+
+def blas_info() -> list[dict]:
+    """The BLAS/LAPACK libraries numpy and scipy call: through threadpoolctl when it is
+    importable (what is loaded: library, version, threading layer, threads), else from
+    numpy's build configuration (what numpy was built against), marked by ``source``."""
+    try:
+        from threadpoolctl import threadpool_info
+    except ImportError:
+        threadpool_info = None
+    if threadpool_info is not None:
+        return [{"source": "threadpoolctl", "api": i.get("internal_api"),
+                 "version": i.get("version"), "threading_layer": i.get("threading_layer"),
+                 "num_threads": i.get("num_threads"), "library": os.path.basename(
+                     i.get("filepath") or "")}
+                for i in threadpool_info() if i.get("user_api") == "blas"]
+    out = []
+    try:
+        config = np.show_config(mode="dicts")
+        deps = config.get("Build Dependencies", {})
+        for part in ("blas", "lapack"):
+            d = deps.get(part) or {}
+            out.append({"source": "numpy build config (threadpoolctl unavailable)",
+                        "api": part, "library": d.get("name"), "version": d.get("version")})
+    except Exception as exc:  # an older numpy without mode="dicts"
+        out.append({"source": "unavailable", "reason": f"{type(exc).__name__}: {exc}"})
+    return out
+
+
 def machine_info() -> dict:
     return {"python": platform.python_version(), "platform": platform.platform(),
-            "cpus": os.cpu_count()}
+            "cpus": os.cpu_count(), "libraries": library_versions(), "blas": blas_info()}
 
 
 def document(runs: list[RunResult], extra: dict | None = None) -> dict:

@@ -89,12 +89,27 @@ def _failed(case, message) -> RunResult:
                                 scene.published_for(method, params).values()])
 
 
-def plan(only=None, quick=False) -> list[tuple[str, str, dict]]:
-    """The (scene, method, overrides) cases of a report; validates every case up front."""
+def plan(only=None, quick=False, methods=None) -> list[tuple[str, str, dict]]:
+    """The (scene, method, overrides) cases of a report; validates every case up front.
+    ``methods``: keep only the cases of these methods (``report --method``); a name that
+    no selected scene offers is bad input naming its close matches."""
     from .scenes import all_scenes
     from . import convergence
     from .results import run_key
     scenes = [get_scene(s) for s in only] if only else all_scenes()
+    if methods:
+        offered = list(dict.fromkeys(m.name for s in scenes for m in s.all_methods))
+        for name in methods:
+            if name not in offered:
+                from .errors import did_you_mean
+                raise InputError(f"--method {name!r}{did_you_mean(name, offered)} is not a "
+                                 "method of the " + ("scenes of --only" if only else "scenes")
+                                 + f"; allowed: {', '.join(offered)}")
+        cases = [c for c in plan(only, quick) if c[1] in methods]
+        if not cases:
+            raise InputError(f"--method {' '.join(methods)}: no run of the report uses "
+                             "these methods (an unavailable one is not run)")
+        return cases
     cases, seen = [], set()
     for scene in scenes:
         for method, overrides in scene.report_cases(quick=quick):
@@ -129,17 +144,46 @@ def _worker(conn, inherited, parent_pid) -> None:
     ``inherited``: the supervisor's ends of the pipes, copied by fork; closed at once so
     that each pipe reaches EOF when the supervisor's own end closes.
     """
+    _quiet_worker()
     _die_with_parent(parent_pid)
     for c in inherited:
         c.close()
     while True:
         try:
             case = conn.recv()
-        except EOFError:
+        except (EOFError, OSError):      # the report process is gone: end quietly
             return
         if case is None:
             return
-        conn.send(run_case(case))
+        result = run_case(case)
+        try:
+            conn.send(result)
+        except (BrokenPipeError, EOFError, OSError):
+            return
+
+
+def _quiet_worker() -> None:
+    """A worker ignores Ctrl-C (the terminal sends SIGINT to the whole process group: the
+    report process alone handles it, prints "pdverify: interrupted" and ends its workers)
+    and dies of SIGTERM without the CLI's handler, which would unwind it with a
+    traceback. SIGINT was blocked across the fork (:func:`_forked`); it is unblocked here,
+    once ignored."""
+    import signal
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.signal(signal.SIGALRM, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+
+def _forked(proc) -> None:
+    """Start ``proc`` with SIGINT blocked across the fork, so that a Ctrl-C before the
+    worker ignores it cannot unwind the worker (the report process gets it right after)."""
+    import signal
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        proc.start()
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
 def _died(case, exitcode) -> RunResult:
@@ -188,7 +232,7 @@ def run_cases(cases, *, jobs: int | None = None, progress=None, client=None,
     in the order of ``cases``, the same numbers whatever ``jobs`` and the order they ran in.
     """
     from .progress import RunProgress
-    from .schedule import default_jobs
+    from .schedule import case_costs, default_jobs
 
     jobs = default_jobs() if jobs is None else jobs
     if jobs < 1:
@@ -199,18 +243,22 @@ def run_cases(cases, *, jobs: int | None = None, progress=None, client=None,
     def line(k, res):
         return run_line(cases[k], res)
 
+    costs = case_costs(cases, known) if progress is not None else None
+
     if client is not None:
         from .cluster import run_cases_on
         try:
             workers = sum(client.nthreads().values())
         except Exception:  # the count only scales the ETA
             workers = 1
-        with RunProgress(cases, workers, progress, auto_refresh=True, line=line) as shown:
+        with RunProgress(cases, workers, progress, auto_refresh=True, line=line,
+                         costs=costs) as shown:
             for k in range(len(cases)):
                 shown.started(k, timed=False)   # queued on the cluster
             return run_cases_on(client, cases, shown.finished, run_case, died_on_cluster)
 
-    with RunProgress(cases, min(jobs, len(cases)), progress, line=line) as shown:
+    with RunProgress(cases, min(jobs, len(cases)), progress, line=line,
+                     costs=costs) as shown:
         return _run_local(cases, jobs, shown, run_timeout, known,
                           schedule if schedule is not None else [])
 
@@ -250,7 +298,7 @@ def _run_local(cases, jobs, shown, run_timeout=None, known=None, slots=None):
         parent, child = ctx.Pipe()
         proc = ctx.Process(target=_worker, args=(child, [parent, *workers], os.getpid()),
                            daemon=True)
-        proc.start()
+        _forked(proc)
         child.close()
         workers[parent] = [proc, None, slot, None]
         return parent

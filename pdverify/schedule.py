@@ -43,6 +43,30 @@ def memory_estimates(cases) -> list[float]:
     return out
 
 
+def case_costs(cases, known=None) -> list[tuple]:
+    """Each case's predicted cost for the progress ETA: ("known", its seconds in the
+    previous report) when ``known`` has it, else ("size", the budget's size model: the
+    memory estimate in bytes times the explicit steps or load increments, at least 1),
+    else (None, None). The progress calibrates each kind by the runs done."""
+    from .scenes import get_scene
+    from .results import run_key
+    known = known or {}
+    out = []
+    for scene_id, method, overrides in cases:
+        scene = get_scene(scene_id)
+        params = scene.resolve(method, overrides)
+        t = known.get(run_key(scene_id, method, params))
+        if t is not None:
+            out.append(("known", float(t)))
+            continue
+        est = scene.estimate(method, params)
+        if est is None or not est.memory > 0:
+            out.append((None, None))
+        else:
+            out.append(("size", float(est.memory) * max(1, est.time_steps + est.increments)))
+    return out
+
+
 def previous_times(path) -> dict:
     """Run time (``total_s``) by :func:`~pdverify.results.run_key` from the results file
     ``path`` of an earlier report; {} if there is none or it cannot be read."""

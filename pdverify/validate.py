@@ -125,3 +125,16 @@ def only(scenes) -> list | None:
             raise InputError(f"--only: scene {s!r} is given twice")
         seen.add(s)
     return list(scenes)
+
+
+def methods(names) -> list | None:
+    """``report --method``: every method at most once (whether the selected scenes offer
+    it is checked by :func:`pdverify.runner.plan`, with the close matches)."""
+    if names is None:
+        return None
+    seen = set()
+    for m in names:
+        if m in seen:
+            raise InputError(f"--method: method {m!r} is given twice")
+        seen.add(m)
+    return list(names)

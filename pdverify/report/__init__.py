@@ -20,10 +20,19 @@ from ..scenes import get_scene
 DEFAULT_OUT = os.path.join("reports", "latest")
 
 
-def default_out(only=None, quick=False) -> str:
+def default_out(only=None, quick=False, methods=None) -> str:
     """Where a report goes without ``--out``: the full report in ``reports/latest``, a
     ``--quick`` one in ``reports/quick`` and an ``--only`` one in a folder named after its
-    scenes, so that neither ever replaces the full report."""
+    scenes, so that neither ever replaces the full report; ``--method`` adds the methods
+    (``reports/only-SCENE-method-M``, ``reports/method-M``)."""
+    if methods:
+        ids = list(dict.fromkeys(methods))
+        tail = "method-" + (ids[0] if len(ids) == 1 else f"{ids[0]}+{len(ids) - 1}-more-"
+                            + hashlib.sha1("\0".join(sorted(ids)).encode()).hexdigest()[:6])
+        base = default_out(only, quick)
+        if not only:
+            return os.path.join("reports", ("quick-" if quick else "") + tail)
+        return f"{base}-{tail}"
     if only:
         ids = list(dict.fromkeys(only))
         name = ids[0] if len(ids) == 1 else f"{ids[0]}+{len(ids) - 1}-more-" + hashlib.sha1(
@@ -114,7 +123,7 @@ def _swap_in(staging: str, out: str) -> None:
 
 
 def build_report(*, out=None, quick=False, only=None, jobs=None, progress=None,
-                 scheduler=None, run_timeout=None) -> int:
+                 scheduler=None, run_timeout=None, methods=None, failed=False) -> int:
     """Run the report; returns 0, or 1 if any run failed. Bad input raises before work.
 
     Figures, results.json and index.html are written into a staging folder next to
@@ -128,10 +137,22 @@ def build_report(*, out=None, quick=False, only=None, jobs=None, progress=None,
     (:mod:`pdverify.cluster`), which is reached before any work starts. ``jobs``: local
     worker processes (None: the cores available to this process); ``run_timeout``: the
     seconds after which a run is killed and recorded as failed (None: no limit).
+    ``methods``: only the runs of these methods. ``failed``: rerun only the planned runs
+    that failed (unexpectedly) or are missing in the previous report in ``out``, and merge
+    them into it (:func:`rerun_plan`; InputError if there is none).
     """
     progress = progress or sys.stderr
-    out = outputs.check_out_dir(out or default_out(only, quick))  # links resolved
-    cases = plan(only=only, quick=quick)  # raises InputError on unknown scenes
+    out = outputs.check_out_dir(out or default_out(only, quick, methods))  # links resolved
+    cases = plan(only=only, quick=quick, methods=methods)  # InputError on unknown names
+    kept = None
+    if failed:
+        cases, kept = rerun_plan(cases, out)
+        if not cases:
+            print(f"report --failed: nothing failed or is missing in {out!r}; it is "
+                  "unchanged", file=progress)
+            return exit_code(kept)
+        print(f"report --failed: rerunning {len(cases)} run(s) that failed or were missing; "
+              f"{len(kept)} kept from the previous report", file=progress)
     check_storage(cases, out)
     parent, name = os.path.split(out)
     if scheduler is not None and run_timeout is not None:
@@ -144,10 +165,42 @@ def build_report(*, out=None, quick=False, only=None, jobs=None, progress=None,
     try:
         with output_lock(out):
             return _locked(cases, out, parent, name, jobs, progress, client, quick,
-                           run_timeout)
+                           run_timeout, kept)
     finally:
         if client is not None:
             client.close()
+
+
+def rerun_plan(cases, out: str):
+    """``report --failed``: (the cases to run again, the previous runs to keep).
+
+    Rerun: the planned cases whose run failed unexpectedly (outcome ``failed``, not a
+    documented finding) or is missing in ``out/results.json``; kept: every other run of
+    that file, as it was (a run of the previous report outside today's plan included).
+    No readable results file there is bad input (exit 2), before any work."""
+    from ..results import RunResult, load_results
+    path = os.path.join(out, "results.json")
+    if outputs.folder_state(out)[0] != "report" or not os.path.isfile(path):
+        raise InputError(f"--failed: {out!r} holds no previous pdverify report (no "
+                         "results.json); run the report without --failed first")
+    try:
+        doc = load_results(path)
+    except (OSError, ValueError) as exc:
+        raise InputError(f"--failed: the previous report's results cannot be read "
+                         f"({exc})") from None
+    previous = {}
+    for run in doc["runs"]:
+        r = RunResult.from_json(run)
+        previous.setdefault(r.key, r)
+    again = []
+    for case in cases:
+        scene_id, method, overrides = case
+        key = run_key(scene_id, method, get_scene(scene_id).resolve(method, overrides))
+        prev = previous.get(key)
+        if prev is None or prev.outcome == "failed":
+            again.append(case)
+            previous.pop(key, None)
+    return again, list(previous.values())
 
 
 #: Bytes a report needs on disk, per run and once (figures of the overview, pages), from
@@ -170,7 +223,7 @@ def check_storage(cases, out: str) -> None:
 
 
 def _locked(cases, out, parent, name, jobs, progress, client, quick=False,
-            run_timeout=None) -> int:
+            run_timeout=None, kept=None) -> int:
     """The report's body, under the output lock: stage, build, swap in.
 
     A report that could not be written whole (:class:`OutputError`: a figure, a VTU file,
@@ -191,7 +244,8 @@ def _locked(cases, out, parent, name, jobs, progress, client, quick=False,
             raise OutputError(f"report: cannot write into its staging folder {staging!r} "
                               f"({exc.strerror or exc}); nothing was run") from None
         try:
-            code = _build(cases, staging, out, jobs, progress, client, quick, run_timeout)
+            code = _build(cases, staging, out, jobs, progress, client, quick, run_timeout,
+                          kept)
             _write_marker(staging)
         except OutputError as exc:
             keep = True
@@ -289,8 +343,25 @@ def _drawn(what, draw, args, empty, progress):
         return empty
 
 
+LOG = "report.log"
+
+
 def _build(cases, out, final, jobs, progress, client=None, quick=False,
-           run_timeout=None) -> int:
+           run_timeout=None, kept=None) -> int:
+    """The report's work into the staging folder ``out``; the progress lines also go to
+    ``out/report.log`` (:data:`LOG`)."""
+    from ..progress import Tee
+    try:
+        log = open(os.path.join(out, LOG), "w", encoding="utf-8")
+    except OSError as exc:
+        raise OutputError(f"cannot write its log {LOG} ({_describe(exc)})") from None
+    with log:
+        return _build_logged(cases, out, final, jobs, Tee(progress, log), client, quick,
+                             run_timeout, kept)
+
+
+def _build_logged(cases, out, final, jobs, progress, client=None, quick=False,
+                  run_timeout=None, kept=None) -> int:
     from ..schedule import critical_path, previous_times
     t0 = time.perf_counter()
     phase = _Phases()
@@ -300,6 +371,8 @@ def _build(cases, out, final, jobs, progress, client=None, quick=False,
         known = previous_times(os.path.join(final, "results.json"))
         results = run_cases(cases, jobs=jobs, progress=progress, client=client,
                             run_timeout=run_timeout, known=known, schedule=slots)
+    if kept is not None:     # report --failed: the new runs merged into the previous ones
+        results = _merged(kept, results)
     figdir = os.path.join(out, "figures")
     with phase("figures_s"):
         os.makedirs(figdir, exist_ok=True)
@@ -307,7 +380,7 @@ def _build(cases, out, final, jobs, progress, client=None, quick=False,
     from .figures import convergence, overview
     sections = []
     order = []
-    for scene_id, _, _ in cases:
+    for scene_id in [c[0] for c in cases] + [r.scene for r in results]:
         if scene_id not in order:
             order.append(scene_id)
     for scene_id in order:
@@ -322,6 +395,10 @@ def _build(cases, out, final, jobs, progress, client=None, quick=False,
             sections.append((scene, html.scene_section(scene, mine, figs)))
     with phase("fields_s"):
         export_fields(results, out)
+        if kept is not None:
+            _keep_fields(results, final, out)
+    with phase("pages_s"):
+        write_tables(results, out)
     scenes = [scene for scene, _ in sections]
     from ..convergence import collect
     studies = collect(results, quick)
@@ -355,6 +432,61 @@ def _build(cases, out, final, jobs, progress, client=None, quick=False,
           f"{time.perf_counter() - t0:.1f} s -> {os.path.join(final, 'index.html')}",
           file=progress)
     return exit_code(results)
+
+
+def _merged(kept, new) -> list:
+    """``report --failed``: the previous runs kept and the runs made now, grouped by scene
+    in the order of the scene registry (a report's order), each group's runs in order."""
+    from ..scenes import all_scenes
+    rank = {s.id: k for k, s in enumerate(all_scenes())}
+    return sorted(list(kept) + list(new), key=lambda r: rank.get(r.scene, len(rank)))
+
+
+def _keep_fields(results, final, out) -> None:
+    """``report --failed``: the VTU files of the runs kept from the previous report in
+    ``final``, copied into ``out`` under their run's new place in results.json."""
+    for k, r in enumerate(results):
+        if r.fields or not r.files:
+            continue
+        files = []
+        for rel in r.files:
+            head, name = os.path.split(rel)
+            new = os.path.join(head, f"{k:03d}-" + name.split("-", 1)[-1])
+            src = os.path.join(final, rel)
+            if os.path.isfile(src):
+                os.makedirs(os.path.join(out, head), exist_ok=True)
+                shutil.copyfile(src, os.path.join(out, new))
+                files.append(new)
+        r.files = files
+
+
+def write_tables(results, out) -> list[str]:
+    """One CSV per scene, ``out/tables/<scene>.csv``: a row per run (method, outcome,
+    message, every parameter, every metric, the run's time), for a spreadsheet or pandas.
+    Returns the files written, relative to ``out``."""
+    import csv
+    import io
+    from ..results import _plain
+    by_scene: dict[str, list] = {}
+    for r in results:
+        by_scene.setdefault(r.scene, []).append(r)
+    written = []
+    for scene_id, runs in by_scene.items():
+        params = list(dict.fromkeys(k for r in runs for k in r.params))
+        metrics = list(dict.fromkeys(k for r in runs for k in r.metrics))
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow(["scene", "method", "outcome", "status", "message"] + params + metrics
+                   + ["total_s"])
+        for r in runs:
+            p, m = _plain(r.params), _plain(r.metrics)
+            w.writerow([r.scene, r.method, r.outcome, r.status, r.message]
+                       + [p.get(k, "") for k in params] + [m.get(k, "") for k in metrics]
+                       + [_plain(r.timings.get("total_s", ""))])
+        rel = os.path.join("tables", f"{scene_id}.csv")
+        atomic_write_text(os.path.join(out, rel), buf.getvalue())
+        written.append(rel)
+    return written
 
 
 def exit_code(results) -> int:

@@ -4,7 +4,7 @@ from __future__ import annotations
 import importlib
 import pkgutil
 
-from ..errors import InputError
+from ..errors import InputError, did_you_mean
 from .base import (MethodSpec, Outcome, Published, Scene, cell_count, influence_param,
                    require_influence, whole_cells)
 
@@ -42,7 +42,8 @@ def get_scene(scene_id: str) -> Scene:
         return _REGISTRY[scene_id]
     except KeyError:
         allowed = ", ".join(sorted(_REGISTRY))
-        raise InputError(f"unknown scene {scene_id!r}; allowed: {allowed}") from None
+        raise InputError(f"unknown scene {scene_id!r}{did_you_mean(scene_id, _REGISTRY)}; "
+                         f"allowed: {allowed}") from None
 
 
 def _tell_the_registry() -> None:

@@ -1,7 +1,6 @@
 """The scene contract: parameters, supported methods, run, and the report's cases."""
 from __future__ import annotations
 
-import difflib
 import traceback
 from dataclasses import dataclass, field, replace
 from typing import Any, Mapping
@@ -9,7 +8,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from .. import budget
-from ..errors import InputError, NumericalError
+from ..errors import InputError, NumericalError, did_you_mean
 from ..params import Param, resolve
 from ..pd.closure import Closure
 from ..pd.influence import INFLUENCES
@@ -335,10 +334,8 @@ class Scene:
             base = next((m.params for m in self.all_methods if m.name == "none"), ())
             return MethodSpec(name, base)
         allowed = [m.name for m in self.all_methods]
-        close = difflib.get_close_matches(name, allowed, n=3)
-        hint = f"; did you mean {' or '.join(close)}?" if close else ""
-        raise InputError(f"{self.id}: method {name!r} is not supported by this scene; "
-                         f"allowed: {', '.join(allowed)}{hint}")
+        raise InputError(f"{self.id}: method {name!r}{did_you_mean(name, allowed)} is not "
+                         f"supported by this scene; allowed: {', '.join(allowed)}")
 
     def _broken_plugin(self, name: str) -> str | None:
         """Why the plugin method ``name`` failed to load, for a scene that takes bond

@@ -19,6 +19,21 @@ def _float_check(default):
     return magnitude if isinstance(default, float) else None
 
 
+#: the units of the FEM references' dataclass fields (``reference_fem``, SI as their
+#: comments state); a field not listed is dimensionless or a count
+FEM_UNITS = {"width": "m", "height": "m", "length": "m", "radius": "m", "depth": "m",
+             "horizon": "m", "thickness": "m", "spacing": "m", "fine_half_width": "m",
+             "fine_depth": "m", "sample_spacing": "m", "E": "Pa", "traction": "Pa",
+             "body_force": "N/m^3"}
+
+
+def _field_param(name, field, cls_name) -> Param:
+    """A reference dataclass field as a parameter; its unit from :data:`FEM_UNITS`."""
+    unit = FEM_UNITS.get(name) if isinstance(field.default, float) else None
+    doc = f"field of the FEM reference's {cls_name}" + (f" [{unit}]" if unit else "")
+    return Param(name, field.default, doc, _float_check(field.default))
+
+
 def _reference_module():
     import reference_fem  # heavy (scikit-fem): imported only when a FEM scene runs
     return reference_fem
@@ -47,7 +62,7 @@ class FemReference(Scene):
     @property
     def params(self):
         # Mirrors the dataclass fields (names, defaults); the dataclass validates values.
-        return tuple(Param(f.name, f.default, "", _float_check(f.default))
+        return tuple(_field_param(f.name, f, self.params_class)
                      for f in dataclasses.fields(self._cls()))
 
     def check(self, method, p):
@@ -99,12 +114,12 @@ class FemAndPD(FemReference):
 
     @property
     def params(self):
-        return tuple(Param(n, f.default, "", _float_check(f.default))
+        return tuple(_field_param(n, f, self.params_class)
                      for n, f in self._fields().items() if n in self.shared)
 
     @property
     def methods(self):
-        fem = MethodSpec(FEM.name, tuple(Param(n, f.default, "", _float_check(f.default))
+        fem = MethodSpec(FEM.name, tuple(_field_param(n, f, self.params_class)
                                          for n, f in self._fields().items()
                                          if n not in self.shared))
         return (fem,) + tuple(MethodSpec(name, self.pd_params + extra)

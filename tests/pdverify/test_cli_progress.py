@@ -168,7 +168,7 @@ def test_list_shows_the_choices_of_a_choice_param(capsys):
     out = capsys.readouterr().out
     assert "plane=strain {strain|stress}" in out
     assert "end_weight=full {full|half}" in out
-    assert "length=1," in out and "length=1 {" not in out  # no braces without choices
+    assert "length=1 m," in out and "length=1 m {" not in out  # no braces without choices
 
 
 @pytest.mark.parametrize("args, reference, metric, paper", [

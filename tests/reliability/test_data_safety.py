@@ -220,12 +220,16 @@ def test_a_report_from_before_the_marker_is_recognised_by_its_exact_shape(tmp_pa
     rep = tmp_path / "rep"
     assert _report(rep) == 0
     capsys.readouterr()
-    (rep / outputs.MARKER).unlink()              # what a report of an earlier version is
+    (rep / outputs.MARKER).unlink()              # what a report of an earlier version is:
+    (rep / "report.log").unlink()                # no marker, no log and no tables (issue 34)
+    shutil.rmtree(rep / "tables")
     assert outputs.folder_state(str(rep)) == ("report", "")
     assert _report(rep) == 0
     assert (rep / outputs.MARKER).is_file()      # marked from now on
     capsys.readouterr()
     (rep / outputs.MARKER).unlink()
+    (rep / "report.log").unlink()
+    shutil.rmtree(rep / "tables")
     (rep / "results.json").write_text('{\n "schema": "other/1"}')
     before = _tree_hash(rep)
     assert _report(rep) == 2

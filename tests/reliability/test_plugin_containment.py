@@ -54,7 +54,7 @@ def test_list_names_every_broken_plugin_and_goes_on(plugin_env):
     assert "plugin not-a-method: failed to load (pdverify_misbehaving:NOT_A_METHOD: " \
            "TypeError: object is not a pdverify Treatment)" in out
     # the scenes keep their own spacing default (0.001 m on the sheet), not the plugin's 0.5
-    assert "params: width=0.05, length=0.1, spacing=0.001" in out
+    assert "params: width=0.05 m, length=0.1 m, spacing=0.001 m" in out
     assert "bond method energy: built-in" in out and "bond method closure-exit: plugin" in out
 
 
