@@ -101,6 +101,8 @@ class Slot:
     seconds since the pool started."""
 
     runs: list = field(default_factory=list)
+    #: worker processes this place has had (a worker is recycled: ``runner.retire``)
+    processes: int = 0
 
     @property
     def end(self) -> float:

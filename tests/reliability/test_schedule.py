@@ -131,3 +131,52 @@ def test_run_timeout_with_a_scheduler_is_bad_input(tmp_path):
         build_report(out=str(tmp_path / "r"), only=["bar1d-traction"], run_timeout=5.0,
                      scheduler="tcp://127.0.0.1:1")
     assert not (tmp_path / "r").exists()          # refused before any work
+
+
+class _Pid(Scene):
+    """Test-only scene: each run reports the process id it ran in, and how many runs
+    that process has run (module state a long-lived worker would carry over)."""
+
+    id = "test-pid"
+    title = "test only"
+    methods = (MethodSpec("light"), MethodSpec("heavy"))
+    seen = []
+
+    def estimate(self, method, params):
+        return budget.Estimate({"heavy": 0.2 * GIB}.get(method, 0.0), f"test-only {method}")
+
+    def solve(self, method, params, timer):
+        _Pid.seen.append(method)
+        return Outcome(metrics={"pid": float(os.getpid()), "runs_here": float(len(_Pid.seen))})
+
+
+@pytest.fixture
+def pid_scene():
+    if "test-pid" not in _REGISTRY:
+        register(_Pid)
+    yield
+    _REGISTRY.pop("test-pid", None)
+    budget.set_limit(None)
+
+
+def test_workers_are_recycled_after_a_bounded_number_of_runs(pid_scene, monkeypatch):
+    """A worker ends after RUNS_PER_WORKER runs and a fresh process takes its place, so no
+    process carries its address space through the whole report (the 6 GB ulimit -v
+    finding: MemoryErrors from a worker's 179th run on)."""
+    import pdverify.runner as runner
+    monkeypatch.setattr(runner, "RUNS_PER_WORKER", 2)
+    slots = []
+    results = run_cases([("test-pid", "light", {})] * 5, jobs=1, schedule=slots)
+    pids = [r.metrics["pid"] for r in results]
+    assert [r.metrics["runs_here"] for r in results] == [1, 2, 1, 2, 1]
+    assert len(set(pids)) == 3 and slots[0].processes == 3
+    assert os.getpid() not in pids
+
+
+def test_a_heavy_run_retires_its_worker(pid_scene):
+    """A run whose estimate is at least HEAVY_FRACTION of the budget (0.2 of 1 GiB) is
+    its worker's last; light runs share one."""
+    budget.set_limit("1G")
+    cases = [("test-pid", m, {}) for m in ("light", "light", "heavy", "light", "light")]
+    results = run_cases(cases, jobs=1)
+    assert [r.metrics["runs_here"] for r in results] == [1, 2, 3, 1, 2]
