@@ -105,7 +105,6 @@ def test_influence_is_one_set_away_on_a_2d_scene():
 
 @pytest.mark.parametrize("args, words", [
     (("body3d-manufactured", "--set", "influence=conical"), "allowed: gaussian"),
-    (("bar1d-force-flux", "--set", "influence=gaussian"), "allowed: hyperbolic"),
     (("plate2d-plane-strain", "--set", "influence=cubic"),
      "allowed: conical, constant, gaussian, hyperbolic"),
     (("wave1d-surface-nodes", "--set", "influence=gaussian"), "unknown key 'influence'"),

@@ -46,3 +46,36 @@ def test_corrected_flux_is_flat():
     # Tolerance: round-off of summing O(m^2) bond forces of size ~tau_inf.
     res = get_scene("bar1d-force-flux").run("taylor-fictitious", {"order": 1})
     assert res.metrics["flux_table_error"] < 1e-12
+
+
+# --- Fig. 8: other influence functions -------------------------------------------------
+@pytest.mark.parametrize("influence", ["hyperbolic", "constant", "gaussian", "conical"])
+def test_fig8_every_influence_hardens_then_softens(influence):
+    """seed 000 §2.2 (text under Figs. 7-8): with any reasonable influence function the
+    flux rises above tau_inf inside the layer and falls below it nearer the end."""
+    from pdverify.scenes import get_scene
+    r = get_scene("bar1d-force-flux").run("none", {"influence": influence, "m_ratio": 12.0,
+                                                   "spacing": 0.15 / 12})
+    assert r.status == "ok", r.message
+    assert r.metrics["hardening_softening"] == 1.0
+    assert r.metrics["flux_max_ratio"] > 1.0
+    assert 0.0 < r.metrics["flux_crossing"] < r.metrics["flux_argmax"] < 1.0
+    # the closed forms are delta / |xi|'s: no table error is claimed for the others
+    assert ("flux_table_error" in r.metrics) == (influence == "hyperbolic")
+
+
+def test_fig8_claim_metric_is_zero_without_the_hardening():
+    """The corrected model's flux is flat (Eq. 33): no hardening, so the claim's metric
+    would be 0; it is recorded for the uncorrected model only, whose claim it is."""
+    from pdverify.scenes import get_scene
+    r = get_scene("bar1d-force-flux").run("taylor-fictitious", {"influence": "constant"})
+    assert r.metrics["flux_max_ratio"] < 1.0 + 1e-9   # Eq. (33), round-off
+    assert "hardening_softening" not in r.metrics
+
+
+def test_fig8_runs_carry_the_claim_as_a_published_entry():
+    from pdverify.scenes import get_scene
+    r = get_scene("bar1d-force-flux").run("none", {"influence": "gaussian", "m_ratio": 6.0,
+                                                   "spacing": 0.025})
+    entries = [e for e in r.published if e["metric"] == "hardening_softening"]
+    assert entries and entries[0]["kind"] == "read off a figure"
