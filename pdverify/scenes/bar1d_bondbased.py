@@ -506,11 +506,38 @@ class Constraints(BondBarScene):
 
 @register
 class Vibration(BondBarScene):
-    """Seed 004 §6.3: a uniformly pre-strained bar, fixed at one end, released at t = 0.
+    """Seed 004 §6.3: a uniformly pre-strained bar, held at some points, released at t = 0.
 
-    N points x_i = (i - 1) Delta, Delta = L / (N - 1); point 1 (x = 0) is held, point N
-    (x = L) is free. Initial displacement eps x, zero velocity (the pre-strain
-    0.001 H(Delta t - t) of the paper, released). Lumped masses rho V_i. Explicit central
+    ``constraint`` picks the column of Table 13 (Figs. 4-5 (a)-(c)):
+
+    - ``end`` (b, the default): N points x_i = (i - 1) Delta, Delta = L / (N - 1);
+      point 1 (x = 0) is held, point N (x = L) is free. Table 13: L = 1, N = 100.
+    - ``mid`` (a): N points over the whole length L, Delta = L / (N - 1), N odd; the
+      midpoint (N + 1)/2 is held and both ends are free. Table 13: L = 2, N = 201, u_101
+      = 0. Each half is a bar of length L/2 held at one end, so Rao's series with length
+      L/2 is its reference (the right half is recorded; the left is its mirror image).
+    - ``end-points`` (c): points 1..``held_points`` held (the delta-constraint of §6.2),
+      the last held point at x = 0 and L = the length from it to the free point N, so
+      Delta = L / (N - held_points). Table 13: L = 1, N = 103, u_1..u_4 = 0.
+
+    Table 13 gives L and N but not what L spans in (c): we read it as the vibrating
+    length (the bar of (b) with three more held points on the left, N_c = N_b + m - 1 as
+    in §6.2, so Delta = 1/99 in both), not the total length (Delta = 1/102). The held
+    points stay Table 13's four at delta = 6 Delta (Fig. 5c plots u_103 of the same
+    setup), not six. In every case the recorded points are the one next to the held
+    region (Fig. 4: u_102, u_2, u_5) and the free end (Fig. 5: u_201, u_100, u_103),
+    metrics ``next_point`` and ``free_point`` (1-based, checked against Table 13 and Fig.
+    5's caption). Initial displacement eps times the distance from the (last) held point
+    on the free side (eps (x - x_mid) on both halves in (a); zero on the held points in
+    (c)), zero velocity (the pre-strain 0.001 H(Delta t - t) of the paper, released).
+    ``homogenized`` adjusts the bonds at the bar's two ends (points 1 and N), as in §6.2;
+    held points inside the bar leave the bonds as they are. The figures' curves were lost
+    in the text conversion: the paper's values beside ours are Table 13's setup and the
+    words of §6.3. In (a) ``modal_frequency_error_pct`` is the lowest mode of the whole
+    bar, the one even about the held midpoint (-1.33 % at delta = 4 Delta), which the odd
+    initial field does not excite: the bonds across the midpoint couple the halves, which
+    classically decouple at a held point; ``frequency_error_pct`` (the fit to the free
+    end, -0.51 %) is the excited odd mode's. Lumped masses rho V_i. Explicit central
     differences (``pdverify.solvers.explicit.central_difference``) with
     dt = dt_factor * 2/omega_max, omega_max the largest natural frequency of the discrete
     operator (the paper uses 0.8 times the bound of Madenci & Oterkus; dt_factor > 1 is
@@ -542,19 +569,39 @@ class Vibration(BondBarScene):
     reference = "analytic"
     figure = "bondbar1d-vibration"
     params = bar_params(E=200e9) + (
-        Param("nodes", 100, "number of points N (Table 13, case b)", at_least(2)),
+        Param("nodes", 100, "number of points N (Table 13: 100 in case b, 201 in a, 103 in c)",
+              at_least(2)),
+        Param("constraint", "end", "held points (Table 13): end = point 1 (b), mid = the "
+              "midpoint (a), end-points = points 1..held_points (c)",
+              choices=("end", "mid", "end-points")),
+        Param("held_points", 4, "points held from the left end with constraint=end-points "
+              "(Table 13 c: 4)", at_least(2)),
         Param("density", 7850.0, "mass density rho [kg/m^3] (ERRATA choice)", positive),
-        Param("length", 1.0, "bar length L between the held and the free point [m]", positive),
+        Param("length", 1.0, "bar length L [m] (Table 13: 1 in b and c, 2 in a; in c from the "
+              "last held point to the free end)", positive),
         Param("pre_strain", 0.001, "initial uniform strain eps", positive),
         Param("periods", 5.0, "duration in periods 4L/c of Rao's first mode", at_least(1.0)),
         Param("dt_factor", 0.8, "time step / stability limit 2/omega_max", positive),
     )
     published = (
         Published("frequency_error_pct", "deviates (Fig. 5b)", "seed 004 §6.3, Fig. 5b",
-                  method="none", kind="read off a figure"),
+                  method="none", kind="read off a figure", where={"constraint": "end"}),
         Published("frequency_error_pct", "matches Rao (Fig. 5b)", "seed 004 §6.3, Fig. 5b",
-                  method="homogenized", kind="read off a figure"),
+                  method="homogenized", kind="read off a figure", where={"constraint": "end"}),
+        # Table 13: the plotted element of Fig. 4 and the free end of Fig. 5, per column
+        *(Published(metric, value, source, exact=True,
+                    where={"constraint": c, "nodes": n, "length": length})
+          for c, n, length, nxt, free in (("mid", 201, 2.0, 102, 201),
+                                          ("end", 100, 1.0, 2, 100),
+                                          ("end-points", 103, 1.0, 5, 103))
+          for metric, value, source in (
+              ("next_point", nxt, "seed 004 Table 13, plotted u_i (Fig. 4)"),
+              ("free_point", free, "seed 004 §6.3 and Fig. 5's caption, u_N"))),
     )
+
+    #: Table 13's columns (a), (c) as overrides of the scene's defaults (b)
+    TABLE13 = {"mid": {"constraint": "mid", "nodes": 201, "length": 2.0},
+               "end-points": {"constraint": "end-points", "nodes": 103, "length": 1.0}}
 
     #: steps x dt_factor / (periods (N - 1)) of the runs: 4.0 at horizon_ratio 2, 2.3-2.5
     #: at 4, 1.3-1.9 at 8 (omega_max Delta / c falls as the horizon grows); the estimate
@@ -568,27 +615,53 @@ class Vibration(BondBarScene):
         return super().estimate(method, p) + history
 
     def cases(self, quick=False):
-        return [(method, {"horizon_ratio": ratio}) for ratio in (4.0, 6.0)
+        return [(method, {"horizon_ratio": ratio, **extra}) for extra in
+                ({}, self.TABLE13["mid"], self.TABLE13["end-points"]) for ratio in (4.0, 6.0)
                 for method in (NONE.name, HOMOGENIZED.name)]
 
+    def check(self, method, p):
+        where = f"{self.id} --method {method}"
+        if p["constraint"] == "mid" and p["nodes"] % 2 == 0:
+            raise InputError(f"{where}: nodes={p['nodes']} must be odd with constraint=mid "
+                             "(the held midpoint is a point)")
+        if p["constraint"] == "end-points" and p["nodes"] < p["held_points"] + 2:
+            raise InputError(f"{where}: nodes={p['nodes']} must be >= held_points + 2 = "
+                             f"{p['held_points'] + 2} with constraint=end-points")
+        super().check(method, p)
+
+    def layout(self, p):
+        """(spacing, held point indices, index of the last held point, free length)."""
+        N, L = p["nodes"], p["length"]
+        if p["constraint"] == "mid":
+            return L / (N - 1), [N // 2], N // 2, L / 2
+        if p["constraint"] == "end-points":
+            k = int(p["held_points"])
+            return L / (N - k), list(range(k)), k - 1, L
+        return L / (N - 1), [0], 0, L
+
     def solve(self, method, p, timer):
-        N, L, eps = p["nodes"], p["length"], p["pre_strain"]
+        N, eps = p["nodes"], p["pre_strain"]
+        spacing, held, last, L = self.layout(p)
         c = rao.wave_speed(p["E"], p["density"])
         f1 = rao.first_mode_frequency(length=L, wave_speed=c)
         with timer.phase("setup"):
-            bar = self.bar(method, p, N, L / (N - 1))
+            bar = self.bar(method, p, N, spacing)
+            x = bar.x - bar.x[last]          # distance from the (last) held point
             mass = bar.lumped_mass(p["density"])
-            dt_limit = exact_stability_limit(bar.K, mass, fixed=[0])
+            dt_limit = exact_stability_limit(bar.K, mass, fixed=held)
             dt = p["dt_factor"] * dt_limit
             steps = int(np.ceil(p["periods"] / f1 / dt))
+            u0 = eps * x
+            u0[held] = 0.0
+            record = [last + 1, N - 1]
         with timer.phase("solve"):
-            run = central_difference(bar.K, eps * bar.x, np.zeros(N), dt, steps, mass=mass,
-                                     fixed=[0], record=[1, N - 1], dt_limit=dt_limit,
+            run = central_difference(bar.K, u0, np.zeros(N), dt, steps, mass=mass,
+                                     fixed=held, record=record, dt_limit=dt_limit,
                                      where=f"{self.id}/{method}")
         with timer.phase("reference"):
-            ref = rao.rao_displacement(bar.x[[1, N - 1]], run.history_times, strain=eps, length=L,
+            ref = rao.rao_displacement(x[record], run.history_times, strain=eps, length=L,
                                        wave_speed=c)
-            omega_1 = min_angular_frequency(bar.K, mass, fixed=[0])
+            omega_1 = min_angular_frequency(bar.K, mass, fixed=held)
         free_end, free_ref = run.history[:, 1], ref[:, 1]
         with timer.phase("fit"):
             f_fit = fitted_frequency(run.history_times, free_end, f1)
@@ -597,6 +670,9 @@ class Vibration(BondBarScene):
             "frequency_error_pct": (f_fit - f1) / f1 * 100.0,
             "modal_frequency_error_pct": (omega_1 / (2 * np.pi) - f1) / f1 * 100.0,
             "rel_l2_error": rel_l2_error(free_end, free_ref),
+            # Table 13 / Fig. 5: the recorded points, 1-based as the paper counts them
+            "next_point": record[0] + 1,
+            "free_point": record[1] + 1,
         }
         fields = {"t": run.history_times, "u_free": free_end, "u_free_ref": free_ref,
                   "u_next": run.history[:, 0], "u_next_ref": ref[:, 0],
