@@ -77,7 +77,8 @@ def _caption(r, cut):
             f"{cut[0]:.3g} m, y > {cut[1]:.3g} m, z > {cut[2]:.3g} m cut away so the "
             "interior mid-planes show; the box's outline in black. Left: displacement "
             "magnitude |u| [mm]; right: the nodal error of Eq. (38) of seed 001 [%]. "
-            "Isometric view, each panel its own colour scale.")
+            "Isometric view; each panel's colour scale is shared by the scene's renderings "
+            "(the largest value over its methods).")
 
 
 #: the two panels: cell-data name, scalar bar title (VTK renders a title with $...$ by
@@ -105,7 +106,9 @@ def render_box_fields(scene, results, folder) -> list[tuple[str, str]]:
 
     pv.OFF_SCREEN = True
     out = []
-    for r in default_runs(scene, results):
+    runs = default_runs(scene, results)
+    tops = shared_tops(runs)
+    for r in runs:
         f = r.fields
         grid = _grid(pv, f)
         keep, cut = _octant(f)
@@ -114,7 +117,7 @@ def render_box_fields(scene, results, folder) -> list[tuple[str, str]]:
         file = f"{scene.id}-{r.method}-3d-{len(out)}.png"
         with _quiet(pv):
             _render(pv, grid, grid.extract_cells(keep), heads, f["lengths"],
-                    os.path.join(folder, file))
+                    os.path.join(folder, file), tops)
         out.append((file, _caption(r, cut)))
     return out
 
@@ -126,7 +129,18 @@ def _quiet(pv):
     return verbosity("error") if verbosity is not None else contextlib.nullcontext()
 
 
-def _render(pv, grid, part, heads, lengths, path):
+def shared_tops(runs) -> list[float]:
+    """The top of each panel's colour scale, shared by ``runs`` (one scene's renderings
+    compare by eye): the largest value of the panel over every run (1 where none is
+    positive)."""
+    tops = []
+    for _, _, values in PANELS:
+        top = max((float(np.nanmax(values(r.fields))) for r in runs), default=0.0)
+        tops.append(top if top > 0 else 1.0)
+    return tops
+
+
+def _render(pv, grid, part, heads, lengths, path, tops=None):
     """The two panels of :data:`PANELS`: ``part`` of ``grid`` coloured on the scale of
     the whole grid, the grid's outline, one colour bar each, isometric view."""
     # a fresh plotter per image: one already shown renders again on every added actor
@@ -134,7 +148,7 @@ def _render(pv, grid, part, heads, lengths, path):
     try:
         for col, (name, title, _) in enumerate(PANELS):
             pl.subplot(0, col)
-            top = float(np.nanmax(grid.cell_data[name]))
+            top = (float(np.nanmax(grid.cell_data[name])) if tops is None else tops[col])
             pl.add_mesh(part, scalars=name, cmap="viridis", show_edges=True,
                         edge_color="#444444", line_width=0.5,
                         ambient=0.65, diffuse=0.35, specular=0.0,  # faces darken little
