@@ -118,12 +118,11 @@ def shared_log_norm(arrays, decades=4.0):
 
 def _tidy_axes(fig):
     """Before saving: log axes label only non-overlapping ticks (decades when two or more
-    are in view, else 1, 2, 5 times a decade; minor ticks unlabelled), and colour bars
+    are in view, else :func:`nice_log_ticks`; minor ticks unlabelled), and colour bars
     print their values in full (no offset or multiplier text above the bar, where it
     ran into panel titles)."""
-    from matplotlib.ticker import (FormatStrFormatter, LogFormatterSciNotation, LogLocator,
-                                   NullFormatter,
-                                   ScalarFormatter)
+    from matplotlib.ticker import (FixedLocator, FormatStrFormatter, FuncFormatter,
+                                   LogLocator, NullFormatter, ScalarFormatter)
     for ax in fig.axes:
         if hasattr(ax, "_colorbar"):
             for axis in (ax.xaxis, ax.yaxis):
@@ -138,21 +137,25 @@ def _tidy_axes(fig):
             axis.set_minor_formatter(NullFormatter())
             if not isinstance(axis.get_major_locator(), LogLocator):
                 continue       # ticks set by hand (e.g. at a study's levels)
-            if np.floor(np.log10(hi)) - np.ceil(np.log10(lo)) < 1:   # < 2 decades in view
-                axis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
-                # label every one of them (by default only decades beyond 1 decade)
-                axis.set_major_formatter(LogFormatterSciNotation(minor_thresholds=(3, 3)))
+            ticks = nice_log_ticks(lo, hi)
+            if ticks is not None:   # < 2 decades in view: LogLocator's own fallback
+                axis.set_major_locator(FixedLocator(ticks))
+                axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.3g}"))
 
 
-def node_image(x, spacing, values, unit=1.0):
-    """Values at the nodes of a uniform 2D grid as an image (rows: y) and its extent
-    (node positions times ``unit``, e.g. 1e3 for mm), for ``imshow(origin="lower")``."""
-    i = np.rint((x[:, 0] - x[:, 0].min()) / spacing).astype(int)
-    j = np.rint((x[:, 1] - x[:, 1].min()) / spacing).astype(int)
-    img = np.full((j.max() + 1, i.max() + 1), np.nan)
-    img[j, i] = values
-    ext = tuple(unit * v for v in (x[:, 0].min(), x[:, 0].max(), x[:, 1].min(), x[:, 1].max()))
-    return img, ext
+def nice_log_ticks(lo, hi):
+    """Major ticks for a log axis from ``lo`` to ``hi`` when fewer than two decades are in
+    view (else None: the decades serve): 1, 2, 5 times a power of ten, or 1, 1.5, 2, 3,
+    5, 7 when that gives fewer than two, or the two ends rounded."""
+    k0, k1 = int(np.floor(np.log10(lo))), int(np.ceil(np.log10(hi)))
+    if sum(1 for k in range(k0, k1 + 1) if lo <= 10.0 ** k <= hi) >= 2:
+        return None
+    for subs in ((1, 2, 5), (1, 1.5, 2, 3, 5, 7)):
+        ticks = [c * 10.0 ** k for k in range(k0, k1 + 1) for c in subs
+                 if lo <= c * 10.0 ** k <= hi]
+        if len(ticks) >= 2:
+            return ticks
+    return [float(f"{lo:.2g}"), float(f"{hi:.2g}")]
 
 
 def save(fig, folder, name) -> str:

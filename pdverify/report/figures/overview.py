@@ -82,14 +82,15 @@ def pareto(scenes, results, folder) -> list[tuple[str, str]]:
         pts = d["points"]
         ys = [d["floor"] if pts[k][3] else pts[k][1] for k in front]
         ax.plot([pts[k][0] for k in front], ys, "-", color="k", lw=1.0, zorder=2)
-        named = set()
+        named = []
         for k, y in zip(front, ys):
             m = pts[k][2]
             if m in named:
                 continue
-            named.add(m)
-            ax.annotate(m, (pts[k][0], y), xytext=(3, 3), textcoords="offset points",
-                        fontsize=6.5, color="k", zorder=4)
+            # alternate above / below the front, so neighbours' names do not overprint
+            ax.annotate(m, (pts[k][0], y), xytext=(4, 3 if len(named) % 2 == 0 else -9),
+                        textcoords="offset points", fontsize=6.5, color="k", zorder=4)
+            named.append(m)
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_ylim(lo, hi)
@@ -109,7 +110,8 @@ def pareto(scenes, results, folder) -> list[tuple[str, str]]:
     handles.append(plt.Line2D([], [], ls="none", marker="v", color="0.6",
                               label="exact (round-off), on the floor"))
     handles.append(plt.Line2D([], [], color="k", lw=1.0, label="Pareto front"))
-    fig.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 0.06 / rows),
+    # above the panels (below them it ran into the bottom row's axis labels)
+    fig.legend(handles=handles, loc="lower center", bbox_to_anchor=(0.5, 0.9 + 0.02 / rows),
                ncol=min(len(handles), 7), fontsize=7, frameon=False)
     name = save(fig, folder, "overview-pareto.png")
     return [(name, f"Error against cost, one panel per scene ({len(data)} scenes): the "

@@ -120,9 +120,10 @@ def _maps_3d(scene, results, folder):
     # shared axes, labels on the outer panels only, no layout engine: a 4 x 8 grid of
     # maps with every tick labelled took ~4x the time of the runs it shows (loaded box)
     fig, axes = plt.subplots(len(runs), 4, figsize=(12, 1.75 * len(runs) + 0.7),
-                             gridspec_kw={"width_ratios": [2, 2, 2, 1], "wspace": 0.12,
-                                          "hspace": 0.45}, squeeze=False, sharex="col",
+                             gridspec_kw={"width_ratios": [2, 2, 2, 1], "wspace": 0.3,
+                                          "hspace": 0.5}, squeeze=False, sharex="col",
                              sharey="col")
+    fig.subplots_adjust(top=1 - 0.55 / (1.75 * len(runs) + 0.7))
     im = None
     for row, (r, err) in enumerate(zip(runs, errs)):
         f = r.fields
@@ -143,8 +144,10 @@ def _maps_3d(scene, results, folder):
             continue
         for col, (ax, (title, z, ext, (a, b))) in enumerate(zip(axes[row], panels)):
             im = ax.imshow(z, origin="lower", extent=ext, cmap="viridis", norm=norm)
-            ax.set_title(f"{_label(r)} (max {vmax:.3g} %): {title}" if col == 0 else title,
-                         fontsize=7.5, loc="left" if col == 0 else "center")
+            ax.set_title(title, fontsize=7)
+            if col == 0:   # the run's name above its row, left
+                ax.text(0, 1.22, f"{_label(r)} (max {vmax:.3g} %)", fontsize=8,
+                        fontweight="bold", transform=ax.transAxes)
             ax.tick_params(labelsize=6)
             if row == len(runs) - 1:
                 ax.set_xlabel(f"{a} [m]", fontsize=6.5)
