@@ -158,6 +158,17 @@ def nice_log_ticks(lo, hi):
     return [float(f"{lo:.2g}"), float(f"{hi:.2g}")]
 
 
+def node_image(x, spacing, values, unit=1.0):
+    """Values at the nodes of a uniform 2D grid as an image (rows: y) and its extent
+    (node positions times ``unit``, e.g. 1e3 for mm), for ``imshow(origin="lower")``."""
+    i = np.rint((x[:, 0] - x[:, 0].min()) / spacing).astype(int)
+    j = np.rint((x[:, 1] - x[:, 1].min()) / spacing).astype(int)
+    img = np.full((j.max() + 1, i.max() + 1), np.nan)
+    img[j, i] = values
+    ext = tuple(unit * v for v in (x[:, 0].min(), x[:, 0].max(), x[:, 1].min(), x[:, 1].max()))
+    return img, ext
+
+
 def save(fig, folder, name) -> str:
     _tidy_axes(fig)
     path = os.path.join(folder, name)
