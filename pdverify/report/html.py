@@ -263,7 +263,11 @@ def _overview_cell(scene, m, runs, best, scale) -> dict | None:
     top = best_run(scene, m, runs)
     if top is not None and top is not r and abs(headline_pct(scene, top)) < abs(
             headline_pct(scene, r)):
-        cell["better"] = _value(scene, top, scale)
+        better = _value(scene, top, scale)
+        # better to the digits shown (a difference in the fourth digit is not a finding)
+        if (better["text"], better["exact"]) != (cell["default"]["text"],
+                                                 cell["default"]["exact"]):
+            cell["better"] = better
     return cell
 
 
