@@ -26,7 +26,7 @@ def test_matrix_cells_best_failed_and_reference():
     # the sweep's more accurate run is the method's best configuration, shown as exact
     # (round-off) beneath the default with its params (issue 34)
     best = bar_row.split('class="best"')[1]
-    assert ">exact<" in best and "order=3" in best
+    assert ">exact<" in best and "order=<wbr>3" in best
     assert 'title="plate2d-clamped/none: singular &lt;x&gt;">failed' in plate_row
     assert "reference" in plate_row
     assert "&#9733;" not in plate_row                            # one ok PD run: no ranking
