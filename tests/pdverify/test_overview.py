@@ -22,7 +22,7 @@ def test_matrix_cells_best_failed_and_reference():
     text = overview([bar, plate], runs)
     bar_row, plate_row = text.split("<tr>")[2:4]
     # default runs in per cent, the best method starred (issue 34: one unit)
-    assert "0.1 % &#9733;" in bar_row and "3 %<" in bar_row
+    assert "0.1 %</span> &#9733;" in bar_row and ">3 %<" in bar_row
     # the sweep's more accurate run is the method's best configuration, shown as exact
     # (round-off) beneath the default with its params (issue 34)
     best = bar_row.split('class="best"')[1]
