@@ -379,6 +379,7 @@ def _build_logged(cases, out, final, jobs, progress, client=None, quick=False,
     from . import figures, html
     from .figures import convergence, overview
     sections = []
+    tabled = set()   # the runs in the scenes' tables (the failure list links to their rows)
     order = []
     for scene_id in [c[0] for c in cases] + [r.scene for r in results]:
         if scene_id not in order:
@@ -388,6 +389,7 @@ def _build_logged(cases, out, final, jobs, progress, client=None, quick=False,
         # the scene's own cases; the convergence studies' extra levels have their section
         own = {run_key(scene_id, m, scene.resolve(m, o)) for m, o in scene.report_cases(quick)}
         mine = [r for r in results if r.scene == scene_id and r.key in own]
+        tabled.update(r.key for r in mine)
         with phase("figures_s"):
             figs = _drawn(f"figure for {scene_id}", figures.draw, (scene, mine, figdir), [],
                           progress)
@@ -415,7 +417,8 @@ def _build_logged(cases, out, final, jobs, progress, client=None, quick=False,
         doc = write_results(os.path.join(out, "results.json"), results,
                             {"convergence": studies, "report_phases": phases})
         atomic_write_text(os.path.join(out, "index.html"),
-                          html.page(doc, sections, time.perf_counter() - t0, results, front))
+                          html.page(doc, sections, time.perf_counter() - t0, results, front,
+                                    tabled))
     outcomes = [r.outcome for r in results]
     failed = outcomes.count("failed")
     expected = outcomes.count("expected-failure")

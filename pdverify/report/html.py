@@ -3,13 +3,14 @@ module turns runs into the values a template shows (numbers formatted, colours, 
 paper's values), the templates hold the markup, and every value is escaped on output."""
 from __future__ import annotations
 
+import hashlib
 import math
 import re
 
 import jinja2
 from markupsafe import Markup
 
-from ..convergence import LEVEL_RESULTS
+from ..convergence import EXACT, LEVEL_RESULTS
 from ..corrections import describe
 from ..errors import InputError
 from ..papers import PAPERS, seed_of
@@ -104,12 +105,18 @@ def _paper_text(p) -> str:
     return _num(p.value) + (" (read off a figure)" if p.kind == FIGURE else "")
 
 
+def run_anchor(result) -> str:
+    """The id of a run's row in its scene's table (the same for the same scene, method
+    and params): ``run-`` and a short hash of :func:`~pdverify.results.run_key`."""
+    return "run-" + hashlib.sha1("\0".join(result.key).encode()).hexdigest()[:12]
+
+
 def _row(scene, r, metrics) -> dict:
     """What the compact and the full table show of one run."""
     t = r.timings
     paper = scene.published_for(r.method, r.params)
     return {
-        "ok": r.status == "ok", "method": r.method, "params": _params(r, scene),
+        "anchor": run_anchor(r), "ok": r.status == "ok", "method": r.method, "params": _params(r, scene),
         "outcome": r.outcome, "expected": r.expected_failure,
         "message": r.message, "warnings": list(r.warnings),
         "cells": [{"value": _ours(r.metrics.get(m, ""), paper.get(m)),
@@ -224,52 +231,139 @@ def figure_list(figures) -> Markup:
     return _ENV.get_template("macros.html").module.figure_list(figures)
 
 
-_LOG_RANGE = (-8.0, 0.0)  # colour scale of the overview: 1e-8 (green) .. 1 (red)
+#: A headline error (as a fraction) at or below this is round-off, shown as "exact" apart
+#: from the colour scale: :data:`pdverify.convergence.EXACT` (1e-10, i.e. 1e-8 %), the bound
+#: the convergence studies use (direct solves' residuals are ~1e-13 relative).
+EXACT_FRACTION = EXACT
 
 
-def _colour(value: float) -> str:
-    """Green (1e-8 or less) to red (1 or more), on a log scale of ``abs(value)``."""
-    lo, hi = _LOG_RANGE
-    v = abs(value)
-    bad = 0.0 if v == 0 else (min(max(math.log10(v), lo), hi) - lo) / (hi - lo)
+def headline_pct(scene, result) -> float | None:
+    """The run's headline error in per cent (``*_pct`` metrics as they are, fractions
+    times 100), its sign kept; None where :func:`headline_value` has none."""
+    if headline_value(scene, result) is None:
+        return None
+    v = float(result.metrics[headline(scene)])
+    return v if headline(scene).endswith("_pct") else 100.0 * v
+
+
+def is_exact(pct) -> bool:
+    """A headline error (per cent) at round-off level (:data:`EXACT_FRACTION`)."""
+    return abs(pct) <= 100.0 * EXACT_FRACTION
+
+
+def cost_s(result) -> float:
+    """A run's cost on the front page: its setup and solve time (the metrics and fields
+    computed afterwards are not counted; ``total_s`` includes them)."""
+    t = result.timings
+    return float(t.get("setup_s", 0.0) or 0.0) + float(t.get("solve_s", 0.0) or 0.0)
+
+
+def colour_scale(pcts) -> tuple[float, float] | None:
+    """The overview's log colour scale, fitted to the errors present: from the smallest
+    error that is not exact to the largest (per cent, absolute values); None if every
+    error is exact or there is none. A single value gets one decade around it."""
+    vals = [abs(v) for v in pcts if v is not None and not is_exact(v)]
+    if not vals:
+        return None
+    lo, hi = min(vals), max(vals)
+    if hi <= lo * 1.0001:
+        lo, hi = lo / 10 ** 0.5, hi * 10 ** 0.5
+    return lo, hi
+
+
+def _colour(pct: float, scale) -> str:
+    """Green (the scale's low end) to red (its high end) on a log scale of ``|pct|``."""
+    lo, hi = scale
+    v = min(max(abs(pct), lo), hi)
+    bad = (math.log10(v) - math.log10(lo)) / (math.log10(hi) - math.log10(lo))
     return f"rgb({int(150 + 100 * bad)},{int(235 - 85 * bad)},150)"
 
 
-def _overview_cell(scene, m, r, metric, best) -> dict | None:
+def _pct_text(pct: float) -> str:
+    return f"{pct:.3g} %"
+
+
+def best_run(scene, method, runs):
+    """The run of ``method`` with the lowest headline error among ``runs`` (ties: the
+    cheaper one), or None when none has a headline error."""
+    mine = [(abs(headline_pct(scene, r)), cost_s(r), k, r) for k, r in enumerate(runs)
+            if r.method == method and headline_pct(scene, r) is not None]
+    return min(mine)[3] if mine else None
+
+
+def _value(scene, r, scale) -> dict:
+    pct = headline_pct(scene, r)
+    exact = is_exact(pct)
+    return {"text": _pct_text(pct), "exact": exact, "params": _params(r, scene),
+            "colour": "" if exact or scale is None else _colour(pct, scale),
+            "cost": f"{cost_s(r):.2g}"}
+
+
+def _overview_cell(scene, m, runs, best, scale) -> dict | None:
+    r = default_run(scene, m, runs)
     if r is None:
+        t = scene.offered().get(m)
+        if t is not None and t.unavailable:
+            return {"kind": "unavailable", "message": t.unavailable}
+        if any(x.name == m for x in scene.all_methods):
+            return {"kind": "not-run"}
         return None
     if r.outcome == "expected-failure":
         return {"kind": "expected", "message": f"expected ({r.expected_failure}): {r.message}"}
     if r.status != "ok":
         return {"kind": "failed", "message": r.message}
-    time = f"{r.timings.get('total_s', 0):.2g}"
     if m == "fem":
-        return {"kind": "fem", "time": time}
+        return {"kind": "fem", "time": f"{cost_s(r):.2g}"}
     if headline_value(scene, r) is None:
         return {"kind": "none"}
-    value = r.metrics[metric]
-    pct = metric.endswith("_pct")      # a percentage: coloured as a fraction
-    return {"kind": "value", "colour": _colour(value / (100 if pct else 1)),
-            "params": _params(r, scene), "value": f"{float(value):.3g}{' %' if pct else ''}",
-            "best": m == best, "time": time}
+    cell = {"kind": "value", "default": _value(scene, r, scale), "best": m == best,
+            "better": None}
+    top = best_run(scene, m, runs)
+    if top is not None and top is not r and abs(headline_pct(scene, top)) < abs(
+            headline_pct(scene, r)):
+        better = _value(scene, top, scale)
+        # better to the digits shown (a difference in the fourth digit is not a finding)
+        if (better["text"], better["exact"]) != (cell["default"]["text"],
+                                                 cell["default"]["exact"]):
+            cell["better"] = better
+    return cell
+
+
+def overview_scale(scenes, results):
+    """The colour scale of :func:`overview` (see :func:`colour_scale`): fitted to the
+    headline errors the matrix shows (each method's default and best run)."""
+    pcts = []
+    for scene in scenes:
+        runs = [r for r in results if r.scene == scene.id]
+        for m in dict.fromkeys(r.method for r in runs):
+            for r in (default_run(scene, m, runs), best_run(scene, m, runs)):
+                if r is not None and r.status == "ok":
+                    pcts.append(headline_pct(scene, r))
+    return colour_scale(pcts)
 
 
 def overview(scenes, results) -> Markup:
-    """Scene x method matrix: each cell the headline error of the method's default run
-    (coloured on a log scale, total time beneath), the best method per scene starred,
-    failed runs red with the reason on hover, FEM cells marked as the reference; method
-    names break at their hyphens so that ~15 columns fit a 1400 px screen."""
+    """Scene x method matrix: each cell the headline error in per cent of the method's
+    run at its default parameters and, when another of its runs is more accurate, that
+    best configuration (its parameters and cost beneath); coloured on a log scale fitted
+    to the errors present (:func:`overview_scale`), round-off marked "exact" apart from
+    the scale; the best method per scene (at default parameters) starred; failed runs
+    red with the reason on hover; a method that cannot run here says why; FEM cells
+    marked as the reference. Method names break at their hyphens so that ~15 columns
+    fit a 1400 px screen."""
     from ..listing import method_columns
     methods = method_columns(scenes)
+    scale = overview_scale(scenes, results)
     rows = []
     for scene in scenes:
         runs = [r for r in results if r.scene == scene.id]
-        metric = headline(scene)
         best = summarise(scene, runs).best
-        rows.append({"scene": scene.id, "metric": metric,
-                     "cells": [_overview_cell(scene, m, default_run(scene, m, runs), metric,
-                                              best) for m in methods]})
-    return _render("overview.html", methods=methods, rows=rows)
+        rows.append({"scene": scene.id, "metric": headline(scene),
+                     "cells": [_overview_cell(scene, m, runs, best, scale) for m in methods]})
+    return _render("overview.html", methods=methods, rows=rows, exact=100 * EXACT_FRACTION,
+                   scale=None if scale is None else [_pct_text(v) for v in scale],
+                   low=None if scale is None else _colour(scale[0], scale),
+                   high=None if scale is None else _colour(scale[1], scale))
 
 
 def papers(scenes) -> Markup:
@@ -282,8 +376,26 @@ def papers(scenes) -> Markup:
     return _render("papers.html", items=items)
 
 
+def failed_runs(results, tabled=None) -> list[dict]:
+    """The runs that count as failures (:attr:`RunResult.counts_as_failure`), each with
+    the anchor the header's failure count links to: its row in the scene's table, or the
+    scene's convergence section for a level that has no row (``tabled``: the keys of the
+    runs in the tables; None: all)."""
+    out = []
+    for r in results or ():
+        if not r.counts_as_failure:
+            continue
+        in_table = tabled is None or r.key in tabled
+        out.append({"scene": r.scene, "method": r.method,
+                    "params": ", ".join(f"{k}={_num(v)}" for k, v in r.params.items()),
+                    "message": r.message or "ok, but documented to fail: the finding is "
+                                            "out of date",
+                    "anchor": run_anchor(r) if in_table else f"{r.scene}-convergence"})
+    return out
+
+
 def page(doc: dict, sections: list[tuple], total_time: float, results=None,
-         front_figures=()) -> str:
+         front_figures=(), tabled=None) -> str:
     runs = doc["runs"]
     scenes = [s for s, _ in sections]
     return _render(
@@ -292,6 +404,7 @@ def page(doc: dict, sections: list[tuple], total_time: float, results=None,
         n_expected=sum(1 for r in runs if r["status"] != "ok" and r.get("expected_failure")),
         n_warned=sum(1 for r in runs if r.get("warnings")), total_time=total_time,
         overview=overview(scenes, results) if results is not None else "",
+        failed=failed_runs(results, tabled),
         front_figures=front_figures, papers=papers(scenes),
         methods=[(m, describe(m)) for m in sorted({r["method"] for r in runs})],
         sections=sections) + "\n"

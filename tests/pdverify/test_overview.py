@@ -21,8 +21,12 @@ def test_matrix_cells_best_failed_and_reference():
             _run(plate, "taylor-fictitious", rel_l2_error=0.0166)]
     text = overview([bar, plate], runs)
     bar_row, plate_row = text.split("<tr>")[2:4]
-    assert "0.001 &#9733;" in bar_row and "0.03<" in bar_row   # default run, best starred
-    assert "1e-20" not in bar_row                                # sweep runs stay below
+    # default runs in per cent, the best method starred (issue 34: one unit)
+    assert "0.1 %</span> &#9733;" in bar_row and ">3 %<" in bar_row
+    # the sweep's more accurate run is the method's best configuration, shown as exact
+    # (round-off) beneath the default with its params (issue 34)
+    best = bar_row.split('class="best"')[1]
+    assert ">exact<" in best and "order=<wbr>3" in best
     assert 'title="plate2d-clamped/none: singular &lt;x&gt;">failed' in plate_row
     assert "reference" in plate_row
     assert "&#9733;" not in plate_row                            # one ok PD run: no ranking

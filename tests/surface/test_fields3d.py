@@ -20,25 +20,32 @@ def run():
     return scene, r
 
 
-def test_render_box_fields_writes_one_nonblank_png_per_run(tmp_path, run):
+def test_render_box_fields_writes_one_nonblank_png_per_scene(tmp_path, run):
+    """One image per scene (issue 34): |u| of the first run, then each run's error on
+    one shared scale, :data:`fields3d.RENDER_COLUMNS` panels a row."""
     scene, r = run
     out = fields3d.render_box_fields(scene, [r], str(tmp_path))
-    assert [name for name, _ in out] == ["body3d-traction-none-3d-0.png"]
+    assert [name for name, _ in out] == ["body3d-traction-3d.png"]
     assert "Eq. (38)" in out[0][1] and "[mm]" in out[0][1]
     path = tmp_path / out[0][0]
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     img = mpimg.imread(path)  # floats in [0, 1]
-    w, h = fields3d.WINDOW
+    cols = fields3d.RENDER_COLUMNS
+    pw, ph = fields3d.PANEL_PX
+    w, h = pw * cols, ph          # two panels (|u|, the error): one row
     assert img.shape[:2] == (h, w)
     rgb = img[..., :3]
     # a blank frame (all background) has std 0, one with only the panel titles and the
     # axes triads about 0.04 (measured, 1400 x 600); the rendering, a white background
     # with coloured bodies and colour bars, about 0.33: 0.15 lies well between
-    assert rgb.std() > 0.15
-    # both panels drew their body: in each half over 5 % of the pixels have a channel
-    # below 0.5 (about 36 % here; the titles and triad alone cover well under 1 %)
-    for half in (rgb[:, : w // 2], rgb[:, w // 2:]):
-        assert (half.min(axis=-1) < 0.5).mean() > 0.05
+    assert rgb[:, : 2 * pw].std() > 0.15     # the two drawn panels
+    # both panels drew their body: in each over 5 % of the pixels have a channel below
+    # 0.5 (about 36 % in the former 1400 x 600 panels; the titles alone cover well under
+    # 1 %); the third panel of the row is empty
+    for k in range(2):
+        panel = rgb[:, k * pw:(k + 1) * pw]
+        assert (panel.min(axis=-1) < 0.5).mean() > 0.05
+    assert (rgb[:, 2 * pw:].min(axis=-1) < 0.5).mean() < 0.01
 
 
 def test_default_runs_pick_one_run_per_method_at_its_defaults():
@@ -58,7 +65,7 @@ def test_default_runs_pick_one_run_per_method_at_its_defaults():
 def test_the_family_draws_the_renderings_after_its_maps(tmp_path, run):
     scene, r = run
     names = [name for name, _ in surface_nodes.surface_node_figures(scene, [r], str(tmp_path))]
-    assert names == ["body3d-traction-none-0-0.png", "body3d-traction-none-3d-0.png",
+    assert names == ["body3d-traction-maps.png", "body3d-traction-3d.png",
                      "body3d-traction-cost.png"]
 
 
@@ -71,5 +78,5 @@ def test_the_family_keeps_its_maps_when_the_renderer_fails(tmp_path, monkeypatch
     monkeypatch.setattr(fields3d, "render_box_fields", broken)
     with pytest.warns(RuntimeWarning, match="no 3D renderings.*no OpenGL"):
         figs = surface_nodes.surface_node_figures(scene, [r], str(tmp_path))
-    assert figs and not any("-3d-" in name for name, _ in figs)
+    assert figs and not any("-3d" in name for name, _ in figs)
     assert all((tmp_path / name).exists() for name, _ in figs)

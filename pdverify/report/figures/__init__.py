@@ -54,6 +54,110 @@ def label(result) -> str:
     return result.method + (f" ({extra})" if extra else "")
 
 
+def distinct_labels(results, base=label) -> list[str]:
+    """``base(r)`` of each run, plus the params that tell apart runs sharing a label (no
+    legend names two lines alike, e.g. two "surface-nodes (order=3)" at two spacings)."""
+    names = [base(r) for r in results]
+    out = []
+    for r, name in zip(results, names):
+        twins = [q for q, n in zip(results, names) if n == name]
+        if len(twins) > 1:
+            differ = [k for k in r.params
+                      if any(q.params.get(k) != r.params[k] for q in twins)]
+            name += "; " + ", ".join(f"{k}={_short(r.params[k])}" for k in differ)
+        out.append(name)
+    return out
+
+
+def _short(v):
+    return f"{v:.4g}" if isinstance(v, float) else v
+
+
+#: A map whose values span less than this, relative to their size, shows round-off and
+#: is replaced by its value: :data:`pdverify.convergence.EXACT` (1e-10; direct solves'
+#: residuals are ~1e-13 relative).
+ROUND_OFF = 1e-10
+
+
+def round_off(values, scale=None) -> bool:
+    """Whether a map of ``values`` would only show round-off: their range is at most
+    :data:`ROUND_OFF` times ``scale`` (default: their largest magnitude; errors in per
+    cent pass 100, so that a map at or below 1e-8 % counts)."""
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v)]
+    if v.size == 0:
+        return True
+    ref = np.abs(v).max() if scale is None else scale
+    return float(v.max() - v.min()) <= ROUND_OFF * ref
+
+
+def number_panel(ax, text, title=None):
+    """An axes showing ``text`` instead of a map (round-off, a single value)."""
+    ax.set_axis_off()
+    ax.text(0.5, 0.5, text, ha="center", va="center", fontsize=8, wrap=True,
+            transform=ax.transAxes, bbox={"fc": "#eef4ff", "ec": "#99b", "lw": 0.5})
+    if title:
+        ax.set_title(title, fontsize=8.5)
+
+
+def shared_log_norm(arrays, decades=4.0):
+    """One logarithmic colour scale for several maps: up to the largest value, down to
+    the smallest positive one but at most ``decades`` below the top (lower values take
+    the lowest colour). None when no value is positive."""
+    from matplotlib.colors import LogNorm
+    pos = [np.asarray(a, dtype=float) for a in arrays]
+    pos = np.concatenate([a[np.isfinite(a) & (a > 0)].ravel() for a in pos]) if pos else []
+    if len(pos) == 0:
+        return None
+    hi = float(pos.max())
+    lo = max(float(pos.min()), hi * 10.0 ** -decades)
+    if lo >= hi:
+        lo = hi / 10
+    return LogNorm(vmin=lo, vmax=hi, clip=True)
+
+
+def _tidy_axes(fig):
+    """Before saving: log axes label only non-overlapping ticks (decades when two or more
+    are in view, else :func:`nice_log_ticks`; minor ticks unlabelled), and colour bars
+    print their values in full (no offset or multiplier text above the bar, where it
+    ran into panel titles)."""
+    from matplotlib.ticker import (FixedLocator, FormatStrFormatter, FuncFormatter,
+                                   LogLocator, NullFormatter, ScalarFormatter)
+    for ax in fig.axes:
+        if hasattr(ax, "_colorbar"):
+            for axis in (ax.xaxis, ax.yaxis):
+                if isinstance(axis.get_major_formatter(), ScalarFormatter):
+                    axis.set_major_formatter(FormatStrFormatter("%.3g"))
+        for axis, scale in ((ax.xaxis, ax.get_xscale()), (ax.yaxis, ax.get_yscale())):
+            if scale != "log":
+                continue
+            lo, hi = sorted(axis.get_view_interval())
+            if not (lo > 0 and np.isfinite(hi)):
+                continue
+            axis.set_minor_formatter(NullFormatter())
+            if not isinstance(axis.get_major_locator(), LogLocator):
+                continue       # ticks set by hand (e.g. at a study's levels)
+            ticks = nice_log_ticks(lo, hi)
+            if ticks is not None:   # < 2 decades in view: LogLocator's own fallback
+                axis.set_major_locator(FixedLocator(ticks))
+                axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.3g}"))
+
+
+def nice_log_ticks(lo, hi):
+    """Major ticks for a log axis from ``lo`` to ``hi`` when fewer than two decades are in
+    view (else None: the decades serve): 1, 2, 5 times a power of ten, or 1, 1.5, 2, 3,
+    5, 7 when that gives fewer than two, or the two ends rounded."""
+    k0, k1 = int(np.floor(np.log10(lo))), int(np.ceil(np.log10(hi)))
+    if sum(1 for k in range(k0, k1 + 1) if lo <= 10.0 ** k <= hi) >= 2:
+        return None
+    for subs in ((1, 2, 5), (1, 1.5, 2, 3, 5, 7)):
+        ticks = [c * 10.0 ** k for k in range(k0, k1 + 1) for c in subs
+                 if lo <= c * 10.0 ** k <= hi]
+        if len(ticks) >= 2:
+            return ticks
+    return [float(f"{lo:.2g}"), float(f"{hi:.2g}")]
+
+
 def node_image(x, spacing, values, unit=1.0):
     """Values at the nodes of a uniform 2D grid as an image (rows: y) and its extent
     (node positions times ``unit``, e.g. 1e3 for mm), for ``imshow(origin="lower")``."""
@@ -66,6 +170,7 @@ def node_image(x, spacing, values, unit=1.0):
 
 
 def save(fig, folder, name) -> str:
+    _tidy_axes(fig)
     path = os.path.join(folder, name)
     fig.savefig(path, dpi=110, bbox_inches="tight")
     plt.close(fig)

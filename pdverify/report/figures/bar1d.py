@@ -4,7 +4,7 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 
-from . import family, label, save as _save
+from . import distinct_labels, family, label, save as _save
 
 
 @family("bar1d")
@@ -14,11 +14,11 @@ def bar_figures(scene, results, folder):
     ref = results[0].fields
     xf = np.linspace(0.0, ref["length"], 400)
     ax1.plot(xf, scene.classical(xf, results[0].params), "k--", lw=1.2, label="classical (reference)")
-    for r in results:
+    for r, name in zip(results, distinct_labels(results)):
         f = r.fields
-        ax1.plot(f["x"], f["u"], "o-", ms=3, lw=1, label=label(r))
+        ax1.plot(f["x"], f["u"], "o-", ms=3, lw=1, label=name)
         err = np.where(f["error_pct"] > 0, f["error_pct"], np.nan)
-        ax2.semilogy(f["x"], err, "o-", ms=3, lw=1, label=label(r))
+        ax2.semilogy(f["x"], err, "o-", ms=3, lw=1, label=name)
     ax1.set_xlabel("x [m]")
     ax1.set_ylabel("u [m]")
     ax1.legend(fontsize=8)

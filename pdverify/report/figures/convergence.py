@@ -4,6 +4,7 @@ rate of each method in the legend."""
 from __future__ import annotations
 
 import matplotlib.pyplot as plt
+import numpy as np
 from matplotlib.ticker import NullFormatter
 
 from . import save
@@ -13,6 +14,37 @@ def _legend(entry) -> str:
     if entry["rate"] is not None:
         return f"{entry['method']} (rate {entry['rate']:.2f})"
     return f"{entry['method']} ({entry['note'].split(' (')[0]})"
+
+
+#: the orders :mod:`pdverify.convergence` expects (its docstring): at fixed m a
+#: consistent treatment converges with its nonlocal truncation order, 2, an uncorrected
+#: model at about 1 (its surface layer is O(delta) thick); at fixed delta the error
+#: tends to the nonlocal model's own (rate 0), drawn against the same two guides
+EXPECTED_ORDERS = (1, 2)
+
+
+def reference_slopes(entries):
+    """The reference lines of a study panel: ``[(p, (h0, h1), (e0, e1))]`` for each p of
+    :data:`EXPECTED_ORDERS`, over the panel's h range, through the geometric mean of the
+    errors (that are not round-off) at the coarsest level; [] without such errors."""
+    from ...convergence import EXACT
+    coarse = {}
+    for e in entries:
+        for lv in e["levels"]:
+            if lv["error"] is not None and lv["error"] > EXACT:
+                coarse.setdefault(lv["h"], []).append(lv["error"])
+    hs = sorted({lv["h"] for e in entries for lv in e["levels"]})
+    if len(hs) < 2 or hs[-1] not in coarse:
+        return []
+    anchor = float(np.exp(np.mean(np.log(coarse[hs[-1]]))))
+    return [(p, (hs[0], hs[-1]), (anchor * (hs[0] / hs[-1]) ** p, anchor))
+            for p in EXPECTED_ORDERS]
+
+
+def _reference_slopes(ax, entries, kind):
+    for p, hs, es in reference_slopes(entries):
+        ax.loglog(hs, es, ls=(0, (4, 3)) if p == 1 else (0, (1, 2)), color="0.35", lw=1,
+                  label=f"reference slope h^{p}")
 
 
 def draw(studies, folder) -> dict:
@@ -29,6 +61,7 @@ def draw(studies, folder) -> dict:
                        if lv["error"] is not None]
                 if pts:
                     ax.loglog(*zip(*pts), "o-", ms=4, label=_legend(e))
+            _reference_slopes(ax, entries, kind)
             # ticks at the levels only: log axes within a decade otherwise label every
             # minor tick and the labels run into each other
             hs = sorted({lv["h"] for e in entries for lv in e["levels"]})
@@ -45,6 +78,9 @@ def draw(studies, folder) -> dict:
         name = save(fig, folder, f"{scene}-convergence-studies.png")
         out[scene] = [(name, f"{scene}: error against the refined length, one line per "
                              "method, the least-squares rate p of error ~ h^p in the legend "
+                             "(grey: reference slopes h^1 and h^2 through the coarsest level, "
+                             "the orders expected of an uncorrected and a consistent treatment "
+                             "under delta-refinement) "
                              "(or why there is none: exact at every level, a failed level). "
                              "Left: delta -> 0 at fixed m; right: m -> infinity at fixed "
                              "delta, which converges to the nonlocal model's own error "

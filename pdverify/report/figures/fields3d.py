@@ -77,7 +77,8 @@ def _caption(r, cut):
             f"{cut[0]:.3g} m, y > {cut[1]:.3g} m, z > {cut[2]:.3g} m cut away so the "
             "interior mid-planes show; the box's outline in black. Left: displacement "
             "magnitude |u| [mm]; right: the nodal error of Eq. (38) of seed 001 [%]. "
-            "Isometric view, each panel its own colour scale.")
+            "Isometric view; each panel's colour scale is shared by the scene's renderings "
+            "(the largest value over its methods).")
 
 
 #: the two panels: cell-data name, scalar bar title (VTK renders a title with $...$ by
@@ -99,24 +100,68 @@ def _grid(pv, f):
 
 
 def render_box_fields(scene, results, folder) -> list[tuple[str, str]]:
-    """One png per run of :func:`default_runs` of ``results`` (3D box runs with fields):
-    |u| and the Eq. (38) error, octant cut away; returns (file, caption) pairs."""
+    """One png of the runs of :func:`default_runs` of ``results`` (3D box runs with
+    fields), octant cut away: the displacement magnitude |u| of the first, then the
+    Eq. (38) error of each on one colour scale shared by all (:func:`shared_tops`), three
+    panels a row; returns one (file, caption) pair."""
     import pyvista as pv
 
     pv.OFF_SCREEN = True
-    out = []
-    for r in default_runs(scene, results):
-        f = r.fields
-        grid = _grid(pv, f)
-        keep, cut = _octant(f)
-        heads = (f"{scene.id}: {label(r)}, h = {f['spacing']:g} m",
-                 f"cut away: x > {cut[0]:.3g} m, y > {cut[1]:.3g} m, z > {cut[2]:.3g} m")
-        file = f"{scene.id}-{r.method}-3d-{len(out)}.png"
-        with _quiet(pv):
-            _render(pv, grid, grid.extract_cells(keep), heads, f["lengths"],
-                    os.path.join(folder, file))
-        out.append((file, _caption(r, cut)))
-    return out
+    runs = default_runs(scene, results)
+    if not runs:
+        return []
+    tops = shared_tops(runs)
+    keep, cut = _octant(runs[0].fields)
+    panels = [(runs[0], 0, f"displacement magnitude [mm]: {label(runs[0])}")] + [
+        (r, 1, f"error [%]: {label(r)} (max {float(np.nanmax(r.fields['error'])):.3g})")
+        for r in runs]
+    file = f"{scene.id}-3d.png"
+    with _quiet(pv):
+        _render_grid(pv, panels, tops, os.path.join(folder, file))
+    f = runs[0].fields
+    return [(file, f"{scene.id}: 3D rendering of the runs' nodal fields on the grid cells "
+                   f"(each node is a cell centre, h = {f['spacing']:g} m), the octant x > "
+                   f"{cut[0]:.3g} m, y > {cut[1]:.3g} m, z > {cut[2]:.3g} m cut away so the "
+                   "interior mid-planes show; the box's outline in black. First panel: "
+                   f"displacement magnitude |u| [mm] of {label(runs[0])}; then the nodal "
+                   "error of Eq. (38) of seed 001 [%] of each method at its defaults, all "
+                   "on one colour scale (0 to the largest error over the methods), so the "
+                   "methods compare by eye. Isometric view.")]
+
+
+#: panels a row of :func:`render_box_fields`, and pixels of one panel
+RENDER_COLUMNS, PANEL_PX = 3, (460, 380)
+
+
+def _render_grid(pv, panels, tops, path):
+    rows = -(-len(panels) // RENDER_COLUMNS)
+    pl = pv.Plotter(shape=(rows, RENDER_COLUMNS), off_screen=True, border=False,
+                    window_size=(PANEL_PX[0] * RENDER_COLUMNS, PANEL_PX[1] * rows))
+    try:
+        bars = set()
+        for k, (r, which, head) in enumerate(panels):
+            pl.subplot(k // RENDER_COLUMNS, k % RENDER_COLUMNS)
+            f = r.fields
+            grid = _grid(pv, f)
+            keep, _ = _octant(f)
+            name, title, _ = PANELS[which]
+            pl.add_mesh(grid.extract_cells(keep), scalars=name, cmap="viridis",
+                        show_edges=True, edge_color="#444444", line_width=0.5,
+                        ambient=0.65, diffuse=0.35, specular=0.0,
+                        clim=(0.0, tops[which]), show_scalar_bar=which not in bars,
+                        scalar_bar_args={"title": title, "fmt": "%.3g", "vertical": False,
+                                         "title_font_size": 14, "label_font_size": 12,
+                                         "n_labels": 4, "position_x": 0.15,
+                                         "position_y": 0.03, "width": 0.7, "height": 0.12})
+            bars.add(which)
+            pl.add_mesh(grid.outline(), color="black", line_width=1.5)
+            pl.add_text(head, position=(0.01, 0.92), viewport=True, font_size=8)
+            pl.view_isometric()
+            pl.camera.zoom(0.85)
+            _lift(pl.camera, 0.09 * float(np.linalg.norm(f["lengths"])))
+        pl.screenshot(path)
+    finally:
+        pl.close()
 
 
 def _quiet(pv):
@@ -126,7 +171,18 @@ def _quiet(pv):
     return verbosity("error") if verbosity is not None else contextlib.nullcontext()
 
 
-def _render(pv, grid, part, heads, lengths, path):
+def shared_tops(runs) -> list[float]:
+    """The top of each panel's colour scale, shared by ``runs`` (one scene's renderings
+    compare by eye): the largest value of the panel over every run (1 where none is
+    positive)."""
+    tops = []
+    for _, _, values in PANELS:
+        top = max((float(np.nanmax(values(r.fields))) for r in runs), default=0.0)
+        tops.append(top if top > 0 else 1.0)
+    return tops
+
+
+def _render(pv, grid, part, heads, lengths, path, tops=None):
     """The two panels of :data:`PANELS`: ``part`` of ``grid`` coloured on the scale of
     the whole grid, the grid's outline, one colour bar each, isometric view."""
     # a fresh plotter per image: one already shown renders again on every added actor
@@ -134,7 +190,7 @@ def _render(pv, grid, part, heads, lengths, path):
     try:
         for col, (name, title, _) in enumerate(PANELS):
             pl.subplot(0, col)
-            top = float(np.nanmax(grid.cell_data[name]))
+            top = (float(np.nanmax(grid.cell_data[name])) if tops is None else tops[col])
             pl.add_mesh(part, scalars=name, cmap="viridis", show_edges=True,
                         edge_color="#444444", line_width=0.5,
                         ambient=0.65, diffuse=0.35, specular=0.0,  # faces darken little
