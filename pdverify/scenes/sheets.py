@@ -4,7 +4,6 @@ from __future__ import annotations
 import numpy as np
 
 from .. import budget
-from ..corrections.energy_directional import directional_closure
 from ..corrections.virtual_nodes import buffered_grid, virtual_nodes_closure
 from ..errors import InputError
 from ..metrics import rel_l2_error
@@ -149,7 +148,7 @@ class TensionSheet(SheetScene):
         Param("load_sharing", "tributary", "end force per end node: by tributary length "
               "(corners half) or equal", choices=("tributary", "equal")),
     )
-    pd_methods = (("none", ()), ("energy-directional", ()))
+    pd_methods = (("none", ()),)   # energy-directional: the registry's, on this box
     published = (
         Published("max_error_pct", "closed form", "seed 003 §4.1.1", method="fem"),
         Published("max_error_ux_pct", 82, "seed 003 Table 1", method="none",
@@ -197,9 +196,7 @@ class TensionSheet(SheetScene):
             grid = BoxGrid((W, H), (-W / 2, -H / 2), h, placement="on-surface")
             stencil = self.stencil(p, delta / h)
             inf = get_influence(p["micromodulus"])
-            closure = (directional_closure(grid, (-W / 2, -H / 2), (W / 2, H / 2), delta, inf)
-                       if method == "energy-directional"
-                       else self.bond_closure(method, p))
+            closure = self.bond_closure(method, p)
             c = self.micromodulus(p, delta)
             model = BondBasedModel(grid, stencil, c, inf, closure, thickness=t)
             n, x = grid.n_ext, grid.x
@@ -298,7 +295,7 @@ class ClampedSheet(SheetScene):
     NODE_VOLUMES = Param("node_volumes", "partial", "volume of the nodes on the surface: half "
                          "on edges, a quarter at corners (ERRATA), or a full cell",
                          choices=("partial", "full"))
-    pd_methods = (("none", (NODE_VOLUMES,)), ("energy-directional", (NODE_VOLUMES,)),
+    pd_methods = (("none", (NODE_VOLUMES,)),
                   ("virtual-nodes", (Param("correct_sides", False, "apply the directional "
                                            "correction on the free sides (variant 4)"),)))
     published = (
@@ -365,9 +362,7 @@ class ClampedSheet(SheetScene):
                 y = grid.x[:, 1]
                 top = np.flatnonzero(np.isclose(y, L / 2))
                 bottom = np.flatnonzero(np.isclose(y, -L / 2))
-                closure = (directional_closure(grid, lo, hi, delta, inf)
-                           if method == "energy-directional"
-                           else self.bond_closure(method, p))
+                closure = self.bond_closure(method, p)
             model = BondBasedModel(grid, self.stencil(p, p["m_ratio"]),
                                    self.micromodulus(p, delta), inf, closure, thickness=t)
             n = grid.n_ext
