@@ -217,19 +217,8 @@ def compare_files(baseline: str, new: str, *, rtol=None, atol=None, stream=None,
     for value, flag in ((rtol, "--rtol"), (atol, "--atol")):
         if value is not None and not (value >= 0 and math.isfinite(value)):
             raise InputError(f"{flag}={value} must be a finite number >= 0")
-    docs = []
-    for path, what in ((baseline, "baseline"), (new, "new results")):
-        try:
-            docs.append(load_results(path))
-        except FileNotFoundError:
-            raise InputError(f"results file {path!r} does not exist") from None
-        except IsADirectoryError:
-            raise InputError(f"results file {path!r} is a folder") from None
-        except PermissionError:
-            raise InputError(f"results file {path!r} cannot be read (permission denied)") from None
-        except ValueError as exc:
-            raise InputError(str(exc)) from None
-        check_unique(docs[-1], path, what)
+    docs = [_load_checked(path, what)
+            for path, what in ((baseline, "baseline"), (new, "new results"))]
     matched: list = []
     changes = compare_docs(docs[0], docs[1], rtol=rtol, atol=atol, matched=matched)
     print(format_changes(changes), file=stream)
@@ -298,13 +287,9 @@ def format_published(rows: list[dict]) -> str:
                      for row in table)
 
 
-def compare_published(path: str, *, stream=None) -> int:
-    """``pdverify compare --against-published RESULTS.json``: check every published entry
-    of every run; 0 when all hold (known differences and statements without a number are
-    listed, not failed), 1 when one fails (listed again at the end), bad input (exit 2,
-    :class:`~pdverify.errors.InputError`): a file that is not a results file or holds no
-    published entry."""
-    stream = stream or sys.stdout
+def _load_checked(path: str, what: str) -> dict:
+    """A results file read and checked (unique run keys), every failure one line of bad
+    input naming the file."""
     try:
         doc = load_results(path)
     except FileNotFoundError:
@@ -315,7 +300,18 @@ def compare_published(path: str, *, stream=None) -> int:
         raise InputError(f"results file {path!r} cannot be read (permission denied)") from None
     except ValueError as exc:
         raise InputError(str(exc)) from None
-    check_unique(doc, path, "results file")
+    check_unique(doc, path, what)
+    return doc
+
+
+def compare_published(path: str, *, stream=None) -> int:
+    """``pdverify compare --against-published RESULTS.json``: check every published entry
+    of every run; 0 when all hold (known differences and statements without a number are
+    listed, not failed), 1 when one fails (listed again at the end), bad input (exit 2,
+    :class:`~pdverify.errors.InputError`): a file that is not a results file or holds no
+    published entry."""
+    stream = stream or sys.stdout
+    doc = _load_checked(path, "results file")
     rows = [row for run in doc["runs"] for row in published.check_run(run)]
     if not rows:
         raise InputError(f"--against-published {path!r}: no run holds a 'published' entry "

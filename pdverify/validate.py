@@ -115,26 +115,24 @@ def run_timeout(value: float | None) -> float | None:
     return value
 
 
-def only(scenes) -> list | None:
-    """``--only``: every scene at most once."""
-    if scenes is None:
+def _once_each(values, flag: str, what: str) -> list | None:
+    """``values`` as a list, each at most once (None stays None)."""
+    if values is None:
         return None
     seen = set()
-    for s in scenes:
-        if s in seen:
-            raise InputError(f"--only: scene {s!r} is given twice")
-        seen.add(s)
-    return list(scenes)
+    for v in values:
+        if v in seen:
+            raise InputError(f"{flag}: {what} {v!r} is given twice")
+        seen.add(v)
+    return list(values)
+
+
+def only(scenes) -> list | None:
+    """``--only``: every scene at most once."""
+    return _once_each(scenes, "--only", "scene")
 
 
 def methods(names) -> list | None:
     """``report --method``: every method at most once (whether the selected scenes offer
     it is checked by :func:`pdverify.runner.plan`, with the close matches)."""
-    if names is None:
-        return None
-    seen = set()
-    for m in names:
-        if m in seen:
-            raise InputError(f"--method: method {m!r} is given twice")
-        seen.add(m)
-    return list(names)
+    return _once_each(names, "--method", "method")
