@@ -35,7 +35,7 @@ from ..params import Param, at_least, open_interval, positive
 from ..pd import (BondBasedModel, BoxGrid, StateBasedConstants, StateBasedModel,
                   bond_micromodulus, build_stencil, get_influence, state_based_stencil)
 from ..pd.influence import INFLUENCES
-from . import MethodSpec, Outcome, Scene, register, whole_cells
+from . import MethodSpec, Outcome, Published, Scene, register, whole_cells
 
 AXES = "xyz"
 
@@ -48,6 +48,21 @@ def strain_states(dim: int) -> list[tuple[str, np.ndarray]]:
         eps[i, j] = eps[j, i] = 0.5
         out.append((f"shear_{AXES[i]}{AXES[j]}", eps))
     return out
+
+
+def bulk_anisotropy_pct(model) -> float:
+    """How far the bulk lattice is from isotropy: the spread (max - min) / min, in %, of
+    its energy density under unit uniaxial strains along the lattice's axis and diagonal
+    directions (2D: [10], [11]; 3D: [100], [110], [111]), the extremes of a cubic or
+    square medium's uniaxial stiffness (its energy n.n:C:n.n/2 is a quartic in n with
+    stationary points there). An isotropic medium gives 0 (seed 003 §4.1.2: "deviations
+    from exact isotropy are less than 2 %" at m = 1/6)."""
+    d = model.dim
+    dirs = [np.eye(d)[0], np.r_[1.0, 1.0, np.zeros(d - 2)] / np.sqrt(2.0)]
+    if d == 3:
+        dirs.append(np.ones(3) / np.sqrt(3.0))
+    w = np.array([model.bulk_work_density(np.outer(n, n)) for n in dirs])
+    return float((w.max() - w.min()) / w.min() * 100.0)
 
 
 def energy_ratios(model) -> dict[str, np.ndarray]:
@@ -106,6 +121,8 @@ class StiffnessScene(Scene):
             "energy_ratio_min": float(min(v.min() for v in ratios.values())),
             "energy_ratio_max": float(max(v.max() for v in ratios.values())),
         }
+        if model.dim > 1:
+            metrics["bulk_anisotropy_pct"] = bulk_anisotropy_pct(model)
         fields = {"x": x, "spacing": p["spacing"], "horizon": model.horizon,
                   "lengths": np.asarray(g.lengths), "origin": np.asarray(g.origin),
                   **{f"ratio_{k}": v for k, v in ratios.items()}}
@@ -143,8 +160,17 @@ class SheetStiffness(StiffnessScene):
               choices=("full-cells", "partial-volume")),
     )
 
+    #: seed 003 §4.1.2 chooses m = 1/6 (delta = 6 Delta), "deviations from exact isotropy
+    #: are less than 2 %", with its quadrature (whole cells) and micromodulus (constant)
+    PAPER_M = {"m_ratio": 6.0, "quadrature": "full-cells", "micromodulus": "constant"}
+    published = (Published("bulk_anisotropy_pct", "< 2", "seed 003 §4.1.2", method="none",
+                           where=PAPER_M),)
+
     def lengths(self, p):
         return (p["width"], p["length"])
+
+    def cases(self, quick=False):
+        return super().cases(quick) + [("none", {"m_ratio": 6.0})]
 
     def build(self, method, p, closure):
         W, H, h = p["width"], p["length"], p["spacing"]

@@ -27,3 +27,26 @@ def test_fluctuation_metric_sees_an_oscillation_and_not_a_smooth_error():
     assert np.isclose(error_fluctuation_pct(x, smooth, 0.05, 1.0), 6.0 * h ** 2)
     wobble = smooth + np.where(x < 0.05, 0.01 * (-1.0) ** np.arange(x.size), 0.0)
     assert error_fluctuation_pct(x, wobble, 0.05, 1.0) > 0.039
+
+
+def test_seed003_4_1_2_bulk_is_isotropic_within_2_percent_at_m_one_sixth():
+    """seed 003 §4.1.2: m = 1/6 "provides a good compromise between numerical accuracy
+    (deviations from exact isotropy are less than 2 %) and efficiency": the bulk lattice's
+    uniaxial energy spread with the paper's whole-cell quadrature is 1.69 %; at m = 1/5
+    (this scene's default, §4.1.1's grid) it is 4.35 %, so the bound is the chosen m's,
+    not every m's; exact partial areas are nearly isotropic (0.20 % at m = 1/6)."""
+    scene = get_scene("stiffness2d-sheet")
+    paper = scene.run("none", {"m_ratio": 6.0})
+    assert paper.metrics["bulk_anisotropy_pct"] < 2.0
+    assert [e["check"] for e in paper.published if e["metric"] == "bulk_anisotropy_pct"] \
+        == ["below"]
+    assert scene.run("none").metrics["bulk_anisotropy_pct"] > 2.0
+    exact = scene.run("none", {"m_ratio": 6.0, "quadrature": "partial-volume"})
+    assert exact.metrics["bulk_anisotropy_pct"] < paper.metrics["bulk_anisotropy_pct"]
+
+
+def test_isotropic_bulk_gives_zero_anisotropy():
+    """The moment-corrected quadrature makes the lattice's fourth moment isotropic by
+    construction, so the 3D LPS bulk is isotropic and the metric is round-off."""
+    r = get_scene("stiffness3d-box").run("none", {"quadrature": "moment-corrected"})
+    assert r.metrics["bulk_anisotropy_pct"] < 1e-9   # round-off of sums of ~1e3 terms
