@@ -76,7 +76,7 @@ def box_factors(model) -> np.ndarray:
 
 def energy_directional_closure(params=None) -> Closure:
     """The registry's ``energy-directional``: :func:`box_factors` on the bond weights."""
-    return Closure(weight_factor=box_factors)
+    return Closure(geometric_factor=box_factors)
 
 
 def own_factor_energy_density(model, u, lower, upper, horizon, axes=None) -> np.ndarray:

@@ -173,7 +173,7 @@ class _GuardedConstitutive:
         return _guard(value, self._who, f"constitutive.{name}") if callable(value) else value
 
 
-_CALLABLE_FIELDS = ("keep", "bond_factor", "weight_factor", "force_factor")
+_CALLABLE_FIELDS = ("keep", "bond_factor", "geometric_factor", "weight_factor", "force_factor")
 
 
 def _plugin_closure(method: "BondMethod", params: Mapping) -> Closure:

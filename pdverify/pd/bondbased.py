@@ -59,6 +59,8 @@ class BondBasedModel:
         self.bond_x, self.bond_n = x, xi / x[:, None]
         self.bond_factor = (closure.bond_factor(a, b, self.bond_n)
                             if closure.bond_factor is not None else np.ones(a.size))
+        if closure.geometric_factor is not None:
+            self.bond_factor = self.bond_factor * closure.geometric_factor(self)
         self.bond_beta = beta[which]
         #: omega(|xi|) beta of every bond (the weight of its end's horizon sum)
         self.bond_weight = influence.omega(x, delta) * self.bond_beta

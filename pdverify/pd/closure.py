@@ -38,6 +38,10 @@ class Closure:
     - ``bond_factor(a, b, n) -> factor``: a factor on each bond's weight beta (end-bond
       or directional corrections); ``n`` the unit bond vectors. In the state-based model it
       enters the weighted volume and the dilatation as well as the force. Default: 1.
+    - ``geometric_factor(model) -> factor``: ``bond_factor`` computed from the model's
+      geometry (``grid``, ``bond_a``, ``bond_b``, ``bond_n``, ``horizon``,
+      ``influence``) instead of given pairs, entering exactly where ``bond_factor`` does
+      (seed 003's directional factor on the grid's own box). Default: 1.
     - ``weight_factor(model) -> factor``: like ``bond_factor``, computed from the model's
       bonds once they are known (``bond_a``, ``bond_b``, ``bond_n``, ``bond_x``,
       ``bond_beta``, ``node_volume``, ``stencil``), before m and the operators (the
@@ -65,6 +69,7 @@ class Closure:
     n_unknown_nodes: int | None = None
     displacement_map_full: sp.spmatrix | None = None
     bond_factor: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray] | None = None
+    geometric_factor: Callable[[object], np.ndarray] | None = None
     weight_factor: Callable[[object], np.ndarray] | None = None
     force_factor: Callable[[object], np.ndarray] | None = None
     constitutive: object | None = None

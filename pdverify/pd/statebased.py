@@ -87,6 +87,8 @@ class StateBasedModel:
         self.bond_beta = beta_h[which]
         if closure.bond_factor is not None:
             self.bond_beta = self.bond_beta * closure.bond_factor(a, b, self.bond_n)
+        if closure.geometric_factor is not None:
+            self.bond_beta = self.bond_beta * closure.geometric_factor(self)
         if closure.weight_factor is not None:
             self.bond_beta = self.bond_beta * closure.weight_factor(self)
         Va, Vb = self.node_volume[a], self.node_volume[b]
