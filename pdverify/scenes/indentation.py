@@ -135,8 +135,13 @@ class Indentation(FemAndPD):
     pd_methods = (("none", ()),)   # energy-directional: the registry's, on this box
     published = (
         # "about 6 %", "about 30 %": one significant digit, so half a unit in that digit
+        # the paper does not say which FEM its 6 % is measured against: against our
+        # finite-strain reference ours is 5.3 % (a known difference, both readings shown),
+        # against the small-strain one 6.3 % (checked)
         Published("force_error_pct", 6, "seed 003 §4.2 (about 6 %)", method="energy-directional",
-                  where=NONLINEAR),
+                  where=NONLINEAR, deviation="003-indentation-reference"),
+        Published("force_error_pct_vs_small_strain", 6, "seed 003 §4.2 (about 6 %), against "
+                  "the small-strain FEM", method="energy-directional", where=NONLINEAR),
         Published("force_bias_pct", -30, "seed 003 §4.2 (about 30 % too soft)", method="none",
                   where=NONLINEAR, tolerance=5.0,
                   tolerance_source="half a unit in the one printed significant digit "

@@ -163,7 +163,7 @@ def test_the_quick_report_says_which_paper_values_need_the_papers_grid():
     quick = [SimpleNamespace(method=m, params=scene.resolve(m, o))
              for m, o in scene.report_cases(quick=True)]
     missing = html.missing_published(scene, quick)
-    assert len(missing) == 3                      # every §4.2 value needs the paper's grid
+    assert len(missing) == 4                      # every §4.2 value needs the paper's grid
     assert all("spacing=0.00025" in m and "seed 003 §4.2" in m for m in missing), missing
     full = [SimpleNamespace(method=m, params=scene.resolve(m, o))
             for m, o in scene.report_cases(quick=False)]
