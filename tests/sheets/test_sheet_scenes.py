@@ -87,7 +87,7 @@ def test_m_convergence_of_the_corrected_sheet():
     (("sheet2d-clamped", "--method", "none", "--set", "m_ratio=6.3"), "must divide"),
     (("sheet2d-clamped", "--method", "none", "--set", "micromodulus=cubic"),
      "allowed: constant, conical"),
-    (("sheet2d-tension", "--method", "virtual-nodes"), "allowed: fem, none, energy-directional"),
+    (("sheet2d-tension", "--method", "virtual-nodes"), "allowed: fem, none, energy, energy-directional"),
     (("sheet2d-clamped", "--method", "energy-directional", "--set", "nu=0.3"), "nu = 1/3"),
 ])
 def test_bad_input_is_one_line_exit_2(args, words):
