@@ -66,12 +66,8 @@ def box_factors(model) -> np.ndarray:
     g = model.grid
     lower = np.asarray(g.origin, dtype=float)
     upper = lower + np.asarray(g.lengths, dtype=float)
-    x, n = g.x, model.bond_n
-    fa = directional_factor(x[model.bond_a], n, lower, upper, model.horizon,
-                            model.influence, g.dim)
-    fb = directional_factor(x[model.bond_b], -n, lower, upper, model.horizon,
-                            model.influence, g.dim)
-    return 0.5 * (fa + fb)
+    closure = directional_closure(g, lower, upper, model.horizon, model.influence)
+    return closure.bond_factor(model.bond_a, model.bond_b, model.bond_n)
 
 
 def energy_directional_closure(params=None) -> Closure:
