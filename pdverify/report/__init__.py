@@ -343,6 +343,73 @@ def _drawn(what, draw, args, empty, progress):
         return empty
 
 
+#: the figure tasks of :func:`_draw_all`, read by the forked drawing processes
+_TASKS: list = []
+
+
+def _draw_all(tasks, jobs, progress) -> list:
+    """Each ``(what, draw, args, empty)`` of ``tasks`` drawn as by :func:`_drawn`, their
+    results in order. With ``jobs`` > 1 (and fork) the tasks are shared out among that
+    many forked processes (the scenes' figures are independent files). The processes
+    ignore Ctrl-C and die with the report, as the run workers do; should one die (a crash
+    in a rendering library), the tasks it leaves are drawn in the report process."""
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor
+    jobs = min(jobs or 1, len(tasks))
+    if jobs <= 1 or "fork" not in mp.get_all_start_methods():
+        return [_drawn(what, draw, args, empty, progress) for what, draw, args, empty in tasks]
+    import signal
+    global _TASKS
+    _TASKS = tasks
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        pool = ProcessPoolExecutor(jobs, mp_context=mp.get_context("fork"),
+                                   initializer=_drawing_process, initargs=(os.getpid(),))
+        pending = [pool.submit(_draw_task, k) for k in range(len(tasks))]
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+    try:
+        out = []
+        for k, job in enumerate(pending):
+            what, draw, args, empty = tasks[k]
+            try:
+                status, value = job.result()
+            except Exception as exc:       # the drawing process died: draw it here
+                print(f"{what}: its drawing process failed ({type(exc).__name__}); drawn "
+                      "in the report process", file=progress)
+                out.append(_drawn(what, draw, args, empty, progress))
+                continue
+            if status == "storage":
+                raise OutputError(f"writing the {what} failed ({value})")
+            if status == "failed":
+                print(f"{what} failed: {value}", file=progress)
+                value = empty
+            out.append(value)
+        return out
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+        _TASKS = []
+
+
+def _drawing_process(parent: int) -> None:
+    from ..runner import _die_with_parent, _quiet_worker
+    _quiet_worker()
+    _die_with_parent(parent)
+
+
+def _draw_task(k: int):
+    """One task of :data:`_TASKS` in a drawing process: ``("ok", result)``, ``("failed",
+    message)`` or ``("storage", description)`` (the exception itself may not pickle)."""
+    what, draw, args, empty = _TASKS[k]
+    try:
+        return "ok", draw(*args)
+    except Exception as exc:
+        failure = storage_failure(exc)
+        if failure is not None:
+            return "storage", _describe(failure)
+        return "failed", f"{type(exc).__name__}: {exc}"
+
+
 LOG = "report.log"
 
 
@@ -384,16 +451,27 @@ def _build_logged(cases, out, final, jobs, progress, client=None, quick=False,
     for scene_id in [c[0] for c in cases] + [r.scene for r in results]:
         if scene_id not in order:
             order.append(scene_id)
+    owned = []
     for scene_id in order:
         scene = get_scene(scene_id)
         # the scene's own cases; the convergence studies' extra levels have their section
         own = {run_key(scene_id, m, scene.resolve(m, o)) for m, o in scene.report_cases(quick)}
         mine = [r for r in results if r.scene == scene_id and r.key in own]
         tabled.update(r.key for r in mine)
-        with phase("figures_s"):
-            figs = _drawn(f"figure for {scene_id}", figures.draw, (scene, mine, figdir), [],
-                          progress)
-        with phase("pages_s"):
+        owned.append((scene, mine))
+    scenes = [scene for scene, _ in owned]
+    from ..convergence import collect
+    studies = collect(results, quick)
+    with phase("figures_s"):
+        drawn = _draw_all(
+            [(f"figure for {scene.id}", figures.draw, (scene, mine, figdir), [])
+             for scene, mine in owned]
+            + [("error-against-cost figures", overview.pareto, (scenes, results, figdir), []),
+               ("convergence figures", convergence.draw, (studies, figdir), {})],
+            jobs, progress)
+    front, conv = drawn[-2:]
+    with phase("pages_s"):
+        for (scene, mine), figs in zip(owned, drawn):
             sections.append((scene, html.scene_section(scene, mine, figs)))
     with phase("fields_s"):
         export_fields(results, out)
@@ -401,13 +479,6 @@ def _build_logged(cases, out, final, jobs, progress, client=None, quick=False,
             _keep_fields(results, final, out)
     with phase("pages_s"):
         write_tables(results, out)
-    scenes = [scene for scene, _ in sections]
-    from ..convergence import collect
-    studies = collect(results, quick)
-    with phase("figures_s"):
-        front = _drawn("error-against-cost figures", overview.pareto,
-                       (scenes, results, figdir), [], progress)
-        conv = _drawn("convergence figures", convergence.draw, (studies, figdir), {}, progress)
     with phase("pages_s"):
         sections = [(scene, text + html.convergence_section(
             [s for s in studies if s["scene"] == scene.id], conv.get(scene.id, [])))

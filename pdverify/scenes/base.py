@@ -7,7 +7,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from .. import budget
+from .. import blas, budget
 from ..errors import InputError, NumericalError, did_you_mean
 from ..params import Param, resolve
 from ..pd.closure import Closure
@@ -422,7 +422,8 @@ class Scene:
             result.timings = timer.as_dict()
             return result
         try:
-            out = self.solve(method, params, timer)
+            with blas.one_thread():   # the same numbers on any machine (pdverify.blas)
+                out = self.solve(method, params, timer)
             bad = [k for k, v in out.metrics.items()
                    if isinstance(v, float) and not np.isfinite(v)]
             if bad:

@@ -1,6 +1,7 @@
 """The report: files written, atomic results.json, failures recorded, not fatal."""
 import json
 import os
+import re
 
 import pytest
 
@@ -125,3 +126,37 @@ def test_a_broken_figure_keeps_the_numbers(tmp_path, monkeypatch, capsys):
     for what in ("figure for bar1d-sine-load", "error-against-cost figures",
                  "convergence figures"):
         assert f"{what} failed: RuntimeError: no ink" in err
+
+
+def test_figures_drawn_by_two_processes_equal_those_drawn_by_one(tmp_path):
+    """The figure phase shares its tasks out among --jobs forked processes: the same
+    figure files and the same page as one process draws."""
+    pages = []
+    for jobs in (1, 2):
+        out = tmp_path / f"j{jobs}"
+        assert build_report(out=str(out), quick=True, only=["bar1d-sine-load",
+                                                            "bar1d-traction"], jobs=jobs) == 0
+        pages.append((sorted(os.listdir(out / "figures")),
+                      re.sub(r"\d+\.\d+ s|\d{4}-\d\d-\d\d[ T][\d:.]+", "",
+                             (out / "index.html").read_text())))
+    assert pages[0][0] and pages[0][0] == pages[1][0]
+    assert pages[0][1].count("<img") == pages[1][1].count("<img") > 0
+
+
+def test_a_drawing_process_that_dies_leaves_its_figures_to_the_report(tmp_path, monkeypatch,
+                                                                       capsys):
+    """A crash in a rendering library kills its drawing process, not the report: the
+    figures it was to draw are drawn in the report process, with a note."""
+    from pdverify.report import figures
+    parent, real = os.getpid(), figures.draw
+
+    def dies_in_a_child(*args):
+        if os.getpid() != parent:
+            os._exit(11)
+        return real(*args)
+    monkeypatch.setattr(figures, "draw", dies_in_a_child)
+    out = tmp_path / "rep"
+    assert build_report(out=str(out), quick=True, only=["bar1d-traction"], jobs=2) == 0
+    assert "figure for bar1d-traction: its drawing process failed" in capsys.readouterr().err
+    assert os.listdir(out / "figures")
+    assert "<img" in (out / "index.html").read_text()
