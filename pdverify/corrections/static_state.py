@@ -43,7 +43,7 @@ def _grid(problem, layers: int) -> BoxGrid:
 
 def _model(problem, grid, closure) -> StateBasedModel:
     return StateBasedModel(grid, problem.stencil, problem.constants, problem.influence,
-                           closure, thickness=problem.thickness)
+                           closure, thickness=problem.thickness, complete_m=problem.complete_m)
 
 
 def _side_sign(face: int) -> float:

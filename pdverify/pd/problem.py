@@ -103,6 +103,8 @@ class StaticProblem:
     load_point: str = "surface"
     solver: str = "auto"
     where: str = "static problem"
+    #: m of a complete neighbourhood (``StateBasedModel``'s ``complete_m``)
+    complete_m: str = "stencil"
 
     def __post_init__(self):
         bad = [f for f in self.conditions if f not in FACES[:2 * len(self.lengths)]]

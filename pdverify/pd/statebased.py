@@ -24,6 +24,10 @@ def state_based_stencil(dim: int, m_ratio: float, spacing: float, influence: Inf
     return build_stencil(dim, float(m_ratio), quadrature=quadrature, moment_weight=moment_weight)
 
 
+#: the m of a complete neighbourhood: the stencil's discrete sum, or the continuum integral
+COMPLETE_M = ("stencil", "continuum")
+
+
 class StateBasedModel:
     """Linearised ordinary state-based PD (seed 000 §4.2 and App. D; seed 001 §2-3).
 
@@ -55,7 +59,7 @@ class StateBasedModel:
 
     def __init__(self, grid: BoxGrid, stencil: Stencil, constants: StateBasedConstants,
                  influence: Influence, closure: Closure | None = None, *,
-                 thickness: float = 1.0):
+                 thickness: float = 1.0, complete_m: str = "stencil"):
         if grid.dim != stencil.dim or grid.dim != constants.dim:
             raise ValueError(f"dimensions differ: grid {grid.dim}, stencil {stencil.dim}, "
                              f"constants {constants.kind}")
@@ -70,8 +74,15 @@ class StateBasedModel:
         V = grid.volume * self.thickness
 
         r_k = np.linalg.norm(stencil.offsets, axis=1) * h
-        #: m of a complete neighbourhood (the discrete Eq. 25 of seed 000 / 22 of seed 001)
-        self.m_inf = float(np.sum(influence.omega(r_k, delta) * r_k ** 2 * stencil.beta) * V)
+        #: m of a complete neighbourhood: ``complete_m="stencil"`` the discrete Eq. (25) of
+        #: seed 000 / (22) of seed 001 over the stencil's volumes, ``"continuum"`` its
+        #: integral (seed 000: A delta^3 for omega = delta/|xi| in 1D), equal at seed 000's
+        #: volumes (beta = 1/2 at |xi| = delta, whole m) and not with whole cells
+        if complete_m not in COMPLETE_M:
+            raise ValueError(f"complete_m={complete_m!r}; allowed: {', '.join(COMPLETE_M)}")
+        self.m_inf = (float(np.sum(influence.omega(r_k, delta) * r_k ** 2 * stencil.beta) * V)
+                      if complete_m == "stencil" else
+                      influence.weighted_volume(grid.dim, delta) * self.thickness)
 
         half = stencil.half
         a, b, which = bond_pairs(grid.ext_shape, stencil.offsets[half])

@@ -25,8 +25,22 @@ BAR_PARAMS = (
     Param("spacing", 0.05, "grid spacing Delta [m]", positive),
     Param("m_ratio", 3.0, "horizon / spacing", at_least(1.0)),
     influence_param("hyperbolic", "seed 000, Eq. 23: delta / |xi|"),
+    Param("quadrature", "partial-volume", "volume fractions beta: partial-volume (seed 000: "
+          "the fraction of each cell inside the horizon, 1/2 for the node at |xi| = delta "
+          "at whole m) or full-cells (beta = 1 for every node within delta)",
+          choices=("partial-volume", "full-cells")),
+    Param("complete_m", "stencil", "m of a complete neighbourhood, used by the corrected "
+          "methods: stencil (the sum of Eq. 25 over the stencil's volumes) or continuum (its "
+          "integral, A delta^3 for omega = delta/|xi|; seed 000 states both)",
+          choices=("stencil", "continuum")),
 )
-PAPER_INFLUENCE = {"influence": "hyperbolic"}  # published numbers sit beside these runs
+#: published numbers sit beside runs with the paper's influence function and volumes
+PAPER_INFLUENCE = {"influence": "hyperbolic", "quadrature": "partial-volume"}
+#: seed 000's exactness with beta = 1 at |xi| = delta (ERRATA 000): the report's cases of
+#: the traction bar, order 1; with the continuum m = A delta^3 beside the stencil's sum
+BETA_VARIANTS = tuple({"order": 1, "quadrature": q, "complete_m": m}
+                      for q, m in (("full-cells", "stencil"), ("full-cells", "continuum"),
+                                   ("partial-volume", "continuum")))
 #: the paper's "machine precision" (Figs. 16, 19) as a bound on max_error_pct: 1e-10
 #: relative = condition (below 1e6 on these bars; ~500 at the defaults) x machine epsilon
 #: 2.2e-16, rounded up
@@ -163,14 +177,15 @@ class StaticBar(StaticStateScene):
         force = self.end_force(p)
         loaded = FaceCondition(traction=lambda x, n: np.full_like(x, force / p["area"]))
         return StaticProblem(
-            (p["length"],), (0.0,), p["spacing"], build_stencil(1, p["m_ratio"]),
+            (p["length"],), (0.0,), p["spacing"],
+            build_stencil(1, p["m_ratio"], quadrature=p["quadrature"]),
             StateBasedConstants("1d", p["E"], p["nu"]), get_influence(p["influence"]),
             conditions={"x-": FaceCondition(prescribed=(0,)),
                         **({"x+": loaded} if force else {})},
             exact=lambda x: self.classical(x[:, 0], p)[:, None],
             body_force=lambda x: self.body_force(x[:, 0], p)[:, None],
             thickness=p["area"], load_point=p.get("load_point", "surface"),
-            solver="direct", where=where)
+            solver="direct", where=where, complete_m=p["complete_m"])
 
     def check(self, method, p):
         check_bar_grid(self.id, method, p, min_horizons=2.0)
@@ -246,6 +261,13 @@ class Traction(StaticBar):
 
     def classical(self, x, p):
         return closed.traction_displacement(x, force=p["force"], E=p["E"], area=p["area"])
+
+    def cases(self, quick=False):
+        """The bars' cases, and on the full report seed 000's exactness with beta = 1 at
+        |xi| = delta (:data:`BETA_VARIANTS`): 30.4 % with the continuum m = A delta^3,
+        exact with m summed over the same volumes, exact with beta = 1/2 and either m."""
+        return super().cases(quick) + ([] if quick else
+                                       [("taylor-fictitious", dict(v)) for v in BETA_VARIANTS])
 
     def end_force(self, p):
         return p["force"]
