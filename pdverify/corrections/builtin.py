@@ -76,7 +76,7 @@ def _none(problem, p):
 
 def _taylor(problem, p):
     from .static_state import assemble_taylor
-    return assemble_taylor(problem, p["order"], p["corners"])
+    return assemble_taylor(problem, p["order"], p.get("corners", CORNERS.default))
 
 
 def _surface(problem, p):

@@ -181,8 +181,8 @@ class FemStaticStateScene(StaticStateScene, FemAndPD):
     def check(self, method, p):
         if method == FEM.name:
             return FemReference.check(self, method, p)
-        StaticStateScene.check(self, method, p)
         self.check_pd(f"{self.id} --method {method}", method, p)
+        StaticStateScene.check(self, method, p)
 
     def check_pd(self, where, method, p):
         """Checks of the physical parameters a PD run reads (the FEM study checks its
