@@ -10,6 +10,7 @@ from ..params import Param, at_least
 from ..pd.problem import LOAD_POINTS
 from .mirror_nodes import MIRROR_POINTS, NEUMANN_READINGS
 from .surface_nodes import MAX_ORDER
+from .taylor_fictitious import CORNER_RULES
 from .treatment import Treatment
 
 FAMILY = ("static-state",)
@@ -75,7 +76,7 @@ def _none(problem, p):
 
 def _taylor(problem, p):
     from .static_state import assemble_taylor
-    return assemble_taylor(problem, p["order"])
+    return assemble_taylor(problem, p["order"], p.get("corners", CORNERS.default))
 
 
 def _surface(problem, p):
@@ -97,6 +98,10 @@ LOAD_POINT = Param("load_point", "surface", "where the uncorrected model evaluat
                    "surface load: at the node it is applied to (like its constraints) or "
                    "at the face centre on the surface", choices=LOAD_POINTS)
 ORDER = Param("order", 1, "Taylor truncation order n", at_least(1))
+CORNERS = Param("corners", "normal-only", "constrained components on the lines through a "
+                "corner node where two faces prescribe the same component (seed 000 "
+                "Remark 4): the normal one only, or both (over-constrained: singular)",
+                choices=CORNER_RULES)
 SURFACE_ORDER = Param("order", 1, "Taylor truncation order N (displacements N, "
                       "dilatations N - 1)", _order_check)
 MIRROR_PARAMS = (
@@ -121,7 +126,7 @@ def family_treatments() -> list[Treatment]:
             "taylor-fictitious", "seed 000: fictitious layer by nearest-node Taylor "
             "extrapolation (1D series along the normal; corners by Eq. 69), Dirichlet and "
             "Neumann conditions via Lagrange multipliers (Eqs. 58, 60, 63)",
-            "Scabbia, Zaccariotto, Galvanetto 2021 (seed 000)", params=(ORDER,),
+            "Scabbia, Zaccariotto, Galvanetto 2021 (seed 000)", params=(ORDER, CORNERS),
             theories=STATE, dims=(1, 2), families=FAMILY, footprint="fictitious",
             scope="state-based 1D and 2D; 3D not offered: at the seed-001 boxes' "
                   "h = 0.05 its corner extrapolation rows make the bordered system 11 M "

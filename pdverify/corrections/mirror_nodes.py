@@ -122,7 +122,14 @@ class MirrorNodes:
         dirichlet_k = np.zeros((nf, d), dtype=bool)
         const_d = np.zeros((nf, d))                  # 2 g of the Dirichlet components
         const = np.zeros((nf, d))                    # traction terms of the Neumann ones
-        g_exact = exact(xB)
+        # the boundary values where a Dirichlet face holds x_B only (elsewhere x_B can
+        # lie outside the body, where a FEM reference is not defined)
+        used = np.zeros(nf, dtype=bool)
+        for face, _ in dirichlet:
+            used |= on_face[:, face]
+        g_exact = np.zeros((nf, d))
+        if np.any(used):
+            g_exact[used] = exact(xB[used])
         for face, k in dirichlet:
             hit = on_face[:, face]
             dirichlet_k[hit, k] = True

@@ -156,11 +156,14 @@ def _eliminated(model, K, rhs, fixed, values, solver, nodes, by_face, **extra):
 
 
 def _sorted(fixed, values):
+    """The prescribed unknowns once each, sorted: a node nearest two faces that prescribe
+    the same component (a corner of a clamped plate) is listed by both, with the same
+    exact value; listed twice, its column would be eliminated twice."""
     if not fixed:
         return np.zeros(0, dtype=int), np.zeros(0)
     fixed, values = np.concatenate(fixed), np.concatenate(values)
-    order = np.argsort(fixed)
-    return fixed[order], values[order]
+    fixed, first = np.unique(fixed, return_index=True)
+    return fixed, values[first]
 
 
 # ------------------------------------------------------------------------------ surface nodes
@@ -207,17 +210,29 @@ def impose_on_surface_nodes(problem, g, closure, flux) -> LinearSystem:
 
 
 # ------------------------------------------------------------------------------ Taylor
-def assemble_taylor(problem, order: int) -> LinearSystem:
+def assemble_taylor(problem, order: int, corners: str = "normal-only") -> LinearSystem:
     """Seed 000's Taylor-extrapolated fictitious nodes with the conditions as constraint
     rows by Lagrange multipliers (module docstring). A prescribed component takes the
     rows of Eq. (58) on the lines of its face (``where``: on part of them); every other
     component of a face with a traction, or of a free face, takes the force flux rows:
     in 1D the bonds crossing the end plane (Eq. 60), in 2D/3D the face-crossing bonds of
     each boundary cell face weighted by alpha (seed 001 Eq. 35, the same rule as the
-    surface nodes' flux)."""
+    surface nodes' flux). Where two faces that both prescribe a component k on their
+    whole face meet, the line through the corner node perpendicular to each face would
+    constrain k twice at the same corner; ``corners`` (Remark 4, ``CORNER_RULES``):
+    ``normal-only`` keeps on such a line only the row of the component normal to its
+    face (the tangential one is imposed by the other face's line), ``both`` keeps every
+    row (the system is then singular: the over-constraint Remark 4 avoids). On faces
+    prescribing different components (seed 001's plate) the rule changes nothing."""
     g = _grid(problem, problem.stencil.reach)
     d = g.dim
-    if d == 1:
+    # a face that prescribes every component on its whole face needs no flux rows; a box
+    # clamped all round (seed 000's plate) then needs neither them nor the face-crossing
+    # fictitious bonds, which enter no real node's equation
+    clamped = all(c.where is None and len(c.prescribed) == d
+                  for c in (problem.conditions.get(f) for f in FACES[:2 * d]) if c is not None)
+    clamped &= len(problem.conditions) == 2 * d
+    if d == 1 or clamped:
         closure = fictitious_closure(g, order)
         flux = None
     else:
@@ -232,9 +247,9 @@ def assemble_taylor(problem, order: int) -> LinearSystem:
     K = model.stiffness(P)
     x_int = g.x[g.interior_ids]
     rhs = problem.body_load(x_int, model.node_volume[g.interior_ids][:, None]).T.ravel()
-    K_b = model.bond_force_matrix()
+    K_b = model.bond_force_matrix() if d == 1 or flux is not None else None
     rows, vals = [], []
-    if d > 1:   # force of each boundary cell face from the real displacements
+    if flux is not None:   # force of each boundary cell face from the real displacements
         Fs = (_surface_flux(model, flux, g.n_surface) @ K_b).tocsr()
     for face in range(2 * d):
         axis, side = divmod(face, 2)
@@ -257,11 +272,14 @@ def assemble_taylor(problem, order: int) -> LinearSystem:
             pres = np.zeros(anchors.shape[0], dtype=bool)
             if cond is not None and k in cond.prescribed:
                 pres[:] = True if cond.where is None else cond.where(cells_face)
-            if np.any(pres):
-                Rk = sp.coo_matrix(R[np.flatnonzero(pres)])
+            imposed = pres.copy()
+            if corners == "normal-only" and k != axis:
+                imposed &= ~_corner_lines(problem, g, anchors, axis, k)
+            if np.any(imposed):
+                Rk = sp.coo_matrix(R[np.flatnonzero(imposed)])
                 rows.append(sp.csr_matrix((Rk.data, (Rk.row, Rk.col + k * ni)),
-                                          shape=(int(pres.sum()), d * ni)))
-                vals.append(exact[pres, k])
+                                          shape=(int(imposed.sum()), d * ni)))
+                vals.append(exact[imposed, k])
             free = np.flatnonzero(~pres)
             if free.size == 0:
                 continue
@@ -305,6 +323,18 @@ def assemble_taylor(problem, order: int) -> LinearSystem:
     return LinearSystem(model, M, np.r_[rhs, np.zeros(A.shape[0] - rhs.size), c], *none, ni,
                         solver=solver, coords=np.r_[_coords(model, x_int), at],
                         reaction=reaction, counts=counts)
+
+
+def _corner_lines(problem, g, anchors, axis, k):
+    """Which of the lines of a face (``anchors``, normal ``axis``) run through a corner
+    node shared with another face prescribing component ``k`` on its whole face."""
+    out = np.zeros(anchors.shape[0], dtype=bool)
+    for other in range(2 * g.dim):
+        cond = problem.conditions.get(FACES[other])
+        if (other // 2 != axis and cond is not None and cond.where is None
+                and k in cond.prescribed):
+            out |= anchors[:, other // 2] == g.boundary_layer(other)
+    return out
 
 
 def _surface_flux(model, flux, n_surface):

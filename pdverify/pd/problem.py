@@ -85,8 +85,8 @@ class StaticProblem:
     cross-section, 2D: 1 per unit thickness). ``body_force(x) -> (n, d)`` per unit
     volume; ``exact(x) -> (n, d)`` the reference solution (the prescribed values).
     ``face_load``/``load_point``: :data:`FACE_LOADS`, :data:`LOAD_POINTS`. ``solver``:
-    ``auto``, ``direct`` or ``nested-dissection`` (``pdverify.solvers.policy``).
-    ``where``: how messages name the run.
+    ``auto``, ``direct`` or ``nested-dissection`` (``pdverify.solvers.policy``);
+    ``ordering``: the direct solves' column ordering. ``where``: how messages name the run.
     """
 
     lengths: tuple
@@ -102,6 +102,9 @@ class StaticProblem:
     face_load: str = "face-mean"
     load_point: str = "surface"
     solver: str = "auto"
+    #: SuperLU's column ordering of the direct solves (``permc_spec``); a scene whose
+    #: systems factor faster under another states it (benchmarks/plate_solvers.py)
+    ordering: str = "COLAMD"
     where: str = "static problem"
     #: m of a complete neighbourhood (``StateBasedModel``'s ``complete_m``)
     complete_m: str = "stencil"

@@ -17,7 +17,8 @@ from .. import budget
 from ..errors import InputError
 from ..solvers.front import solve as solve_system
 from ..solvers.policy import auto_note
-from .base import Outcome, Scene, whole_cells
+from .base import MethodSpec, Outcome, Scene, whole_cells
+from .fem_references import FEM, FemAndPD, FemReference
 
 
 class StaticStateScene(Scene):
@@ -47,12 +48,16 @@ class StaticStateScene(Scene):
                     "prescribes a component on part of a face")
         return None
 
+    def default_params(self) -> dict:
+        """The defaults of every parameter the description reads."""
+        return {q.name: q.default for q in self.params}
+
     def _whole_faces(self) -> bool:
         """Whether the scene's conditions cover whole faces (a property of the scene,
         not of its params: computed once, from the defaults)."""
         cached = self.__dict__.get("_whole_faces_cache")
         if cached is None:
-            p = {q.name: q.default for q in self.params}
+            p = self.default_params()
             cached = self.__dict__["_whole_faces_cache"] = self.problem(p, self.id).whole_faces()
         return cached
 
@@ -94,14 +99,19 @@ class StaticStateScene(Scene):
 
     # ----------------------------------------------------------------- solve
     def solve(self, method, p, timer):
+        return self.solve_problem(method, p, timer, self.problem)
+
+    def solve_problem(self, method, p, timer, describe):
+        """Assemble ``describe(p, where)`` by the treatment ``method``, solve and
+        measure it."""
         from ..corrections.registry import plugin_call
         where = f"{self.id}/{method}"
         with timer.phase("setup"):
-            problem = self.problem(p, where)
+            problem = describe(p, where)
             t = self.treatment(method)
             system = plugin_call(t, "assemble", t.assemble, problem, p)
         with timer.phase("solve"):
-            x, info = solve_system(system, where=where)
+            x, info = solve_system(system, where=where, ordering=problem.ordering)
             if p.get("solver") == "auto":
                 info["solver_choice"] = auto_note(system.solver, system.dofs)
         return self.measure(p, problem, system, x, info)
@@ -126,6 +136,80 @@ class StaticStateScene(Scene):
         U = system.displacements(x)
         ni = system.model.grid.n_interior
         return U[:ni], (U[ni:] if system.extra_x is not None else None)
+
+
+#: the treatment whose parameters the closure treatments (bond methods) take: the
+#: uncorrected baseline, which imposes the conditions as they do
+BASELINE = "none"
+
+
+class FemStaticStateScene(StaticStateScene, FemAndPD):
+    """A scene of the ``static-state`` family whose reference is a converged FEM solution
+    (``reference_fem``), run as the scene's own method ``fem``.
+
+    What a subclass states: the reference (``params_class``, ``function``; the FEM
+    dataclass's fields named in ``shared`` are the scene's physical parameters, its
+    other fields the ``fem`` method's), the PD discretisation's parameters
+    (``pd_params``: every treatment takes them; a FEM study has its own ``spacing``),
+    ``baseline_params`` (parameters of how the uncorrected baseline and the closure
+    treatments impose the conditions, which they take beside ``pd_params``), and as
+    every family scene :meth:`box`, :meth:`problem` (its ``exact``: the FEM field, from
+    :meth:`reference_of`) and :meth:`measure`. The treatments, their parameters and why
+    one does not run come from the registry, as for the other family scenes.
+    """
+
+    reference = "fem"
+    methods = property(FemAndPD.methods.fget)
+    pd_params: tuple = ()
+    baseline_params: tuple = ()
+
+    def default_params(self) -> dict:
+        return {q.name: q.default
+                for q in self.params + self.pd_params + self.baseline_params}
+
+    @property
+    def all_methods(self) -> tuple[MethodSpec, ...]:
+        own = tuple(self.methods)
+        offered = self.offered()
+        out = []
+        for m in Scene.all_methods.fget(self)[len(own):]:
+            t = offered[m.name]
+            extra = self.baseline_params if (t.kind == "closure" or m.name == BASELINE) else ()
+            out.append(MethodSpec(m.name, self.pd_params + extra + m.params))
+        return own + tuple(out)
+
+    def check(self, method, p):
+        if method == FEM.name:
+            return FemReference.check(self, method, p)
+        self.check_pd(f"{self.id} --method {method}", method, p)
+        StaticStateScene.check(self, method, p)
+
+    def check_pd(self, where, method, p):
+        """Checks of the physical parameters a PD run reads (the FEM study checks its
+        own through its dataclass)."""
+
+    def estimate(self, method, p):
+        if method == FEM.name:
+            return FemReference.estimate(self, method, p)
+        # the FEM reference (at the fem method's defaults) runs first unless cached
+        fem = FemReference.estimate(self, FEM.name, self.reference_params(p))
+        return budget.larger(StaticStateScene.estimate(self, method, p), fem)
+
+    def reference_of(self, p):
+        """The converged FEM reference of the params ``p`` (from the disk cache after its
+        first computation; the last one is kept in memory, as a run reads it twice)."""
+        key = tuple(sorted(self.reference_params(p).items()))
+        memo = self.__dict__.get("_reference_memo")
+        if memo is None or memo[0] != key:
+            memo = self.__dict__["_reference_memo"] = (key, self.fem_reference(p))
+        return memo[1]
+
+    def solve(self, method, p, timer):
+        if method == FEM.name:
+            return FemReference.solve(self, method, p, timer)
+        with timer.phase("reference"):
+            self.reference_of(p)
+        return self.solve_problem(method, p, timer, self.problem)
 
 
 def surface_error_pct(u_extra, u_ref_extra, scale) -> float:

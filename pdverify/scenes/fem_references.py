@@ -1,6 +1,7 @@
 """FEM references as scenes with method ``fem`` (issue #5), and the base of the scenes that
-run PD methods beside their FEM reference (``FemAndPD``: the seed-000 plate in ``plate2d``,
-the seed-003 sheets in ``sheets``)."""
+run PD methods beside their FEM reference (``FemAndPD``: the seed-003 sheets in
+``sheets``; a ``static-state`` description with a FEM reference, such as the seed-000
+plate in ``plate2d``, subclasses ``family.FemStaticStateScene``, which builds on it)."""
 from __future__ import annotations
 
 import dataclasses

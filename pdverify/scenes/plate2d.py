@@ -1,24 +1,25 @@
-"""Seed 000 §6: the clamped plate, 2D state-based PD uncorrected and with Taylor fictitious
-nodes, against the converged FEM reference."""
+"""Seed 000 §6: the clamped plate, 2D state-based PD against the converged FEM reference:
+a ``static-state`` description that every treatment of the family assembles.
+``StatePlate`` is the plate's own model wrapper (uncorrected, or Taylor fictitious nodes
+with the clamp's Lagrange rows), kept for the Taylor tests and the solver benchmark."""
 from __future__ import annotations
 
 import numpy as np
 
-from .. import budget
-from ..corrections.taylor_fictitious import (CORNER_RULES, clamped_rows, fictitious_closure,
-                                             needed_nodes)
+from ..corrections.taylor_fictitious import clamped_rows, fictitious_closure
 from ..errors import InputError
 from ..metrics import rel_l2_error
 from ..params import Param, at_least, positive
 from ..pd import (QUADRATURES, BoxGrid, StateBasedConstants, StateBasedModel, get_influence,
                   state_based_stencil)
+from ..pd.problem import FACES, FaceCondition, StaticProblem
 from ..solvers.dense import solve_with_dirichlet
 from ..solvers.static import solve_constrained
 from . import Outcome, Published, influence_param, register, whole_cells
-from .fem_references import FemAndPD
+from .family import FemStaticStateScene
 
-#: SuperLU ordering of both PD solves here: minimum degree on A + A^T, 2.9x faster than
-#: COLAMD on the h = 0.025 m Lagrange system (benchmarks/plate_solvers.py).
+#: SuperLU ordering of the plate's direct solves: minimum degree on A + A^T, 2.9x faster
+#: than COLAMD on the h = 0.025 m Lagrange system (benchmarks/plate_solvers.py).
 ORDERING = "MMD_AT_PLUS_A"
 
 ALL_FACES = (0, 1, 2, 3)
@@ -126,7 +127,7 @@ def plate_errors(x, u, u_ref, lengths, horizon) -> tuple[dict, np.ndarray]:
 
 
 @register
-class ClampedPlate(FemAndPD):
+class ClampedPlate(FemStaticStateScene):
     """Seed 000 §6 (Table 4, Figs. 27-30): a 3 x 2 m plate clamped on all four edges under
     a uniform body load in x, plane stress, thickness 0.05 m, E = 1 GPa, nu = 0.2
     (ERRATA: clamped on every edge, the load magnitude is not given, 1e6 N/m^3 here;
@@ -136,20 +137,30 @@ class ClampedPlate(FemAndPD):
     field by 1.6e-4 % on the Table 4 grid, far below every PD error (``reference_change_pct``
     in every PD run; a test checks it is under a tenth of the smallest PD error).
 
-    PD: 2D linear state-based, the hyperbolic influence omega = delta / |xi| of seed 000
-    by default (param ``influence``), constants from energy equivalence in plane stress
+    The problem, stated once (a ``static-state`` description, :meth:`problem`): the box
+    [0, 3] x [0, 2] m, both components prescribed on all four faces at the reference's
+    value (zero on the edges: the clamp), the body force (b, 0) on every node (loads
+    b h^2 t per real node, Eq. 54's 2D analogue), no traction. PD: 2D linear
+    state-based, the hyperbolic influence omega = delta / |xi| of seed 000 by default
+    (param ``influence``), constants from energy equivalence in plane stress
     (``StateBasedConstants``: they do not depend on omega, which enters through m),
     cell-centred nodes at spacing 0.1 m (600 real nodes), m = 3, 2D partial volumes
     (``quadrature=partial-volume``, the exact cell fractions inside the horizon) or, our
     addition, ``moment-corrected`` (those fractions adjusted so the stencil's fourth
     moment is isotropic: the discrete bulk then has the continuum moduli).
 
-    - ``none``: truncated neighbourhoods, m_i over the bonds a node has (Eq. 50), the
-      outermost ring of real nodes fixed (ERRATA: the 1D baseline imposes the classical
-      value on the node nearest the boundary). ``ring_value=reference`` (default, as in
-      1D) fixes the ring at the FEM displacement there; ``ring_value=zero`` fixes it at 0
-      (what a user without a reference would do; the ring is h/2 inside the edge).
-    - ``taylor-fictitious`` (param ``order`` n): fictitious layer of thickness delta;
+    Every treatment of the family imposes the clamp in its own way
+    (``pdverify.corrections.static_state``):
+
+    - the uncorrected baseline: truncated neighbourhoods, m_i over the bonds a node has
+      (Eq. 50), the outermost ring of real nodes fixed (ERRATA: the 1D baseline imposes
+      the classical value on the node nearest the boundary); the closure treatments
+      (bond methods) are clamped the same way. Param ``ring_value`` (theirs only):
+      ``reference`` (default, as in 1D) fixes the ring at the FEM displacement there,
+      ``zero`` at the clamp's value 0 (what a user without a reference would do; the
+      ring is h/2 inside the edge). The other treatments impose the clamp on the edges,
+      where both readings give 0.
+    - Taylor fictitious nodes (param ``order`` n): fictitious layer of thickness delta;
       edge fictitious nodes by the 1D Taylor series of order n along the normal from the
       n + 1 real nodes of their line (the same weights for u and v), corner fictitious
       nodes by the 2D series of Eq. (69) to order n about the corner node, its derivatives
@@ -164,12 +175,15 @@ class ClampedPlate(FemAndPD):
       corner node only the component normal to each line's edge; ``both`` constrains both
       components on every line, and the system is then exactly singular: the run fails
       with that message (the over-constraint Remark 4 avoids; tested, not in the report).
+    - Surface nodes (seed 001, param ``order`` N), mirror nodes and PDDO (seed 001 §5):
+      the treatments of seed 001's boxes, here with every surface node, mirror relation
+      or PDDO boundary row of the four edges clamped at 0 (both components); none of
+      seed 000's or 001's papers runs them on this plate: they fill the comparison.
 
     Metrics (Eq. 70, normalised by max |u_FEM|): ``max_error_u_pct``,
     ``max_error_v_pct``, ``rel_l2_error``, the same maxima over the ``boundary_`` layer
     (within delta of an edge), its ``corner_`` regions (within delta of two edges) and the
-    ``interior_``; ``reference_change_pct``. Loads: b h^2 t per real node (Eq. 54's 2D
-    analogue).
+    ``interior_``; ``reference_change_pct``.
 
     Findings (not tuned): with Table 4's values every order beats ``none`` at the
     corners and edges except e_v for n = 1 at one node per corner, the second node on
@@ -178,16 +192,25 @@ class ClampedPlate(FemAndPD):
     quadrature's anisotropic fourth moment is a fixed-m model error) and converge at
     rate ~2 with the moment-corrected quadrature; at fixed delta the corrected errors
     converge with m, while ``none``'s grow: fixing one ring of nodes clamps an ever
-    thinner layer, which a nonlocal model does not feel.
+    thinner layer, which a nonlocal model does not feel. At Table 4's grid surface nodes
+    (N = 1, 2, 3) and PDDO beat ``none`` at every corner and edge node in both
+    components; mirror nodes do in u, and in v except one node per corner (the
+    outermost-row node 5h/2 from the corner along x, either mirror point), as Taylor
+    n = 1 (tests/treatments/test_plate_cells.py; the numbers are in the report's
+    table). Clamped all round at an affine field's values, surface nodes, PDDO, Taylor
+    and the mirror nodes with ``mirror_point=corrected`` reproduce it to round-off, the
+    nearest mirror node does not (near the corners); a quadratic field with its body
+    force is reproduced by the order-2 Taylor series (fictitious and surface nodes) and
+    by PDDO with moment-corrected weights (with partial volumes PDDO's continuum
+    operator in its layer and the lattice's LPS beyond differ by the lattice's moduli
+    error: 9e-4 relative).
     """
 
     id = "plate2d-clamped"
     title = "Clamped plate under body load in x: Taylor fictitious nodes in 2D"
     seed = "000 §6.2"
-    reference = "fem"
     figure = "plate2d"
     dim = 2
-    closure_theory = "state-based"
     params_class, function = "PlateParams", "clamped_plate"
     shared = ("length", "width", "thickness", "E", "nu", "body_force")
     pd_params = (
@@ -198,15 +221,10 @@ class ClampedPlate(FemAndPD):
               "horizon, or those adjusted to an isotropic fourth moment (our addition)",
               choices=QUADRATURES),
     )
-    pd_methods = (
-        ("none", (Param("ring_value", "reference", "value imposed on the outermost ring of "
-                        "nodes: the FEM displacement there (as the 1D baseline) or zero",
-                        choices=("reference", "zero")),)),
-        ("taylor-fictitious", (Param("order", 1, "Taylor order n", at_least(1)),
-                               Param("corners", "normal-only", "constrained components on "
-                                     "the lines through a corner node (Remark 4)",
-                                     choices=CORNER_RULES))),
-    )
+    baseline_params = (
+        Param("ring_value", "reference", "value imposed on the outermost ring of nodes: the "
+              "FEM displacement there (as the 1D baseline) or zero",
+              choices=("reference", "zero")),)
     published = (
         Published("max_error_u_pct", "below none (Fig. 29)", "seed 000 §6.2",
                   method="taylor-fictitious", where={"order": 1, **TABLE4},
@@ -222,21 +240,11 @@ class ClampedPlate(FemAndPD):
     m_sweep = (2, 3, 4)
     m_sweep_horizon = 0.2
 
-    def estimate_pd(self, method, p):
-        """Cell-centred real nodes and the fictitious ring m deep; the dilatation couples
-        nodes 2m spacings apart."""
-        h, m = p["spacing"], p["m_ratio"]
-        nodes = (p["length"] / h + 2 * m) * (p["width"] / h + 2 * m)
-        return budget.linear_system(nodes, 2, 2, 2 * m, dense_allowed=method == "none")
+    def box(self, p):
+        return (p["length"], p["width"]), (0.0, 0.0)
 
     def check_pd(self, where, method, p):
-        n_axis = whole_cells(where, p["spacing"], [(k, p[k]) for k in ("length", "width")])
-        if method == "taylor-fictitious":
-            need = needed_nodes(p["order"])
-            if min(n_axis) < need:
-                raise InputError(f"{where}: order={p['order']} needs {need} real nodes along "
-                                 f"every edge; the plate has {min(n_axis)} along its shorter "
-                                 f"side (order <= {min(n_axis) - 1})")
+        whole_cells(where, p["spacing"], [(k, p[k]) for k in ("length", "width")])
         for name in ("E", "thickness"):
             if not (np.isfinite(p[name]) and p[name] > 0):
                 raise InputError(f"{where}: {name}={p[name]!r} must be a finite number > 0")
@@ -246,12 +254,49 @@ class ClampedPlate(FemAndPD):
         if not -1.0 < p["nu"] < 0.5:
             raise InputError(f"{where}: nu={p['nu']!r} must be in (-1, 0.5)")
 
+    def problem(self, p, where):
+        inf = get_influence(p["influence"])
+        b = p["body_force"]
+        if p.get("ring_value", "reference") == "zero":
+            def value(x):
+                return np.zeros_like(x)
+        else:
+            def value(x):
+                return self.reference_of(p).evaluate(x)
+        clamped = FaceCondition(prescribed=(0, 1))
+        return StaticProblem(
+            (p["length"], p["width"]), (0.0, 0.0), float(p["spacing"]),
+            state_based_stencil(2, p["m_ratio"], p["spacing"], inf, p["quadrature"]),
+            StateBasedConstants("plane-stress", p["E"], p["nu"]), inf,
+            {face: clamped for face in FACES[:4]}, exact=value,
+            body_force=lambda x: np.c_[np.full(len(x), b), np.zeros(len(x))],
+            thickness=p["thickness"], solver="direct", ordering=ORDERING, where=where)
+
+    def measure(self, p, problem, system, x, info):
+        ref = self.reference_of(p)
+        lengths = (p["length"], p["width"])
+        x_int = self.real_nodes(system)
+        u, _ = self.solution(system, x)
+        u_ref = ref.evaluate(x_int)
+        horizon = system.model.horizon
+        metrics, err = plate_errors(x_int, u, u_ref, lengths, horizon)
+        metrics["reference_change_pct"] = float(ref.refinement[-1].extra["field_change_pct"])
+        fields = {"x": x_int, "u": u, "u_ref": u_ref, "error": err, "spacing": p["spacing"],
+                  "horizon": horizon, "lengths": lengths}
+        size = self.size(system)
+        size["stiffness_nnz"] = int(system.K.nnz)
+        if system.B is not None:
+            info["constraints"] = int(system.B.shape[0])
+        return Outcome(metrics=metrics, size=size, fields=fields, diagnostics=info)
+
     def cases(self, quick=False):
         out = [("fem", {}), ("none", {})] + [("taylor-fictitious", {"order": n})
                                             for n in (1, 2, 3)]
+        new = ([("surface-nodes", {"order": n}) for n in (1, 2, 3)]
+               + [("mirror-nodes", {}), ("pddo", {})])
         if quick:
-            return out
-        out += [("none", {"ring_value": "zero"}), ("taylor-fictitious", {"order": 4})]
+            return out + new[:1] + new[3:]
+        out += [("none", {"ring_value": "zero"}), ("taylor-fictitious", {"order": 4})] + new
         mc = {"quadrature": "moment-corrected"}
         for h in self.delta_sweep:
             if h != 0.1:
@@ -262,29 +307,3 @@ class ClampedPlate(FemAndPD):
             mp = {"spacing": self.m_sweep_horizon / m, "m_ratio": float(m)}
             out += [("none", mp)] + [("taylor-fictitious", {"order": n, **mp}) for n in (1, 2, 3)]
         return out
-
-    def solve_pd(self, method, p, timer):
-        order = p["order"] if method == "taylor-fictitious" else None
-        lengths = (p["length"], p["width"])
-        with timer.phase("reference"):
-            ref = self.fem_reference(p)
-        with timer.phase("setup"):
-            c = StateBasedConstants("plane-stress", p["E"], p["nu"])
-            plate = StatePlate(lengths, p["spacing"], p["m_ratio"], c, p["influence"], order,
-                               p["quadrature"], p["thickness"],
-                               p.get("corners", "normal-only"),
-                               closure=self.bond_closure(method, p))
-            x = plate.x
-            u_ref = ref.evaluate(x)
-            f = np.zeros(2 * x.shape[0])
-            f[:x.shape[0]] = p["body_force"] * p["spacing"] ** 2 * p["thickness"]
-            ring_values = None
-            if order is None and p["ring_value"] == "reference":
-                ring_values = u_ref[plate.ring()]
-        with timer.phase("solve"):
-            u, info = plate.solve(f, ring_values=ring_values, where=f"{self.id}/{method}")
-        metrics, err = plate_errors(x, u, u_ref, lengths, plate.horizon)
-        metrics["reference_change_pct"] = float(ref.refinement[-1].extra["field_change_pct"])
-        fields = {"x": x, "u": u, "u_ref": u_ref, "error": err, "spacing": p["spacing"],
-                  "horizon": plate.horizon, "lengths": lengths}
-        return Outcome(metrics=metrics, size=plate.size(), fields=fields, diagnostics=info)

@@ -123,11 +123,11 @@ def treatment_env(tmp_path_factory):
 
 
 def test_treatment_plugin_serves_every_scene_of_its_family(treatment_env):
-    """``list`` offers it on every static-state scene (the seed-000 bars and the seed-001
-    boxes and plate) and says why not elsewhere."""
+    """``list`` offers it on every static-state scene (the seed-000 bars and clamped
+    plate, the seed-001 boxes and plate) and says why not elsewhere."""
     import pdverify.scenes as scenes
     family = sorted(s.id for s in scenes.all_scenes() if s.family == "static-state")
-    assert len(family) == 7
+    assert len(family) == 8
     r = cli(treatment_env, "list")
     assert r.returncode == 0, r.stderr
     matrix = r.stdout.split("method x scene:\n", 1)[1].splitlines()

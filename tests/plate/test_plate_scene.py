@@ -129,7 +129,7 @@ def test_corners_both_is_a_failed_run_with_the_reason():
 
 
 @pytest.mark.parametrize("args, needle", [
-    (["--method", "taylor-fictitious", "--set", "order=20"], "order=20 needs 21 real nodes"),
+    (["--method", "taylor-fictitious", "--set", "order=10"], "order=10 is too large for 20 nodes"),
     (["--method", "none", "--set", "spacing=0.07"], "spacing=0.07 must divide length=3"),
     (["--method", "none", "--set", "spacing=0.4"], "spacing=0.4 must divide length=3"),
     (["--method", "taylor-fictitious", "--set", "corners=diagonal"], "corners"),
