@@ -1,5 +1,6 @@
 """manufactured/surface3d.py: the closed forms of seed 001 Eqs. (39)-(43)."""
 import numpy as np
+import pytest
 
 from manufactured import surface3d as m3
 
@@ -88,3 +89,22 @@ def test_traction_fields():
     v = m3.plate_displacement(np.array([[1.0, 1.0]]), p=240e6, E=E, nu=NU)
     np.testing.assert_allclose(v, [[-NU * (1 + NU) * 240e6 / E, (1 - NU ** 2) * 240e6 / E]],
                                rtol=1e-15)
+
+
+def test_max_displacement_is_fig_11s_scale_on_the_nodes_and_the_corners():
+    """body3d-manufactured's max_displacement: the largest |u| of Eq. (42) over the body,
+    at its x = l_x corners: no node of a run exceeds it, the tip nodes come within a cell
+    of it, and the stand-in body's 0.0615 m is 29 times Fig. 11's 0.0021 m (deviation
+    001-fig11-body; a 0.3 x 0.15 x 0.15 m body gives 0.00202 m)."""
+    from pdverify.scenes import get_scene
+    res = get_scene("body3d-manufactured").run("none", {"spacing": 0.1})
+    assert res.status == "ok", res.message
+    top = res.metrics["max_displacement"]
+    nodal = np.linalg.norm(res.fields["u_ref"], axis=1).max()
+    assert nodal <= top and nodal > 0.7 * top          # nodes h/2 inside the corners
+    assert top == pytest.approx(0.0614918693812442, rel=1e-12)   # the closed form
+    corner = np.array([[0.3, 0.075, 0.075]])
+    assert np.linalg.norm(m3.manufactured_displacement(corner)) == pytest.approx(
+        0.002023, abs=5e-7)
+    entry = [e for e in res.published if e["metric"] == "max_displacement"]
+    assert entry and entry[0]["value"] == 0.0021 and entry[0]["deviation"] == "001-fig11-body"
