@@ -63,14 +63,14 @@ class StateBar:
 
     def __init__(self, p: dict, order: int | None = None, closure=None):
         p = {**{q.name: q.default for q in BAR_PARAMS}, **p}  # unset keys: the paper's values
-        stencil = build_stencil(1, p["m_ratio"])
+        stencil = build_stencil(1, p["m_ratio"], quadrature=p["quadrature"])
         layers = stencil.reach if order else 0
         self.grid = g = BoxGrid((p["length"],), (0.0,), p["spacing"], layers)
         closure = fictitious_closure(g, order) if order else closure
         self.order = order
         self.model = StateBasedModel(g, stencil, StateBasedConstants("1d", p["E"], p["nu"]),
                                      get_influence(p["influence"]), closure,
-                                     thickness=p["area"])
+                                     thickness=p["area"], complete_m=p["complete_m"])
         self.K_b = self.model.bond_force_matrix()
         self.K = (self.model.equilibrium_rows() @ self.K_b).tocsr()
         self.x_real = g.x[g.interior_ids, 0]

@@ -16,7 +16,7 @@ _FEATURES = closed.flux_features()  # (1.26285..., 0.77160..., 0.39403...)
 #: the paper's printed values of the continuum's features (tau_max / tau_inf at x/delta,
 #: and where tau = tau_inf again), beside the report's finest grid
 PAPER_FEATURES = "seed 000 §2.2, text under Fig. 7"
-FINEST = {"m_ratio": 48.0}
+FINEST = {"m_ratio": 48.0, "quadrature": "partial-volume", "complete_m": "stencil"}
 CONTINUUM = ("the paper's values are the continuum's (m -> infinity); compared at the "
              "report's finest grid, m = 48 (the full report; the quick report stops at "
              "m = 12)")
