@@ -52,6 +52,14 @@ class StVenantKirchhoff:
         self._grad = np.ascontiguousarray(grad.transpose(2, 3, 0, 1))   # (e, q, a, K)
         self._grad_t = np.ascontiguousarray(grad.transpose(2, 0, 3, 1)).reshape(
             self.n_el, grad.shape[0], -1)                               # (e, a, (q, K))
+        # every element is an axis-aligned box (tensor-product mesh): its gradients are
+        # the first element's times 1 / h_K (h_K: the element's edge along K)
+        self._ghat = grad[:, :, 0, :].reshape(grad.shape[0], -1)     # (a, (K, q))
+        self._inv_h = (np.abs(grad).sum(axis=(0, 3))
+                       / np.abs(grad[:, :, 0, :]).sum(axis=(0, 2))[:, None])   # (K, e)
+        affine = grad[:, :, 0, None, :] * self._inv_h[None, :, :, None]
+        if np.max(np.abs(affine - grad)) > 1e-12 * np.max(np.abs(grad)):
+            raise RuntimeError("StVenantKirchhoff: the elements are not axis-aligned boxes")
         self.dx = b.dx
         self.dofs = b.element_dofs                             # (local, el)
         # CSR pattern of the global matrix and where each element entry (e, r, s) goes
@@ -64,19 +72,36 @@ class StVenantKirchhoff:
         self._nnz = keys.size
 
     def _state(self, u):
-        dim = self.model.dim
-        ue = np.asarray(u)[self.dofs]                      # (local, el)
-        G = np.einsum("riKeq,re->iKeq", self.dphi, ue)
-        eye = np.eye(dim)[:, :, None, None]
-        F = G + eye
-        E = 0.5 * (np.einsum("kiep,kjep->ijep", F, F) - eye)
-        S = 2.0 * self.mu * E + self.lam * np.trace(E)[None, None] * eye
+        """F and S per quadrature point, each (i, K, e, q)."""
+        ne, nq = self.n_el, self.n_qp
+        ue = np.asarray(u)[self.dofs].reshape(-1, 2, ne)                # (a, i, e)
+        # grad u[i, K, e, q] = sum_a u[a, i, e] grad phi_a[K, q] / h_K[e]: one product
+        # (np.einsum, not a BLAS product: threaded BLAS on these thin shapes was 20-80
+        # times slower on a loaded 2-core machine; benchmarks/fem_indentation.py)
+        G = np.einsum("aie,ak->iek", ue, self._ghat).reshape(2, ne, 2, nq)
+        F = G.transpose(0, 2, 1, 3) * self._inv_h[None, :, :, None]
+        F[0, 0] += 1.0
+        F[1, 1] += 1.0
+        E = np.empty_like(F)
+        for K in range(2):
+            for L in range(K, 2):
+                E[K, L] = E[L, K] = 0.5 * (F[0, K] * F[0, L] + F[1, K] * F[1, L] - (K == L))
+        S = 2.0 * self.mu * E
+        tr = self.lam * (E[0, 0] + E[1, 1])
+        S[0, 0] += tr
+        S[1, 1] += tr
         return F, S
 
     def internal_force(self, u) -> np.ndarray:
         F, S = self._state(u)
-        P = np.einsum("ikep,kjep->ijep", F, S)
-        fe = np.einsum("riKeq,iKeq,eq->re", self.dphi, P, self.dx)
+        ne = self.n_el
+        W = np.empty((2, ne, 2, self.n_qp))                              # (i, e, K, q)
+        for i in range(2):
+            for K in range(2):
+                W[i, :, K] = ((F[i, 0] * S[0, K] + F[i, 1] * S[1, K]) * self.dx
+                              * self._inv_h[K][:, None])
+        # f[a, i, e] = sum_{K, q} P[i, K, e, q] dx[e, q] grad phi_a[K, q] / h_K[e]
+        fe = np.einsum("iek,ak->aie", W.reshape(2, ne, -1), self._ghat)
         return self.scale * np.bincount(self.dofs.ravel(), fe.ravel(), self.basis.N)
 
     def tangent(self, u) -> sp.csr_matrix:
