@@ -39,17 +39,42 @@ Contact law (our exact choice; the paper gives only the sentence above):
 - Contact width = x distance between the outermost stuck nodes (deformed positions); it
   is quantised by the surface node spacing h / 2.
 
-Solution method: the bottom-fixed stiffness is factorised once per mesh. Stuck DOFs carry
-unknown point forces only, so the candidate displacements are u_C = G_CS f_S with
-G = K^-1 restricted to the candidate rows; the columns of G for a node are computed (two
-solves) when it is caught. Each contact iteration is then a dense solve of size 2 |S|.
-The full field is one more solve at full depth.
+Symmetry (``symmetry="half"``, the default): block, indenter, mesh (checked: mirror
+images to round-off, a vertex line on the axis) and the contact law are symmetric about
+x = 0, and the law's catches, made per node by its own penetration, are too. Only the
+right half x >= 0 is solved, with u_x = 0 on the axis (u_x odd, u_y even). Every
+reported quantity is the full block's: the force and the bottom reaction are twice the
+half's (the axis node's reaction, from one side only, is half the full block's like every
+other node's), the contact width twice the outermost stuck x, the stuck-node count
+mirrored (the axis node once), the field and contact points mirrored. A half model
+cannot show an asymmetric solution; the full block shows none here: ``symmetry="full"``
+(the whole block, kept) agrees with the half to round-off on the coarsest mesh
+(tests/reference_fem/test_indentation_symmetry.py) and over the whole default studies
+to the Newton tolerance's effect (benchmarks/fem_indentation.py).
+
+Solution method (small strain): the fixed stiffness (bottom, and the axis u_x of the
+half model) is factorised once per mesh. Stuck DOFs carry unknown point forces only, so
+the candidate displacements are u_C = G_CS f_S with G = K^-1 restricted to the candidate
+rows; the columns of G for a node are computed (two solves) when it is caught. Each
+contact iteration is then a dense solve of size 2 |S| (less the axis node's u_x, held by
+the symmetry condition). The full field is one more solve at full depth.
+
+Solution method (finite strain, St Venant-Kirchhoff): each increment starts from the
+tangent predictor and iterates to a free residual below :data:`NEWTON_RTOL` of the force
+scale. The sparse LU of the tangent is kept across iterations and increments (a modified
+Newton step costs one residual and one back-substitution) as long as a step reduces the
+free residual at least 10-fold (:data:`REUSE_CONTRACTION`); otherwise that iteration is a
+Newton step with the tangent factorised at the iterate and a halving line search. A
+catch changes the free set and so factorises anew. ``solve_level_finite(...,
+newton="plain")`` factorises at every iterate (the former method, for measurement); the
+two stop at the same rule and agree to its order (measured 3e-11 relative on the force).
 
 Mesh: tensor-product Q2 mesh with uniform spacing h in |x| <= fine_half_width and in
 y >= -fine_depth, growing geometrically (grading_ratio) outside; level l bisects every
 element of level 0 l times (nested meshes, every element halves). The compared quantity
 is the force at full depth; its level-to-level change (and that of the whole force-depth
-curve) is recorded.
+curve) is recorded. The refinement table's ``dofs`` are those of the solved model (half
+the block's for ``symmetry="half"``).
 """
 from __future__ import annotations
 
@@ -581,13 +606,16 @@ def _contact_steps(p: IndentationParams, substeps: int, store: _FlexibilityColum
                 forces=np.array(forces), widths=np.array(widths), counts=np.array(counts))
 
 
-def compute(p: IndentationParams) -> IndentationResult:
-    """Run the refinement study (no cache)."""
+def compute(p: IndentationParams, newton: str = "reuse") -> IndentationResult:
+    """Run the refinement study (no cache); ``newton`` as in :func:`solve_level_finite`
+    (finite strain only)."""
     t_start = time.perf_counter()
     rows, prev = [], None
     for level in range(p.levels):
-        solver = solve_level if p.kinematics == "small" else solve_level_finite
-        s = solver(p, level, check_steps=level == p.levels - 1)
+        if p.kinematics == "small":
+            s = solve_level(p, level, check_steps=level == p.levels - 1)
+        else:
+            s = solve_level_finite(p, level, check_steps=level == p.levels - 1, newton=newton)
         q = float(s["forces"][-1])
         q_prev = None if prev is None else prev["forces"][-1]
         extra = {"contact_width_m": float(s["widths"][-1]),
