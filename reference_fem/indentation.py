@@ -466,11 +466,12 @@ def _newton(svk, u, fixed, previous, depth, tangent: _Tangent, maxiter: int = 30
     (the last equilibrium; ``u`` holds the new prescribed values); returns the number of
     linear solves.
 
-    The predictor and each iteration first try the kept factorisation (``tangent.kept``:
-    with ``newton="plain"`` a fresh one at every iterate); an iteration whose step does not
-    reduce the free residual by :data:`REUSE_CONTRACTION` is redone with the tangent
-    factorised at the iterate, and its step is halved by a line search until the residual
-    decreases. The stopping rule (:data:`NEWTON_RTOL`) is the same either way."""
+    The predictor uses the kept factorisation (``tangent.kept``; a fresh one at
+    ``previous`` when the free set has changed, and always with ``newton="plain"``). Each
+    iteration first tries a step with it (not with ``"plain"``); if that step does not
+    reduce the free residual by :data:`REUSE_CONTRACTION`, the iteration is a Newton step
+    with the tangent factorised at the iterate, halved by a line search until the
+    residual decreases. The stopping rule (:data:`NEWTON_RTOL`) is the same either way."""
     free = np.flatnonzero(~fixed)
     change = np.where(fixed, u - previous, 0.0)
     t = tangent.kept(previous, fixed)
@@ -483,18 +484,15 @@ def _newton(svk, u, fixed, previous, depth, tangent: _Tangent, maxiter: int = 30
     for _ in range(maxiter):
         if norm <= NEWTON_RTOL * scale:
             return solves
-        t = tangent.kept(u, fixed)
-        trial, f_t, n_t = None, None, np.inf
-        if t is tangent and tangent.keep:      # a step with the kept factorisation
+        n_t = np.inf
+        if tangent.keep:      # a step with the kept factorisation (of this free set)
             trial = u.copy()
-            trial[free] -= t.lu.solve(f[free])
+            trial[free] -= tangent.lu.solve(f[free])
             solves += 1
             f_t = svk.internal_force(trial)
             n_t = float(np.linalg.norm(f_t[free]))
-        if n_t > REUSE_CONTRACTION * norm:     # a Newton step with a line search
-            if trial is not None:
-                t = tangent.at(u, fixed)
-            du = -t.lu.solve(f[free])
+        if n_t > REUSE_CONTRACTION * norm:     # a Newton step at the iterate, line search
+            du = -tangent.at(u, fixed).lu.solve(f[free])
             solves += 1
             step = 1.0
             for _ in range(13):
