@@ -39,17 +39,42 @@ Contact law (our exact choice; the paper gives only the sentence above):
 - Contact width = x distance between the outermost stuck nodes (deformed positions); it
   is quantised by the surface node spacing h / 2.
 
-Solution method: the bottom-fixed stiffness is factorised once per mesh. Stuck DOFs carry
-unknown point forces only, so the candidate displacements are u_C = G_CS f_S with
-G = K^-1 restricted to the candidate rows; the columns of G for a node are computed (two
-solves) when it is caught. Each contact iteration is then a dense solve of size 2 |S|.
-The full field is one more solve at full depth.
+Symmetry (``symmetry="half"``, the default): block, indenter, mesh (checked: mirror
+images to round-off, a vertex line on the axis) and the contact law are symmetric about
+x = 0, and the law's catches, made per node by its own penetration, are too. Only the
+right half x >= 0 is solved, with u_x = 0 on the axis (u_x odd, u_y even). Every
+reported quantity is the full block's: the force and the bottom reaction are twice the
+half's (the axis node's reaction, from one side only, is half the full block's like every
+other node's), the contact width twice the outermost stuck x, the stuck-node count
+mirrored (the axis node once), the field and contact points mirrored. A half model
+cannot show an asymmetric solution; the full block shows none here: ``symmetry="full"``
+(the whole block, kept) agrees with the half to round-off on the coarsest mesh
+(tests/reference_fem/test_indentation_symmetry.py) and over the whole default studies
+to the Newton tolerance's effect (benchmarks/fem_indentation.py).
+
+Solution method (small strain): the fixed stiffness (bottom, and the axis u_x of the
+half model) is factorised once per mesh. Stuck DOFs carry unknown point forces only, so
+the candidate displacements are u_C = G_CS f_S with G = K^-1 restricted to the candidate
+rows; the columns of G for a node are computed (two solves) when it is caught. Each
+contact iteration is then a dense solve of size 2 |S| (less the axis node's u_x, held by
+the symmetry condition). The full field is one more solve at full depth.
+
+Solution method (finite strain, St Venant-Kirchhoff): each increment starts from the
+tangent predictor and iterates to a free residual below :data:`NEWTON_RTOL` of the force
+scale. The sparse LU of the tangent is kept across iterations and increments (a modified
+Newton step costs one residual and one back-substitution) as long as a step reduces the
+free residual at least 10-fold (:data:`REUSE_CONTRACTION`); otherwise that iteration is a
+Newton step with the tangent factorised at the iterate and a halving line search. A
+catch changes the free set and so factorises anew. ``solve_level_finite(...,
+newton="plain")`` factorises at every iterate (the former method, for measurement); the
+two stop at the same rule and agree to its order (measured 3e-11 relative on the force).
 
 Mesh: tensor-product Q2 mesh with uniform spacing h in |x| <= fine_half_width and in
 y >= -fine_depth, growing geometrically (grading_ratio) outside; level l bisects every
 element of level 0 l times (nested meshes, every element halves). The compared quantity
 is the force at full depth; its level-to-level change (and that of the whole force-depth
-curve) is recorded.
+curve) is recorded. The refinement table's ``dofs`` are those of the solved model (half
+the block's for ``symmetry="half"``).
 """
 from __future__ import annotations
 
@@ -64,12 +89,13 @@ from . import params as _p
 from .cache import cached
 from .elasticity import Material, TensorElasticity
 from .hyperelastic import StVenantKirchhoff
-from .field import midpoint_refined
+from .field import FieldSolution, midpoint_refined
 from .meshing import fine_then_geometric
 from .results import ReferenceResult, RefinementRow, change_pct
 
 REFERENCE = "block2d-indentation"
 KINEMATICS = ("small", "finite")
+SYMMETRIES = ("half", "full")
 
 
 @dataclass(frozen=True)
@@ -91,6 +117,7 @@ class IndentationParams:
     grading_ratio: float = 1.3     # element growth factor outside the fine zone (level 0)
     levels: int = 3                # level l halves every element l times
     kinematics: str = "small"      # small strain, or finite (St Venant-Kirchhoff, Newton)
+    symmetry: str = "half"         # half (x >= 0, u_x = 0 on the axis) or the full block
 
     def __post_init__(self):
         _p.positive(REFERENCE, width=self.width, height=self.height, radius=self.radius,
@@ -109,6 +136,8 @@ class IndentationParams:
         _p.require(2 <= self.levels <= 5, REFERENCE, f"levels must be 2..5, got {self.levels}")
         _p.require(self.kinematics in KINEMATICS, REFERENCE,
                    f"kinematics must be one of {', '.join(KINEMATICS)}, got {self.kinematics!r}")
+        _p.require(self.symmetry in SYMMETRIES, REFERENCE,
+                   f"symmetry must be one of {', '.join(SYMMETRIES)}, got {self.symmetry!r}")
 
     def finest_cells(self) -> tuple[int, int]:
         """Elements along x and y of the finest level, counted without building the mesh
@@ -188,17 +217,56 @@ def mesh_coordinates(p: IndentationParams, level: int):
     return _bisect(xs, level), _bisect(ys, level)
 
 
+def _right_half(xs: np.ndarray) -> np.ndarray:
+    """The vertices x >= 0 of a mesh line symmetric about x = 0 with a vertex there."""
+    c = xs.size // 2
+    if xs.size % 2 == 0 or xs[c] != 0.0 or np.max(np.abs(xs + xs[::-1])) > 1e-12 * np.ptp(xs):
+        raise RuntimeError("indentation: the x mesh line is not symmetric about x = 0")
+    return xs[c:]
+
+
+def _half_model(p: IndentationParams, level: int):
+    """The model of the mesh that is solved (the right half for ``symmetry="half"``), the
+    full mesh's x line, and the Dirichlet dofs: the bottom edge, and u_x on the axis x = 0
+    for the half model (the mirror condition of a problem symmetric about the axis: u_x
+    odd, u_y even)."""
+    xs, ys = mesh_coordinates(p, level)
+    half = p.symmetry == "half"
+    model = TensorElasticity((_right_half(xs) if half else xs, ys),
+                             Material(p.E, p.nu, "plane_stress", p.thickness))
+    tol = 1e-9 * p.height
+    fixed = model.dofs(lambda x, y: y < -p.height + tol)
+    if half:
+        fixed = np.union1d(fixed, model.dofs(lambda x, y: np.abs(x) < tol, [0]))
+    return model, xs, fixed
+
+
+def _mirrored_field(field: FieldSolution, xs: np.ndarray) -> FieldSolution:
+    """The full block's field from the right half's (u_x odd, u_y even about x = 0)."""
+    left = field.values[:0:-1].copy()
+    left[..., 0] *= -1.0
+    return FieldSolution(coords=(xs, field.coords[1]),
+                         values=np.concatenate([left, field.values]), lam=field.lam,
+                         mu=field.mu)
+
+
+def _mirrored_points(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Points x >= 0 (increasing) and their mirror images, the axis point once."""
+    off = x > 0.0
+    return (np.concatenate([-x[off][::-1], x[~off], x[off]]),
+            np.concatenate([y[off][::-1], y[~off], y[off]]))
+
+
 def solve_level(p: IndentationParams, level: int, check_steps: bool = False) -> dict:
     """Quasi-static sticking-contact stepping on one mesh (see the module docstring);
     with ``check_steps`` the stepping is repeated with 2 n_steps on the same mesh."""
     t0 = time.perf_counter()
-    model = TensorElasticity(mesh_coordinates(p, level),
-                             Material(p.E, p.nu, "plane_stress", p.thickness))
+    model, xs, fixed = _half_model(p, level)
+    half = p.symmetry == "half"
     K = model.stiffness
     N = model.basis.N
     tol = 1e-9 * p.height
-    bottom = model.dofs(lambda x, y: y < -p.height + tol)
-    free = np.setdiff1d(np.arange(N), bottom)
+    free = np.setdiff1d(np.arange(N), fixed)
     lu = spla.splu(K[free][:, free].tocsc(), permc_spec="MMD_AT_PLUS_A")
     row_of = np.full(N, -1)
     row_of[free] = np.arange(free.size)
@@ -209,14 +277,15 @@ def solve_level(p: IndentationParams, level: int, check_steps: bool = False) -> 
     X0 = model.dof_coords[0, cx]
     if not np.allclose(X0, model.dof_coords[0, cy]):
         raise RuntimeError("top-edge x and y DOFs do not pair up")
-    cand_rows = row_of[np.concatenate([cx, cy])]   # candidate DOF order: all u_x, then all u_y
+    # candidate DOF order: all u_x, then all u_y; -1: held by the symmetry condition
+    cand_rows = row_of[np.concatenate([cx, cy])]
     t_setup = time.perf_counter() - t0
 
     t1 = time.perf_counter()
     store = _FlexibilityColumns(lu, free.size, cand_rows)
-    out = _contact_steps(p, p.substeps, store, X0)
+    out = _contact_steps(p, p.substeps, store, X0, half)
     S, fS = out["order"], out["fS"]
-    # full field at full depth: point forces on the stuck DOFs, bottom fixed
+    # full field at full depth: point forces on the stuck DOFs, bottom (and axis) fixed
     f = np.zeros(N)
     f[cx[S]], f[cy[S]] = fS[0::2], fS[1::2]
     u = np.zeros(N)
@@ -226,33 +295,43 @@ def solve_level(p: IndentationParams, level: int, check_steps: bool = False) -> 
     target = out["target"]
     err = max(np.max(np.abs(u[cx[S]] - target[:, 0])), np.max(np.abs(u[cy[S]] - target[:, 1])))
     bottom_y = model.dofs(lambda x, y: y < -p.height + tol, [1])
-    bottom_reaction = float((model.reactions(u)[bottom_y]).sum())
+    bottom_reaction = (2.0 if half else 1.0) * float((model.reactions(u)[bottom_y]).sum())
     solve_s = time.perf_counter() - t1
     step_change = float("nan")
     if check_steps:
-        twice = _contact_steps(p, 2 * p.substeps, store, X0)
+        twice = _contact_steps(p, 2 * p.substeps, store, X0, half)
         step_change = float(100 * np.max(np.abs(twice["forces"] - out["forces"])[1:]
                                          / twice["forces"][1:]))
-    return dict(model=model, field=model.field(u), depths=out["depths"], forces=out["forces"],
-                widths=out["widths"], counts=out["counts"], contact_x=X0[S] + target[:, 0],
-                contact_y=target[:, 1], constraint_error=float(err / p.depth),
+    field, contact_x, contact_y = model.field(u), X0[S] + target[:, 0], target[:, 1]
+    if half:
+        order = np.argsort(contact_x)
+        field = _mirrored_field(field, xs)
+        contact_x, contact_y = _mirrored_points(contact_x[order], contact_y[order])
+    return dict(model=model, field=field, depths=out["depths"], forces=out["forces"],
+                widths=out["widths"], counts=out["counts"], contact_x=contact_x,
+                contact_y=contact_y, constraint_error=float(err / p.depth),
                 stuck_dofs=np.stack([cx[S], cy[S]]), stuck_targets=target,
                 bottom_reaction=bottom_reaction, n_solves=store.n_solves + 1,
                 step_change_pct=step_change, setup_s=t_setup, solve_s=solve_s,
                 h_min=float(min(np.diff(model.coords[0]).min(), np.diff(model.coords[1]).min())))
 
 
-def solve_level_finite(p: IndentationParams, level: int, check_steps: bool = False) -> dict:
+def solve_level_finite(p: IndentationParams, level: int, check_steps: bool = False,
+                       newton: str = "reuse") -> dict:
     """The contact law of the module docstring with finite-strain kinematics
     (:class:`~reference_fem.hyperelastic.StVenantKirchhoff`): each increment is solved by
     Newton's method, candidates are tested at their deformed positions as before; with
-    ``check_steps`` the stepping is repeated with twice the increments."""
+    ``check_steps`` the stepping is repeated with twice the increments. ``newton``:
+    ``"reuse"`` keeps a factorised tangent while it converges fast (:func:`_newton`),
+    ``"plain"`` factorises the tangent at every iterate (the former method, kept to
+    measure against)."""
+    if newton not in NEWTON_METHODS:
+        raise ValueError(f"newton must be one of {', '.join(NEWTON_METHODS)}, got {newton!r}")
     t0 = time.perf_counter()
-    model = TensorElasticity(mesh_coordinates(p, level),
-                             Material(p.E, p.nu, "plane_stress", p.thickness))
+    model, xs, fixed = _half_model(p, level)
+    half = p.symmetry == "half"
     svk = StVenantKirchhoff(model)
     tol = 1e-9 * p.height
-    bottom = model.dofs(lambda x, y: y < -p.height + tol)
     on_top = lambda x, y: y > -tol  # noqa: E731
     cx, cy = model.dofs(on_top, [0]), model.dofs(on_top, [1])
     cx = cx[np.argsort(model.dof_coords[0, cx])]
@@ -260,11 +339,11 @@ def solve_level_finite(p: IndentationParams, level: int, check_steps: bool = Fal
     X0 = model.dof_coords[0, cx]
     t_setup = time.perf_counter() - t0
     t1 = time.perf_counter()
-    out = _finite_steps(p, p.substeps, svk, bottom, cx, cy, X0)
+    out = _finite_steps(p, p.substeps, svk, fixed, cx, cy, X0, newton)
     solve_s = time.perf_counter() - t1
     step_change = float("nan")
     if check_steps:
-        twice = _finite_steps(p, 2 * p.substeps, svk, bottom, cx, cy, X0)
+        twice = _finite_steps(p, 2 * p.substeps, svk, fixed, cx, cy, X0, newton)
         step_change = float(100 * np.max(np.abs(twice["forces"] - out["forces"])[1:]
                                          / twice["forces"][1:]))
     u, stuck, target = out["u"], out["stuck"], out["target"]
@@ -272,27 +351,37 @@ def solve_level_finite(p: IndentationParams, level: int, check_steps: bool = Fal
     bottom_y = model.dofs(lambda x, y: y < -p.height + tol, [1])
     err = max(np.max(np.abs(u[cx[stuck]] - target[stuck, 0]), initial=0.0),
               np.max(np.abs(u[cy[stuck]] - target[stuck, 1]), initial=0.0))
-    return dict(model=model, field=model.field(u), depths=out["depths"], forces=out["forces"],
-                widths=out["widths"], counts=out["counts"], contact_x=X0[stuck] + u[cx[stuck]],
-                contact_y=target[stuck, 1], constraint_error=float(err / p.depth),
-                bottom_reaction=float(f[bottom_y].sum()), n_solves=out["solves"],
+    field = model.field(u)
+    contact_x, contact_y = X0[stuck] + u[cx[stuck]], target[stuck, 1]
+    if half:
+        field = _mirrored_field(field, xs)
+        contact_x, contact_y = _mirrored_points(contact_x, contact_y)
+    return dict(model=model, field=field, depths=out["depths"], forces=out["forces"],
+                widths=out["widths"], counts=out["counts"], contact_x=contact_x,
+                contact_y=contact_y, constraint_error=float(err / p.depth),
+                bottom_reaction=(2.0 if half else 1.0) * float(f[bottom_y].sum()),
+                n_solves=out["solves"], n_factorisations=out["factorisations"],
                 step_change_pct=step_change, setup_s=t_setup, solve_s=solve_s,
                 h_min=float(min(np.diff(model.coords[0]).min(), np.diff(model.coords[1]).min())),
                 min_jacobian=out["min_jacobian"])
 
 
-def _finite_steps(p, substeps, svk, bottom, cx, cy, X0) -> dict:
+def _finite_steps(p, substeps, svk, fixed_dofs, cx, cy, X0, newton="reuse") -> dict:
+    """The finite-strain stepping on the solved mesh; forces, widths and counts are the
+    full block's (doubled, mirrored) for ``p.symmetry == "half"``."""
     N = svk.basis.N
     R = p.radius
+    half = p.symmetry == "half"
     n_inc = p.n_steps * substeps
     dd = p.depth / n_inc
     fixed = np.zeros(N, dtype=bool)
-    fixed[bottom] = True
+    fixed[fixed_dofs] = True
     stuck = np.zeros(X0.size, dtype=bool)
     target = np.zeros((X0.size, 2))    # prescribed (u_x, u_y) of stuck nodes
     u = np.zeros(N)
     depths, forces, widths, counts = [0.0], [0.0], [0.0], [0]
     solves, min_jac = 0, 1.0
+    tangent = _Tangent(svk, keep=newton == "reuse")
     for step in range(1, n_inc + 1):
         d = p.depth * step / n_inc
         yc = R - d
@@ -300,7 +389,7 @@ def _finite_steps(p, substeps, svk, bottom, cx, cy, X0) -> dict:
         target[stuck, 1] -= dd
         u[cy[stuck]] = target[stuck, 1]
         while True:
-            solves += _newton(svk, u, fixed, previous, d)
+            solves += _newton(svk, u, fixed, previous, d, tangent)
             det, x = svk.min_jacobian(u)
             min_jac = min(min_jac, det)
             if det <= 0:
@@ -322,34 +411,72 @@ def _finite_steps(p, substeps, svk, bottom, cx, cy, X0) -> dict:
         f = svk.internal_force(u)
         xs = X0[stuck] + u[cx[stuck]]
         depths.append(d)
-        forces.append(-float(f[cy[stuck]].sum()))
-        widths.append(float(xs.max() - xs.min()) if xs.size else 0.0)
-        counts.append(int(stuck.sum()))
+        if half:   # the axis node's y reaction is half the full block's, like every other
+            forces.append(-2.0 * float(f[cy[stuck]].sum()))
+            widths.append(2.0 * float(xs.max()) if xs.size else 0.0)
+            counts.append(2 * int(stuck.sum()) - int(np.sum(stuck & (X0 == 0.0))))
+        else:
+            forces.append(-float(f[cy[stuck]].sum()))
+            widths.append(float(xs.max() - xs.min()) if xs.size else 0.0)
+            counts.append(int(stuck.sum()))
     return dict(u=u, stuck=stuck, target=target, depths=np.array(depths), forces=np.array(forces),
                 widths=np.array(widths), counts=np.array(counts), solves=solves,
-                min_jacobian=min_jac)
+                factorisations=tangent.n_factorisations, min_jacobian=min_jac)
 
 
 #: Newton's stopping rule for the finite-strain steps: the free residual below 1e-10 of
 #: the larger of its start and the reactions (the forces are compared at 1e-2 and below).
 NEWTON_RTOL = 1e-10
+NEWTON_METHODS = ("reuse", "plain")
+#: a step with the kept factorisation is taken if it reduces the free residual at least
+#: this much; otherwise the tangent is refactorised at the iterate (a Newton step). A
+#: cost trade-off only (the stopping rule fixes the accuracy); chosen by measurement
+#: (benchmarks/fem_indentation.py).
+REUSE_CONTRACTION = 0.1
 
 
-def _newton(svk, u, fixed, previous, depth, maxiter: int = 30) -> int:
+class _Tangent:
+    """The tangent K at some state and the sparse LU of its free block. With ``keep`` it
+    is kept (modified Newton) until the free set changes or :func:`_newton` asks for a
+    fresh one; without, every :meth:`at` factorises anew (plain Newton)."""
+
+    def __init__(self, svk, keep: bool):
+        self.svk, self.keep = svk, keep
+        self.K = self.lu = self.fixed = None
+        self.n_factorisations = 0
+
+    def at(self, u, fixed) -> "_Tangent":
+        """Factorise the tangent at ``u`` on the free dofs of ``fixed``."""
+        self.K = self.svk.tangent(u)
+        free = np.flatnonzero(~fixed)
+        self.lu = spla.splu(self.K[free][:, free].tocsc(), permc_spec="MMD_AT_PLUS_A")
+        self.fixed = fixed.copy()
+        self.n_factorisations += 1
+        return self
+
+    def kept(self, u, fixed) -> "_Tangent":
+        """The kept factorisation if it is for the same free set, else one at ``u``."""
+        if self.keep and self.fixed is not None and np.array_equal(fixed, self.fixed):
+            return self
+        return self.at(u, fixed)
+
+
+def _newton(svk, u, fixed, previous, depth, tangent: _Tangent, maxiter: int = 30) -> int:
     """Equilibrium on the free dofs, in place, from the tangent predictor at ``previous``
     (the last equilibrium; ``u`` holds the new prescribed values); returns the number of
-    linear solves. Sparse LU per iteration; a line search halves steps that do not reduce
-    the residual."""
+    linear solves.
+
+    The predictor uses the kept factorisation (``tangent.kept``; a fresh one at
+    ``previous`` when the free set has changed, and always with ``newton="plain"``). Each
+    iteration first tries a step with it (not with ``"plain"``); if that step does not
+    reduce the free residual by :data:`REUSE_CONTRACTION`, the iteration is a Newton step
+    with the tangent factorised at the iterate, halved by a line search until the
+    residual decreases. The stopping rule (:data:`NEWTON_RTOL`) is the same either way."""
     free = np.flatnonzero(~fixed)
-
-    def lu_solve(K, r):
-        lu = spla.splu(K[free][:, free].tocsc(), permc_spec="MMD_AT_PLUS_A")
-        return lu.solve(r)
-
     change = np.where(fixed, u - previous, 0.0)
-    K0 = svk.tangent(previous)
-    r0 = svk.internal_force(previous) + K0 @ change
-    u[free] = previous[free] - lu_solve(K0, r0[free])
+    t = tangent.kept(previous, fixed)
+    r0 = svk.internal_force(previous) + t.K @ change
+    u[free] = previous[free] - t.lu.solve(r0[free])
     solves = 1
     f = svk.internal_force(u)
     norm = float(np.linalg.norm(f[free]))
@@ -357,20 +484,28 @@ def _newton(svk, u, fixed, previous, depth, maxiter: int = 30) -> int:
     for _ in range(maxiter):
         if norm <= NEWTON_RTOL * scale:
             return solves
-        du = -lu_solve(svk.tangent(u), f[free])
-        solves += 1
-        step = 1.0
-        for _ in range(13):
+        n_t = np.inf
+        if tangent.keep:      # a step with the kept factorisation (of this free set)
             trial = u.copy()
-            trial[free] += step * du
+            trial[free] -= tangent.lu.solve(f[free])
+            solves += 1
             f_t = svk.internal_force(trial)
             n_t = float(np.linalg.norm(f_t[free]))
-            if n_t <= (1 - 1e-4 * step) * norm:
-                break
-            step *= 0.5
-        else:
-            raise FloatingPointError(f"indentation (finite strain): Newton's line search "
-                                     f"failed at depth {depth * 1e3:.4g} mm")
+        if n_t > REUSE_CONTRACTION * norm:     # a Newton step at the iterate, line search
+            du = -tangent.at(u, fixed).lu.solve(f[free])
+            solves += 1
+            step = 1.0
+            for _ in range(13):
+                trial = u.copy()
+                trial[free] += step * du
+                f_t = svk.internal_force(trial)
+                n_t = float(np.linalg.norm(f_t[free]))
+                if n_t <= (1 - 1e-4 * step) * norm:
+                    break
+                step *= 0.5
+            else:
+                raise FloatingPointError(f"indentation (finite strain): Newton's line search "
+                                         f"failed at depth {depth * 1e3:.4g} mm")
         u[:] = trial
         f, norm = f_t, n_t
         scale = max(scale, float(np.linalg.norm(f[fixed])))
@@ -383,12 +518,14 @@ class _FlexibilityColumns:
     computed once per node (two solves) when first needed.
 
     ``cand_rows`` are the rows (in the numbering of the factorised system) of the top-edge
-    DOFs, all u_x then all u_y; column 2 i (2 i + 1) of :attr:`G` is the response to a
-    unit x (y) force at candidate node i.
+    DOFs, all u_x then all u_y, -1 for a DOF held fixed (u_x on the axis of the half
+    model: its row and column of G are zero, :attr:`active` is False); column 2 i
+    (2 i + 1) of :attr:`G` is the response to a unit x (y) force at candidate node i.
     """
 
     def __init__(self, lu, n_free: int, cand_rows: np.ndarray):
         self.lu, self.n_free, self.rows = lu, n_free, cand_rows
+        self.active = cand_rows >= 0
         self.nc = cand_rows.size // 2
         self.G = np.zeros((2 * self.nc, 2 * self.nc))
         self.known = np.zeros(self.nc, dtype=bool)
@@ -400,9 +537,10 @@ class _FlexibilityColumns:
             return
         rhs = np.zeros((self.n_free, 2 * new.size))
         k = np.arange(new.size)
-        rhs[self.rows[new], 2 * k] = 1.0
-        rhs[self.rows[self.nc + new], 2 * k + 1] = 1.0
-        cols = self.lu.solve(rhs)[self.rows]
+        for col, dof in ((2 * k, new), (2 * k + 1, self.nc + new)):
+            on = self.active[dof]
+            rhs[self.rows[dof[on]], col[on]] = 1.0
+        cols = np.where(self.active[:, None], self.lu.solve(rhs)[self.rows], 0.0)
         self.G[:, 2 * new] = cols[:, 0::2]
         self.G[:, 2 * new + 1] = cols[:, 1::2]
         self.known[new] = True
@@ -410,10 +548,12 @@ class _FlexibilityColumns:
 
 
 def _contact_steps(p: IndentationParams, substeps: int, store: _FlexibilityColumns,
-                   X0: np.ndarray) -> dict:
+                   X0: np.ndarray, half: bool = False) -> dict:
     """Depth stepping with the sticking contact law of the module docstring, in
     ``p.n_steps * substeps`` equal increments, recorded at the ``p.n_steps`` output depths.
-    ``X0`` are the x coordinates of the candidate nodes (the order of ``store``).
+    ``X0`` are the x coordinates of the candidate nodes (the order of ``store``). With
+    ``half`` the candidates are those of the right half (x >= 0) and the recorded forces,
+    widths and counts the full block's (doubled, mirrored).
     """
     nc = X0.size
     n_inc = p.n_steps * substeps
@@ -432,9 +572,11 @@ def _contact_steps(p: IndentationParams, substeps: int, store: _FlexibilityColum
             if S.size:
                 cols = np.stack([2 * S, 2 * S + 1], axis=1).ravel()
                 rows = np.stack([S, nc + S], axis=1).ravel()
-                GS = store.G[:, cols]
-                fS = np.linalg.solve(GS[rows], target[S].ravel())
-                u = GS @ fS
+                on = store.active[rows]        # the forces that are unknowns
+                GS = store.G[:, cols[on]]
+                fS = np.zeros(cols.size)
+                fS[on] = np.linalg.solve(GS[rows[on]], target[S].ravel()[on])
+                u = GS @ fS[on]
                 uc = np.stack([u[:nc], u[nc:]], axis=1)
             x, y = X0 + uc[:, 0], uc[:, 1]
             gap = np.hypot(x, y - yc) - R
@@ -450,24 +592,34 @@ def _contact_steps(p: IndentationParams, substeps: int, store: _FlexibilityColum
             continue
         xs_stuck = X0[stuck] + target[stuck, 0]
         depths.append(d)
-        forces.append(-float(fS[1::2].sum()))
-        widths.append(float(xs_stuck.max() - xs_stuck.min()) if xs_stuck.size else 0.0)
-        counts.append(int(stuck.sum()))
+        if half:   # the axis node's y force is half the full block's, like every other
+            forces.append(-2.0 * float(fS[1::2].sum()))
+            widths.append(2.0 * float(xs_stuck.max()) if xs_stuck.size else 0.0)
+            counts.append(2 * int(stuck.sum()) - int(np.sum(stuck & (X0 == 0.0))))
+        else:
+            forces.append(-float(fS[1::2].sum()))
+            widths.append(float(xs_stuck.max() - xs_stuck.min()) if xs_stuck.size else 0.0)
+            counts.append(int(stuck.sum()))
     return dict(order=S, fS=fS, target=target[S], depths=np.array(depths),
                 forces=np.array(forces), widths=np.array(widths), counts=np.array(counts))
 
 
-def compute(p: IndentationParams) -> IndentationResult:
-    """Run the refinement study (no cache)."""
+def compute(p: IndentationParams, newton: str = "reuse") -> IndentationResult:
+    """Run the refinement study (no cache); ``newton`` as in :func:`solve_level_finite`
+    (finite strain only)."""
     t_start = time.perf_counter()
     rows, prev = [], None
     for level in range(p.levels):
-        solver = solve_level if p.kinematics == "small" else solve_level_finite
-        s = solver(p, level, check_steps=level == p.levels - 1)
+        if p.kinematics == "small":
+            s = solve_level(p, level, check_steps=level == p.levels - 1)
+        else:
+            s = solve_level_finite(p, level, check_steps=level == p.levels - 1, newton=newton)
         q = float(s["forces"][-1])
         q_prev = None if prev is None else prev["forces"][-1]
         extra = {"contact_width_m": float(s["widths"][-1]),
                  "contact_nodes": int(s["counts"][-1]), "solves": int(s["n_solves"])}
+        if "n_factorisations" in s:
+            extra["factorisations"] = int(s["n_factorisations"])
         if prev is not None:
             dF = np.abs(s["forces"] - prev["forces"])[1:]
             extra["curve_change_pct"] = float(100 * np.max(dF) / abs(q))
