@@ -1,6 +1,7 @@
 """On-disk cache of converged references, keyed by a hash of everything that defines them."""
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import hashlib
 import json
@@ -58,16 +59,19 @@ def cached(reference: str, params: dict, compute: Callable[[], results.Reference
     """
     key = cache_key(reference, params)
     path = cache_dir() / f"{reference}-{key[:24]}.npz"
-    if use_cache and path.is_file():
-        try:
-            res = results.from_npz(path, classes)
-            if res.cache_key == key:
-                return dataclasses.replace(res, from_cache=True)
-        except Exception:  # noqa: BLE001 - any unreadable entry is a miss (BadZipFile, EOFError, ...)
-            pass
-    res = dataclasses.replace(compute(), cache_key=key, from_cache=False)
-    if use_cache:
-        path.parent.mkdir(parents=True, exist_ok=True)
+    if not use_cache:
+        return dataclasses.replace(compute(), cache_key=key, from_cache=False)
+    hit = _read(path, key, classes)
+    if hit is not None:
+        return hit
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with _key_lock(path):
+        # a process that held the lock may have computed it meanwhile: one study per key,
+        # however many runs of a report need it at once
+        hit = _read(path, key, classes)
+        if hit is not None:
+            return hit
+        res = dataclasses.replace(compute(), cache_key=key, from_cache=False)
         fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp.npz")
         os.close(fd)
         try:
@@ -79,3 +83,37 @@ def cached(reference: str, params: dict, compute: Callable[[], results.Reference
             if os.path.exists(tmp):
                 os.unlink(tmp)
     return res
+
+
+def _read(path: Path, key: str, classes: dict):
+    """The cached result at ``path`` if it reads back whole and carries ``key``, else
+    None (a miss)."""
+    if not path.is_file():
+        return None
+    try:
+        res = results.from_npz(path, classes)
+        if res.cache_key == key:
+            return dataclasses.replace(res, from_cache=True)
+    except Exception:  # noqa: BLE001 - any unreadable entry is a miss (BadZipFile, EOFError, ...)
+        pass
+    return None
+
+
+@contextlib.contextmanager
+def _key_lock(path: Path):
+    """An exclusive lock on ``path``'s key while its reference is computed, so that two
+    runs needing the same reference at once (a report's workers: the FEM run and a PD run
+    of the same scene) compute it once; the other waits, then reads it. The lock file
+    (``<entry>.lock``, empty) stays in the cache folder; the kernel releases the lock
+    when its process ends, however it ends. Without ``fcntl`` (not POSIX): no lock."""
+    try:
+        import fcntl
+    except ImportError:
+        yield
+        return
+    with open(path.parent / (path.name + ".lock"), "a") as f:
+        fcntl.flock(f, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(f, fcntl.LOCK_UN)

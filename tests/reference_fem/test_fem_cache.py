@@ -88,3 +88,30 @@ def test_cached_reuse_is_fast(cache_dir):
     rf.tension_sheet(**CHEAP)
     # generous functional bound (issue budget 1 s is checked in the bench test)
     assert time.perf_counter() - t0 < 5.0
+
+
+def test_two_processes_needing_one_reference_compute_it_once(cache_dir):
+    """A report's FEM run and a PD run of the same scene ask for the same reference at
+    once: the first computes it under the key's lock, the other waits and reads it."""
+    import multiprocessing as mp
+    with mp.get_context("fork").Pool(2) as pool:
+        got = pool.map(_sheet, [str(cache_dir)] * 2)
+    assert got[0][0] == got[1][0]                       # the same entry
+    assert sorted(g[1] for g in got) == [False, True]   # computed once, read once
+    assert (cache_dir / "calls").read_text() == "x"
+    assert len(list(cache_dir.glob("sheet2d-tension-*.npz"))) == 1
+
+
+def _sheet(folder):
+    from pathlib import Path
+
+    from reference_fem.tension_sheet import TensionSheetResult
+
+    def slow():
+        with open(Path(folder) / "calls", "a") as f:
+            f.write("x")
+        time.sleep(1.0)            # long enough for the other process to arrive
+        return rf.tension_sheet(use_cache=False, **CHEAP)
+    res = cache.cached("sheet2d-tension", {"probe": 1}, slow,
+                       {"TensionSheetResult": TensionSheetResult})
+    return res.cache_key, res.from_cache
