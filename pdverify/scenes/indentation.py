@@ -30,6 +30,9 @@ CATCH_TOLERANCE = 1e-9
 #: the smallest first output depth as a fraction of R: 1000 x CATCH_TOLERANCE
 MIN_OUTPUT_DEPTH = 1e-6
 KINEMATICS = ("nonlinear", "linear")
+#: ``half``: the PD model of the half block x >= 0 with mirrored neighbours (exact for the
+#: symmetric solution, :mod:`pdverify.pd.nonlinear`); ``full``: the whole block
+SYMMETRY = ("half", "full")
 #: ``solver=auto`` uses CG from this many unknowns: on the quick grid (41 x 41 nodes, m = 6,
 #: 3,362 unknowns) a sparse LU per Newton step made the corrected curve 13 s, CG 2.6 s.
 CG_FROM_UNKNOWNS = 1000
@@ -131,6 +134,9 @@ class Indentation(FemAndPD):
               at_least(1)),
         Param("kinematics", "nonlinear", "nonlinear (current bond lengths and directions) "
               "or linear (small displacements)", choices=KINEMATICS),
+        Param("symmetry", "half", "half (the block's half x >= 0, mirrored neighbours "
+              "across the indenter's axis: the symmetric solution exactly) or full (the "
+              "whole block, which could also show an asymmetric one)", choices=SYMMETRY),
     )
     pd_methods = (("none", ()),)   # energy-directional: the registry's, on this box
     published = (
@@ -253,16 +259,18 @@ class Indentation(FemAndPD):
             model = BondBasedModel(grid, SheetScene.stencil(p, delta / h),
                                    SheetScene.micromodulus(p, delta), inf, closure,
                                    thickness=p["thickness"])
-            kin = (NonlinearBondBased if p["kinematics"] == "nonlinear" else LinearBondBased)(model)
+            kin = (NonlinearBondBased if p["kinematics"] == "nonlinear" else LinearBondBased)(
+                model, mirror_axis=0 if p["symmetry"] == "half" else None)
             kin.pattern                  # the tangent's pattern, built in the setup phase
-            unknowns = 2 * grid.n_ext
+            unknowns = 2 * kin.n
             use_cg = p["solver"] == "cg" or (p["solver"] == "auto"
                                              and unknowns >= CG_FROM_UNKNOWNS)
+            ids = kin.node_ids
             lin = DirichletLinearSolver(kin.pattern, "cg" if use_cg else "direct",
-                                        Lattice.component_major(grid.index, grid.x, 2),
+                                        Lattice.component_major(grid.index[ids], grid.x[ids], 2),
                                         width=int(round(delta / h)),
-                                        describe=lambda k: _describe(grid, k))
-        size = {"nodes": int(grid.n_ext), "unknowns": int(unknowns), "bonds": model.n_bonds(),
+                                        describe=lambda k: _describe(grid, kin, k))
+        size = {"nodes": int(kin.n), "unknowns": int(unknowns), "bonds": int(kin.a.size),
                 "tangent_nnz": int(kin.pattern.nnz)}
         with timer.phase("reference"):
             ref = self.fem_reference(p)
@@ -278,6 +286,8 @@ class Indentation(FemAndPD):
                             if k in other})
         diagnostics = {"solver": ("CG + two-level smoothed aggregation, reused across Newton "
                                   "iterations" if use_cg else "sparse LU per Newton iteration"),
+                       "model": ("half block x >= 0, mirrored neighbours" if kin.half is not None
+                                 else "whole block"),
                        "linear_solves": lin.stats.solves,
                        "preconditioner_builds": lin.stats.rebuilds,
                        "preconditioner_setup_s": lin.stats.setup_s,
@@ -297,7 +307,7 @@ class Indentation(FemAndPD):
                   "fem_depths": np.asarray(ref.depths), "fem_forces": np.asarray(ref.forces),
                   "fem_kinematics": ref.params["kinematics"],
                   "fem_small_forces": np.asarray(small.forces),
-                  "x": grid.x, "u": curve["u"].reshape(2, -1).T,
+                  "x": grid.x, "u": kin.expand(curve["u"]).reshape(2, -1).T,
                   "energy": kin.energy_density(curve["u"]), "spacing": h, "horizon": delta,
                   "failure": failure}
         if failure is None:
@@ -310,17 +320,25 @@ class Indentation(FemAndPD):
 
 def indent(kin, grid, p, lin, where):
     """Depth stepping with the sticking contact law of :class:`Indentation`; returns the
-    curve (dict of per-output-depth lists, the last equilibrium ``u``) and ``None``, or the
-    curve up to the last equilibrium and a failure dict (depth, message, node) when the
-    lattice folds or Newton fails."""
-    n = grid.n_ext
-    x0 = grid.x
+    curve (dict of per-output-depth lists, the last equilibrium ``u`` of ``kin``'s unknowns)
+    and ``None``, or the curve up to the last equilibrium and a failure dict (depth,
+    message, node) when the lattice folds or Newton fails. With a half model (``kin.half``)
+    the nodes on the axis keep u_x = 0, and the contact width and count are the whole
+    top's (the mirror images of the stuck nodes are stuck); the force, a sum of the half
+    model's reactions, is the whole body's already."""
+    n = kin.n
+    x0 = grid.x[kin.node_ids]
+    index = grid.index[kin.node_ids]
     R = p["radius"]
-    top = np.flatnonzero(grid.index[:, 1] == grid.index[:, 1].max())
+    top = np.flatnonzero(index[:, 1] == grid.index[:, 1].max())
     top = top[np.argsort(x0[top, 0])]
-    bottom = np.flatnonzero(grid.index[:, 1] == 0)
+    bottom = np.flatnonzero(index[:, 1] == 0)
     fixed = np.zeros(2 * n, dtype=bool)
     fixed[bottom] = fixed[n + bottom] = True
+    if kin.half is not None:
+        fixed[kin.plane_unknowns] = True
+        image_x = grid.x[kin.half["image"][top], 0]     # the top nodes' mirror images
+        copies = np.where(kin.half["image"][top] == kin.node_ids[top], 1, 2)
     stuck = np.zeros(top.size, dtype=bool)
     u = np.zeros(2 * n)
     n_inc = p["n_steps"] * p["substeps"]
@@ -366,10 +384,14 @@ def indent(kin, grid, p, lin, where):
             continue
         f = kin.internal_force(u)
         xs = x0[top[stuck], 0] + u[top[stuck]]
+        count = int(stuck.sum())
+        if kin.half is not None:
+            xs = np.concatenate([xs, image_x[stuck] - u[top[stuck]]])
+            count = int(copies[stuck].sum())
         curve["depths"].append(d)
         curve["forces"].append(-float(f[n + top[stuck]].sum()))
         curve["widths"].append(float(xs.max() - xs.min()) if xs.size else 0.0)
-        curve["counts"].append(int(stuck.sum()))
+        curve["counts"].append(count)
         curve["newton"].append(iterations)
         curve["min_cos"].append(state["cos"])           # of the final u of this increment
         curve["min_stretch"].append(state["ratio"])
@@ -385,14 +407,14 @@ def _node_at(grid, node) -> str:
     return f"node {node} at ({x[0]:.4g}, {x[1]:.4g}) mm"
 
 
-def _describe(grid, k) -> str:
-    """Unknown k (component-major) as 'u_y of node i at (x, y) mm'."""
-    return f"u_{'xy'[k // grid.n_ext]} of {_node_at(grid, k % grid.n_ext)}"
+def _describe(grid, kin, k) -> str:
+    """Unknown k of ``kin`` (component-major) as 'u_y of node i at (x, y) mm'."""
+    return f"u_{'xy'[k // kin.n]} of {_node_at(grid, int(kin.node_ids[k % kin.n]))}"
 
 
 def _ends(kin, grid, bond):
     """(lower, upper) node of a bond in lattice order (row, then column), and its offset."""
-    a, b = int(kin.a[bond]), int(kin.b[bond])
+    a, b = kin.bond_nodes(bond)
     off = grid.index[b] - grid.index[a]
     return ((a, b) if off[1] > 0 or (off[1] == 0 and off[0] > 0) else (b, a)), off
 

@@ -160,17 +160,25 @@ def newton(model, u, solver: DirichletLinearSolver, *, where: str, previous=None
 
     Each step solves tangent du = -f and takes the largest of 1, 1/2, 1/4, ... that
     reduces ||f_free|| by the Armijo fraction 1e-4 of the step. Stops at
-    ||f_free|| <= rtol * max(||f_free|| at the start, ||reactions||). A step the line
+    ||f_free|| <= rtol * max(||f_free|| at the start, ||reactions||), the norms weighted
+    by ``model.residual_weight`` when it has one (a half model's: the whole body's norms).
+    A step the line
     search cannot make, or ``maxiter`` iterations, raise :class:`NumericalError` naming
     ``where`` and the residual reached.
     """
     free = ~solver.fixed
+    weight = getattr(model, "residual_weight", None)
+
+    def norm_of(f, rows):
+        if weight is None:
+            return float(np.linalg.norm(f[rows]))
+        return float(np.sqrt(np.dot(weight[rows] * f[rows], f[rows])))
 
     def residual(v):
         f = model.internal_force(v)
         if not np.all(np.isfinite(f)):
             raise NumericalError(f"{where}: non-finite internal forces")
-        return f, float(np.linalg.norm(f[free]))
+        return f, norm_of(f, free)
 
     if previous is not None:
         change = np.where(solver.fixed, u - previous, 0.0)
@@ -179,7 +187,7 @@ def newton(model, u, solver: DirichletLinearSolver, *, where: str, previous=None
         du = solver.solve(T0.data, -(f0 + T0 @ change), FORCING_MAX, where)
         u[free] = previous[free] + du[free]
     f, norm = residual(u)
-    scale = max(norm, float(np.linalg.norm(f[solver.fixed])))
+    scale = max(norm, norm_of(f, solver.fixed))
     report = NewtonReport(0, [norm], scale=scale)
     if scale == 0.0:
         return report
@@ -204,7 +212,7 @@ def newton(model, u, solver: DirichletLinearSolver, *, where: str, previous=None
                                  f"reduces the residual ({norm / scale:.1e} of the force scale)")
         u[:] = trial
         f, norm = f_t, n_t
-        scale = max(scale, float(np.linalg.norm(f[solver.fixed])))
+        scale = max(scale, norm_of(f, solver.fixed))
         report.iterations += 1
         report.residuals.append(norm)
     report.scale = scale
