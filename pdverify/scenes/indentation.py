@@ -333,10 +333,11 @@ def indent(kin, grid, p, lin, where):
     top = np.flatnonzero(index[:, 1] == grid.index[:, 1].max())
     top = top[np.argsort(x0[top, 0])]
     bottom = np.flatnonzero(index[:, 1] == 0)
-    fixed = np.zeros(2 * n, dtype=bool)
+    fixed = np.zeros(2 * n, dtype=bool)              # the body's prescribed unknowns
     fixed[bottom] = fixed[n + bottom] = True
+    plane = np.zeros(2 * n, dtype=bool)              # and those of the symmetry
     if kin.half is not None:
-        fixed[kin.plane_unknowns] = True
+        plane[kin.plane_unknowns] = True
         image_x = grid.x[kin.half["image"][top], 0]     # the top nodes' mirror images
         copies = np.where(kin.half["image"][top] == kin.node_ids[top], 1, 2)
     stuck = np.zeros(top.size, dtype=bool)
@@ -346,7 +347,7 @@ def indent(kin, grid, p, lin, where):
     curve = {"depths": [0.0], "forces": [0.0], "widths": [0.0], "counts": [0], "step_s": [],
              "newton": [0], "residuals": [], "cuts": 0, "u": u.copy(), "min_cos": [1.0],
              "min_stretch": [1.0]}
-    lin.set_fixed(fixed)
+    lin.set_fixed(fixed | plane, watched=plane & ~fixed)
     t_step = time.perf_counter()
     iterations = 0
     for inc in range(1, n_inc + 1):
@@ -379,7 +380,7 @@ def indent(kin, grid, p, lin, where):
             u[n + idx] = yc - np.sqrt(R ** 2 - X[new] ** 2) - x0[idx, 1]
             stuck |= new
             fixed[idx] = fixed[n + idx] = True
-            lin.set_fixed(fixed)
+            lin.set_fixed(fixed | plane, watched=plane & ~fixed)
         if inc % p["substeps"]:
             continue
         f = kin.internal_force(u)
@@ -408,8 +409,12 @@ def _node_at(grid, node) -> str:
 
 
 def _describe(grid, kin, k) -> str:
-    """Unknown k of ``kin`` (component-major) as 'u_y of node i at (x, y) mm'."""
-    return f"u_{'xy'[k // kin.n]} of {_node_at(grid, int(kin.node_ids[k % kin.n]))}"
+    """Unknown k of ``kin`` (component-major) as 'u_y of node i at (x, y) mm' (of a half
+    model: of the node or its mirror image, the one the whole body's lower index names)."""
+    node = int(kin.node_ids[k % kin.n])
+    if kin.half is not None:
+        node = min(node, int(kin.half["image"][k % kin.n]))
+    return f"u_{'xy'[k // kin.n]} of {_node_at(grid, node)}"
 
 
 def _ends(kin, grid, bond):

@@ -71,15 +71,19 @@ class DirichletLinearSolver:
         if method not in ("direct", "cg"):
             raise ValueError(f"method={method!r}: allowed direct, cg")
         self.pattern, self.method, self.lattice, self.width = pattern, method, lattice, width
+        self.watched = None
         self.describe = describe or (lambda k: f"unknown {k}")
         self.precond = None
         self.fixed = None
         self._diag0 = None
         self.stats = LinearStats()
 
-    def set_fixed(self, fixed: np.ndarray) -> None:
-        """Mark the prescribed unknowns (boolean per unknown)."""
+    def set_fixed(self, fixed: np.ndarray, watched: np.ndarray | None = None) -> None:
+        """Mark the prescribed unknowns (boolean per unknown); ``watched``: prescribed ones
+        whose own stiffness is still checked like a free one's (a half model's u_x on the
+        symmetry plane, free in the whole body, whose diagonal there is the body's)."""
         self.fixed = np.asarray(fixed, dtype=bool)
+        self.watched = None if watched is None else np.asarray(watched, dtype=bool)
         P = self.pattern
         self._kill = np.flatnonzero(self.fixed[P.row_of] | self.fixed[P.indices])
 
@@ -99,7 +103,8 @@ class DirichletLinearSolver:
         the tangent on the pattern, is overwritten)."""
         free = ~self.fixed
         diag = data[self.pattern.diagonal]
-        bad = np.flatnonzero(free & ~(diag > 0))
+        bad = np.flatnonzero((free if self.watched is None else free | self.watched)
+                             & ~(diag > 0))
         if bad.size:
             k = bad[np.argmin(diag[bad])]
             raise NumericalError(f"{where}: the tangent has lost definiteness: "
