@@ -16,7 +16,8 @@ Variants (paper grid: 161 x 161 nodes, m = 6, 20 depth steps):
 - ``half``: this tree's default, the half block with mirrored neighbours;
 - ``full``: this tree with ``symmetry=full`` (the whole block);
 - ``before``: ``--before REV`` (a git revision, e.g. ``main`` or a commit): the package as
-  it is at REV, extracted with ``git archive`` into a temporary folder, at its defaults.
+  it is at REV, extracted with ``git archive`` into a temporary folder, at its defaults;
+  or an existing folder holding another checkout (e.g. ``/path/to/main``).
 
 Cases: the corrected nonlinear curve (``energy-directional``; budget, issue 32: <= 15 s on
 a quiet 2-core machine); with ``--scene`` every PD run the full report makes of the scene
@@ -89,7 +90,9 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         variants = [("half", ROOT, {}), ("full", ROOT, {"symmetry": "full"})]
         if args.before:
-            variants.append((f"before ({args.before})", extract(args.before, Path(tmp)), {}))
+            path = (Path(args.before) if Path(args.before).is_dir()
+                    else extract(args.before, Path(tmp)))
+            variants.append((f"before ({args.before})", path, {}))
         results = {}
         for _ in range(args.repeat):
             for method, over in cases:

@@ -137,7 +137,7 @@ class DirichletLinearSolver:
         return du
 
     def _build(self, T):
-        self.precond = TwoLevelPreconditioner(T, self.lattice, self.width)
+        self.precond = TwoLevelPreconditioner(T, self.lattice, self.width, fused=True)
         self._best_rate, self._lost = np.inf, 0.0
         self.stats.rebuilds += 1
         self.stats.setup_s += self.precond.setup_s
