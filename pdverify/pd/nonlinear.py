@@ -267,61 +267,64 @@ class NonlinearBondBased:
         return ((np.bincount(self.a, half, self.n) + np.bincount(self.b, half, self.n))
                 / self.model.node_volume)
 
+    def _gather(self) -> np.ndarray:
+        """Per data position of :attr:`pattern`, its slot in the stacked values that
+        :meth:`tangent_data` computes: per block p <= q the bonds' -B_pq, then the nodes'
+        diagonal sums, then a zero (positions only a crossing bond of a half model reaches).
+        A gather into the CSR data reads those values in data order instead of scattering
+        them bond by bond: 69 ms -> 37 ms an assembly on the half paper grid (CPU time,
+        a side measurement). Frees the pattern's per-bond positions, except the crossing
+        bonds' (added on top)."""
+        P, n, dim = self.pattern, self.n, self.dim
+        nb = self.a.size
+        c = nb if self.half is None else self.half["plain"]
+        blocks = [(p, q) for p in range(dim) for q in range(p, dim)]
+        g = np.full(P.nnz, len(blocks) * (nb + n), dtype=np.intp)
+        for t, (p, q) in enumerate(blocks):
+            for i, j in {(p, q), (q, p)}:
+                g[P.ab[i][j][:c]] = t * nb + np.arange(c)
+                g[P.ba[i][j][:c]] = t * nb + np.arange(c)
+                g[P.diag[i][j]] = len(blocks) * nb + t * n + np.arange(n)
+        P.ab = [[x[c:] for x in row] for row in P.ab]
+        P.ba = [[x[c:] for x in row] for row in P.ba]
+        return g
+
     def tangent_data(self, u) -> np.ndarray:
         """CSR data of the tangent on :attr:`pattern` (blocks (p, q) and (q, p) share B),
-        in a buffer that the next call overwrites."""
+        in a buffer that the next call overwrites. A half model's crossing bonds add
+        -R_a B R_b at (a, b), -R_b B R_a at (b, a) and R B R on the diagonals (module
+        docstring); the plain ones are the whole body's."""
         y, l = self.bond_vectors(u)
         geo = self.s * (1.0 - self.L / l)         # T / l
         y *= np.sqrt(self.s * self.L / l) / l     # sqrt(s - T/l) n  (T/l < s: l > 0)
         P = self.pattern
-        if self.half is not None:
-            return self._half_tangent_data(P, y, geo)
-        if self._data is None:        # reused: every position is written below
-            self._data = np.empty(P.nnz)
-        data = self._data
-        for p in range(self.dim):
-            for q in range(p, self.dim):
-                B = y[p] * y[q]                   # (s - T/l) n_p n_q
-                if p == q:
-                    B += geo
-                diag = np.bincount(self.a, B, self.n) + np.bincount(self.b, B, self.n)
-                np.negative(B, out=B)
-                for i, j in {(p, q), (q, p)}:
-                    data[P.ab[i][j]] = B
-                    data[P.ba[i][j]] = B
-                    data[P.diag[i][j]] = diag
-        return data
-
-    def _half_tangent_data(self, P, y, geo) -> np.ndarray:
-        """The half model's tangent S^T T S: per bond the blocks R_a B R_a and R_b B R_b on
-        its nodes' diagonals, -R_a B R_b at (a, b) and -R_b B R_a at (b, a); the plain bonds
-        (no R) written as for the whole body, the crossing ones added on top."""
-        h, c, k = self.half, self.half["plain"], self.half["axis"]
         if self._data is None:
+            self._gather_index = self._gather()
             self._data = np.empty(P.nnz)
-        data = self._data
-        data.fill(0.0)                # positions of crossing bonds alone are only added to
-        for p in range(self.dim):
-            for q in range(p, self.dim):
-                B = y[p] * y[q]
-                if p == q:
-                    B += geo
-                if (p == k) != (q == k):          # R_a B R_a, R_b B R_b: r_a or r_b on one side
-                    diag = (np.bincount(self.a, h["ra"] * B, self.n)
-                            + np.bincount(self.b, h["rb"] * B, self.n))
-                else:
-                    diag = np.bincount(self.a, B, self.n) + np.bincount(self.b, B, self.n)
-                for i, j in {(p, q), (q, p)}:
-                    data[P.diag[i][j]] = diag
-                    data[P.ab[i][j][:c]] = -B[:c]
-                    data[P.ba[i][j][:c]] = -B[:c]
-                for i, j in {(p, q), (q, p)}:     # -r_a,i r_b,j B at (a, b); -r_b,i r_a,j B at (b, a)
-                    ri_a = h["ra"][c:] if i == k else 1.0
-                    rj_b = h["rb"][c:] if j == k else 1.0
-                    ri_b = h["rb"][c:] if i == k else 1.0
-                    rj_a = h["ra"][c:] if j == k else 1.0
-                    np.add.at(data, P.ab[i][j][c:], -ri_a * rj_b * B[c:])
-                    np.add.at(data, P.ba[i][j][c:], -ri_b * rj_a * B[c:])
+        n, nb, h = self.n, self.a.size, self.half
+        blocks = [(p, q) for p in range(self.dim) for q in range(p, self.dim)]
+        src = np.empty(len(blocks) * (nb + n) + 1)
+        src[-1] = 0.0
+        k = None if h is None else h["axis"]
+        for t, (p, q) in enumerate(blocks):
+            B = src[t * nb:(t + 1) * nb]
+            np.multiply(y[p], y[q], out=B)        # (s - T/l) n_p n_q
+            if p == q:
+                B += geo
+            if h is not None and (p == k) != (q == k):   # R_a B R_a, R_b B R_b off-diagonal
+                diag = np.bincount(self.a, h["ra"] * B, n) + np.bincount(self.b, h["rb"] * B, n)
+            else:
+                diag = np.bincount(self.a, B, n) + np.bincount(self.b, B, n)
+            src[len(blocks) * nb + t * n:len(blocks) * nb + (t + 1) * n] = diag
+            np.negative(B, out=B)
+        data = np.take(src, self._gather_index, out=self._data)
+        if h is not None:
+            c, ra, rb = h["plain"], h["ra"][h["plain"]:], h["rb"][h["plain"]:]
+            for t, (p, q) in enumerate(blocks):
+                B = src[t * nb + c:(t + 1) * nb]      # -B of the crossing bonds
+                for i, j in {(p, q), (q, p)}:     # r_a,i r_b,j (-B) at (a, b) and its mirror
+                    np.add.at(data, P.ab[i][j], (ra if i == k else 1.0) * (rb if j == k else 1.0) * B)
+                    np.add.at(data, P.ba[i][j], (rb if i == k else 1.0) * (ra if j == k else 1.0) * B)
         return data
 
     def tangent(self, u) -> sp.csr_matrix:
