@@ -272,8 +272,9 @@ class NonlinearBondBased:
         :meth:`tangent_data` computes: per block p <= q the bonds' -B_pq, then the nodes'
         diagonal sums, then a zero (positions only a crossing bond of a half model reaches).
         A gather into the CSR data reads those values in data order instead of scattering
-        them bond by bond: 69 ms -> 37 ms an assembly on the half paper grid (CPU time,
-        a side measurement). Frees the pattern's per-bond positions, except the crossing
+        them bond by bond: an assembly on the paper grid took 116 ms against 145 ms (whole
+        block), 66 ms against 74 ms (half; CPU time, medians of 7 alternating, a side
+        measurement on a busy machine), the same numbers bit for bit. Frees the pattern's per-bond positions, except the crossing
         bonds' (added on top)."""
         P, n, dim = self.pattern, self.n, self.dim
         nb = self.a.size
