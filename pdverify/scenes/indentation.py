@@ -68,6 +68,20 @@ class Indentation(FemAndPD):
     §4.1), delta = 1.5 mm (m = 6). ``energy-directional`` applies Eq. (14) with all four
     faces counted, as in §4.1. Bottom row fixed, sides free.
 
+    Symmetry (``symmetry``): block, indenter and contact law are symmetric about the
+    indenter's axis x = 0. ``half`` (default) solves for the nodes with x >= 0 only: a
+    bond reaching across the axis joins its node to the mirror image of the other end
+    (u_x odd, u_y even; u_x = 0 on the axis), each pair of mirror bonds counted once with
+    twice the stiffness (:mod:`pdverify.pd.nonlinear`). That is the whole block's model
+    restricted to symmetric displacements, not an approximation: Newton's norms are the
+    whole block's, the force sums the half's reactions (the axis nodes counted once), the
+    axis nodes' u_x stiffness is still checked as the whole block's free unknown (the quick
+    grid's uncorrected run loses definiteness there), and a test shows half and ``full``
+    equal to round-off. What the half model cannot show is an asymmetric solution of the
+    whole block: at the paper's grid every failing run (``none`` both kinematics,
+    ``energy``, ``volume``, ``perifit``) fails at the same depth with the same message in
+    both (measured, issue 32), so the report runs the half model.
+
     Kinematics (``kinematics``): ``nonlinear`` (default; ERRATA: §4.2 is beyond small
     displacements) = the bond force acts along the current bond and depends on the
     current length (:mod:`pdverify.pd.nonlinear`), solved by Newton with a line search
