@@ -147,7 +147,8 @@ class TwoLevelPreconditioner:
         self._w32 = ((SMOOTHER_WEIGHT / rho) * d_inv).astype(f32)
         # fused: K (x1 + P e) = K x1 + (K P) e, one product with K per application instead
         # of two; the same operator in exact arithmetic (float32 round-off apart), 8.1 ms
-        # against 12.5 ms an application on the half indentation's tangent (26,082 unknowns;
+        # against 12.5 ms an application on the half indentation's tangent (26,082 unknowns,
+        # CPU time, one BLAS thread, mean of 20, a side measurement;
         # benchmarks/indentation.py times whole curves)
         self._KP32 = (self._K32 @ self._P32).tocsr() if fused else None
         self.K = K
