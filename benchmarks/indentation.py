@@ -1,66 +1,123 @@
-"""The indentation scene's speed budgets (issue 14), side by side in one run.
+"""The indentation scene's PD speed (issues 14 and 32): before and after, side by side in one run.
 
 Plain script (no test runner):
 
-    python benchmarks/indentation.py [--repeat N] [--skip-direct]
+    python benchmarks/indentation.py [--repeat N] [--before REV] [--scene] [--quick]
 
-Times, median of ``--repeat`` (default 3) runs each, alternating:
+Each timed run is a fresh ``python`` process (so no run inherits another's caches or
+grown memory) running ``get_scene('block2d-indentation').run(METHOD, OVERRIDES)``; the
+variants alternate within each repeat, and the table shows medians of ``--repeat``
+(default 3) runs: the run's total and solve phase (its own timings), the process's CPU
+time, linear solves, CG iterations, preconditioner builds, Newton iterations and the
+status. The FEM references come from the cache (the first variant's run fills it).
 
-- the corrected nonlinear curve at the paper's grid (161 x 161 nodes, m = 6, 51,842
-  unknowns, 20 depth steps), CG with the preconditioner reused across Newton iterations
-  and steps; budget < 60 s for the whole curve, < 1 s per linear solve;
-- the same on the quick grid (41 x 41 nodes, spacing 1 mm, m = 6), CG against a sparse
-  LU per Newton step (``--skip-direct`` leaves the LU out); budget < 5 s.
+Variants (paper grid: 161 x 161 nodes, m = 6, 20 depth steps):
 
-The FEM references are computed (and cached) before the clock starts; only the PD solve
-phase and the run's total are timed. Prints per case: median total, median solve, linear
-solves, CG iterations, preconditioner builds, median and max time per output depth.
+- ``half``: this tree's default, the half block with mirrored neighbours;
+- ``full``: this tree with ``symmetry=full`` (the whole block);
+- ``before``: ``--before REV`` (a git revision, e.g. ``main`` or a commit): the package as
+  it is at REV, extracted with ``git archive`` into a temporary folder, at its defaults;
+  or an existing folder holding another checkout (e.g. ``/path/to/main``).
+
+Cases: the corrected nonlinear curve (``energy-directional``; budget, issue 32: <= 15 s on
+a quiet 2-core machine); with ``--scene`` every PD run the full report makes of the scene
+(budget: <= 60 s together), each variant's sum printed at the end; ``--quick`` adds the
+quick grid (41 x 41 nodes) of the corrected curve.
 """
 from __future__ import annotations
 
 import argparse
+import json
+import os
 import statistics
+import subprocess
+import sys
+import tarfile
+import tempfile
+from pathlib import Path
 
-from pdverify.scenes import get_scene
-
+ROOT = Path(__file__).resolve().parents[1]
 QUICK = {"spacing": 0.001, "horizon": 0.006}
+#: one run in a fresh process: prints its timings and diagnostics as JSON
+RUNNER = """
+import json, resource, sys
+from pdverify.scenes import get_scene
+method, over = sys.argv[1], json.loads(sys.argv[2])
+r = get_scene("block2d-indentation").run(method, over)
+cpu = resource.getrusage(resource.RUSAGE_SELF)
+print(json.dumps({"status": r.status, "message": r.message, "timings": r.timings,
+                  "diagnostics": {k: v for k, v in r.diagnostics.items()
+                                  if isinstance(v, (int, float, str))},
+                  "metrics": r.metrics, "cpu_s": cpu.ru_utime + cpu.ru_stime}))
+"""
+
+
+def extract(rev: str, into: Path) -> Path:
+    """The ``pdverify`` package (and what it reads at run time) of git revision ``rev``."""
+    data = subprocess.run(["git", "-C", str(ROOT), "archive", "--format=tar", rev, "pdverify",
+                           "reference_fem", "manufactured"],
+                          check=True, capture_output=True).stdout
+    tar = into / "src.tar"
+    tar.write_bytes(data)
+    with tarfile.open(tar) as t:
+        t.extractall(into, filter="data")
+    return into
+
+
+def run_once(path: Path, method: str, over: dict) -> dict:
+    env = {**os.environ, "PYTHONPATH": str(path)}
+    out = subprocess.run([sys.executable, "-c", RUNNER, method, json.dumps(over)], env=env,
+                         cwd=path, check=True, capture_output=True, text=True).stdout
+    return json.loads(out.strip().splitlines()[-1])
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
-    ap.add_argument("--skip-direct", action="store_true")
+    ap.add_argument("--before", metavar="REV", help="git revision to time as 'before'")
+    ap.add_argument("--scene", action="store_true",
+                    help="every PD run of the scene in the full report, not only the "
+                         "corrected curve")
+    ap.add_argument("--quick", action="store_true", help="also the quick grid")
     args = ap.parse_args()
-    scene = get_scene("block2d-indentation")
-    cases = [("paper grid, CG", {"solver": "cg"}), ("quick grid, CG", {**QUICK, "solver": "cg"})]
-    if not args.skip_direct:
-        cases.append(("quick grid, sparse LU", {**QUICK, "solver": "direct"}))
-    for _, over in cases:                       # references into the cache, untimed
-        scene.fem_reference(scene.resolve("energy-directional", over))
-    runs = {name: [] for name, _ in cases}
-    for _ in range(args.repeat):
-        for name, over in cases:
-            r = scene.run("energy-directional", over)
-            if r.status != "ok":
-                raise SystemExit(f"{name}: {r.message}")
-            runs[name].append(r)
-    print(f"{'case':24s} {'total s':>8s} {'solve s':>8s} {'solves':>7s} {'CG it':>6s} "
-          f"{'builds':>6s} {'s/solve':>8s} {'step med':>8s} {'step max':>8s}")
-    base = None
-    for name, rs in runs.items():
-        total = statistics.median(r.timings["total_s"] for r in rs)
-        solve = statistics.median(r.timings["solve_s"] for r in rs)
-        d = rs[0].diagnostics
-        per = statistics.median(r.diagnostics["linear_solve_s"] / r.diagnostics["linear_solves"]
-                                for r in rs)
-        print(f"{name:24s} {total:8.2f} {solve:8.2f} {d['linear_solves']:7d} "
-              f"{d.get('cg_iterations', 0):6d} {d['preconditioner_builds']:6d} {per:8.3f} "
-              f"{statistics.median(r.diagnostics['median_step_s'] for r in rs):8.2f} "
-              f"{statistics.median(r.diagnostics['max_step_s'] for r in rs):8.2f}")
-        if name.startswith("quick grid, CG"):
-            base = total
-        elif base is not None:
-            print(f"{'':24s} sparse LU / CG on the quick grid: {total / base:.1f}x")
+    cases = [("energy-directional", {})]
+    if args.scene:
+        sys.path.insert(0, str(ROOT))
+        from pdverify.scenes import get_scene
+        cases = [(m, o) for m, o in get_scene("block2d-indentation").cases() if m != "fem"]
+    if args.quick:
+        cases.append(("energy-directional", dict(QUICK)))
+    with tempfile.TemporaryDirectory() as tmp:
+        variants = [("half", ROOT, {}), ("full", ROOT, {"symmetry": "full"})]
+        if args.before:
+            path = (Path(args.before) if Path(args.before).is_dir()
+                    else extract(args.before, Path(tmp)))
+            variants.append((f"before ({args.before})", path, {}))
+        results = {}
+        for _ in range(args.repeat):
+            for method, over in cases:
+                for name, path, extra in variants:
+                    r = run_once(path, method, {**over, **extra})
+                    results.setdefault((method, json.dumps(over), name), []).append(r)
+                    print(f"  {name:18s} {method} {over}: {r['status']} "
+                          f"{r['timings']['total_s']:.1f} s", file=sys.stderr, flush=True)
+    print(f"{'case':44s} {'variant':18s} {'total s':>8s} {'solve s':>8s} {'cpu s':>7s} "
+          f"{'solves':>6s} {'CG it':>6s} {'builds':>6s} {'newton':>6s}  status")
+    sums = {}
+    for (method, over, name), rs in results.items():
+        med = {k: statistics.median(r["timings"][k] for r in rs) for k in ("total_s", "solve_s")}
+        cpu = statistics.median(r["cpu_s"] for r in rs)
+        d, m = rs[0]["diagnostics"], rs[0]["metrics"]
+        case = f"{method} {over if over != '{}' else ''}"
+        print(f"{case:44s} {name:18s} {med['total_s']:8.2f} {med['solve_s']:8.2f} {cpu:7.1f} "
+              f"{d.get('linear_solves', 0):6d} {d.get('cg_iterations', 0):6d} "
+              f"{d.get('preconditioner_builds', 0):6d} {m.get('newton_iterations', 0):6d}  "
+              f"{rs[0]['status']}"
+              + (f" at {m['failure_depth_mm']:.3g} mm" if "failure_depth_mm" in m else ""))
+        sums[name] = sums.get(name, 0.0) + med["total_s"]
+    base = sums.get("half")
+    print("sum of the medians: " + ", ".join(
+        f"{name} {t:.1f} s ({t / base:.2f}x half)" for name, t in sums.items()))
 
 
 if __name__ == "__main__":

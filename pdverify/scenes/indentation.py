@@ -5,6 +5,7 @@ from __future__ import annotations
 import time
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from .. import budget
 from ..errors import InputError, NumericalError
@@ -30,6 +31,9 @@ CATCH_TOLERANCE = 1e-9
 #: the smallest first output depth as a fraction of R: 1000 x CATCH_TOLERANCE
 MIN_OUTPUT_DEPTH = 1e-6
 KINEMATICS = ("nonlinear", "linear")
+#: ``half``: the PD model of the half block x >= 0 with mirrored neighbours (exact for the
+#: symmetric solution, :mod:`pdverify.pd.nonlinear`); ``full``: the whole block
+SYMMETRY = ("half", "full")
 #: ``solver=auto`` uses CG from this many unknowns: on the quick grid (41 x 41 nodes, m = 6,
 #: 3,362 unknowns) a sparse LU per Newton step made the corrected curve 13 s, CG 2.6 s.
 CG_FROM_UNKNOWNS = 1000
@@ -63,6 +67,20 @@ class Indentation(FemAndPD):
     "matching grid of nodes"; boundary nodes carry half a cell, corners a quarter, as in
     §4.1), delta = 1.5 mm (m = 6). ``energy-directional`` applies Eq. (14) with all four
     faces counted, as in §4.1. Bottom row fixed, sides free.
+
+    Symmetry (``symmetry``): block, indenter and contact law are symmetric about the
+    indenter's axis x = 0. ``half`` (default) solves for the nodes with x >= 0 only: a
+    bond reaching across the axis joins its node to the mirror image of the other end
+    (u_x odd, u_y even; u_x = 0 on the axis), each pair of mirror bonds counted once with
+    twice the stiffness (:mod:`pdverify.pd.nonlinear`). That is the whole block's model
+    restricted to symmetric displacements, not an approximation: Newton's norms are the
+    whole block's, the force sums the half's reactions (the axis nodes counted once), the
+    axis nodes' u_x stiffness is still checked as the whole block's free unknown (the quick
+    grid's uncorrected run loses definiteness there), and a test shows half and ``full``
+    equal to round-off. What the half model cannot show is an asymmetric solution of the
+    whole block: at the paper's grid every failing run (``none`` both kinematics,
+    ``energy``, ``volume``, ``perifit``) fails at the same depth with the same message in
+    both (measured, issue 32), so the report runs the half model.
 
     Kinematics (``kinematics``): ``nonlinear`` (default; ERRATA: §4.2 is beyond small
     displacements) = the bond force acts along the current bond and depends on the
@@ -131,6 +149,9 @@ class Indentation(FemAndPD):
               at_least(1)),
         Param("kinematics", "nonlinear", "nonlinear (current bond lengths and directions) "
               "or linear (small displacements)", choices=KINEMATICS),
+        Param("symmetry", "half", "half (the block's half x >= 0, mirrored neighbours "
+              "across the indenter's axis: the symmetric solution exactly) or full (the "
+              "whole block, which could also show an asymmetric one)", choices=SYMMETRY),
     )
     pd_methods = (("none", ()),)   # energy-directional: the registry's, on this box
     published = (
@@ -253,22 +274,27 @@ class Indentation(FemAndPD):
             model = BondBasedModel(grid, SheetScene.stencil(p, delta / h),
                                    SheetScene.micromodulus(p, delta), inf, closure,
                                    thickness=p["thickness"])
-            kin = (NonlinearBondBased if p["kinematics"] == "nonlinear" else LinearBondBased)(model)
+            kin = (NonlinearBondBased if p["kinematics"] == "nonlinear" else LinearBondBased)(
+                model, mirror_axis=0 if p["symmetry"] == "half" else None)
             kin.pattern                  # the tangent's pattern, built in the setup phase
-            unknowns = 2 * grid.n_ext
+            unknowns = 2 * kin.n
             use_cg = p["solver"] == "cg" or (p["solver"] == "auto"
                                              and unknowns >= CG_FROM_UNKNOWNS)
+            ids = kin.node_ids
             lin = DirichletLinearSolver(kin.pattern, "cg" if use_cg else "direct",
-                                        Lattice.component_major(grid.index, grid.x, 2),
+                                        Lattice.component_major(grid.index[ids], grid.x[ids], 2),
                                         width=int(round(delta / h)),
-                                        describe=lambda k: _describe(grid, k))
-        size = {"nodes": int(grid.n_ext), "unknowns": int(unknowns), "bonds": model.n_bonds(),
+                                        describe=lambda k: _describe(grid, kin, k))
+        size = {"nodes": int(kin.n), "unknowns": int(unknowns), "bonds": int(kin.a.size),
                 "tangent_nnz": int(kin.pattern.nnz)}
         with timer.phase("reference"):
             ref = self.fem_reference(p)
             small = (self.fem_reference({**p, "kinematics": "linear"})
                      if p["kinematics"] == "nonlinear" else ref)
-        with timer.phase("solve"):
+        # one BLAS thread: the preconditioner's dense coarse products (1,134 square on the
+        # half paper grid) took 8 ms with OpenBLAS's threads on a busy 2-core machine
+        # against 0.14 ms with one (CPU time; benchmarks/indentation.py times the curves)
+        with timer.phase("solve"), threadpool_limits(limits=1, user_api="blas"):
             curve, failure = indent(kin, grid, p, lin, where)
         metrics = curve_metrics(curve, ref, failure)
         if small is not ref:     # the other reading: against the small-strain FEM
@@ -278,6 +304,8 @@ class Indentation(FemAndPD):
                             if k in other})
         diagnostics = {"solver": ("CG + two-level smoothed aggregation, reused across Newton "
                                   "iterations" if use_cg else "sparse LU per Newton iteration"),
+                       "model": ("half block x >= 0, mirrored neighbours" if kin.half is not None
+                                 else "whole block"),
                        "linear_solves": lin.stats.solves,
                        "preconditioner_builds": lin.stats.rebuilds,
                        "preconditioner_setup_s": lin.stats.setup_s,
@@ -297,7 +325,7 @@ class Indentation(FemAndPD):
                   "fem_depths": np.asarray(ref.depths), "fem_forces": np.asarray(ref.forces),
                   "fem_kinematics": ref.params["kinematics"],
                   "fem_small_forces": np.asarray(small.forces),
-                  "x": grid.x, "u": curve["u"].reshape(2, -1).T,
+                  "x": grid.x, "u": kin.expand(curve["u"]).reshape(2, -1).T,
                   "energy": kin.energy_density(curve["u"]), "spacing": h, "horizon": delta,
                   "failure": failure}
         if failure is None:
@@ -310,17 +338,26 @@ class Indentation(FemAndPD):
 
 def indent(kin, grid, p, lin, where):
     """Depth stepping with the sticking contact law of :class:`Indentation`; returns the
-    curve (dict of per-output-depth lists, the last equilibrium ``u``) and ``None``, or the
-    curve up to the last equilibrium and a failure dict (depth, message, node) when the
-    lattice folds or Newton fails."""
-    n = grid.n_ext
-    x0 = grid.x
+    curve (dict of per-output-depth lists, the last equilibrium ``u`` of ``kin``'s unknowns)
+    and ``None``, or the curve up to the last equilibrium and a failure dict (depth,
+    message, node) when the lattice folds or Newton fails. With a half model (``kin.half``)
+    the nodes on the axis keep u_x = 0, and the contact width and count are the whole
+    top's (the mirror images of the stuck nodes are stuck); the force, a sum of the half
+    model's reactions, is the whole body's already."""
+    n = kin.n
+    x0 = grid.x[kin.node_ids]
+    index = grid.index[kin.node_ids]
     R = p["radius"]
-    top = np.flatnonzero(grid.index[:, 1] == grid.index[:, 1].max())
+    top = np.flatnonzero(index[:, 1] == grid.index[:, 1].max())
     top = top[np.argsort(x0[top, 0])]
-    bottom = np.flatnonzero(grid.index[:, 1] == 0)
-    fixed = np.zeros(2 * n, dtype=bool)
+    bottom = np.flatnonzero(index[:, 1] == 0)
+    fixed = np.zeros(2 * n, dtype=bool)              # the body's prescribed unknowns
     fixed[bottom] = fixed[n + bottom] = True
+    plane = np.zeros(2 * n, dtype=bool)              # and those of the symmetry
+    if kin.half is not None:
+        plane[kin.plane_unknowns] = True
+        image_x = grid.x[kin.half["image"][top], 0]     # the top nodes' mirror images
+        copies = np.where(kin.half["image"][top] == kin.node_ids[top], 1, 2)
     stuck = np.zeros(top.size, dtype=bool)
     u = np.zeros(2 * n)
     n_inc = p["n_steps"] * p["substeps"]
@@ -328,7 +365,7 @@ def indent(kin, grid, p, lin, where):
     curve = {"depths": [0.0], "forces": [0.0], "widths": [0.0], "counts": [0], "step_s": [],
              "newton": [0], "residuals": [], "cuts": 0, "u": u.copy(), "min_cos": [1.0],
              "min_stretch": [1.0]}
-    lin.set_fixed(fixed)
+    lin.set_fixed(fixed | plane, watched=plane & ~fixed)
     t_step = time.perf_counter()
     iterations = 0
     for inc in range(1, n_inc + 1):
@@ -361,15 +398,19 @@ def indent(kin, grid, p, lin, where):
             u[n + idx] = yc - np.sqrt(R ** 2 - X[new] ** 2) - x0[idx, 1]
             stuck |= new
             fixed[idx] = fixed[n + idx] = True
-            lin.set_fixed(fixed)
+            lin.set_fixed(fixed | plane, watched=plane & ~fixed)
         if inc % p["substeps"]:
             continue
         f = kin.internal_force(u)
         xs = x0[top[stuck], 0] + u[top[stuck]]
+        count = int(stuck.sum())
+        if kin.half is not None:
+            xs = np.concatenate([xs, image_x[stuck] - u[top[stuck]]])
+            count = int(copies[stuck].sum())
         curve["depths"].append(d)
         curve["forces"].append(-float(f[n + top[stuck]].sum()))
         curve["widths"].append(float(xs.max() - xs.min()) if xs.size else 0.0)
-        curve["counts"].append(int(stuck.sum()))
+        curve["counts"].append(count)
         curve["newton"].append(iterations)
         curve["min_cos"].append(state["cos"])           # of the final u of this increment
         curve["min_stretch"].append(state["ratio"])
@@ -385,14 +426,18 @@ def _node_at(grid, node) -> str:
     return f"node {node} at ({x[0]:.4g}, {x[1]:.4g}) mm"
 
 
-def _describe(grid, k) -> str:
-    """Unknown k (component-major) as 'u_y of node i at (x, y) mm'."""
-    return f"u_{'xy'[k // grid.n_ext]} of {_node_at(grid, k % grid.n_ext)}"
+def _describe(grid, kin, k) -> str:
+    """Unknown k of ``kin`` (component-major) as 'u_y of node i at (x, y) mm' (of a half
+    model: of the node or its mirror image, the one the whole body's lower index names)."""
+    node = int(kin.node_ids[k % kin.n])
+    if kin.half is not None:
+        node = min(node, int(kin.half["image"][k % kin.n]))
+    return f"u_{'xy'[k // kin.n]} of {_node_at(grid, node)}"
 
 
 def _ends(kin, grid, bond):
     """(lower, upper) node of a bond in lattice order (row, then column), and its offset."""
-    a, b = int(kin.a[bond]), int(kin.b[bond])
+    a, b = kin.bond_nodes(bond)
     off = grid.index[b] - grid.index[a]
     return ((a, b) if off[1] > 0 or (off[1] == 0 and off[0] > 0) else (b, a)), off
 

@@ -71,15 +71,19 @@ class DirichletLinearSolver:
         if method not in ("direct", "cg"):
             raise ValueError(f"method={method!r}: allowed direct, cg")
         self.pattern, self.method, self.lattice, self.width = pattern, method, lattice, width
+        self.watched = None
         self.describe = describe or (lambda k: f"unknown {k}")
         self.precond = None
         self.fixed = None
         self._diag0 = None
         self.stats = LinearStats()
 
-    def set_fixed(self, fixed: np.ndarray) -> None:
-        """Mark the prescribed unknowns (boolean per unknown)."""
+    def set_fixed(self, fixed: np.ndarray, watched: np.ndarray | None = None) -> None:
+        """Mark the prescribed unknowns (boolean per unknown); ``watched``: prescribed ones
+        whose own stiffness is still checked like a free one's (a half model's u_x on the
+        symmetry plane, free in the whole body, whose diagonal there is the body's)."""
         self.fixed = np.asarray(fixed, dtype=bool)
+        self.watched = None if watched is None else np.asarray(watched, dtype=bool)
         P = self.pattern
         self._kill = np.flatnonzero(self.fixed[P.row_of] | self.fixed[P.indices])
 
@@ -99,7 +103,8 @@ class DirichletLinearSolver:
         the tangent on the pattern, is overwritten)."""
         free = ~self.fixed
         diag = data[self.pattern.diagonal]
-        bad = np.flatnonzero(free & ~(diag > 0))
+        bad = np.flatnonzero((free if self.watched is None else free | self.watched)
+                             & ~(diag > 0))
         if bad.size:
             k = bad[np.argmin(diag[bad])]
             raise NumericalError(f"{where}: the tangent has lost definiteness: "
@@ -132,7 +137,7 @@ class DirichletLinearSolver:
         return du
 
     def _build(self, T):
-        self.precond = TwoLevelPreconditioner(T, self.lattice, self.width)
+        self.precond = TwoLevelPreconditioner(T, self.lattice, self.width, fused=True)
         self._best_rate, self._lost = np.inf, 0.0
         self.stats.rebuilds += 1
         self.stats.setup_s += self.precond.setup_s
@@ -160,17 +165,25 @@ def newton(model, u, solver: DirichletLinearSolver, *, where: str, previous=None
 
     Each step solves tangent du = -f and takes the largest of 1, 1/2, 1/4, ... that
     reduces ||f_free|| by the Armijo fraction 1e-4 of the step. Stops at
-    ||f_free|| <= rtol * max(||f_free|| at the start, ||reactions||). A step the line
+    ||f_free|| <= rtol * max(||f_free|| at the start, ||reactions||), the norms weighted
+    by ``model.residual_weight`` when it has one (a half model's: the whole body's norms).
+    A step the line
     search cannot make, or ``maxiter`` iterations, raise :class:`NumericalError` naming
     ``where`` and the residual reached.
     """
     free = ~solver.fixed
+    weight = getattr(model, "residual_weight", None)
+
+    def norm_of(f, rows):
+        if weight is None:
+            return float(np.linalg.norm(f[rows]))
+        return float(np.sqrt(np.dot(weight[rows] * f[rows], f[rows])))
 
     def residual(v):
         f = model.internal_force(v)
         if not np.all(np.isfinite(f)):
             raise NumericalError(f"{where}: non-finite internal forces")
-        return f, float(np.linalg.norm(f[free]))
+        return f, norm_of(f, free)
 
     if previous is not None:
         change = np.where(solver.fixed, u - previous, 0.0)
@@ -179,7 +192,7 @@ def newton(model, u, solver: DirichletLinearSolver, *, where: str, previous=None
         du = solver.solve(T0.data, -(f0 + T0 @ change), FORCING_MAX, where)
         u[free] = previous[free] + du[free]
     f, norm = residual(u)
-    scale = max(norm, float(np.linalg.norm(f[solver.fixed])))
+    scale = max(norm, norm_of(f, solver.fixed))
     report = NewtonReport(0, [norm], scale=scale)
     if scale == 0.0:
         return report
@@ -204,7 +217,7 @@ def newton(model, u, solver: DirichletLinearSolver, *, where: str, previous=None
                                  f"reduces the residual ({norm / scale:.1e} of the force scale)")
         u[:] = trial
         f, norm = f_t, n_t
-        scale = max(scale, float(np.linalg.norm(f[solver.fixed])))
+        scale = max(scale, norm_of(f, solver.fixed))
         report.iterations += 1
         report.residuals.append(norm)
     report.scale = scale

@@ -243,3 +243,104 @@ def test_paper_grid_linear_runs_against_small_strain_fem():
         kinematic = np.abs(nl.fields["fem_forces"][2:5] / nl.fields["fem_small_forces"][2:5]
                            - 1) * 100
         assert np.all(np.abs(err[0] - err[1]) < kinematic), (method, err, kinematic)
+
+
+# ------------------------------------------------------------------ the half model (issue 32)
+def _symmetric_block(nx=10, ny=6, m=3, h=1e-3):
+    """An 11 x 7 node block centred on x = 0 (a node column on the axis)."""
+    grid = BoxGrid((nx * h, ny * h), (-nx * h / 2, 0.0), h, placement="on-surface")
+    c = bond_micromodulus("constant", 2, 1e9, m * h, plane="stress")
+    return BondBasedModel(grid, build_stencil(2, m), c, get_influence("constant"))
+
+
+@pytest.mark.parametrize("kinematics", [NonlinearBondBased, LinearBondBased])
+def test_half_model_is_the_whole_body_restricted_to_symmetric_states(kinematics):
+    """Issue 32: with u = S u_h (u_x odd, u_y even, u_x = 0 on the axis) the half model's
+    energy is the whole body's, its forces are S^T f(S u_h) and its tangent S^T T S (on the
+    unknowns that are not u_x on the axis), and its weighted norm is the body's."""
+    model = _symmetric_block()
+    full, half = kinematics(model), kinematics(model, mirror_axis=0)
+    assert half.n == 6 * 7 and full.n == 11 * 7
+    rng = np.random.default_rng(1)
+    uh = rng.normal(size=2 * half.n) * 0.2 * model.spacing
+    uh[half.plane_unknowns] = 0.0
+    S = np.stack([half.expand(e) for e in np.eye(2 * half.n)], axis=1)
+    u = S @ uh
+    x = model.grid.x
+    mirror = np.array([np.flatnonzero(np.all(np.isclose(x, [-p[0], p[1]]), axis=1))[0]
+                       for p in x])
+    n = full.n
+    assert np.array_equal(u[mirror], -u[:n]) and np.array_equal(u[n + mirror], u[n:])
+    keep = np.ones(2 * half.n, dtype=bool)
+    keep[half.plane_unknowns] = False
+    f, g = full.internal_force(u), half.internal_force(uh)
+    # the same bond forces summed in another order: round-off, 1e-13 of the largest force
+    # (each node sums ~30 bonds; 100 eps per bond with room)
+    assert np.abs((S.T @ f - g)[keep]).max() <= 1e-13 * np.abs(g).max()
+    T, Th = full.tangent(u).toarray(), half.tangent(uh).toarray()
+    assert np.abs((S.T @ T @ S - Th)[np.ix_(keep, keep)]).max() <= 1e-13 * np.abs(Th).max()
+    assert np.array_equal(Th, Th.T)
+    assert half.energy(uh) == pytest.approx(full.energy(u), rel=1e-13)
+    w = half.residual_weight
+    assert np.sqrt(np.sum(w * g * g)) == pytest.approx(np.linalg.norm(f), rel=1e-13)
+    assert np.allclose(half.energy_density(uh), full.energy_density(u), rtol=1e-13, atol=0)
+    # the most shortened and the most turned bond: the same values, named by the bond the
+    # whole body names or by its mirror image (the two differ in the body by round-off)
+    hs, fs = half.bond_extremes(uh), full.bond_extremes(u)
+    for value, bond in (("ratio", "ratio_bond"), ("cos", "cos_bond")):
+        assert hs[value] == pytest.approx(fs[value], rel=1e-13)
+        a, b = int(model.bond_a[fs[bond]]), int(model.bond_b[fs[bond]])
+        assert set(half.bond_nodes(hs[bond])) in ({a, b}, {int(mirror[a]), int(mirror[b])})
+
+
+def test_half_model_tangent_matches_finite_differences():
+    """The half model's tangent is its own forces' Jacobian (crossing bonds included)."""
+    model = _symmetric_block()
+    half = NonlinearBondBased(model, mirror_axis=0)
+    assert half.a.size > half.half["plain"]           # some bonds cross the axis
+    uh = np.random.default_rng(2).normal(size=2 * half.n) * 0.2 * model.spacing
+    T = half.tangent(uh).toarray()
+    step = 1e-7 * model.spacing
+    J = np.stack([(half.internal_force(uh + e) - half.internal_force(uh - e)) / (2 * step)
+                  for e in np.eye(uh.size) * step], axis=1)
+    # the bound of test_tangent_matches_finite_differences (issue 14: 1e-6)
+    assert np.abs(J - T).max() <= 1e-6 * np.abs(T).max()
+
+
+@pytest.mark.parametrize("kinematics", ["nonlinear", "linear"])
+def test_half_scene_equals_full_scene_to_round_off(kinematics):
+    """Issue 32: at a small grid (spacing 2 mm, m = 3) with the direct solver, the half
+    model's curve, field and metrics equal the whole block's to round-off: Newton takes the
+    same steps (its norms are the body's)."""
+    scene = get_scene("block2d-indentation")
+    over = {"spacing": 0.002, "horizon": 0.006, "solver": "direct", "kinematics": kinematics}
+    full = scene.run("energy-directional", {**over, "symmetry": "full"})
+    half = scene.run("energy-directional", {**over, "symmetry": "half"})
+    assert full.status == half.status == "ok", (full.message, half.message)
+    assert half.size["unknowns"] < 0.6 * full.size["unknowns"]
+    # round-off: the same sums in another order, through a sparse LU of condition ~1e5:
+    # 1e-11 relative (measured 1e-15)
+    for key in ("forces", "contact_widths", "contact_counts", "u"):
+        a, b = np.asarray(full.fields[key], float), np.asarray(half.fields[key], float)
+        assert a.shape == b.shape
+        assert np.abs(a - b).max() <= 1e-11 * np.abs(a).max(), key
+    assert full.metrics["newton_iterations"] == half.metrics["newton_iterations"]
+    assert full.metrics.keys() == half.metrics.keys()
+    for k, v in full.metrics.items():
+        assert half.metrics[k] == pytest.approx(v, rel=1e-9, abs=1e-9), k
+
+
+@pytest.mark.slow
+def test_half_scene_fails_as_the_full_one_on_the_quick_grid():
+    """Issue 32: the uncorrected run on the quick grid fails in the whole block at 1.8 mm
+    because the tangent loses definiteness against u_x of an axis node (an antisymmetric
+    motion); the half model, which prescribes u_x = 0 there, still checks that stiffness
+    as the body's and fails at the same depth with the same message."""
+    scene = get_scene("block2d-indentation")
+    over = {**QUICK, "solver": "direct"}
+    full = scene.run("none", {**over, "symmetry": "full"})
+    half = scene.run("none", {**over, "symmetry": "half"})
+    assert full.status == half.status == "failed"
+    assert "lost definiteness: u_x of node 859 at (0, -1) mm" in full.message
+    assert half.message == full.message
+    assert half.metrics["failure_depth_mm"] == full.metrics["failure_depth_mm"]
