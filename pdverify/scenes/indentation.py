@@ -5,7 +5,6 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
 from .. import budget
 from ..errors import InputError, NumericalError
@@ -291,10 +290,10 @@ class Indentation(FemAndPD):
             ref = self.fem_reference(p)
             small = (self.fem_reference({**p, "kinematics": "linear"})
                      if p["kinematics"] == "nonlinear" else ref)
-        # one BLAS thread: the preconditioner's dense coarse products (1,134 square on the
-        # half paper grid) took 8 ms with OpenBLAS's threads on a busy 2-core machine
-        # against 0.14 ms with one (CPU time; benchmarks/indentation.py times the curves)
-        with timer.phase("solve"), threadpool_limits(limits=1, user_api="blas"):
+        # one BLAS thread, as every run (pdverify.blas): here it also matters for speed,
+        # the preconditioner's dense coarse products (1,134 square on the half paper grid)
+        # took 8 ms with OpenBLAS's threads on a busy 2-core machine against 0.14 ms
+        with timer.phase("solve"):
             curve, failure = indent(kin, grid, p, lin, where)
         metrics = curve_metrics(curve, ref, failure)
         if small is not ref:     # the other reading: against the small-strain FEM
