@@ -242,6 +242,17 @@ def linear_system(nodes: float, dim: int, dofs_per_node: int, reach: float,
                             f"{how}")
 
 
+def iterative_system(nodes: float, dim: int, dofs_per_node: int, reach: float,
+                     extra_bytes: float = 0.0, copies: int = 2) -> Estimate:
+    """Memory of a system solved by preconditioned CG on ``nodes`` lattice nodes: no
+    factor, ``copies`` matrices of the stencil's non-zeros (the system, and the
+    preconditioner's products bounded by one more), and ``extra_bytes``."""
+    n, nnz = _unknowns_and_nonzeros(nodes, dim, dofs_per_node, reach)
+    return Estimate(copies * BYTES_PER_NONZERO * nnz + extra_bytes,
+                    f"{nodes:.4g} nodes, {n:.4g} unknowns, ~{nnz:.3g} non-zeros, CG (no "
+                    "factor)")
+
+
 #: nested dissection of a 3D lattice body: the factor holds the top separator's block and
 #: those of every level below, 2^k separators of (1/2^(2/3))^k its size at depth k, a
 #: geometric sum of 1 / (1 - 2^(-1/3)) = 4.85 top-separator blocks, for L and U each
