@@ -355,7 +355,8 @@ def _draw_all(tasks, jobs, progress) -> list:
     in a rendering library), the tasks it leaves are drawn in the report process."""
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor
-    jobs = min(jobs or 1, len(tasks))
+    from ..schedule import default_jobs
+    jobs = min(default_jobs() if jobs is None else jobs, len(tasks))
     if jobs <= 1 or "fork" not in mp.get_all_start_methods():
         return [_drawn(what, draw, args, empty, progress) for what, draw, args, empty in tasks]
     import signal
