@@ -39,3 +39,24 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker(skip_bench)
         if "slow" in item.keywords and not slow:
             item.add_marker(skip_slow)
+
+
+_SHARED_RUNS = {}
+
+
+@pytest.fixture(scope="session")
+def run_once():
+    """``run_once(scene, method, **over)``: the scene's run, made once per test session and
+    shared by every test that asks for the same scene, method and parameters (issue 32:
+    several files re-ran the same default case). The runs are deterministic (the report is
+    bitwise reproducible), so a shared result is the one each test would have made; tests
+    read it and must not change it. A test that patches pdverify must call the scene
+    itself."""
+    from pdverify.scenes import get_scene
+
+    def run(scene, method=None, **over):
+        key = (scene, method, repr(sorted(over.items())))
+        if key not in _SHARED_RUNS:
+            _SHARED_RUNS[key] = get_scene(scene).run(method, dict(over))
+        return _SHARED_RUNS[key]
+    return run

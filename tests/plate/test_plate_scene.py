@@ -101,6 +101,7 @@ def test_delta_convergence_with_partial_volumes_stops_at_the_quadrature_error():
     assert abs(e[1] / e[0] - 1) < 0.1
 
 
+@pytest.mark.slow  # slow tier (issue 32): 18 s: a convergence study (loaded machine)
 def test_m_convergence_at_fixed_delta():
     # delta = 0.2 m, m = 2, 3, 4: the partial-volume quadrature error shrinks at least
     # like h / delta = 1 / m (the cut cells are an O(h / delta) fraction of the horizon),
