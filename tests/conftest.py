@@ -60,3 +60,24 @@ def run_once():
             _SHARED_RUNS[key] = get_scene(scene).run(method, dict(over))
         return _SHARED_RUNS[key]
     return run
+
+
+@pytest.fixture(scope="session")
+def cli_concurrently():
+    """``cli_concurrently(argvs, env=None, cwd=None)``: each argv run as its own
+    ``python -m pdverify ARGV`` (a fresh interpreter: its real exit code and stderr), as
+    many at a time as the process has cores; returns ``{tuple(argv): CompletedProcess}``.
+    For the tables of bad-input cases, whose cost is the interpreter's start (issue 32)."""
+    import subprocess
+    import sys
+    from concurrent.futures import ThreadPoolExecutor
+
+    def run_all(argvs, env=None, cwd=None, timeout=120):
+        def one(argv):
+            return subprocess.run([sys.executable, "-m", "pdverify", *argv],
+                                  capture_output=True, text=True, env=env, cwd=cwd,
+                                  timeout=timeout)
+        argvs = [tuple(a) for a in argvs]
+        with ThreadPoolExecutor(max_workers=len(os.sched_getaffinity(0))) as pool:
+            return dict(zip(argvs, pool.map(one, argvs)))
+    return run_all

@@ -85,7 +85,7 @@ def test_m_convergence_of_the_corrected_sheet(_run):
 
 
 # --------------------------------------------------------------------- bad input
-@pytest.mark.parametrize("args, words", [
+BAD_INPUT = [
     (("sheet2d-tension", "--method", "none", "--set", "spacing=0.003"), "must divide"),
     (("sheet2d-tension", "--method", "none", "--set", "horizon=0.0015"), "must be >= 2"),
     (("sheet2d-clamped", "--method", "none", "--set", "m_ratio=1.5"), "must be >= 2"),
@@ -94,10 +94,18 @@ def test_m_convergence_of_the_corrected_sheet(_run):
      "allowed: constant, conical"),
     (("sheet2d-tension", "--method", "virtual-nodes"), "allowed: fem, none, energy, energy-directional"),
     (("sheet2d-clamped", "--method", "energy-directional", "--set", "nu=0.3"), "nu = 1/3"),
-])
-def test_bad_input_is_one_line_exit_2(args, words):
-    res = subprocess.run([sys.executable, "-m", "pdverify", "run", *args], capture_output=True,
-                         text=True, timeout=120)
+]
+
+
+@pytest.fixture(scope="module")
+def bad_input_runs(cli_concurrently):
+    """Every case in its own interpreter, one per core at a time (issue 32)."""
+    return cli_concurrently([("run", *args) for args, _ in BAD_INPUT])
+
+
+@pytest.mark.parametrize("args, words", BAD_INPUT)
+def test_bad_input_is_one_line_exit_2(args, words, bad_input_runs):
+    res = bad_input_runs[("run", *args)]
     assert res.returncode == 2, res.stdout + res.stderr
     lines = res.stderr.strip().splitlines()
     assert len(lines) == 1 and words in lines[0] and "Traceback" not in res.stderr
