@@ -10,14 +10,18 @@ from pdverify.scenes import get_scene
 SCENE = "plate2d-clamped"
 
 
-def _run(method, **over):
-    r = get_scene(SCENE).run(method, over)
-    assert r.status == "ok", r.message
-    return r
+@pytest.fixture(scope="module")
+def _run(run_once):
+    """One run of the plate, shared through the session (``run_once`` in conftest)."""
+    def run(method, **over):
+        r = run_once(SCENE, method, **over)
+        assert r.status == "ok", r.message
+        return r
+    return run
 
 
 @pytest.fixture(scope="module")
-def table4():
+def table4(_run):
     """Table 4 runs: none (ring at the reference value, as the 1D baseline) and n = 1..3."""
     return {"none": _run("none"), **{n: _run("taylor-fictitious", order=n) for n in (1, 2, 3)}}
 
@@ -67,7 +71,7 @@ def test_maximum_error_falls_from_order_1_to_3(table4):
     assert worst[3] < 0.5 * worst[1]
 
 
-def test_fem_reference_is_converged_far_beyond_the_pd_error(table4):
+def test_fem_reference_is_converged_far_beyond_the_pd_error(table4, _run):
     # issue 15: the FEM field must change by less than a tenth of the smallest PD error
     # over its last refinement; the smallest PD error in the report is the
     # moment-corrected order 3 at spacing 0.05 m
@@ -82,7 +86,7 @@ def _rate(xs, errors):
 
 
 @pytest.mark.parametrize("order", [1, 2, 3])
-def test_delta_convergence_at_fixed_m_with_moment_corrected_weights(order):
+def test_delta_convergence_at_fixed_m_with_moment_corrected_weights(order, _run):
     # delta -> 0 at m = 3: the corrected model's error is the nonlocal O(delta^2) term
     # plus the closure's O(h^(n+1)); the fitted rate of the rel. L2 error must reach 2
     # (10 % allowance for the pre-asymptotic fit over three levels)
@@ -92,7 +96,7 @@ def test_delta_convergence_at_fixed_m_with_moment_corrected_weights(order):
     assert _rate(hs, e) > 1.8
 
 
-def test_delta_convergence_with_partial_volumes_stops_at_the_quadrature_error():
+def test_delta_convergence_with_partial_volumes_stops_at_the_quadrature_error(_run):
     # with exact partial volumes at fixed m = 3 the discrete bulk moduli differ from the
     # continuum ones (anisotropic fourth moment), an h-independent model error: the
     # order-3 error stays within 10 % of its coarse value while delta shrinks 4x
@@ -102,7 +106,7 @@ def test_delta_convergence_with_partial_volumes_stops_at_the_quadrature_error():
 
 
 @pytest.mark.slow  # slow tier (issue 32): 18 s: a convergence study (loaded machine)
-def test_m_convergence_at_fixed_delta():
+def test_m_convergence_at_fixed_delta(_run):
     # delta = 0.2 m, m = 2, 3, 4: the partial-volume quadrature error shrinks at least
     # like h / delta = 1 / m (the cut cells are an O(h / delta) fraction of the horizon),
     # so the corrected errors must fall at a fitted rate of at least 1 in m. The
@@ -117,7 +121,7 @@ def test_m_convergence_at_fixed_delta():
     assert e[-1] > e[0]
 
 
-def test_ring_value_zero_is_worse_than_reference(table4):
+def test_ring_value_zero_is_worse_than_reference(table4, _run):
     # the two readings of the uncorrected baseline: ring nodes at 0 (h/2 inside the
     # clamped edge) add the offset error to the surface effect
     zero = _run("none", ring_value="zero")
