@@ -1,6 +1,4 @@
 """Seed 000 §6.2 on the PD side: the clamped plate against its FEM reference (issue 15)."""
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -133,15 +131,23 @@ def test_corners_both_is_a_failed_run_with_the_reason():
     assert r.status == "failed" and "singular" in r.message
 
 
-@pytest.mark.parametrize("args, needle", [
+BAD_INPUT = [
     (["--method", "taylor-fictitious", "--set", "order=20"], "order=20 needs 21 real nodes"),
     (["--method", "none", "--set", "spacing=0.07"], "spacing=0.07 must divide length=3"),
     (["--method", "none", "--set", "spacing=0.4"], "spacing=0.4 must divide length=3"),
     (["--method", "taylor-fictitious", "--set", "corners=diagonal"], "corners"),
     (["--method", "none", "--set", "body_force=0"], "body_force=0"),
-])
-def test_bad_input_exit_2_one_line(args, needle):
-    p = subprocess.run([sys.executable, "-m", "pdverify", "run", SCENE, *args],
-                       capture_output=True, text=True)
+]
+
+
+@pytest.fixture(scope="module")
+def bad_input_runs(cli_concurrently):
+    """Every case in its own interpreter, one per core at a time (issue 32)."""
+    return cli_concurrently([("run", SCENE, *args) for args, _ in BAD_INPUT])
+
+
+@pytest.mark.parametrize("args, needle", BAD_INPUT)
+def test_bad_input_exit_2_one_line(args, needle, bad_input_runs):
+    p = bad_input_runs[("run", SCENE, *args)]
     assert p.returncode == 2
     assert needle in p.stderr and p.stderr.count("\n") == 1

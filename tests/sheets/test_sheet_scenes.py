@@ -1,11 +1,6 @@
 """Seed 003 §4.1 scenes: Tables 1 and 2, m-convergence, bad input (issue 13)."""
-import subprocess
-import sys
-
 import numpy as np
 import pytest
-
-from pdverify.scenes import get_scene
 
 
 @pytest.fixture(scope="module")
