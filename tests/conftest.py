@@ -39,3 +39,45 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker(skip_bench)
         if "slow" in item.keywords and not slow:
             item.add_marker(skip_slow)
+
+
+_SHARED_RUNS = {}
+
+
+@pytest.fixture(scope="session")
+def run_once():
+    """``run_once(scene, method, **over)``: the scene's run, made once per test session and
+    shared by every test that asks for the same scene, method and parameters (issue 32:
+    several files re-ran the same default case). The runs are deterministic (the report is
+    bitwise reproducible), so a shared result is the one each test would have made; tests
+    read it and must not change it. A test that patches pdverify must call the scene
+    itself."""
+    from pdverify.scenes import get_scene
+
+    def run(scene, method=None, **over):
+        key = (scene, method, repr(sorted(over.items())))
+        if key not in _SHARED_RUNS:
+            _SHARED_RUNS[key] = get_scene(scene).run(method, dict(over))
+        return _SHARED_RUNS[key]
+    return run
+
+
+@pytest.fixture(scope="session")
+def cli_concurrently():
+    """``cli_concurrently(argvs, env=None, cwd=None)``: each argv run as its own
+    ``python -m pdverify ARGV`` (a fresh interpreter: its real exit code and stderr), as
+    many at a time as the process has cores; returns ``{tuple(argv): CompletedProcess}``.
+    For the tables of bad-input cases, whose cost is the interpreter's start (issue 32)."""
+    import subprocess
+    import sys
+    from concurrent.futures import ThreadPoolExecutor
+
+    def run_all(argvs, env=None, cwd=None, timeout=120):
+        def one(argv):
+            return subprocess.run([sys.executable, "-m", "pdverify", *argv],
+                                  capture_output=True, text=True, env=env, cwd=cwd,
+                                  timeout=timeout)
+        argvs = [tuple(a) for a in argvs]
+        with ThreadPoolExecutor(max_workers=len(os.sched_getaffinity(0))) as pool:
+            return dict(zip(argvs, pool.map(one, argvs)))
+    return run_all

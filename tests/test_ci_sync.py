@@ -56,10 +56,15 @@ def test_slow_tests_run_only_with_runslow(tmp_path):
         "import pytest\n\n\ndef test_fast():\n    pass\n\n\n"
         "@pytest.mark.slow\ndef test_slow():\n    pass\n")
 
+    import os
+    # the tiers are the conftest's alone: the installed plugins (hypothesis, benchmark) are
+    # not loaded, which costs 3 s of start-up per run here on a loaded machine (issue 32)
+    env = {**os.environ, "PYTEST_DISABLE_PLUGIN_AUTOLOAD": "1"}
+
     def outcome(*args):
         run = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
                               "-W", "ignore::pytest.PytestUnknownMarkWarning", *args],
-                             cwd=tmp_path, capture_output=True, text=True)
+                             cwd=tmp_path, capture_output=True, text=True, env=env)
         return run.returncode, run.stdout.strip().splitlines()[-1]
 
     code, last = outcome()

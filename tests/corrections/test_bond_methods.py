@@ -93,13 +93,17 @@ def test_horizon_volume_of_a_corner():
 
 
 # ---------------------------------------------------------------- the stiffness scenes
-def metrics(scene, method, **over):
-    r = get_scene(scene).run(method, over)
-    assert r.status == "ok", r.message
-    return r.metrics
+@pytest.fixture(scope="module")
+def metrics(run_once):
+    """The metrics of one run, shared through the session (``run_once`` in conftest)."""
+    def get(scene, method, **over):
+        r = run_once(scene, method, **over)
+        assert r.status == "ok", r.message
+        return r.metrics
+    return get
 
 
-def test_bond_based_bulk_is_exact_uncorrected():
+def test_bond_based_bulk_is_exact_uncorrected(metrics):
     """Uncorrected bond-based sheet: nodes beyond one horizon have complete bonds, so
     W_i = W_bulk there to round-off (machine-epsilon claim, in percent)."""
     m = metrics("stiffness2d-sheet", "none", spacing=0.0025)
@@ -109,7 +113,7 @@ def test_bond_based_bulk_is_exact_uncorrected():
 @pytest.mark.parametrize("scene,over", [("stiffness2d-sheet", {}),
                                         ("stiffness3d-box", {"spacing": 0.1}),
                                         ("stiffness2d-plate", {"spacing": 0.05})])
-def test_energy_beats_none_under_homogeneous_strain(scene, over):
+def test_energy_beats_none_under_homogeneous_strain(scene, over, metrics):
     """The energy correction lowers the largest and the RMS surface error of W_i/W_bulk
     (measured at the defaults: sheet 75 -> 40 %, box 39.4 -> 24.4 %, plate 27.5 -> 18.2 %)."""
     none, energy = metrics(scene, "none", **over), metrics(scene, "energy", **over)
@@ -117,7 +121,7 @@ def test_energy_beats_none_under_homogeneous_strain(scene, over):
         assert energy[key] < none[key]
 
 
-def test_volume_beats_none_on_the_bond_based_sheet_only():
+def test_volume_beats_none_on_the_bond_based_sheet_only(metrics):
     """Measured finding: the volume correction helps the bond-based sheet (75 -> 48 % at
     the largest) but not the LPS box (39.4 -> 61.4 % at the default size) or plate
     (27.5 -> 38.2 %): an LPS bond force is already divided by m_i over the truncated
@@ -130,7 +134,7 @@ def test_volume_beats_none_on_the_bond_based_sheet_only():
     assert vol["surface_energy_error_pct"] > none["surface_energy_error_pct"]
 
 
-def test_energy_beats_none_on_boundary_value_problems():
+def test_energy_beats_none_on_boundary_value_problems(metrics):
     """The same correction on the displacement scenes (homogeneous stress; measured:
     sheet2d-tension u_x 301 -> 65 %, body3d-traction at h = 0.1 31 -> 24 %)."""
     none = metrics("sheet2d-tension", "none")
@@ -197,7 +201,7 @@ def test_perifit_missing_is_listed_unavailable_with_the_install_command(monkeypa
         registry.reload()
 
 
-def test_perifit_weights_on_the_sheet():
+def test_perifit_weights_on_the_sheet(metrics, run_once):
     """With perifit installed: its weights beat none on the bond-based sheet under
     homogeneous strain (measured: 75 -> 51 % at the largest, 33.5 -> 20.4 % RMS), and
     every run records the perifit version that produced them."""
@@ -206,12 +210,12 @@ def test_perifit_weights_on_the_sheet():
     none, pf = metrics("stiffness2d-sheet", "none"), metrics("stiffness2d-sheet", "perifit")
     for key in ("surface_energy_error_pct", "surface_energy_rms_pct"):
         assert pf[key] < none[key]
-    r = get_scene("stiffness2d-sheet").run("perifit")
+    r = run_once("stiffness2d-sheet", "perifit")
     assert r.params["perifit_version"] == version("perifit")
 
 
 # ---------------------------------------------------------------- every scene it applies to
-def test_bond_based_box_energy_and_volume_beat_none():
+def test_bond_based_box_energy_and_volume_beat_none(metrics):
     """stiffness3d-box-bond (the box in the formulation the peers' corrections were
     written for): energy and volume lower the largest and the RMS surface error at the
     default size (measured: largest 83.2 -> 53.5 / 59.2 %, RMS 39.0 -> 20.8 / 23.1 %)."""
@@ -222,7 +226,7 @@ def test_bond_based_box_energy_and_volume_beat_none():
             assert m[key] < none[key], (method, key)
 
 
-def test_perifit_beats_none_on_the_bond_based_box():
+def test_perifit_beats_none_on_the_bond_based_box(metrics):
     """With perifit installed: its bb weights beat none on the bond-based box (measured:
     largest 83.2 -> 61.7 %, RMS 39.0 -> 28.3 %)."""
     pytest.importorskip("perifit")
@@ -247,6 +251,7 @@ def _largest_surface_error(model):
                for _, eps in strain_states(3))
 
 
+@pytest.mark.slow  # slow tier (issue 32): a finding at the default box, 11 s and 9 s (loaded machine)
 @pytest.mark.parametrize("quadrature", ["partial-volume", "full-cells"])
 def test_perifit_does_not_beat_none_on_the_lps_box_in_any_reading(quadrature):
     """Finding (with perifit installed), stiffness3d-box at its default size: no reading
@@ -277,7 +282,7 @@ def test_perifit_does_not_beat_none_on_the_lps_box_in_any_reading(quadrature):
     ("bar1d-homogenization", "max_error_pct", True),
     ("bar1d-constraints", "max_error_pct", True),
     ("bar1d-vibration", "max_error_pct", False)])
-def test_energy_and_volume_on_the_seed_004_bars(scene, key, best):
+def test_energy_and_volume_on_the_seed_004_bars(scene, key, best, metrics):
     """The bond-based bars of seed 004 take energy and volume beside homogenized. Both
     lower none's error (measured, max_error_pct: tension 21.8 -> 12.2 / 10.5, constraints
     10.9 -> 6.1 / 5.2, vibration 29.4 -> 6.5 / 8.7); the end-bond homogenisation stays
@@ -300,7 +305,7 @@ def test_bond_bar_takes_one_boundary_treatment():
                  closure=Closure())
 
 
-def test_bond_methods_on_the_clamped_plate():
+def test_bond_methods_on_the_clamped_plate(metrics):
     """plate2d-clamped (seed 000's plate, LPS) takes energy, volume and PALS, clamped as
     none is (the ring at the FEM value). Measured at Table 4's grid, max_error_u_pct:
     none 7.43, energy 6.52, volume 6.40, PALS 10.29, taylor-fictitious (n = 1) 1.47.
@@ -314,7 +319,8 @@ def test_bond_methods_on_the_clamped_plate():
     assert max(got.values()) > metrics("plate2d-clamped", "taylor-fictitious")["max_error_u_pct"]
 
 
-def test_energy_and_volume_on_the_indentation():
+@pytest.mark.slow  # slow tier (issue 32): 13 s: three indentation curves (loaded machine)
+def test_energy_and_volume_on_the_indentation(metrics):
     """block2d-indentation takes energy and volume (and perifit when installed) at the
     quick report's coarse grid (spacing 1 mm, m = 6): both reach 2 mm where none folds at
     1.8 mm, yet stay far softer than the FEM (measured force_error_pct: none 66.8, energy

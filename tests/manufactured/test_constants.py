@@ -31,6 +31,7 @@ def test_gaussian_delta1_delta2_numbers():
     assert abs(float(radial_moment("gaussian", 6, 1)) / 2 - 0.0333661374) <= 5e-11
 
 
+@pytest.mark.slow  # slow tier (issue 32): 23 s: sympy's integrals (loaded machine)
 def test_radial_moments_against_direct_integration():
     # exact: sympy integrates int_0^delta omega l^k dl directly (independent of the recurrence
     # and closed forms in influence.py); also seed 001, Eq. (54) (double integral = Delta_1).

@@ -153,7 +153,11 @@ def test_ctrl_c_during_a_report_prints_no_worker_traceback(tmp_path):
     proc = subprocess.Popen([sys.executable, "-m", "pdverify", "report", "--quick", "--only",
                              "sheet2d-tension", "--jobs", "2", "--out", str(tmp_path / "r")],
                             cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, start_new_session=True)
+                            text=True, start_new_session=True,
+                            # as from a terminal: Ctrl-C at its default even when the suite
+                            # itself was started with SIGINT ignored (a background job of a
+                            # non-interactive shell), which the report would inherit
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     lines = []
     try:
         deadline = time.monotonic() + 300

@@ -54,6 +54,7 @@ def test_scheduler_from_the_environment(monkeypatch):
     assert scheduler_address(None) is None
 
 
+@pytest.mark.slow  # slow tier (issue 32): 12 s: it waits out the 10 s connect timeout (loaded machine)
 def test_unreachable_scheduler_exits_2_before_any_work(tmp_path):
     out = tmp_path / "rep"
     p = subprocess.run([sys.executable, "-m", "pdverify", "report", "--out", str(out),

@@ -51,6 +51,7 @@ def test_cg_matches_the_direct_solution_within_its_error_bound(dim, nodes, m):
     assert err < 100 * max(info["solver_error_estimate"], 1e-14)
 
 
+@pytest.mark.slow  # slow tier (issue 32): 10 s: two grids up to 81 x 81 (loaded machine)
 def test_iterations_do_not_grow_with_the_grid():
     """Two-level convergence: with aggregates one horizon wide, CG's iteration count at
     fixed m stays bounded as the grid is refined (measured 12 at 50,880 unknowns)."""

@@ -1,6 +1,4 @@
 """Seed 000 §6.2 on the PD side: the clamped plate against its FEM reference (issue 15)."""
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -10,14 +8,18 @@ from pdverify.scenes import get_scene
 SCENE = "plate2d-clamped"
 
 
-def _run(method, **over):
-    r = get_scene(SCENE).run(method, over)
-    assert r.status == "ok", r.message
-    return r
+@pytest.fixture(scope="module")
+def _run(run_once):
+    """One run of the plate, shared through the session (``run_once`` in conftest)."""
+    def run(method, **over):
+        r = run_once(SCENE, method, **over)
+        assert r.status == "ok", r.message
+        return r
+    return run
 
 
 @pytest.fixture(scope="module")
-def table4():
+def table4(_run):
     """Table 4 runs: none (ring at the reference value, as the 1D baseline) and n = 1..3."""
     return {"none": _run("none"), **{n: _run("taylor-fictitious", order=n) for n in (1, 2, 3)}}
 
@@ -67,7 +69,7 @@ def test_maximum_error_falls_from_order_1_to_3(table4):
     assert worst[3] < 0.5 * worst[1]
 
 
-def test_fem_reference_is_converged_far_beyond_the_pd_error(table4):
+def test_fem_reference_is_converged_far_beyond_the_pd_error(table4, _run):
     # issue 15: the FEM field must change by less than a tenth of the smallest PD error
     # over its last refinement; the smallest PD error in the report is the
     # moment-corrected order 3 at spacing 0.05 m
@@ -82,7 +84,7 @@ def _rate(xs, errors):
 
 
 @pytest.mark.parametrize("order", [1, 2, 3])
-def test_delta_convergence_at_fixed_m_with_moment_corrected_weights(order):
+def test_delta_convergence_at_fixed_m_with_moment_corrected_weights(order, _run):
     # delta -> 0 at m = 3: the corrected model's error is the nonlocal O(delta^2) term
     # plus the closure's O(h^(n+1)); the fitted rate of the rel. L2 error must reach 2
     # (10 % allowance for the pre-asymptotic fit over three levels)
@@ -92,7 +94,7 @@ def test_delta_convergence_at_fixed_m_with_moment_corrected_weights(order):
     assert _rate(hs, e) > 1.8
 
 
-def test_delta_convergence_with_partial_volumes_stops_at_the_quadrature_error():
+def test_delta_convergence_with_partial_volumes_stops_at_the_quadrature_error(_run):
     # with exact partial volumes at fixed m = 3 the discrete bulk moduli differ from the
     # continuum ones (anisotropic fourth moment), an h-independent model error: the
     # order-3 error stays within 10 % of its coarse value while delta shrinks 4x
@@ -101,7 +103,8 @@ def test_delta_convergence_with_partial_volumes_stops_at_the_quadrature_error():
     assert abs(e[1] / e[0] - 1) < 0.1
 
 
-def test_m_convergence_at_fixed_delta():
+@pytest.mark.slow  # slow tier (issue 32): 18 s: a convergence study (loaded machine)
+def test_m_convergence_at_fixed_delta(_run):
     # delta = 0.2 m, m = 2, 3, 4: the partial-volume quadrature error shrinks at least
     # like h / delta = 1 / m (the cut cells are an O(h / delta) fraction of the horizon),
     # so the corrected errors must fall at a fitted rate of at least 1 in m. The
@@ -116,7 +119,7 @@ def test_m_convergence_at_fixed_delta():
     assert e[-1] > e[0]
 
 
-def test_ring_value_zero_is_worse_than_reference(table4):
+def test_ring_value_zero_is_worse_than_reference(table4, _run):
     # the two readings of the uncorrected baseline: ring nodes at 0 (h/2 inside the
     # clamped edge) add the offset error to the surface effect
     zero = _run("none", ring_value="zero")
@@ -128,15 +131,23 @@ def test_corners_both_is_a_failed_run_with_the_reason():
     assert r.status == "failed" and "singular" in r.message
 
 
-@pytest.mark.parametrize("args, needle", [
+BAD_INPUT = [
     (["--method", "taylor-fictitious", "--set", "order=10"], "order=10 is too large for 20 nodes"),
     (["--method", "none", "--set", "spacing=0.07"], "spacing=0.07 must divide length=3"),
     (["--method", "none", "--set", "spacing=0.4"], "spacing=0.4 must divide length=3"),
     (["--method", "taylor-fictitious", "--set", "corners=diagonal"], "corners"),
     (["--method", "none", "--set", "body_force=0"], "body_force=0"),
-])
-def test_bad_input_exit_2_one_line(args, needle):
-    p = subprocess.run([sys.executable, "-m", "pdverify", "run", SCENE, *args],
-                       capture_output=True, text=True)
+]
+
+
+@pytest.fixture(scope="module")
+def bad_input_runs(cli_concurrently):
+    """Every case in its own interpreter, one per core at a time (issue 32)."""
+    return cli_concurrently([("run", SCENE, *args) for args, _ in BAD_INPUT])
+
+
+@pytest.mark.parametrize("args, needle", BAD_INPUT)
+def test_bad_input_exit_2_one_line(args, needle, bad_input_runs):
+    p = bad_input_runs[("run", SCENE, *args)]
     assert p.returncode == 2
     assert needle in p.stderr and p.stderr.count("\n") == 1

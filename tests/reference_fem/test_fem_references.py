@@ -115,6 +115,7 @@ def test_clamped_sheet_graded_convergence(clamped):
 
 # --- block2d-indentation (seed 003 Sec. 4.2) ---------------------------------------------
 
+@pytest.mark.slow  # slow tier (issue 32): the finite-strain FEM reference, 14 s (loaded machine)
 def test_indentation_converged(indent):
     # issue 5: change of the full-depth force over the last refinement below 1 %
     assert indent.refinement_change_pct < 1.0
@@ -126,6 +127,7 @@ def test_indentation_converged(indent):
     assert len(indent.depths) >= 21 and indent.depths[-1] == pytest.approx(0.002, rel=1e-12)
 
 
+@pytest.mark.slow  # slow tier (issue 32): the finite-strain FEM reference, 14 s (loaded machine)
 def test_indentation_curve_monotone_and_width_grows(indent):
     assert indent.force_monotone and np.all(np.diff(indent.forces) > 0)
     w = indent.contact_widths
@@ -137,6 +139,7 @@ def test_indentation_curve_monotone_and_width_grows(indent):
     assert indent.metrics()["force_monotone"] == 1.0
 
 
+@pytest.mark.slow  # slow tier (issue 32): the finite-strain FEM reference, 14 s (loaded machine)
 def test_indentation_contact_kinematics_and_equilibrium(indent):
     p = indent.params
     R, d = p["radius"], p["depth"]
@@ -152,6 +155,7 @@ def test_indentation_contact_kinematics_and_equilibrium(indent):
     assert indent.contact_x.size == indent.contact_nodes[-1]
 
 
+@pytest.mark.slow  # slow tier (issue 32): the finite-strain FEM reference, 14 s (loaded machine)
 def test_indentation_no_free_node_penetrates(indent):
     p = indent.params
     R, d = p["radius"], p["depth"]
@@ -190,6 +194,7 @@ def test_indentation_flexibility_solver_matches_direct_condensation(cache_env, s
                                rtol=0, atol=1e-9 * p.depth)
 
 
+@pytest.mark.slow  # slow tier (issue 32): the finite-strain FEM reference, 14 s (loaded machine)
 def test_indentation_fields_at_full_depth(indent):
     p = indent.params
     W, H = p["width"], p["height"]
@@ -210,7 +215,9 @@ def test_indentation_fields_at_full_depth(indent):
 
 # --- results common to all ---------------------------------------------------------------
 
-@pytest.mark.parametrize("name", ["plate", "tension", "clamped", "indent"])
+# the finite-strain indentation reference in the slow tier with its other tests (issue 32)
+@pytest.mark.parametrize("name", ["plate", "tension", "clamped",
+                                  pytest.param("indent", marks=pytest.mark.slow)])
 def test_result_records(name, request):
     res = request.getfixturevalue(name)
     assert res.refinement_change_pct == res.refinement[-1].change_pct

@@ -134,15 +134,34 @@ def test_killed_reports_leave_the_previous_one_intact(tmp_path, env):
 
 
 def test_second_report_into_the_same_folder_is_refused(tmp_path, env):
+    # the first report is frozen (SIGSTOP) once its first run has finished, so it holds
+    # the folder's lock while the second starts, however long the second takes to start on
+    # a loaded machine; one cheap scene is enough for that (issue 32: this was a 4-scene
+    # report with a cold FEM cache, 113 s on a loaded machine, timed by a 1.5 s sleep)
     out = tmp_path / "rep"
-    first = _report(out, env=env)
-    time.sleep(1.5)
-    second = _report(out, env=env)
-    _, err = second.communicate()
-    first.communicate()
+    first = subprocess.Popen([sys.executable, "-m", "pdverify", "report", "--quick", "--out",
+                              str(out), "--only", "bar1d-traction"],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                             env=env)
+    try:
+        seen = []
+        for line in first.stderr:
+            seen.append(line)
+            if re.match(r"\[1/\d+\]", line):
+                first.send_signal(signal.SIGSTOP)
+                break
+        assert first.poll() is None, "".join(seen)
+        second = _report(out, env=env)
+        _, err = second.communicate()
+    finally:
+        first.send_signal(signal.SIGCONT)
+    rest = first.stderr.read()
+    first.wait()
     assert second.returncode == 2
     assert "is being written by pdverify report (pid" in err and err.count("\n") == 1
-    assert first.returncode == 0
+    assert f"(pid {first.pid})" in err
+    assert first.returncode == 0, "".join(seen) + rest
+    assert "report:" in rest
 
 
 def test_a_stop_inside_exec_or_import_waits_until_it_has_returned(monkeypatch):

@@ -138,6 +138,7 @@ def test_affine_energy_density_of_the_corrected_lattice(strain):
     assert unc[depth == 2].max() > 0.2 and unc[depth == 3].max() > dev[depth == 3].max()
 
 
+@pytest.mark.slow  # slow tier (issue 32): 10 s: a convergence study up to m = 24 (loaded machine)
 def test_corrected_energy_converges_at_fixed_depth_with_m():
     # at depth delta / 2 the deviation falls as m grows (delta fixed): 3.7, 2.8, 1.1 %
     devs = []

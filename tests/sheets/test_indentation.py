@@ -178,6 +178,7 @@ def test_lost_definiteness_is_named():
 
 
 # ------------------------------------------------------------------------- the scene
+@pytest.mark.slow  # slow tier (issue 32): 18 s: a load-step convergence study (loaded machine)
 def test_quick_grid_load_step_convergence():
     """Issue 14: halving the depth increment changes the final force by less than 0.2 %, the
     FEM reference's own bound for doubling its increments (reference_fem.indentation)."""

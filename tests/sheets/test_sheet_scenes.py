@@ -1,17 +1,16 @@
 """Seed 003 §4.1 scenes: Tables 1 and 2, m-convergence, bad input (issue 13)."""
-import subprocess
-import sys
-
 import numpy as np
 import pytest
 
-from pdverify.scenes import get_scene
 
-
-def _run(scene, method, **over):
-    r = get_scene(scene).run(method, over)
-    assert r.status == "ok", r.message
-    return r
+@pytest.fixture(scope="module")
+def _run(run_once):
+    """One run of the scene, shared through the session (``run_once`` in conftest)."""
+    def run(scene, method, **over):
+        r = run_once(scene, method, **over)
+        assert r.status == "ok", r.message
+        return r
+    return run
 
 
 # --------------------------------------------------------------------- Table 2
@@ -21,14 +20,14 @@ def _run(scene, method, **over):
     ("virtual-nodes", {}, 8.43),
     ("virtual-nodes", {"correct_sides": True}, 8.64),
 ])
-def test_table_2_within_2_pct_of_the_paper(method, over, paper):
+def test_table_2_within_2_pct_of_the_paper(method, over, paper, _run):
     # seed 003 Table 2; issue 13 allows 2 % (the node volumes and the horizon quadrature
     # are unstated: half/quarter volumes per ERRATA, whole cells inside the horizon)
     r = _run("sheet2d-clamped", method, **over)
     assert r.metrics["tensile_stress_mpa"] == pytest.approx(paper, rel=0.02)
 
 
-def test_table_2_other_readings_are_recorded_not_tuned():
+def test_table_2_other_readings_are_recorded_not_tuned(_run):
     # ERRATA: full volumes on the boundary nodes give ~6.5 / ~12.1 MPa instead
     full = _run("sheet2d-clamped", "none", node_volumes="full").metrics["tensile_stress_mpa"]
     assert full == pytest.approx(6.5, rel=0.02)
@@ -38,7 +37,7 @@ def test_table_2_other_readings_are_recorded_not_tuned():
     assert abs(pv / 8.64 - 1) > 0.02
 
 
-def test_corrected_clamped_sheet_is_close_to_fem():
+def test_corrected_clamped_sheet_is_close_to_fem(_run):
     r = _run("sheet2d-clamped", "energy-directional")
     # the paper: "reduces the overall error to about 1 %" (10.21 vs 10.32)
     assert abs(r.metrics["tensile_stress_error_pct"]) < 2.0
@@ -47,7 +46,7 @@ def test_corrected_clamped_sheet_is_close_to_fem():
 
 
 # --------------------------------------------------------------------- Table 1
-def test_table_1_corrected_is_near_the_paper_and_20_times_better():
+def test_table_1_corrected_is_near_the_paper_and_20_times_better(_run):
     unc = _run("sheet2d-tension", "none")
     cor = _run("sheet2d-tension", "energy-directional")
     u = np.array([unc.metrics["max_error_ux_pct"], unc.metrics["max_error_uy_pct"]])
@@ -59,14 +58,15 @@ def test_table_1_corrected_is_near_the_paper_and_20_times_better():
     np.testing.assert_allclose(c, [2.6, 3.2], rtol=0.25)   # "near 2.6 % / 3.2 %"
 
 
-def test_table_1_equal_end_forces_do_not_reproduce_it():
+def test_table_1_equal_end_forces_do_not_reproduce_it(_run):
     # the other load reading (ERRATA: unstated): corner nodes with half a cell get a full
     # share, and the corrected error grows tenfold
     cor = _run("sheet2d-tension", "energy-directional", load_sharing="equal")
     assert cor.metrics["max_error_ux_pct"] > 20
 
 
-def test_m_convergence_of_the_corrected_sheet():
+@pytest.mark.slow  # slow tier (issue 32): 14 s: a convergence study (loaded machine)
+def test_m_convergence_of_the_corrected_sheet(_run):
     # m = 2, 4, 5 at fixed delta = 5 mm: the corrected error falls (fitted log-log slope of
     # the relative L2 error < -1; measured -2.4) and beats the uncorrected one at every m
     m, cor, unc = [], [], []
@@ -80,7 +80,7 @@ def test_m_convergence_of_the_corrected_sheet():
 
 
 # --------------------------------------------------------------------- bad input
-@pytest.mark.parametrize("args, words", [
+BAD_INPUT = [
     (("sheet2d-tension", "--method", "none", "--set", "spacing=0.003"), "must divide"),
     (("sheet2d-tension", "--method", "none", "--set", "horizon=0.0015"), "must be >= 2"),
     (("sheet2d-clamped", "--method", "none", "--set", "m_ratio=1.5"), "must be >= 2"),
@@ -89,10 +89,18 @@ def test_m_convergence_of_the_corrected_sheet():
      "allowed: constant, conical"),
     (("sheet2d-tension", "--method", "virtual-nodes"), "allowed: fem, none, energy, energy-directional"),
     (("sheet2d-clamped", "--method", "energy-directional", "--set", "nu=0.3"), "nu = 1/3"),
-])
-def test_bad_input_is_one_line_exit_2(args, words):
-    res = subprocess.run([sys.executable, "-m", "pdverify", "run", *args], capture_output=True,
-                         text=True, timeout=120)
+]
+
+
+@pytest.fixture(scope="module")
+def bad_input_runs(cli_concurrently):
+    """Every case in its own interpreter, one per core at a time (issue 32)."""
+    return cli_concurrently([("run", *args) for args, _ in BAD_INPUT])
+
+
+@pytest.mark.parametrize("args, words", BAD_INPUT)
+def test_bad_input_is_one_line_exit_2(args, words, bad_input_runs):
+    res = bad_input_runs[("run", *args)]
     assert res.returncode == 2, res.stdout + res.stderr
     lines = res.stderr.strip().splitlines()
     assert len(lines) == 1 and words in lines[0] and "Traceback" not in res.stderr

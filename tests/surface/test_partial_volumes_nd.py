@@ -59,7 +59,7 @@ def test_2d_fraction_matches_closed_form_segment():
     np.testing.assert_allclose(beta, ref, rtol=0, atol=1e-13)
 
 
-@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("dim", [2, pytest.param(3, marks=pytest.mark.slow)])  # 3D: 17 s
 def test_weighted_volume_converges_to_the_analytic_value(dim):
     """m_h = sum omega |xi|^2 beta V -> m (3D: 4 pi Delta_1) as h -> 0 at fixed delta."""
     delta = 1.0

@@ -15,7 +15,7 @@ def _cli(*args, timeout=120):
                           capture_output=True, text=True, timeout=timeout)
 
 
-@pytest.mark.parametrize("scene,args,needle", [
+UNSUPPORTED = [
     ("body3d-manufactured", ["--method", "surface-nodes", "--set", "order=4"], "order"),
     ("plate2d-plane-strain", ["--method", "surface-nodes", "--set", "order=0"], "order"),
     ("body3d-traction", ["--set", "geometry=cylinder"], "geometry"),
@@ -27,9 +27,19 @@ def _cli(*args, timeout=120):
     ("body3d-manufactured", ["--method", "none", "--set", "load_point=edge"], "load_point"),
     ("plate2d-plane-strain", ["--set", "quadrature=exact"], "quadrature"),
     ("body3d-manufactured", ["--set", "surface_load=edge"], "surface_load"),
-])
-def test_unsupported_input_exits_2_with_one_line(scene, args, needle):
-    r = _cli("run", scene, *args)
+]
+
+
+@pytest.fixture(scope="module")
+def unsupported_runs(cli_concurrently):
+    """Every case in its own interpreter, one per core at a time (issue 32)."""
+    return cli_concurrently([("run", scene, *args) for scene, args, _ in UNSUPPORTED],
+                            env=dict(os.environ, PYTHONPATH=ROOT), cwd=ROOT)
+
+
+@pytest.mark.parametrize("scene,args,needle", UNSUPPORTED)
+def test_unsupported_input_exits_2_with_one_line(scene, args, needle, unsupported_runs):
+    r = unsupported_runs[("run", scene, *args)]
     assert r.returncode == 2, r.stderr
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and needle in lines[0], r.stderr

@@ -7,8 +7,14 @@ from pdverify.pd import StateBasedConstants
 from pdverify.scenes.surface_nodes import StateBox
 
 
-def _run(scene, method, **over):
-    r = get_scene(scene).run(method, over)
+@pytest.fixture(scope="module")
+def _run(run_once):
+    """One run of the scene, shared through the session (``run_once`` in conftest)."""
+    return lambda scene, method, **over: _checked(run_once(scene, method, **over), scene,
+                                                  method, over)
+
+
+def _checked(r, scene, method, over):
     assert r.status == "ok", r.message
     print(f"{scene} {method} {over}: " + ", ".join(
         f"{k}={v:.4g}" for k, v in r.metrics.items() if "max_error" in k and "_u_" not in k
@@ -39,12 +45,12 @@ def _discrete_plate_strain_error(p, m_ratio):
     return abs(ex / (-nu * (1 + nu) * t / E) - 1) * 100, abs(ey / ((1 - nu ** 2) * t / E) - 1) * 100
 
 
-def test_plate_uncorrected_above_5_pct():
+def test_plate_uncorrected_above_5_pct(_run):
     r = _run("plate2d-plane-strain", "none")
     assert r.metrics["max_error_pct"] > 5.0  # issue 7 'Must show'
 
 
-def test_plate_surface_nodes_is_the_discrete_material_response():
+def test_plate_surface_nodes_is_the_discrete_material_response(_run):
     """With surface nodes the plate deforms homogeneously, exactly as the discrete material.
 
     The whole remaining error is the discrete material's own stiffness error (lattice
@@ -66,11 +72,11 @@ def test_plate_surface_nodes_is_the_discrete_material_response():
                    "m = 3 the discrete 2D material itself is off by 1.2 % in u (lattice "
                    "anisotropy, see test above); it falls to 0.098 % at m = 5 and to "
                    "round-off with quadrature=moment-corrected (test below)")
-def test_plate_surface_nodes_below_0p1_pct():
+def test_plate_surface_nodes_below_0p1_pct(_run):
     assert _run("plate2d-plane-strain", "surface-nodes").metrics["max_error_pct"] < 0.1
 
 
-def test_plate_surface_nodes_with_moment_corrected_quadrature_is_exact():
+def test_plate_surface_nodes_with_moment_corrected_quadrature_is_exact(_run):
     """Isotropic lattice moments: the discrete material is the continuum one, so the
     surface node method reproduces the linear field of Eq. (43) to round-off."""
     r = _run("plate2d-plane-strain", "surface-nodes", quadrature="moment-corrected")
@@ -83,7 +89,7 @@ def test_plate_surface_nodes_with_moment_corrected_quadrature_is_exact():
 
 
 @pytest.mark.parametrize("influence", ["hyperbolic", "constant", "conical"])
-def test_plate_exactness_holds_for_every_influence_function(influence):
+def test_plate_exactness_holds_for_every_influence_function(influence, _run):
     """The same claim with another registered influence (``--set influence=...``): the
     lattice error depends on the influence, the method's exactness does not."""
     exact = _run("plate2d-plane-strain", "surface-nodes", influence=influence,
@@ -101,7 +107,7 @@ def test_plate_discrete_material_error_falls_with_m_ratio():
 
 
 @pytest.mark.slow
-def test_body3d_traction_must_show():
+def test_body3d_traction_must_show(_run):
     none = _run("body3d-traction", "none")
     sn = _run("body3d-traction", "surface-nodes", order=1)
     assert none.metrics["max_error_pct"] > 20.0   # issue 7 (paper: > 30 %)
@@ -113,7 +119,7 @@ def test_body3d_traction_must_show():
 
 
 @pytest.fixture(scope="module")
-def manufactured_runs():
+def manufactured_runs(_run):
     runs = {"none": _run("body3d-manufactured", "none")}
     runs.update({n: _run("body3d-manufactured", "surface-nodes", order=n) for n in (1, 2, 3)})
     return runs
@@ -141,7 +147,7 @@ def test_body3d_manufactured_order_1_below_1_pct(manufactured_runs):
 
 
 @pytest.mark.slow
-def test_body3d_manufactured_error_falls_as_h_falls_at_fixed_delta():
+def test_body3d_manufactured_error_falls_as_h_falls_at_fixed_delta(_run):
     """Fixed delta = 0.15 m on a smaller body; h = 0.05, 0.0375, 0.03 (m = 3, 4, 5), N = 3."""
     hs = np.array([0.05, 0.0375, 0.03])
     errs, l2 = [], []

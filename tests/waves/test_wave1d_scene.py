@@ -87,14 +87,23 @@ def test_step_above_the_stability_limit_fails_the_run_naming_the_limit():
     assert ok.status == "ok", ok.message
 
 
-@pytest.mark.parametrize("args, phrase", [
+BAD_INPUT = [
     (["--set", "horizon=0.3", "--set", "m_ratio=7"], "must divide length"),
     (["--set", "dt=1e-4"], "the first sampled instant"),
     (["--set", "order=50"], "order=50 needs"),
     (["--method", "none", "--set", "order=2"], "unknown key 'order'"),
-])
-def test_bad_input_exits_2_with_one_line(args, phrase):
-    proc = cli("run", SCENE, *args)
+]
+
+
+@pytest.fixture(scope="module")
+def bad_input_runs(cli_concurrently):
+    """Every case in its own interpreter, one per core at a time (issue 32)."""
+    return cli_concurrently([("run", SCENE, *args) for args, _ in BAD_INPUT], cwd=ROOT)
+
+
+@pytest.mark.parametrize("args, phrase", BAD_INPUT)
+def test_bad_input_exits_2_with_one_line(args, phrase, bad_input_runs):
+    proc = bad_input_runs[("run", SCENE, *args)]
     assert proc.returncode == 2, proc.stdout + proc.stderr
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and phrase in lines[0], proc.stderr
