@@ -101,6 +101,16 @@ class StatePlate:
         return out
 
 
+def plate_regions(x, lengths, horizon) -> dict:
+    """Masks of the nodes ``x`` of a rectangle [0, l_x] x [0, l_y]: ``boundary_`` within
+    one horizon of an edge, ``corner_`` within one horizon of two edges, ``interior_``
+    the rest."""
+    dx = np.minimum(x[:, 0], lengths[0] - x[:, 0])
+    dy = np.minimum(x[:, 1], lengths[1] - x[:, 1])
+    near = np.minimum(dx, dy) < horizon
+    return {"boundary_": near, "corner_": np.maximum(dx, dy) < horizon, "interior_": ~near}
+
+
 def plate_errors(x, u, u_ref, lengths, horizon) -> tuple[dict, np.ndarray]:
     """Eq. (70) of seed 000 in percent, overall and split by region.
 
@@ -111,11 +121,7 @@ def plate_errors(x, u, u_ref, lengths, horizon) -> tuple[dict, np.ndarray]:
     """
     scale = np.max(np.abs(u_ref[:, 0]))
     err = np.abs(u - u_ref) / scale * 100.0
-    dx = np.minimum(x[:, 0], lengths[0] - x[:, 0])
-    dy = np.minimum(x[:, 1], lengths[1] - x[:, 1])
-    near = np.minimum(dx, dy) < horizon
-    regions = {"": np.ones(x.shape[0], dtype=bool), "boundary_": near,
-               "corner_": np.maximum(dx, dy) < horizon, "interior_": ~near}
+    regions = {"": np.ones(x.shape[0], dtype=bool), **plate_regions(x, lengths, horizon)}
     out = {}
     for prefix, mask in regions.items():
         if not mask.any():

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from pdverify.scenes import get_scene
+from pdverify.scenes.plate2d import plate_regions
 
 SCENE = "plate2d-clamped"
 
@@ -25,12 +26,8 @@ def table4(_run):
 
 
 def _regions(r):
-    x, h = r.fields["x"], r.fields["horizon"]
-    L, W = r.fields["lengths"]
-    dx, dy = np.minimum(x[:, 0], L - x[:, 0]), np.minimum(x[:, 1], W - x[:, 1])
-    near = np.minimum(dx, dy) < h
-    corner = np.maximum(dx, dy) < h
-    return {"corner": corner, "edge": near & ~corner}
+    m = plate_regions(r.fields["x"], r.fields["lengths"], r.fields["horizon"])
+    return {"corner": m["corner_"], "edge": m["boundary_"] & ~m["corner_"]}
 
 
 def test_every_order_beats_none_at_corners_and_edges(table4):

@@ -11,6 +11,7 @@ import pytest
 from pdverify.corrections.registry import treatments
 from pdverify.pd import BoxGrid, StateBasedModel
 from pdverify.scenes import get_scene
+from pdverify.scenes.plate2d import plate_regions
 from pdverify.solvers.front import solve
 
 SCENE = "plate2d-clamped"
@@ -101,12 +102,8 @@ def test_quadratic_field_with_its_body_force(method, over, exact):
 
 
 def _regions(r):
-    x, h = r.fields["x"], r.fields["horizon"]
-    L, W = r.fields["lengths"]
-    dx, dy = np.minimum(x[:, 0], L - x[:, 0]), np.minimum(x[:, 1], W - x[:, 1])
-    near = np.minimum(dx, dy) < h
-    corner = np.maximum(dx, dy) < h
-    return {"corner": corner, "edge": near & ~corner}
+    m = plate_regions(r.fields["x"], r.fields["lengths"], r.fields["horizon"])
+    return {"corner": m["corner_"], "edge": m["boundary_"] & ~m["corner_"]}
 
 
 @pytest.fixture(scope="module")
