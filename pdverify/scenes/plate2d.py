@@ -213,7 +213,7 @@ class ClampedPlate(FemStaticStateScene):
     """
 
     id = "plate2d-clamped"
-    title = "Clamped plate under body load in x: Taylor fictitious nodes in 2D"
+    title = "Clamped plate under body load in x (2D state-based, FEM reference)"
     seed = "000 §6.2"
     figure = "plate2d"
     dim = 2
