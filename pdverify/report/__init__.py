@@ -333,14 +333,31 @@ def _drawn(what, draw, args, empty, progress):
     """``draw(*args)``, or ``empty`` and a note if the plotting code raises: a broken
     figure must not lose the numbers. A storage failure (disk full, read-only, I/O error;
     :func:`storage_failure`) is not a broken figure: it makes the report incomplete."""
+    return _settled(what, *_attempt(draw, args), empty, progress)
+
+
+def _attempt(draw, args):
+    """``("ok", draw(*args))``, or what went wrong as plain data (a drawing process sends
+    it back; the exception itself may not pickle): ``("storage", description)`` for a
+    storage failure, ``("failed", message)`` for any other."""
     try:
-        return draw(*args)
+        return "ok", draw(*args)
     except Exception as exc:
         failure = storage_failure(exc)
         if failure is not None:
-            raise OutputError(f"writing the {what} failed ({_describe(failure)})") from exc
-        print(f"{what} failed: {type(exc).__name__}: {exc}", file=progress)
+            return "storage", _describe(failure)
+        return "failed", f"{type(exc).__name__}: {exc}"
+
+
+def _settled(what, status, value, empty, progress):
+    """The figures of an :func:`_attempt`: a storage failure raises
+    :class:`OutputError`, a broken figure is a note and ``empty``."""
+    if status == "storage":
+        raise OutputError(f"writing the {what} failed ({value})")
+    if status == "failed":
+        print(f"{what} failed: {value}", file=progress)
         return empty
+    return value
 
 
 #: the figure tasks of :func:`_draw_all`, read by the forked drawing processes
@@ -378,14 +395,8 @@ def _draw_all(tasks, jobs, progress) -> list:
             except Exception as exc:       # the drawing process died: draw it here
                 print(f"{what}: its drawing process failed ({type(exc).__name__}); drawn "
                       "in the report process", file=progress)
-                out.append(_drawn(what, draw, args, empty, progress))
-                continue
-            if status == "storage":
-                raise OutputError(f"writing the {what} failed ({value})")
-            if status == "failed":
-                print(f"{what} failed: {value}", file=progress)
-                value = empty
-            out.append(value)
+                status, value = _attempt(draw, args)
+            out.append(_settled(what, status, value, empty, progress))
         return out
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
@@ -399,16 +410,9 @@ def _drawing_process(parent: int) -> None:
 
 
 def _draw_task(k: int):
-    """One task of :data:`_TASKS` in a drawing process: ``("ok", result)``, ``("failed",
-    message)`` or ``("storage", description)`` (the exception itself may not pickle)."""
-    what, draw, args, empty = _TASKS[k]
-    try:
-        return "ok", draw(*args)
-    except Exception as exc:
-        failure = storage_failure(exc)
-        if failure is not None:
-            return "storage", _describe(failure)
-        return "failed", f"{type(exc).__name__}: {exc}"
+    """One task of :data:`_TASKS`, in a drawing process (:func:`_attempt`)."""
+    _, draw, args, _ = _TASKS[k]
+    return _attempt(draw, args)
 
 
 LOG = "report.log"
