@@ -22,9 +22,9 @@ half model keeps the nodes on one side and on the plane (index_k >= the middle) 
 u = S u_h expands them to every node (a mirrored node takes its image's displacement with
 u_k reversed). Its energy is the whole body's, E_h(u_h) = E(S u_h), written as a sum over
 one bond of each mirror pair {bond, its image} (weight 2; 1 for a bond that is its own
-image; this holds for u_k = 0 on the plane): a bond with both ends kept is kept as it is, a bond that crosses the plane keeps its
-kept end and reaches the other through its image (the "mirrored neighbour": y = xi + R u_b -
-u_a, R reversing component k). So f_h = S^T f(S u_h) and the tangent S^T T S, symmetric;
+image; this holds for u_k = 0 on the plane): a bond with both ends kept is kept as it
+is, a bond that crosses the plane keeps its kept end and reaches the other through its
+image (the "mirrored neighbour": y = xi + R u_b - u_a, R reversing component k). So f_h = S^T f(S u_h) and the tangent S^T T S, symmetric;
 at a symmetric state f_h = D f on the kept nodes (D = 2 off the plane, 1 on it), so Newton
 on the half model takes, in exact arithmetic, the full model's steps (norms weighted by
 ``residual_weight`` = 1 / D are the body's), and a sum of reactions over kept nodes is the
@@ -274,8 +274,8 @@ class NonlinearBondBased:
         A gather into the CSR data reads those values in data order instead of scattering
         them bond by bond: an assembly on the paper grid took 116 ms against 145 ms (whole
         block), 66 ms against 74 ms (half; CPU time, medians of 7 alternating, a side
-        measurement on a busy machine), the same numbers bit for bit. Frees the pattern's per-bond positions, except the crossing
-        bonds' (added on top)."""
+        measurement on a busy machine), the same numbers bit for bit. Frees the pattern's
+        per-bond positions, except the crossing bonds' (added on top)."""
         P, n, dim = self.pattern, self.n, self.dim
         nb = self.a.size
         c = nb if self.half is None else self.half["plain"]

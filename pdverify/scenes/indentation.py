@@ -298,9 +298,6 @@ class Indentation(FemAndPD):
             ref = self.fem_reference(p)
             small = (self.fem_reference({**p, "kinematics": "linear"})
                      if p["kinematics"] == "nonlinear" else ref)
-        # one BLAS thread, as every run (pdverify.blas): here it also matters for speed,
-        # the preconditioner's dense coarse products (1,134 square on the half paper grid)
-        # took 8 ms with OpenBLAS's threads on a busy 2-core machine against 0.14 ms
         with timer.phase("solve"):
             curve, failure = indent(kin, grid, p, lin, where)
         metrics = curve_metrics(curve, ref, failure)
