@@ -26,7 +26,8 @@ image; this holds for u_k = 0 on the plane): a bond with both ends kept is kept 
 is, a bond that crosses the plane keeps its kept end and reaches the other through its
 image (the "mirrored neighbour": y = xi + R u_b - u_a, R reversing component k).
 So f_h = S^T f(S u_h) and the tangent S^T T S, symmetric; at a symmetric state
-f_h = D f on the kept nodes (D = 2 off the plane, 1 on it), so Newton on the half model takes, in exact arithmetic, the full model's steps (norms weighted by
+f_h = D f on the kept nodes (D = 2 off the plane, 1 on it), so Newton on the half model
+takes, in exact arithmetic, the full model's steps (norms weighted by
 ``residual_weight`` = 1 / D are the body's), and a sum of reactions over kept nodes is the
 whole body's. Nothing in it forbids an asymmetric solution in the full model, which the half
 model cannot show (a bifurcation).
