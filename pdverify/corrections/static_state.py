@@ -386,7 +386,7 @@ def assemble_mirror(problem, neumann: str, mirror_point: str) -> LinearSystem:
     return LinearSystem(model, K, rhs, np.zeros(0, dtype=int), np.zeros(0), nu_,
                         solver=solver,
                         coords=None if solver == "direct" else _coords(model, x_int),
-                        counts={"fictitious_nodes": int(g.n_ext - g.n_interior)})
+                        counts={"fictitious_nodes": int(g.n_ext - g.n_interior)}, offset=U_c)
 
 
 def assemble_pddo(problem) -> LinearSystem:

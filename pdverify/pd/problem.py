@@ -167,7 +167,11 @@ class LinearSystem:
     (surface nodes), measured too when the scene asks. ``reaction(x, face)``: the normal
     force the face transmits, tension positive, as the treatment defines it (the force
     flux through the face, or the reactions of its prescribed unknowns). ``counts``:
-    node counts the treatment reports beside the size.
+    node counts the treatment reports beside the size. ``offset``: the displacement
+    ``(n_ext, d)`` of the grid's nodes that the unknowns do not carry (the mirror nodes'
+    affine part); every grid node's displacement is the model's ``A_U_full`` applied to
+    the unknowns plus ``offset`` (None: zero). It is the only part of a system's
+    displacement map that can depend on the prescribed values.
     """
 
     model: object
@@ -183,6 +187,7 @@ class LinearSystem:
     extra_x: np.ndarray | None = None
     reaction: Callable[[np.ndarray, int], float] | None = None
     counts: dict = field(default_factory=dict)
+    offset: np.ndarray | None = None
 
     @property
     def dim(self) -> int:

@@ -225,13 +225,18 @@ class StateBasedModel:
         e = self.A_e @ (self.A_U_full @ np.asarray(u, dtype=float))
         return self.K_e @ e + self.K_theta @ (self.A_Theta @ (self.A_theta @ e))
 
-    def bond_end_forces(self, u) -> tuple[np.ndarray, np.ndarray]:
+    def bond_end_forces(self, u, offset=None) -> tuple[np.ndarray, np.ndarray]:
         """The bond forces of :meth:`bond_forces` split by the end whose force state
         gives them: f = f_a + f_b, f_a = beta V_a V_b t_a(xi) (k_e omega e / m_a +
         k_theta omega |xi| theta_a / m_a for LPS). ``ke_share_a`` is end a's part of K_e;
         a K_theta entry belongs to the end whose node its column is (modulo the grid's
-        node count: a force state may carry several nodal scalars per node)."""
-        e = self.A_e @ (self.A_U_full @ np.asarray(u, dtype=float))
+        node count: a force state may carry several nodal scalars per node).
+        ``offset``: (n_ext, d) displacements of the grid nodes added to the unknowns'
+        image (a treatment's affine part, ``LinearSystem.offset``)."""
+        U = self.A_U_full @ np.asarray(u, dtype=float)
+        if offset is not None:
+            U = U + np.asarray(offset, dtype=float).T.ravel()
+        e = self.A_e @ U
         Theta = self.A_Theta @ (self.A_theta @ e)
         KT = self.K_theta.tocoo()
         at_a = KT.col % self.grid.n_ext == self.bond_a[KT.row]
