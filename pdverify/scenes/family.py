@@ -11,8 +11,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from .. import budget
 from ..errors import InputError
 from ..solvers.front import solve as solve_system
@@ -210,8 +208,3 @@ class FemStaticStateScene(StaticStateScene, FemAndPD):
         with timer.phase("reference"):
             self.reference_of(p)
         return self.solve_problem(method, p, timer, self.problem)
-
-
-def surface_error_pct(u_extra, u_ref_extra, scale) -> float:
-    """Largest component error of the extra (surface) nodes, in % of ``scale``."""
-    return float(np.max(np.abs(u_extra - u_ref_extra) / scale) * 100.0)

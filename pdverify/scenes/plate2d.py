@@ -8,7 +8,7 @@ import numpy as np
 
 from ..corrections.taylor_fictitious import clamped_rows, fictitious_closure
 from ..errors import InputError
-from ..metrics import rel_l2_error
+from ..metrics import plate_errors
 from ..params import Param, at_least, positive
 from ..pd import (QUADRATURES, BoxGrid, StateBasedConstants, StateBasedModel, get_influence,
                   state_based_stencil)
@@ -99,37 +99,6 @@ class StatePlate:
             out["fictitious_nodes"] = int(g.n_ext - g.n_interior)
             out["constraints"] = int(self.B.shape[0])
         return out
-
-
-def plate_regions(x, lengths, horizon) -> dict:
-    """Masks of the nodes ``x`` of a rectangle [0, l_x] x [0, l_y]: ``boundary_`` within
-    one horizon of an edge, ``corner_`` within one horizon of two edges, ``interior_``
-    the rest."""
-    dx = np.minimum(x[:, 0], lengths[0] - x[:, 0])
-    dy = np.minimum(x[:, 1], lengths[1] - x[:, 1])
-    near = np.minimum(dx, dy) < horizon
-    return {"boundary_": near, "corner_": np.maximum(dx, dy) < horizon, "interior_": ~near}
-
-
-def plate_errors(x, u, u_ref, lengths, horizon) -> tuple[dict, np.ndarray]:
-    """Eq. (70) of seed 000 in percent, overall and split by region.
-
-    Both components are normalised by max |u^FEM| over the PD nodes, u the x-displacement
-    (the paper's bold u; at the Table 4 load max |v| is 6 % of it). Regions: ``boundary``
-    = nodes within one horizon of an edge, ``corner`` = within one horizon of two edges,
-    ``interior`` = the rest.
-    """
-    scale = np.max(np.abs(u_ref[:, 0]))
-    err = np.abs(u - u_ref) / scale * 100.0
-    regions = {"": np.ones(x.shape[0], dtype=bool), **plate_regions(x, lengths, horizon)}
-    out = {}
-    for prefix, mask in regions.items():
-        if not mask.any():
-            continue
-        out[prefix + "max_error_u_pct"] = float(err[mask, 0].max())
-        out[prefix + "max_error_v_pct"] = float(err[mask, 1].max())
-    out["rel_l2_error"] = rel_l2_error(u, u_ref)
-    return out, err
 
 
 @register

@@ -8,15 +8,14 @@ import numpy as np
 from manufactured import surface3d as closed
 
 from ..corrections.surface_nodes import flux_rows, surface_node_closure
-from ..errors import NumericalError
-from ..metrics import rel_l2_error
+from ..metrics import error_metrics, surface_error_pct
 from ..params import Param, at_least, open_interval, positive
 from ..pd import (QUADRATURES, BoxGrid, StateBasedConstants, StateBasedModel, get_influence,
                   state_based_stencil)
 from ..pd.problem import FACES, FaceCondition, StaticProblem
 from ..solvers.policy import ND3D_FROM_UNKNOWNS, ND_FROM_UNKNOWNS, STATIC_SOLVERS
 from . import Outcome, Published, influence_param, register, require_influence
-from .family import StaticStateScene, surface_error_pct
+from .family import StaticStateScene
 
 
 class StateBox:
@@ -117,42 +116,6 @@ SOLVER = Param("solver", "auto", "linear solver: direct (K multiplied out; spars
 # published numbers sit beside the paper's quadrature and influence only
 PAPER_QUADRATURE = {"quadrature": "partial-volume", "influence": "gaussian"}
 MOMENT = {"quadrature": "moment-corrected"}
-
-def error_metrics(x, u, u_ref, dist, horizon, dim) -> tuple[dict, np.ndarray]:
-    """Eq. (38) (3D) / Eq. (44) (2D) errors in percent, overall and split at delta.
-
-    u_max per component is the largest |u_ref| over the interior nodes. ``boundary_``
-    metrics are over nodes within one horizon of the surface, ``interior_`` over the rest.
-    """
-    scale = np.max(np.abs(u_ref), axis=0)
-    tiny = np.flatnonzero(~(scale > np.finfo(float).tiny))
-    if tiny.size:
-        raise NumericalError(f"Eq. ({38 if dim == 3 else 44}) divides each component's "
-                             f"error by its largest reference value, and component "
-                             f"{'xyz'[tiny[0]]} of the reference is {scale[tiny[0]]:.3g} "
-                             "everywhere (e.g. nu = 0 gives no lateral displacement): the "
-                             "error is undefined")
-    comp = np.abs(u - u_ref) / scale * 100.0        # (n, d) per-component percent
-    mag = np.sqrt(np.sum(comp ** 2, axis=1))         # Eq. (38)
-    near = dist <= horizon
-    out = {}
-
-    def part(prefix, mask):
-        if not np.any(mask):
-            return
-        if dim == 3:
-            out[prefix + "max_error_pct"] = float(mag[mask].max())
-        else:
-            out[prefix + "max_error_pct"] = float(comp[mask].max())
-            out[prefix + "max_error_u_pct"] = float(comp[mask, 0].max())
-            out[prefix + "max_error_v_pct"] = float(comp[mask, 1].max())
-        out[prefix + "rel_l2_error"] = rel_l2_error(u[mask], u_ref[mask])
-
-    part("", np.ones(x.shape[0], dtype=bool))
-    part("boundary_", near)
-    part("interior_", ~near)
-    return out, (mag if dim == 3 else comp)
-
 
 METHOD_CHOICES = """
     Choices of the surface node method where seed 001 is silent (all seed-001 scenes):

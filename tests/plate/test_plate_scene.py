@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from pdverify.scenes import get_scene
-from pdverify.scenes.plate2d import plate_regions
+from pdverify.metrics import plate_regions
 
 SCENE = "plate2d-clamped"
 

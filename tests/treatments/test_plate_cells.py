@@ -11,7 +11,7 @@ import pytest
 from pdverify.corrections.registry import treatments
 from pdverify.pd import BoxGrid, StateBasedModel
 from pdverify.scenes import get_scene
-from pdverify.scenes.plate2d import plate_regions
+from pdverify.metrics import plate_regions
 from pdverify.solvers.front import solve
 
 SCENE = "plate2d-clamped"
