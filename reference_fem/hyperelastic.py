@@ -86,6 +86,10 @@ class StVenantKirchhoff:
         F = G.transpose(0, 2, 1, 3) * self._inv_h[None, :, :, None]
         F[0, 0] += 1.0
         F[1, 1] += 1.0
+        return F, self._stress(F)
+
+    def _stress(self, F):
+        """The second Piola-Kirchhoff stress S(F), (K, L, e, q)."""
         E = np.empty_like(F)
         for K in range(2):
             for L in range(K, 2):
@@ -94,7 +98,7 @@ class StVenantKirchhoff:
         tr = self.lam * (E[0, 0] + E[1, 1])
         S[0, 0] += tr
         S[1, 1] += tr
-        return F, S
+        return S
 
     def internal_force(self, u) -> np.ndarray:
         F, S = self._state(u)
@@ -110,6 +114,20 @@ class StVenantKirchhoff:
 
     def tangent(self, u) -> sp.csr_matrix:
         F, S = self._state(u)                                  # (i, K, e, q)
+        A = self._moduli(F, S)
+        A *= self.dx[:, :, None, None, None, None]
+        # Y[e, q, (K, i, j), b] = sum_L A[..., L] grad[e, q, b, L]
+        Y = A.reshape(self.n_el, self.n_qp, 8, 2) @ np.swapaxes(self._grad, 2, 3)
+        # Ke[e, a, (i, j, b)] = sum_{q, K} grad[e, q, a, K] Y[e, q, K, (i, j, b)]
+        nb = self._grad.shape[2]
+        Ke = self._grad_t @ Y.reshape(self.n_el, 2 * self.n_qp, 4 * nb)
+        Ke = Ke.reshape(self.n_el, nb, 2, 2, nb).transpose(0, 1, 2, 4, 3)  # (e, a, i, b, j)
+        data = np.bincount(self._slot, Ke.ravel(), self._nnz)
+        N = self.basis.N
+        return sp.csr_matrix((self.scale * data, self._indices, self._indptr), shape=(N, N))
+
+    def _moduli(self, F, S):
+        """A[e, q, K, i, j, L] = dP_iK / dF_jL per quadrature point."""
         lam, mu = self.lam, self.mu
         FFt = np.einsum("iMeq,jMeq->ijeq", F, F)
         # A[e, q, K, i, j, L] = delta_ij S_KL + lam F_iK F_jL + mu (F_iL F_jK + (F F^T)_ij
@@ -126,16 +144,7 @@ class StVenantKirchhoff:
                         if K == L:
                             a += mu * FFt[i, j]
                         A[:, :, K, i, j, L] = a
-        A *= self.dx[:, :, None, None, None, None]
-        # Y[e, q, (K, i, j), b] = sum_L A[..., L] grad[e, q, b, L]
-        Y = A.reshape(self.n_el, self.n_qp, 8, 2) @ np.swapaxes(self._grad, 2, 3)
-        # Ke[e, a, (i, j, b)] = sum_{q, K} grad[e, q, a, K] Y[e, q, K, (i, j, b)]
-        nb = self._grad.shape[2]
-        Ke = self._grad_t @ Y.reshape(self.n_el, 2 * self.n_qp, 4 * nb)
-        Ke = Ke.reshape(self.n_el, nb, 2, 2, nb).transpose(0, 1, 2, 4, 3)  # (e, a, i, b, j)
-        data = np.bincount(self._slot, Ke.ravel(), self._nnz)
-        N = self.basis.N
-        return sp.csr_matrix((self.scale * data, self._indices, self._indptr), shape=(N, N))
+        return A
 
     def min_jacobian(self, u) -> tuple[float, np.ndarray]:
         """The smallest det F over all quadrature points and where it is (x, y): <= 0 means
@@ -145,3 +154,50 @@ class StVenantKirchhoff:
         k = np.unravel_index(np.argmin(det), det.shape)
         x = self.basis.mapping.F(self.basis.X)[:, k[0], k[1]]
         return float(det[k]), x
+
+
+class NeoHookean(StVenantKirchhoff):
+    """The compressible neo-Hookean law with the same Lame parameters, on the same mesh
+    machinery: W = mu / 2 (tr C - 2 - 2 ln J) + lam / 2 (ln J)^2 (2D), so
+    S = mu (I - C^-1) + lam ln J C^-1 and, with G = F C^-1 = F^-T and c = mu - lam ln J,
+    A_iKjL = delta_ij S_KL + lam G_iK G_jL + c (delta_ij C^-1_KL + G_iL G_jK) (the
+    material tangent lam C^-1 (x) C^-1 + c (C^-1_IK C^-1_JL + C^-1_IL C^-1_JK) pushed
+    through F, using F C^-1 F^T = I). For small strains both laws reduce to the same linear
+    elasticity; in compression the neo-Hookean law stiffens (ln J -> -inf as J -> 0) where
+    St Venant-Kirchhoff softens. A state with J <= 0 has no energy: its stress is NaN, so
+    Newton's line search rejects the step and the mesh-folding check names it.
+    """
+
+    def _inverse_c(self, F):
+        """(C^-1 (K, L, e, q), J, G = F^-T (i, K, e, q))."""
+        J = F[0, 0] * F[1, 1] - F[0, 1] * F[1, 0]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            G = np.empty_like(F)                         # F^-T
+            G[0, 0], G[1, 1] = F[1, 1] / J, F[0, 0] / J
+            G[0, 1], G[1, 0] = -F[1, 0] / J, -F[0, 1] / J
+        Ci = np.einsum("iKeq,iLeq->KLeq", G, G)          # C^-1 = F^-1 F^-T
+        return Ci, J, G
+
+    def _stress(self, F):
+        Ci, J, _ = self._inverse_c(F)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            lnJ = np.where(J > 0, np.log(np.where(J > 0, J, 1.0)), np.nan)
+        S = -self.mu * Ci + self.lam * lnJ * Ci
+        S[0, 0] += self.mu
+        S[1, 1] += self.mu
+        return S
+
+    def _moduli(self, F, S):
+        Ci, J, G = self._inverse_c(F)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            lnJ = np.where(J > 0, np.log(np.where(J > 0, J, 1.0)), np.nan)
+        c = self.mu - self.lam * lnJ
+        eye = np.eye(2)
+        A = (np.einsum("ij,KLeq->eqKijL", eye, S + c * Ci)
+             + self.lam * np.einsum("iKeq,jLeq->eqKijL", G, G)
+             + np.einsum("eq,iLeq,jKeq->eqKijL", c, G, G))
+        return np.ascontiguousarray(A)
+
+
+#: the finite-strain material laws by name
+LAWS = {"saint-venant-kirchhoff": StVenantKirchhoff, "neo-hookean": NeoHookean}

@@ -59,9 +59,9 @@ rows; the columns of G for a node are computed (two solves) when it is caught. E
 contact iteration is then a dense solve of size 2 |S| (less the axis node's u_x, held by
 the symmetry condition). The full field is one more solve at full depth.
 
-Solution method (finite strain, St Venant-Kirchhoff): each increment starts from the
-tangent predictor and iterates to a free residual below :data:`NEWTON_RTOL` of the force
-scale. The sparse LU of the tangent is kept across iterations and increments (a modified
+Solution method (finite strain, St Venant-Kirchhoff or neo-Hookean: ``law``): each
+increment starts from the tangent predictor and iterates to a free residual below
+:data:`NEWTON_RTOL` of the force scale. The sparse LU of the tangent is kept across iterations and increments (a modified
 Newton step costs one residual and one back-substitution) as long as a step reduces the
 free residual at least 10-fold (:data:`REUSE_CONTRACTION`); otherwise that iteration is a
 Newton step with the tangent factorised at the iterate and a halving line search. A
@@ -88,7 +88,7 @@ import scipy.sparse.linalg as spla
 from . import params as _p
 from .cache import cached
 from .elasticity import Material, TensorElasticity
-from .hyperelastic import StVenantKirchhoff
+from .hyperelastic import LAWS
 from .field import FieldSolution, midpoint_refined
 from .meshing import fine_then_geometric
 from .results import ReferenceResult, RefinementRow, change_pct
@@ -118,6 +118,10 @@ class IndentationParams:
     levels: int = 3                # level l halves every element l times
     kinematics: str = "small"      # small strain, or finite (St Venant-Kirchhoff, Newton)
     symmetry: str = "half"         # half (x >= 0, u_x = 0 on the axis) or the full block
+    #: the finite-strain material law (``hyperelastic.LAWS``): St Venant-Kirchhoff (the
+    #: reference the PD runs are measured against) or compressible neo-Hookean with the
+    #: same Lame parameters (which law the paper's FEM used is not stated)
+    law: str = "saint-venant-kirchhoff"
 
     def __post_init__(self):
         _p.positive(REFERENCE, width=self.width, height=self.height, radius=self.radius,
@@ -138,6 +142,11 @@ class IndentationParams:
                    f"kinematics must be one of {', '.join(KINEMATICS)}, got {self.kinematics!r}")
         _p.require(self.symmetry in SYMMETRIES, REFERENCE,
                    f"symmetry must be one of {', '.join(SYMMETRIES)}, got {self.symmetry!r}")
+        _p.require(self.law in LAWS, REFERENCE,
+                   f"law must be one of {', '.join(LAWS)}, got {self.law!r}")
+        _p.require(self.kinematics == "finite" or self.law == "saint-venant-kirchhoff",
+                   REFERENCE, f"law={self.law} needs kinematics=finite (small strain has "
+                   "one linear law)")
 
     def finest_cells(self) -> tuple[int, int]:
         """Elements along x and y of the finest level, counted without building the mesh
@@ -330,7 +339,7 @@ def solve_level_finite(p: IndentationParams, level: int, check_steps: bool = Fal
     t0 = time.perf_counter()
     model, xs, fixed = _half_model(p, level)
     half = p.symmetry == "half"
-    svk = StVenantKirchhoff(model)
+    svk = LAWS[p.law](model)
     tol = 1e-9 * p.height
     on_top = lambda x, y: y > -tol  # noqa: E731
     cx, cy = model.dofs(on_top, [0]), model.dofs(on_top, [1])

@@ -33,13 +33,23 @@ def _label(r):
     return base
 
 
-def fem_label(fem_kinematics: str) -> str:
+def fem_label(fem_kinematics: str, law: str = "saint-venant-kirchhoff") -> str:
     """The name of a FEM reference curve by its kinematics (a run's ``fem_kinematics``:
     nonlinear PD is measured against the finite-strain St Venant-Kirchhoff FEM, linear PD
-    against the small-strain FEM)."""
+    against the small-strain FEM) and material law."""
     if fem_kinematics == "finite":
-        return "FEM, finite strain, St Venant-Kirchhoff"
+        return ("FEM, finite strain, neo-Hookean" if law == "neo-hookean"
+                else "FEM, finite strain, St Venant-Kirchhoff")
     return "FEM, small strain"
+
+
+def _other_laws(fem_runs) -> list:
+    """The finite-strain FEM runs of another law than the PD runs' reference, drawn beside
+    it (dash-dot): ``[(label, depths, forces)]``."""
+    return [(fem_label("finite", r.params["law"]), r.fields["depths"], r.fields["forces"])
+            for r in fem_runs if r.status == "ok" and r.params.get("kinematics") == "finite"
+            and r.params.get("law", "saint-venant-kirchhoff") != "saint-venant-kirchhoff"
+            and "forces" in r.fields]
 
 
 def _curves(ax, fem, runs, inset=False):
@@ -50,6 +60,9 @@ def _curves(ax, fem, runs, inset=False):
         if fem.get("small") is not None:
             ax.plot(fem["depths"] * 1e3, fem["small"] / 1e3, "k--", lw=1,
                     label=None if inset else "FEM, small strain")
+        for name, depths, forces in fem.get("others", ()):
+            ax.plot(np.asarray(depths) * 1e3, np.asarray(forces) / 1e3, "k-.", lw=1,
+                    label=None if inset else f"{name} (same constants)")
     for r in runs:
         f = r.fields
         color, ls, marker = _style(r)
@@ -73,7 +86,8 @@ def indentation_figures(scene, results, folder):
     kin = runs[0].fields.get("fem_kinematics", "linear")
     fem = {"depths": runs[0].fields["fem_depths"], "forces": runs[0].fields["fem_forces"],
            "label": fem_label(kin),
-           "small": runs[0].fields.get("fem_small_forces") if kin == "finite" else None}
+           "small": runs[0].fields.get("fem_small_forces") if kin == "finite" else None,
+           "others": _other_laws(fem_runs) if kin == "finite" else []}
     fig, (ax, ax2) = plt.subplots(1, 2, figsize=(13, 5), layout="constrained")
     _curves(ax, fem, runs)
     ax.set_xlabel("indentation depth [mm]")
@@ -103,6 +117,7 @@ def indentation_figures(scene, results, folder):
                 "Fig. 4 of seed 003: indentation force against depth at the paper's grid "
                 f"(161 x 161 nodes, m = 6), {fem_label(kin)} (the reference"
                 + ("; dashed: the small-strain FEM" if kin == "finite" else "")
+                + _law_note(fem)
                 + ") and PD without correction, with "
                 "the directional correction and with the energy, volume (and perifit) "
                 "corrections, nonlinear (solid) and linear (dotted) kinematics; "
@@ -113,6 +128,19 @@ def indentation_figures(scene, results, folder):
     if good:
         out.append(_fig5(scene, good[0], folder))
     return out
+
+
+def _law_note(fem) -> str:
+    """The caption's word on the other laws: each one's force at full depth over the
+    small-strain FEM's, beside St Venant-Kirchhoff's (from the curves drawn)."""
+    if fem.get("small") is None or not fem.get("others"):
+        return ""
+    small = float(fem["small"][-1])
+    parts = [f"{name}: {forces[-1] / small:.3f}" for name, _, forces in fem["others"]]
+    return ("; dash-dot: " + ", ".join(n for n, _, _ in fem["others"]) + " with the same "
+            "constants; force at full depth over the small-strain FEM's: St Venant-Kirchhoff "
+            f"{float(fem['forces'][-1]) / small:.3f}, " + ", ".join(parts)
+            + " (so most of the gap between the references is the law, not the geometry)")
 
 
 def _fig5(scene, r, folder):
