@@ -80,3 +80,26 @@ def test_the_family_keeps_its_maps_when_the_renderer_fails(tmp_path, monkeypatch
         figs = surface_nodes.surface_node_figures(scene, [r], str(tmp_path))
     assert figs and not any("-3d" in name for name, _ in figs)
     assert all((tmp_path / name).exists() for name, _ in figs)
+
+
+def test_render_deformed_draws_seed001_fig11_beside_the_paper(tmp_path):
+    """Seed 001 Fig. 11's view (issue 33): the deformed body of the exact field and of the
+    best default run, one png; the caption puts the paper's colour-bar top (0.0021 m,
+    read off the figure) beside the exact field's largest |u| with its deviation."""
+    scene = get_scene("body3d-manufactured")
+    r = scene.run("none", {"spacing": 0.125, "load_point": "node"})
+    assert r.status == "ok"
+    out = fields3d.render_deformed(scene, [r], str(tmp_path))
+    assert [name for name, _ in out] == ["body3d-manufactured-deformed.png"]
+    caption = out[0][1]
+    assert "0.0021 m" in caption and f"{r.metrics['max_displacement']:.3g} m" in caption
+    assert "001-fig11-body" in caption
+    rgb = mpimg.imread(tmp_path / out[0][0])[..., :3]
+    for half in (rgb[:, : rgb.shape[1] // 2], rgb[:, rgb.shape[1] // 2:]):
+        # both bodies drawn (the thresholds of the test above)
+        assert (half.min(axis=-1) < 0.5).mean() > 0.05
+
+
+def test_render_deformed_needs_the_max_displacement_metric(tmp_path, run):
+    scene, r = run            # body3d-traction records no max_displacement
+    assert fields3d.render_deformed(scene, [r], str(tmp_path)) == []

@@ -192,8 +192,9 @@ def _renderings_3d(scene, results, folder):
     """pyvista renderings of |u| and the error (:mod:`.fields3d`); a renderer that fails
     (no OpenGL, ...) costs these images only, with a warning naming the cause."""
     try:
-        from .fields3d import render_box_fields
-        return render_box_fields(scene, results, folder)
+        from .fields3d import render_box_fields, render_deformed
+        return render_box_fields(scene, results, folder) + render_deformed(scene, results,
+                                                                           folder)
     except Exception as exc:  # noqa: BLE001  (any VTK/OpenGL failure: keep the report)
         warnings.warn(f"{scene.id}: no 3D renderings ({type(exc).__name__}: {exc})",
                       RuntimeWarning, stacklevel=2)
