@@ -28,8 +28,9 @@ diffusion. What we implement, and which parts are our reading (a guess where mar
      the boundary cells it names: x_B's cell is the real cell containing it (a point on
      a cell boundary goes to the upper cell, as for the mirror point). *Reading:* the
      paper's mirror relations hold per face; this is their pointwise form;
-   - otherwise, also on the rest of a partly prescribed face (Neumann): u_f,k = u_m,k + (x_f - x_m) . G_k, G_ka = du_k/dx_a from the
-     traction t of the face normal to axis a that contains x_B (0 if none):
+   - otherwise, also on the rest of a partly prescribed face (Neumann):
+     u_f,k = u_m,k + (x_f - x_m) . G_k, G_ka = du_k/dx_a from the traction t of the
+     face normal to axis a that contains x_B (0 if none):
      du_a/dx_a = s t_a / (lambda + 2 mu), du_k/dx_a = s t_k / mu (k != a), s = the
      sign of the outward normal. *Reading (a guess):* the local traction condition with
      the tangential derivatives neglected, the elastic analogue of the diffusion
