@@ -145,15 +145,17 @@ def family_treatments() -> list[Treatment]:
             "mirror nodes inside the body (odd reflection for Dirichlet components, the "
             "traction through the Neumann relation)",
             "Zhao, Jafarzadeh, Chen, Bobaru 2020; seed 001 §5.2", params=MIRROR_PARAMS,
-            theories=STATE, families=FAMILY, footprint="fictitious", whole_faces_only=True,
-            scope="whole-face Dirichlet conditions (a mirror relation holds per face)",
+            theories=STATE, families=FAMILY, footprint="fictitious",
+            scope="state-based boxes; the mirror relation (Dirichlet or traction) is "
+                  "chosen per boundary cell face",
             build=_mirror, checker=_check_mirror),
         FamilyTreatment(
             "pddo", "seed 001 §5: peridynamic differential operator (moment matrices exact "
             "for quadratics) for the boundary rows and the equilibrium within 2 delta, LPS "
             "beyond", "Behera, Roy, Anicode, Madenci, Spencer 2022; seed 001 §5.3",
-            theories=STATE, families=FAMILY, whole_faces_only=True,
-            scope="whole-face Dirichlet conditions (boundary rows per face)", build=_pddo),
+            theories=STATE, families=FAMILY,
+            scope="state-based boxes; the boundary row (Dirichlet or traction) is chosen "
+                  "per boundary node", build=_pddo),
     ]
 
 

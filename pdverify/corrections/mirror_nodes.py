@@ -19,11 +19,18 @@ diffusion. What we implement, and which parts are our reading (a guess where mar
    The mirror node m is the real node nearest to it (cell containing it; a point on a
    cell boundary goes to the upper cell). On a straight face the mirror point is a node;
    near corners n_f tilts and the mirror node is only the nearest one.
-4. Mirror relations, per component k, with the faces that contain x_B:
-   - a face prescribing u_k (Dirichlet): u_f,k = 2 g_k(x_B) - u_m,k (odd reflection: the
-     mean of u_f and u_m is the boundary value; exact for fields linear along n);
-   - otherwise (Neumann): u_f,k = u_m,k + (x_f - x_m) . G_k, G_ka = du_k/dx_a from the
-     traction t of the face normal to axis a that contains x_B (0 if none):
+4. Mirror relations, per component k, with the faces that contain x_B, chosen per
+   boundary cell face (per surface point), not per face:
+   - a face prescribing u_k at x_B (Dirichlet): u_f,k = 2 g_k(x_B) - u_m,k (odd
+     reflection: the mean of u_f and u_m is the boundary value; exact for fields linear
+     along n). A face that prescribes u_k on part of it only (``where`` over its
+     boundary cells, e.g. seed 001 Fig. 8's row next to x = 0) does so at the x_B in
+     the boundary cells it names: x_B's cell is the real cell containing it (a point on
+     a cell boundary goes to the upper cell, as for the mirror point). *Reading:* the
+     paper's mirror relations hold per face; this is their pointwise form;
+   - otherwise, also on the rest of a partly prescribed face (Neumann):
+     u_f,k = u_m,k + (x_f - x_m) . G_k, G_ka = du_k/dx_a from the traction t of the
+     face normal to axis a that contains x_B (0 if none):
      du_a/dx_a = s t_a / (lambda + 2 mu), du_k/dx_a = s t_k / mu (k != a), s = the
      sign of the outward normal. *Reading (a guess):* the local traction condition with
      the tangential derivatives neglected, the elastic analogue of the diffusion
@@ -67,6 +74,27 @@ def _box_entry(x, n, lo, hi):
     return np.maximum(np.max(t_enter, axis=1), 0.0)
 
 
+def prescribed_parts(dirichlet):
+    """``[(face, component, where)]`` of the prescribed components: an item
+    ``(face, component)`` prescribes it on the whole face (``where=None``), an item
+    ``(face, component, where)`` on the boundary cells where ``where(cells)`` (integer
+    cell indices, (n, d)) is true, as :class:`~pdverify.pd.problem.FaceCondition`."""
+    return [(item[0], item[1], item[2] if len(item) > 2 else None) for item in dirichlet]
+
+
+def prescribed_at(where, cells) -> np.ndarray | bool:
+    """Which of the boundary ``cells`` a condition covers (``where=None``: all)."""
+    return True if where is None else np.asarray(where(cells), dtype=bool)
+
+
+def cells_of(grid, points) -> np.ndarray:
+    """The real cell (integer index) containing each point, clipped into the body; a
+    point on a cell boundary goes to the upper cell."""
+    lo = np.asarray(grid.origin)
+    return np.clip(np.floor((points - lo) / grid.spacing + 1e-9).astype(int), 0,
+                   np.asarray(grid.nodes_per_axis) - 1)
+
+
 NEUMANN_READINGS = ("full-traction", "normal-only")
 MIRROR_POINTS = ("nearest", "corrected")
 
@@ -84,7 +112,8 @@ def _difference_pairs(grid, cells, axis):
 class MirrorNodes:
     """Mirror nodes of a padded box grid and the affine map they give the fictitious nodes.
 
-    ``dirichlet``: (face, component) pairs prescribed, with ``exact(x) -> (n, d)`` giving
+    ``dirichlet``: the prescribed (face, component) pairs, or (face, component, where)
+    for part of a face (:func:`prescribed_parts`), with ``exact(x) -> (n, d)`` giving
     the prescribed values g; ``traction(x, normal, face) -> (n, d)`` the applied traction
     of each face (zero on free faces); ``moduli`` = (lambda, mu) of the material;
     ``neumann``: how a traction becomes the gradient of the Neumann relation
@@ -108,8 +137,7 @@ class MirrorNodes:
         t = _box_entry(x, n, lo, hi)
         xB = x + t[:, None] * n
         star = x + 2.0 * t[:, None] * n
-        cell = np.clip(np.floor((star - lo) / h + 1e-9).astype(int), 0,
-                       np.asarray(g.nodes_per_axis) - 1)
+        cell = cells_of(g, star)
         mirror = g.ext_id(cell)
         self.fictitious, self.mirror, self.boundary_point = fict, mirror, xB
         step = x - g.x[mirror]                       # x_f - x_m
@@ -122,16 +150,21 @@ class MirrorNodes:
         dirichlet_k = np.zeros((nf, d), dtype=bool)
         const_d = np.zeros((nf, d))                  # 2 g of the Dirichlet components
         const = np.zeros((nf, d))                    # traction terms of the Neumann ones
-        # the boundary values where a Dirichlet face holds x_B only (elsewhere x_B can
-        # lie outside the body, where a FEM reference is not defined)
+        # which x_B each prescribed component holds at: on its face, in the boundary
+        # cells it covers
+        parts = prescribed_parts(dirichlet)
+        boundary_cells = cells_of(g, xB)
+        hits = [on_face[:, face] & prescribed_at(where, boundary_cells)
+                for face, _, where in parts]
+        # the boundary values there only (elsewhere x_B can lie outside the body, where a
+        # FEM reference is not defined, or off the prescribed part of a face)
         used = np.zeros(nf, dtype=bool)
-        for face, _ in dirichlet:
-            used |= on_face[:, face]
+        for hit in hits:
+            used |= hit
         g_exact = np.zeros((nf, d))
         if np.any(used):
             g_exact[used] = exact(xB[used])
-        for face, k in dirichlet:
-            hit = on_face[:, face]
+        for (_, k, _), hit in zip(parts, hits):
             dirichlet_k[hit, k] = True
             const_d[hit, k] = 2.0 * g_exact[hit, k]
         # the gradient D_kb of component k along axis b at the mirror node, as

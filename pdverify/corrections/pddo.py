@@ -17,7 +17,12 @@ subdomains, not a port:
   (x_B - x_i) / 2 = g (Dirichlet), or sigma(grad u(x_B)) n = t with
   grad u(x_B) = D u + D^2 u (x_B - x_i) (traction). x_B is the node's projection on the
   face. Per component, a Dirichlet face takes precedence; otherwise the traction of the
-  face normal to that component if the node touches it, else of its other face.
+  face normal to that component if the node touches it, else of its other face. The
+  choice is made per node (per boundary cell), not per face: a face that prescribes a
+  component on part of it only (``where`` over its boundary cells, e.g. seed 001
+  Fig. 8's row next to x = 0) is a Dirichlet face for the nodes of the cells it names
+  and a traction face for its other nodes (*reading:* the paper states its boundary
+  conditions per face).
 - **Surface layer** (the other nodes within 2 delta of the surface): the equilibrium
   equation with the PDDO operators, -(lambda + mu) grad div u - mu lap u = b (times the
   node volume, so the rows are forces like the PD rows).
@@ -35,6 +40,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .factors import node_moments, solve_per_node
+from .mirror_nodes import prescribed_at, prescribed_parts
 
 
 def monomial_orders(d: int) -> list[tuple[int, ...]]:
@@ -80,17 +86,21 @@ def _d2(D, l, m):
     return D[(min(l, m), max(l, m))]
 
 
-def _choose_faces(touches, dir_faces, d):
+def _choose_faces(touches, parts, cells, d):
     """Per component k: (face, kind) of every node, kind 1 = Dirichlet, 2 = traction, 0 =
-    none (not an outer node). Dirichlet first, then the face normal to k, then any."""
+    none (not an outer node). Dirichlet first (a face prescribing k at the node's cell:
+    ``parts`` as :func:`~pdverify.corrections.mirror_nodes.prescribed_parts`), then the
+    face normal to k, then any."""
     n = touches.shape[0]
     out = []
     for k in range(d):
         face_of, kind = np.full(n, -1), np.zeros(n, dtype=int)
-        steps = ([(f, 1) for f in range(2 * d) if (f, k) in dir_faces]
-                 + [(f, 2) for f in (2 * k, 2 * k + 1)] + [(f, 2) for f in range(2 * d)])
-        for face, kd in steps:
-            hit = touches[:, face] & (face_of < 0)
+        steps = ([(f, touches[:, f] & prescribed_at(where, cells), 1)
+                  for f, k_, where in sorted(parts, key=lambda q: q[0]) if k_ == k]
+                 + [(f, touches[:, f], 2) for f in (2 * k, 2 * k + 1)]
+                 + [(f, touches[:, f], 2) for f in range(2 * d)])
+        for face, on, kd in steps:
+            hit = on & (face_of < 0)
             face_of[hit], kind[hit] = face, kd
         out.append((face_of, kind))
     return out
@@ -101,7 +111,8 @@ def pddo_system(model, face_dirichlet, exact, traction, moduli, body_load=None):
     plain-grid ``model`` (its equilibrium rows serve the bulk): ``A`` (d n x d n,
     component-major: one row per component of every real node) and ``rhs``: the boundary
     data on the outer rows, ``body_load`` (n, d; b V per node) on the others.
-    ``face_dirichlet``: (face, component) pairs prescribed at ``exact(x)``;
+    ``face_dirichlet``: (face, component) pairs prescribed at ``exact(x)``, or
+    (face, component, where) on part of a face (per node: its cell);
     ``traction(x, normal, face)``."""
     g, d, h = model.grid, model.dim, model.spacing
     n = g.n_interior
@@ -129,7 +140,8 @@ def pddo_system(model, face_dirichlet, exact, traction, moduli, body_load=None):
     rhs = np.zeros(d * n)
     if body_load is not None:
         rhs += np.where(np.tile(outer, d), 0.0, np.asarray(body_load).T.ravel())
-    for k, (face_of, kind) in enumerate(_choose_faces(touches, set(face_dirichlet), d)):
+    chosen = _choose_faces(touches, prescribed_parts(face_dirichlet), cells, d)
+    for k, (face_of, kind) in enumerate(chosen):
         for face in range(2 * d):
             axis, side = divmod(face, 2)
             for kd in (1, 2):

@@ -14,7 +14,8 @@ keyed by face and component) into a :class:`~pdverify.pd.problem.LinearSystem`.
   every line perpendicular to a face (Eq. 58), tractions as the force flux through every
   boundary cell face (Eq. 60 in 1D; the face-crossing bonds of seed 001 §3.4 in 2D/3D).
 - ``mirror-nodes`` and ``pddo`` (seed 001 §5): through the modules of the same name;
-  both need whole-face conditions.
+  both choose the Dirichlet or the traction relation per boundary cell face, so a
+  component prescribed on part of a face is imposed there only.
 
 Each function returns the system; the scene solves it (``pdverify.solvers.front``) and
 measures it. Node counts and the budget's footprint come from :func:`footprint`.
@@ -85,10 +86,6 @@ def _traction_of(problem):
             return np.zeros_like(x)
         return cond.traction(x, n)
     return traction
-
-
-def _face_dirichlet(problem):
-    return tuple((f, k) for f, k, _ in problem.prescribed())
 
 
 def footprint(kind: str, cells, m_ratio: float):
@@ -364,7 +361,7 @@ def assemble_mirror(problem, neumann: str, mirror_point: str) -> LinearSystem:
     """Seed 001 §5's mirror node method (``corrections.mirror_nodes``): the loads and
     constraints enter through the mirror relations only."""
     g = _grid(problem, problem.stencil.reach)
-    mirror = MirrorNodes(g, problem.stencil, dirichlet=_face_dirichlet(problem),
+    mirror = MirrorNodes(g, problem.stencil, dirichlet=problem.prescribed(),
                          exact=problem.exact, traction=_traction_of(problem),
                          moduli=problem.constants.moduli(), neumann=neumann,
                          mirror_point=mirror_point)
@@ -396,7 +393,7 @@ def assemble_pddo(problem) -> LinearSystem:
     model = _model(problem, g, None)
     x_int = g.x[g.interior_ids]
     body = problem.body_load(x_int, model.node_volume[g.interior_ids][:, None])
-    A, rhs, counts = pddo_system(model, _face_dirichlet(problem), problem.exact,
+    A, rhs, counts = pddo_system(model, problem.prescribed(), problem.exact,
                                  _traction_of(problem), problem.constants.moduli(), body)
     return LinearSystem(model, A, rhs, np.zeros(0, dtype=int), np.zeros(0), g.n_interior,
                         solver="direct", counts=counts)
