@@ -292,6 +292,14 @@ class Body3DTraction(Body3D):
     4e-4). With ``quadrature=moment-corrected`` the error is about 2e-10 %, i.e. the
     method is exact for this field to round-off (tested).
 
+    ``mirror-nodes`` and ``pddo`` (seed 001 §5) take the same conditions per boundary
+    cell: the Dirichlet relation (boundary rows) where a component is prescribed, the
+    traction one elsewhere on the face. Both reproduce Eq. (39) to round-off (1.4e-10 and
+    1.2e-10 %, tests/treatments/test_partial_faces.py), even the nearest mirror node:
+    each prescribed component varies along its face's normal only, and the mirror
+    point's normal coordinate falls on a node. At this size every node is within 2 delta
+    of the surface, so PDDO has no LPS bulk here.
+
     Metrics over the interior nodes: ``max_error_pct`` = max of Eq. (38) with u_max per
     component over the nodes, ``rel_l2_error``, and both split into ``boundary_`` (nodes
     within delta of the surface) and ``interior_``; ``surface_max_error_pct`` is the

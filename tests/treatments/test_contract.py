@@ -174,3 +174,17 @@ def test_import_graph_runs_one_way():
 
 def test_cycle_finder_can_fail():
     assert _cycles({"a": {"b"}, "b": {"a"}, "c": set()}) == [["a", "b"]]
+
+
+def test_a_whole_faces_only_treatment_is_refused_where_part_of_a_face_is_prescribed():
+    """No built-in needs it since mirror-nodes and pddo choose their relation per boundary
+    cell; a plugin that can impose a component only on whole faces declares
+    ``whole_faces_only`` and gets its one-line reason on body3d-traction (its v and w
+    constraints hold on one cell row of a face), not on body3d-manufactured."""
+    import dataclasses
+    from pdverify.scenes import get_scene
+    t = dataclasses.replace(treatments()["mirror-nodes"], name="whole-faces-demo",
+                            whole_faces_only=True, scope="whole faces only (demo)")
+    reason = t.why_not(get_scene("body3d-traction"))
+    assert reason and "prescribes a component on part of a face" in reason
+    assert t.why_not(get_scene("body3d-manufactured")) is None
