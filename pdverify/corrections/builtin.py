@@ -127,7 +127,7 @@ def family_treatments() -> list[Treatment]:
             "extrapolation (1D series along the normal; corners by Eq. 69), Dirichlet and "
             "Neumann conditions via Lagrange multipliers (Eqs. 58, 60, 63)",
             "Scabbia, Zaccariotto, Galvanetto 2021 (seed 000)", params=(ORDER, CORNERS),
-            theories=STATE, dims=(1, 2), families=FAMILY, footprint="fictitious",
+            theories=STATE, dims=(1, 2, 3), families=FAMILY, footprint="fictitious",
             scope="state-based 1D and 2D; 3D not offered: at the seed-001 boxes' "
                   "h = 0.05 its corner extrapolation rows make the bordered system 11 M "
                   "non-zeros, 90-110 s and 5-6 GB (measured), and on a 8 x 6 x 6-cell box "

@@ -241,13 +241,16 @@ def assemble_taylor(problem, order: int, corners: str = "normal-only") -> Linear
     model = _model(problem, g, closure)
     ni = g.n_interior
     P = model.equilibrium_rows()
-    K = model.stiffness(P)
+    solver = static_solver(problem.solver, d, d * ni)
     x_int = g.x[g.interior_ids]
     rhs = problem.body_load(x_int, model.node_volume[g.interior_ids][:, None]).T.ravel()
-    K_b = model.bond_force_matrix() if d == 1 or flux is not None else None
+    K_b = model.bond_force_matrix() if d == 1 else None
+    # the constraint rows act on the solver's unknowns: the real displacements (direct),
+    # or those and the real dilatations (the augmented system of nested dissection)
+    width = d * ni if solver == "direct" else (d + 1) * ni
     rows, vals = [], []
-    if flux is not None:   # force of each boundary cell face from the real displacements
-        Fs = (_surface_flux(model, flux, g.n_surface) @ K_b).tocsr()
+    if flux is not None:   # force of each boundary cell face from the unknowns
+        Fs = (_surface_flux(model, flux, g.n_surface) @ _bond_forces(model, solver)).tocsr()
     for face in range(2 * d):
         axis, side = divmod(face, 2)
         cond = problem.conditions.get(FACES[face])
@@ -275,7 +278,7 @@ def assemble_taylor(problem, order: int, corners: str = "normal-only") -> Linear
             if np.any(imposed):
                 Rk = sp.coo_matrix(R[np.flatnonzero(imposed)])
                 rows.append(sp.csr_matrix((Rk.data, (Rk.row, Rk.col + k * ni)),
-                                          shape=(int(imposed.sum()), d * ni)))
+                                          shape=(int(imposed.sum()), width)))
                 vals.append(exact[imposed, k])
             free = np.flatnonzero(~pres)
             if free.size == 0:
@@ -302,24 +305,35 @@ def assemble_taylor(problem, order: int, corners: str = "normal-only") -> Linear
         return float((model.crossing_selector([g.face_coordinate(face)]) @ K_b @ x[:ni])[0])
     counts = {"fictitious_nodes": int(g.n_ext - g.n_interior), "constraints": int(B.shape[0])}
     none = np.zeros(0, dtype=int), np.zeros(0)
-    solver = static_solver(problem.solver, d, d * ni)
     if solver == "direct":
-        return LinearSystem(model, K, rhs, *none, ni, B=B, c=c, reaction=reaction,
-                            counts=counts)
+        return LinearSystem(model, model.stiffness(P), rhs, *none, ni, B=B, c=c,
+                            reaction=reaction, counts=counts)
     # the bordered augmented system [[A, B^T], [B, 0]] (dilatations and multipliers as
     # unknowns) under nested dissection: each block couples within one horizon, so its
     # separators are half as thick as K's (on the seed-001 plate at h = 0.0125: 6.7 s
     # against 19.6 s for the Lagrange system of K, same machine, solutions equal to
-    # 5e-13); a multiplier sits at the mean position of the nodes its row involves
+    # 5e-13); the flux rows too act on the dilatations as unknowns (see _bond_forces); a
+    # multiplier sits at the mean position of the nodes its row involves
     A = model.augmented_stiffness(P)
-    Bx = sp.hstack([B, sp.csr_matrix((B.shape[0], A.shape[0] - B.shape[1]))]).tocsr()
-    M = sp.bmat([[A, Bx.T], [Bx, None]], format="csr")
-    x_int = g.x[g.interior_ids]
+    M = sp.bmat([[A, B.T], [B, None]], format="csr")
     absB = abs(B).tocsr()
-    at = (absB @ np.tile(x_int, (d, 1))) / np.asarray(absB.sum(axis=1))
+    at = (absB @ np.tile(x_int, (d + 1, 1))) / np.asarray(absB.sum(axis=1))
     return LinearSystem(model, M, np.r_[rhs, np.zeros(A.shape[0] - rhs.size), c], *none, ni,
                         solver=solver, coords=np.r_[_coords(model, x_int), at],
                         reaction=reaction, counts=counts)
+
+
+def _bond_forces(model, solver):
+    """Scalar bond forces (times beta V_a V_b) as a matrix on the solver's unknowns: of the
+    real displacements (``model.bond_force_matrix``, whose dilatation term couples nodes
+    two horizons apart), or for the augmented system of the displacements and the real
+    dilatations [K_e A_e A_U, K_theta A_Theta], each block within one horizon: on the 3D
+    box at h = 0.05 the flux rows of a face then hold ~1/10 of the non-zeros (the
+    bordered matrix 11.0 M -> see benchmarks/taylor3d.py)."""
+    if solver == "direct":
+        return model.bond_force_matrix()
+    e = (model.A_e @ model.A_U_full).tocsr()
+    return sp.hstack([model.K_e @ e, model.K_theta @ model.A_Theta]).tocsr()
 
 
 def _corner_lines(problem, g, anchors, axis, k):
