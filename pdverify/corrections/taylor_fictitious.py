@@ -120,6 +120,17 @@ def boundary_value_rows(grid, order: int, face: int) -> tuple[sp.csr_matrix, np.
 CORNER_RULES = ("normal-only", "both")
 
 
+def yields_component(axis: int, other_axis: int, k: int) -> bool:
+    """Whether, under ``normal-only``, a line of a face with normal ``axis`` through a
+    node it shares with a face of normal ``other_axis`` (both prescribing component
+    ``k`` on their whole face) leaves ``k`` to the other face's line: when ``k`` is the
+    other face's normal component (Remark 4's rule for two faces), or, in 3D, when ``k``
+    is tangential to both faces and the other face has the lower axis. Without that
+    second case the component along a 3D box edge (u_z where x- and y- meet) was on
+    neither line: unconstrained, the Lagrange system singular."""
+    return k != axis and (other_axis == k or (other_axis != axis and other_axis < axis))
+
+
 def clamped_rows(grid, order: int, faces, corners: str = "normal-only"):
     """Constraint rows of clamped ``faces``: the displacement at the boundary point of every
     line perpendicular to a face, by the Taylor extrapolation of Eq. (58), for every
@@ -136,15 +147,14 @@ def clamped_rows(grid, order: int, faces, corners: str = "normal-only"):
     for face in faces:
         axis = face // 2
         R, anchors = boundary_value_rows(grid, order, face)
-        at_corner = np.zeros(anchors.shape[0], dtype=bool)
-        for other in faces:
-            if other // 2 != axis:
-                at_corner |= anchors[:, other // 2] == grid.boundary_layer(other)
         x = grid.x[grid.ext_id(anchors)]
         x[:, axis] = grid.face_coordinate(face)
         for k in range(d):
-            keep = np.flatnonzero(np.ones_like(at_corner) if (corners == "both" or k == axis)
-                                  else ~at_corner)
+            at_corner = np.zeros(anchors.shape[0], dtype=bool)
+            for other in faces:
+                if corners == "normal-only" and yields_component(axis, other // 2, k):
+                    at_corner |= anchors[:, other // 2] == grid.boundary_layer(other)
+            keep = np.flatnonzero(~at_corner)
             Rk = sp.coo_matrix(R[keep])
             blocks.append(sp.csr_matrix((Rk.data, (Rk.row, Rk.col + k * n)),
                                         shape=(keep.size, d * n)))
