@@ -127,7 +127,9 @@ def yields_component(axis: int, other_axis: int, k: int) -> bool:
     other face's normal component (Remark 4's rule for two faces), or, in 3D, when ``k``
     is tangential to both faces and the other face has the lower axis. Without that
     second case the component along a 3D box edge (u_z where x- and y- meet) was on
-    neither line: unconstrained, the Lagrange system singular."""
+    neither line: not imposed there at all (the system stays regular; the edge nodes'
+    equilibrium set it), where every other boundary node has each component imposed on
+    exactly one line."""
     return k != axis and (other_axis == k or (other_axis != axis and other_axis < axis))
 
 
