@@ -312,26 +312,49 @@ def assemble_taylor(problem, order: int, corners: str = "normal-only") -> Linear
     # unknowns) under nested dissection: each block couples within one horizon, so its
     # separators are half as thick as K's (on the seed-001 plate at h = 0.0125: 6.7 s
     # against 19.6 s for the Lagrange system of K, same machine, solutions equal to
-    # 5e-13); the flux rows too act on the dilatations as unknowns (see _bond_forces); a
-    # multiplier sits at the mean position of the nodes its row involves
+    # 5e-13); in 3D the flux rows too act on the dilatations as unknowns (_bond_forces);
+    # a multiplier sits at the mean position of the nodes its row involves
     A = model.augmented_stiffness(P)
-    M = sp.bmat([[A, B.T], [B, None]], format="csr")
     absB = abs(B).tocsr()
     at = (absB @ np.tile(x_int, (d + 1, 1))) / np.asarray(absB.sum(axis=1))
-    return LinearSystem(model, M, np.r_[rhs, np.zeros(A.shape[0] - rhs.size), c], *none, ni,
-                        solver=solver, coords=np.r_[_coords(model, x_int), at],
+    B_theta = B[:, d * ni:]
+    if B_theta.nnz == 0:
+        M = sp.bmat([[A, B.T], [B, None]], format="csr")
+        return LinearSystem(model, M, np.r_[rhs, np.zeros(A.shape[0] - rhs.size), c], *none,
+                            ni, solver=solver, coords=np.r_[_coords(model, x_int), at],
+                            reaction=reaction, counts=counts)
+    # rows on the dilatations (3D): the multipliers' forces on the displacements must be
+    # those of the direct system, (B_u + B_theta G)^T lambda with G = A_theta A_e A_U
+    # (theta = G u); B^T alone would put B_theta^T lambda into the dilatation rows and
+    # solve another problem (7 % apart on body3d-manufactured, order 2, h = 0.0625).
+    # Kept sparse by mu = B_theta^T lambda as ni more unknowns at the nodes:
+    # [[A, [G^T; 0], [B_u^T; 0]], [0, I, -B_theta^T], [B, 0, 0]]
+    G = (model.A_theta @ (model.A_e @ model.A_U_full)).tocsr()
+    zero_theta = sp.csr_matrix((ni, ni))
+    M = sp.bmat([[A, sp.vstack([G.T, zero_theta]), sp.vstack([B[:, :d * ni].T,
+                                                                sp.csr_matrix((ni, B.shape[0]))])],
+                 [None, sp.identity(ni, format="csr"), -B_theta.T],
+                 [B, None, None]], format="csr")
+    return LinearSystem(model, M, np.r_[rhs, np.zeros(A.shape[0] - rhs.size + ni), c], *none,
+                        ni, solver=solver, coords=np.r_[_coords(model, x_int), x_int, at],
                         reaction=reaction, counts=counts)
 
 
 def _bond_forces(model, solver):
-    """Scalar bond forces (times beta V_a V_b) as a matrix on the solver's unknowns: of the
-    real displacements (``model.bond_force_matrix``, whose dilatation term couples nodes
-    two horizons apart), or for the augmented system of the displacements and the real
-    dilatations [K_e A_e A_U, K_theta A_Theta], each block within one horizon: on the 3D
-    box at h = 0.05 the flux rows of a face then hold ~1/10 of the non-zeros (the
-    bordered matrix 11.0 M -> see benchmarks/taylor3d.py)."""
+    """Scalar bond forces (times beta V_a V_b) as a matrix on the solver's unknowns, the
+    flux rows' factor. Direct: of the real displacements (``model.bond_force_matrix``,
+    whose dilatation term couples nodes two horizons apart). Augmented (displacements,
+    then the real dilatations): in 3D [K_e A_e A_U, K_theta A_Theta], each block within
+    one horizon, which takes body3d-traction at h = 0.05 from 11.0 M to 5.3 M non-zeros,
+    5.3 GB to 1.8 GB and 42 s to 24 s (benchmarks/taylor3d.py); in 2D the bond forces of
+    the displacements beside zero dilatation columns, as before: there the one-horizon
+    form raised the plane-strain plate's condition estimate at h = 0.0125 from 2.1e5 to
+    6.8e9 and moved its errors by 3e-7 (relative)."""
     if solver == "direct":
         return model.bond_force_matrix()
+    ni = model.A_theta.shape[0]
+    if model.dim != 3:
+        return sp.hstack([model.bond_force_matrix(), sp.csr_matrix((model.bond_a.size, ni))])
     e = (model.A_e @ model.A_U_full).tocsr()
     return sp.hstack([model.K_e @ e, model.K_theta @ model.A_Theta]).tocsr()
 

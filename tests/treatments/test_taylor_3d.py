@@ -24,7 +24,7 @@ MISS = 1e-6
 def _system(scene_id, box, **over):
     scene = get_scene(scene_id)
     p = scene.resolve(METHOD, {"lx": box[0], "ly": box[1], "lz": box[2], "spacing": 0.1,
-                               "solver": "direct", **over})
+                               "solver": over.pop("solver", "direct"), **over})
     problem = scene.problem(p, "test")
     return problem, p
 
@@ -133,3 +133,20 @@ def test_clamped_box_imposes_each_component_once_at_every_boundary_node(order):
     boundary[[0, -1], :, :] = boundary[:, [0, -1], :] = boundary[:, :, [0, -1]] = True
     assert np.all(count[boundary] == 1), np.argwhere(count[boundary] != 1)[:5]
     assert np.all(count[~boundary] == 0)
+
+
+def test_bordered_system_solves_the_same_problem_as_the_direct_one():
+    """The nested-dissection path (dilatations and mu = B_theta^T lambda as unknowns)
+    is a rewriting of the direct Lagrange system: on a field no order reproduces
+    (body3d-manufactured's cubic, so that the multipliers are nonzero) both give the same
+    displacements. Tolerance: each solve's forward error is below its condition estimate
+    times eps (a factor 100 for the norms), so their difference below the sum."""
+    out = {}
+    for solver in ("direct", "nested-dissection"):
+        problem, p = _system("body3d-manufactured", (1.0, 0.6, 0.6), order=2, solver=solver)
+        system = _assemble(problem, p)
+        x, info = solve(system, where=f"test/{solver}")
+        out[solver] = (system.displacements(x)[:system.model.grid.n_interior],
+                       info["condition_estimate"])
+    (u1, c1), (u2, c2) = out["direct"], out["nested-dissection"]
+    assert np.abs(u1 - u2).max() / np.abs(u1).max() < 100 * EPS * (c1 + c2)
