@@ -128,11 +128,13 @@ def family_treatments() -> list[Treatment]:
             "Neumann conditions via Lagrange multipliers (Eqs. 58, 60, 63)",
             "Scabbia, Zaccariotto, Galvanetto 2021 (seed 000)", params=(ORDER, CORNERS),
             theories=STATE, dims=(1, 2, 3), families=FAMILY, footprint="fictitious",
-            scope="state-based 1D and 2D; 3D not offered: at the seed-001 boxes' "
-                  "h = 0.05 its corner extrapolation rows make the bordered system 11 M "
-                  "non-zeros, 90-110 s and 5-6 GB (measured), and on a 8 x 6 x 6-cell box "
-                  "its Lagrange system was near-singular (condition 1e16), not yet "
-                  "understood",
+            scope="state-based 1D, 2D and 3D (3D is our extension). 3D at the seed-001 "
+                  "boxes' h = 0.05: 35-40 s and 2.1-2.2 GB (bordered system under nested "
+                  "dissection, 6.1-6.5 M non-zeros); one flux row of each edge cell's "
+                  "complementary shear pair is dropped (else near-singular: "
+                  "static_state.assemble_taylor). body3d-manufactured's quick grid "
+                  "(10 x 5 x 5 cells) keeps 2 dependent constraint rows and fails as "
+                  "near-singular",
             build=_taylor, checker=_check_taylor),
         FamilyTreatment(
             "surface-nodes", "seeds 001/002: surface nodes carry the boundary conditions, "

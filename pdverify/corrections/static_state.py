@@ -220,7 +220,26 @@ def assemble_taylor(problem, order: int, corners: str = "normal-only") -> Linear
     ``normal-only`` keeps on such a line only the row of the component normal to its
     face (the tangential one is imposed by the other face's line), ``both`` keeps every
     row (the system is then singular: the over-constraint Remark 4 avoids). On faces
-    prescribing different components (seed 001's plate) the rule changes nothing."""
+    prescribing different components (seed 001's plate) the rule changes nothing.
+
+    3D (our extension; seed 000 is 1D/2D). Two findings of issue 30, each fixed at its
+    cause. (1) The near-singular Lagrange system of the 3D boxes came from the flux
+    rows, not from the corner rule: at an edge cell whose two faces both take flux rows,
+    face a's row of component b and face b's row of component a are the shear force of
+    one cell on its two faces (sigma_ab = sigma_ba), near-dependent rows, one direction
+    per body edge; on the 8 x 6 x 6-cell box one combination was exactly dependent, on
+    the quick 10 x 5 x 5 grid B was square and 20 rows short of full rank. One row of
+    each pair is dropped (:func:`_shear_pair_lines`). (2) The corner rule handled pairs
+    of faces only: on a box clamped all round, the component along an edge (tangential
+    to both faces) was imposed on neither line; it now goes to the face of the lower axis
+    (:func:`~pdverify.corrections.taylor_fictitious.yields_component`). Both are pinned
+    in tests/treatments/test_taylor_3d.py. What remains: B's smallest singular values
+    (rows scaled to unit 1-norm) are still ~1e-4 at h = 0.1 (condition estimates 1e7 to
+    1e10); on body3d-manufactured's cubic field order 1 gives 30 / 18 / 13 % at
+    h = 1/12, 1/16, 1/20 (surface nodes N = 1: 1.9 % at 1/20), order 2 0.54 / 0.22 /
+    0.105 % (surface nodes N = 2: 0.32 %); why order 1 is that far off is not yet
+    investigated. body3d-manufactured's quick grid
+    (10 x 5 x 5) keeps 2 dependent rows and fails as near-singular."""
     g = _grid(problem, problem.stencil.reach)
     d = g.dim
     # a face that prescribes every component on its whole face needs no flux rows; a box
@@ -345,8 +364,9 @@ def _bond_forces(model, solver):
     flux rows' factor. Direct: of the real displacements (``model.bond_force_matrix``,
     whose dilatation term couples nodes two horizons apart). Augmented (displacements,
     then the real dilatations): in 3D [K_e A_e A_U, K_theta A_Theta], each block within
-    one horizon, which takes body3d-traction at h = 0.05 from 11.0 M to 5.3 M non-zeros,
-    5.3 GB to 1.8 GB and 42 s to 24 s (benchmarks/taylor3d.py); in 2D the bond forces of
+    one horizon, which (with the mu unknowns of assemble_taylor) takes body3d-traction at
+    h = 0.05 from 11.0 M to 6.2 M non-zeros, 5.3 GB to 2.1 GB and 42 s to 36 s (whole
+    runs, /usr/bin/time; benchmarks/taylor3d.py times the parts); in 2D the bond forces of
     the displacements beside zero dilatation columns, as before: there the one-horizon
     form raised the plane-strain plate's condition estimate at h = 0.0125 from 2.1e5 to
     6.8e9 and moved its errors by 3e-7 (relative)."""
@@ -380,7 +400,7 @@ def _shear_pair_lines(problem, g, anchors, axis, k):
     equal in the continuum, near-equal on the lattice, so imposing both makes the
     constraint rows (near-)dependent, one direction per body edge (measured on 10 x 7 x 7
     cells at m = 3: the smallest singular values of the row-normalised B 7e-7 ... 8e-6,
-    each concentrated on one edge's pair rows, 1e-4 with one row of each pair dropped;
+    concentrated on the edge cells' rows, 1e-4 with one row of each pair dropped;
     on the quick 10 x 5 x 5 grid B was square and 20 rows short of full rank, full rank
     without them). The row of the face with the lower axis is kept (either serves: a
     field meeting the kept row meets the dropped one to the lattice error). In 2D the
