@@ -67,9 +67,13 @@ def _run(args, queue):
     from pdverify.solvers.front import solve
     scene_id, spacing, order, alternative = args
     t0 = time.perf_counter()
-    system = _system(scene_id, spacing, order, alternative)
-    t1 = time.perf_counter()
-    x, info = solve(system, where=f"bench/{alternative}")
+    try:
+        system = _system(scene_id, spacing, order, alternative)
+        t1 = time.perf_counter()
+        x, info = solve(system, where=f"bench/{alternative}")
+    except Exception as exc:   # a near-singular system is a result here, not a crash
+        queue.put({"failed": str(exc)})
+        return
     t2 = time.perf_counter()
     u = system.displacements(x)[:system.model.grid.n_interior]
     queue.put({"setup_s": t1 - t0, "solve_s": t2 - t1, "nnz": int(system.K.nnz),
@@ -103,6 +107,11 @@ def main(argv=None) -> int:
             first = None
             for alt in a.only:
                 runs = [_once((scene_id, h, a.order, alt)) for _ in range(a.repeat)]
+                if "failed" in runs[0]:
+                    print(f"{scene_id} h={h:g} {alt:10s} failed: {runs[0]['failed']}")
+                    rows.append({"scene": scene_id, "spacing": h, "alternative": alt,
+                                 "failed": runs[0]["failed"]})
+                    continue
                 u = runs[0]["u"]
                 first = u if first is None else first
                 row = {"scene": scene_id, "spacing": h, "alternative": alt,
