@@ -96,7 +96,8 @@ def cells_of(grid, points) -> np.ndarray:
 
 
 NEUMANN_READINGS = ("full-traction", "normal-only")
-MIRROR_POINTS = ("nearest", "corrected")
+MIRROR_POINTS = ("nearest", "corrected", "at-mirror-point")
+GRADIENT_AT = ("mirror", "boundary")
 
 
 def _difference_pairs(grid, cells, axis):
@@ -118,15 +119,19 @@ class MirrorNodes:
     of each face (zero on free faces); ``moduli`` = (lambda, mu) of the material;
     ``neumann``: how a traction becomes the gradient of the Neumann relation
     (:data:`NEUMANN_READINGS`); ``mirror_point``: the nearest node as it is, or with its
-    mismatch corrected by its gradient (:data:`MIRROR_POINTS`; module docstring).
+    mismatch corrected by its gradient, or taken as sitting at the mirror point
+    (:data:`MIRROR_POINTS`); ``gradient_at``: the cell whose central differences give
+    the tangential derivatives of the full traction relation, the mirror node's or the
+    boundary point's (:data:`GRADIENT_AT`; module docstring).
     """
 
     def __init__(self, grid, stencil, dirichlet, exact, traction, moduli,
-                 neumann="full-traction", mirror_point="nearest"):
-        if neumann not in NEUMANN_READINGS:
-            raise ValueError(f"neumann={neumann!r}; allowed: {', '.join(NEUMANN_READINGS)}")
-        if mirror_point not in MIRROR_POINTS:
-            raise ValueError(f"mirror_point={mirror_point!r}; allowed: {', '.join(MIRROR_POINTS)}")
+                 neumann="full-traction", mirror_point="nearest", gradient_at="mirror"):
+        for name, value, allowed in (("neumann", neumann, NEUMANN_READINGS),
+                                     ("mirror_point", mirror_point, MIRROR_POINTS),
+                                     ("gradient_at", gradient_at, GRADIENT_AT)):
+            if value not in allowed:
+                raise ValueError(f"{name}={value!r}; allowed: {', '.join(allowed)}")
         g, d, h = grid, grid.dim, grid.spacing
         self.grid = g
         fict = np.flatnonzero(~g.is_interior)
@@ -140,7 +145,9 @@ class MirrorNodes:
         cell = cells_of(g, star)
         mirror = g.ext_id(cell)
         self.fictitious, self.mirror, self.boundary_point = fict, mirror, xB
-        step = x - g.x[mirror]                       # x_f - x_m
+        # the step of the Neumann relation: x_f - x_m, or x_f - x* when the mirror node
+        # is taken as sitting at the mirror point x* (then wrong by x* - x_m near corners)
+        step = x - (star if mirror_point == "at-mirror-point" else g.x[mirror])
         lam, mu = moduli
         tol = 1e-9 * h
         nf = fict.size
@@ -169,7 +176,8 @@ class MirrorNodes:
             const_d[hit, k] = 2.0 * g_exact[hit, k]
         # the gradient D_kb of component k along axis b at the mirror node, as
         # constant + sum over (node, component) entries: lists per (k, b)
-        pairs = [_difference_pairs(g, cell, b) for b in range(d)]
+        at = cell if gradient_at == "mirror" else boundary_cells
+        pairs = [_difference_pairs(g, at, b) for b in range(d)]
         full = neumann == "full-traction"
         entries = []   # (fict mask, k, node ids, component j, coefficient per fict)
         dirichlet_entries = []
