@@ -41,6 +41,26 @@ diffusion. What we implement, and which parts are our reading (a guess where mar
      conditions via the mirror nodes'.
    The loads enter through these relations only (no nodal forces); the constant parts
    (2 g, the traction terms) become the right-hand side.
+
+Further readings of seed 001 §5.2 (params; defaults as above, issue 33's study on
+plate2d-plane-strain):
+
+- ``mirror_point``: ``nearest`` (above), ``corrected`` (u_f = 2 g - u_m + (x_f + x_m -
+  2 x_B) . grad u_m for a Dirichlet component: the mismatch between the mirror node and
+  the mirror point corrected by the node's gradient; our variant, exact for affine
+  fields) or ``at-mirror-point`` (the Neumann step taken from the mirror point x*
+  instead of the node, u_f = u_m + (x_f - x*) . G: the text's 'same (symmetric)
+  distance from the boundary' read literally, the mirror node standing for x*. Exact
+  beside a straight face, where x_m = x*; not near corners, where it is wrong by
+  (x* - x_m) . G).
+- ``gradient_at``: the cell whose central differences give the tangential derivatives
+  of the full traction relation, ``mirror`` (x_m's) or ``boundary`` (x_B's: the
+  traction condition holds at the boundary). The same for affine fields.
+- Not implemented: the paper's 2 delta fictitious layer with the fictitious nodes'
+  dilatations computed from their own neighbourhoods (the engine computes dilatations
+  of real nodes only; fictitious ones come through ``dilatation_map``). With
+  displacement relations exact for affine fields it gives the same affine field (every
+  neighbourhood it adds is complete), so it cannot change the plate's result.
 """
 from __future__ import annotations
 
