@@ -479,8 +479,9 @@ class Plate2DPlaneStrain(SurfaceNodeScene):
     side): ``pals`` (``pdverify.corrections.pals``: constraints and loads as ``none``),
     ``mirror-nodes`` (``corrections.mirror_nodes``; u = 0 on x = 0 and v = 0 on y = 0
     through odd reflections, the tractions through the Neumann relation; params
-    ``neumann``, ``mirror_point`` and ``gradient_at``) and ``pddo`` (``corrections.pddo``: boundary rows
-    on the outer node layer, PDDO equilibrium within 2 delta, LPS beyond). Each module's
+    ``neumann``, ``mirror_point`` and ``gradient_at``) and ``pddo``
+    (``corrections.pddo``: boundary rows on the outer node layer, PDDO equilibrium
+    within 2 delta, LPS beyond; param ``bulk_model``). Each module's
     docstring says which parts are our reading. Findings at h = 0.02 (not tuned):
     PALS 2.54 % in u, 2.20 % in v (none: 12.3, 7.6 %; SNM 1.20, 0.51 %), so PALS lowers
     both errors and SNM stays below it, as §5 says; with the full traction condition
@@ -505,8 +506,10 @@ class Plate2DPlaneStrain(SurfaceNodeScene):
     affine fields gives round-off; a wrong boundary strain moves the plate to another
     homogeneous state, in which the free face x = l_x ties u to v (equal relative
     errors if its relation is exact, u worse if not, as normal-only); a corner mismatch
-    errs at the corners in both components. An error in v away from the corners that
-    leaves u exact needs a field the plate does not have.
+    errs at the corners in both components. So 'close in x, worst in y' cannot come
+    from a homogeneous error (equal relative errors, or u worse), only from errors local
+    to the boundary, and the local errors of these readings (corner mismatches) are
+    small in both components.
     """
 
     id = "plate2d-plane-strain"

@@ -23,20 +23,19 @@ def _label(r) -> str:
     return label(r) + "".join(", " + e for e in extra)
 
 
-
-
+def _paper_settings(r) -> bool:
+    """A run at seed 001's quadrature, influence function and m-ratio."""
+    return (r.params.get("quadrature") == "partial-volume"
+            and r.params.get("influence") == "gaussian" and r.params.get("m_ratio") == 3.0)
 
 
 def _columns_2d(scene, results):
     """The runs of the 2D plate's shared-scale figure, with their titles: the panels of
     seed 001 §5 (:data:`SECTION5`, at the paper's settings) in the paper's order, then
     every other method's run at its default parameters."""
-    def paper(r):
-        return (r.params.get("quadrature") == "partial-volume"
-                and r.params.get("influence") == "gaussian" and r.params.get("m_ratio") == 3.0)
     cols, seen = [], set()
     for method, want, title in SECTION5:
-        hit = [r for r in results if r.method == method and paper(r)
+        hit = [r for r in results if r.method == method and _paper_settings(r)
                and all(r.params.get(k) == v for k, v in want.items())]
         if hit and id(hit[0]) not in seen:
             cols.append((title, hit[0]))
@@ -223,11 +222,6 @@ SECTION5_READINGS = (
 )
 
 
-def _paper_settings(r) -> bool:
-    return (r.params.get("quadrature") == "partial-volume"
-            and r.params.get("influence") == "gaussian" and r.params.get("m_ratio") == 3.0)
-
-
 def _reading_run(results, method, want, spacing):
     """The run of ``method`` at the paper's settings and ``spacing`` whose reading params
     are ``want`` (the others at their defaults)."""
@@ -303,9 +297,10 @@ def _readings_table(scene, results, folder):
                "homogeneous state (normal-only: the free face x = l_x imposes the relation "
                "that ties u to v, so both err, u more) or errs at the corners, where the "
                "mirror node is only the nearest one (the step from the mirror point: in "
-               "both components, v below PALS). The paper's 'close in x except one corner, "
-               "worst in y' needs an error in v away from the corners that leaves u "
-               "exact, which no reading of a homogeneous plate gives.")
+               "both components, v below PALS). In a homogeneous state whose free-face "
+               "relation is exact the relative errors of u and v are equal, so 'close in "
+               "x except one corner, worst in y' can only come from errors local to the "
+               "boundary, and the readings' local errors are small in both components.")
     return [(name, "Seed 001 §5.2-5.4, the readings of the mirror node method and the PDDO "
                    "layer that the text allows, run on the plate at the paper's settings: "
                    "the largest Eq. (44) error of each component, where it sits (within one "
