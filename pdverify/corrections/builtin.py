@@ -8,7 +8,8 @@ from typing import Any, Callable, Mapping
 from ..errors import InputError
 from ..params import Param, at_least
 from ..pd.problem import LOAD_POINTS
-from .mirror_nodes import MIRROR_POINTS, NEUMANN_READINGS
+from .mirror_nodes import GRADIENT_AT, MIRROR_POINTS, NEUMANN_READINGS
+from .pddo import BULK_MODELS
 from .surface_nodes import MAX_ORDER
 from .taylor_fictitious import CORNER_RULES
 from .treatment import Treatment
@@ -86,12 +87,13 @@ def _surface(problem, p):
 
 def _mirror(problem, p):
     from .static_state import assemble_mirror
-    return assemble_mirror(problem, p["neumann"], p["mirror_point"])
+    return assemble_mirror(problem, p["neumann"], p["mirror_point"],
+                           p.get("gradient_at", "mirror"))
 
 
 def _pddo(problem, p):
     from .static_state import assemble_pddo
-    return assemble_pddo(problem)
+    return assemble_pddo(problem, p.get("bulk_model", "lps"))
 
 
 LOAD_POINT = Param("load_point", "surface", "where the uncorrected model evaluates a "
@@ -110,8 +112,19 @@ MIRROR_PARAMS = (
           "at the mirror node (central differences), or the normal derivatives alone "
           "(tangential terms dropped)", choices=NEUMANN_READINGS),
     Param("mirror_point", "nearest", "mirror node: the real node nearest the mirror point "
-          "(the method), or that node with the mismatch corrected by its gradient "
-          "(our variant; exact for linear fields)", choices=MIRROR_POINTS))
+          "(the method), that node with the mismatch corrected by its gradient "
+          "(our variant; exact for linear fields), or that node taken as sitting at the "
+          "mirror point in the Neumann relation (step x_f - x*: a reading of seed 001 "
+          "§5.2's 'same distance from the boundary'; not exact near corners)",
+          choices=MIRROR_POINTS),
+    Param("gradient_at", "mirror", "where the full traction relation's tangential "
+          "derivatives are differenced: at the mirror node or at the boundary point "
+          "(same for affine fields)", choices=GRADIENT_AT))
+
+PDDO_PARAMS = (
+    Param("bulk_model", "lps", "equations of the nodes beyond 2 delta: the LPS model (ours) "
+          "or the PDDO equilibrium of the layer (a stand-in for the paper's non-ordinary "
+          "bulk; both exact for affine fields)", choices=BULK_MODELS),)
 
 STATE = ("state-based",)
 
@@ -155,7 +168,7 @@ def family_treatments() -> list[Treatment]:
             "pddo", "seed 001 §5: peridynamic differential operator (moment matrices exact "
             "for quadratics) for the boundary rows and the equilibrium within 2 delta, LPS "
             "beyond", "Behera, Roy, Anicode, Madenci, Spencer 2022; seed 001 §5.3",
-            theories=STATE, families=FAMILY,
+            params=PDDO_PARAMS, theories=STATE, families=FAMILY,
             scope="state-based boxes; the boundary row (Dirichlet or traction) is chosen "
                   "per boundary node", build=_pddo),
     ]

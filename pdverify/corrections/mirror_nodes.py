@@ -41,6 +41,26 @@ diffusion. What we implement, and which parts are our reading (a guess where mar
      conditions via the mirror nodes'.
    The loads enter through these relations only (no nodal forces); the constant parts
    (2 g, the traction terms) become the right-hand side.
+
+Further readings of seed 001 §5.2 (params; defaults as above, issue 33's study on
+plate2d-plane-strain):
+
+- ``mirror_point``: ``nearest`` (above), ``corrected`` (u_f = 2 g - u_m + (x_f + x_m -
+  2 x_B) . grad u_m for a Dirichlet component: the mismatch between the mirror node and
+  the mirror point corrected by the node's gradient; our variant, exact for affine
+  fields) or ``at-mirror-point`` (the Neumann step taken from the mirror point x*
+  instead of the node, u_f = u_m + (x_f - x*) . G: the text's 'same (symmetric)
+  distance from the boundary' read literally, the mirror node standing for x*. Exact
+  beside a straight face, where x_m = x*; not near corners, where it is wrong by
+  (x* - x_m) . G).
+- ``gradient_at``: the cell whose central differences give the tangential derivatives
+  of the full traction relation, ``mirror`` (x_m's) or ``boundary`` (x_B's: the
+  traction condition holds at the boundary). The same for affine fields.
+- Not implemented: the paper's 2 delta fictitious layer with the fictitious nodes'
+  dilatations computed from their own neighbourhoods (the engine computes dilatations
+  of real nodes only; fictitious ones come through ``dilatation_map``). With
+  displacement relations exact for affine fields it gives the same affine field (every
+  neighbourhood it adds is complete), so it cannot change the plate's result.
 """
 from __future__ import annotations
 
@@ -96,7 +116,8 @@ def cells_of(grid, points) -> np.ndarray:
 
 
 NEUMANN_READINGS = ("full-traction", "normal-only")
-MIRROR_POINTS = ("nearest", "corrected")
+MIRROR_POINTS = ("nearest", "corrected", "at-mirror-point")
+GRADIENT_AT = ("mirror", "boundary")
 
 
 def _difference_pairs(grid, cells, axis):
@@ -118,15 +139,19 @@ class MirrorNodes:
     of each face (zero on free faces); ``moduli`` = (lambda, mu) of the material;
     ``neumann``: how a traction becomes the gradient of the Neumann relation
     (:data:`NEUMANN_READINGS`); ``mirror_point``: the nearest node as it is, or with its
-    mismatch corrected by its gradient (:data:`MIRROR_POINTS`; module docstring).
+    mismatch corrected by its gradient, or taken as sitting at the mirror point
+    (:data:`MIRROR_POINTS`); ``gradient_at``: the cell whose central differences give
+    the tangential derivatives of the full traction relation, the mirror node's or the
+    boundary point's (:data:`GRADIENT_AT`; module docstring).
     """
 
     def __init__(self, grid, stencil, dirichlet, exact, traction, moduli,
-                 neumann="full-traction", mirror_point="nearest"):
-        if neumann not in NEUMANN_READINGS:
-            raise ValueError(f"neumann={neumann!r}; allowed: {', '.join(NEUMANN_READINGS)}")
-        if mirror_point not in MIRROR_POINTS:
-            raise ValueError(f"mirror_point={mirror_point!r}; allowed: {', '.join(MIRROR_POINTS)}")
+                 neumann="full-traction", mirror_point="nearest", gradient_at="mirror"):
+        for name, value, allowed in (("neumann", neumann, NEUMANN_READINGS),
+                                     ("mirror_point", mirror_point, MIRROR_POINTS),
+                                     ("gradient_at", gradient_at, GRADIENT_AT)):
+            if value not in allowed:
+                raise ValueError(f"{name}={value!r}; allowed: {', '.join(allowed)}")
         g, d, h = grid, grid.dim, grid.spacing
         self.grid = g
         fict = np.flatnonzero(~g.is_interior)
@@ -140,7 +165,9 @@ class MirrorNodes:
         cell = cells_of(g, star)
         mirror = g.ext_id(cell)
         self.fictitious, self.mirror, self.boundary_point = fict, mirror, xB
-        step = x - g.x[mirror]                       # x_f - x_m
+        # the step of the Neumann relation: x_f - x_m, or x_f - x* when the mirror node
+        # is taken as sitting at the mirror point x* (then wrong by x* - x_m near corners)
+        step = x - (star if mirror_point == "at-mirror-point" else g.x[mirror])
         lam, mu = moduli
         tol = 1e-9 * h
         nf = fict.size
@@ -169,7 +196,8 @@ class MirrorNodes:
             const_d[hit, k] = 2.0 * g_exact[hit, k]
         # the gradient D_kb of component k along axis b at the mirror node, as
         # constant + sum over (node, component) entries: lists per (k, b)
-        pairs = [_difference_pairs(g, cell, b) for b in range(d)]
+        at = cell if gradient_at == "mirror" else boundary_cells
+        pairs = [_difference_pairs(g, at, b) for b in range(d)]
         full = neumann == "full-traction"
         entries = []   # (fict mask, k, node ids, component j, coefficient per fict)
         dirichlet_entries = []

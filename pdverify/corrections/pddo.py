@@ -28,6 +28,14 @@ subdomains, not a port:
   node volume, so the rows are forces like the PD rows).
 - **Bulk** (farther than 2 delta): the standard linear state-based (LPS) equations of
   the uncorrected model; their neighbourhoods and their neighbours' are complete.
+  *Reading* ``bulk_model="pddo"``: the bulk too takes the PDDO equilibrium of the layer.
+  It stands in for the paper's non-ordinary bulk (seed 001 §5.3: 'based on the
+  non-ordinary state-based Peridynamics framework'), whose equations, like these, are
+  built from PDDO derivatives rather than ordinary bond forces; it is not a port of the
+  bond-associated correspondence model. Both bulks are exact for affine fields (the
+  PDDO operators are exact for quadratics; an affine field carries no LPS force in a
+  complete neighbourhood), so on seed 001's plate the choice cannot change the
+  round-off result.
 
 The system is square and nonsymmetric (direct sparse LU). A node whose moment matrix is
 singular to 1e-12 (too few neighbours in some direction) is a failed run naming it.
@@ -106,14 +114,22 @@ def _choose_faces(touches, parts, cells, d):
     return out
 
 
-def pddo_system(model, face_dirichlet, exact, traction, moduli, body_load=None):
+#: what governs the nodes farther than 2 delta from the surface: the LPS equations of the
+#: uncorrected model, or the PDDO equilibrium as in the layer (the module docstring)
+BULK_MODELS = ("lps", "pddo")
+
+
+def pddo_system(model, face_dirichlet, exact, traction, moduli, body_load=None,
+                bulk_model="lps"):
     """The square system (A, rhs, counts) of the PDDO boundary layer on the uncorrected
     plain-grid ``model`` (its equilibrium rows serve the bulk): ``A`` (d n x d n,
     component-major: one row per component of every real node) and ``rhs``: the boundary
     data on the outer rows, ``body_load`` (n, d; b V per node) on the others.
     ``face_dirichlet``: (face, component) pairs prescribed at ``exact(x)``, or
     (face, component, where) on part of a face (per node: its cell);
-    ``traction(x, normal, face)``."""
+    ``traction(x, normal, face)``; ``bulk_model``: :data:`BULK_MODELS`."""
+    if bulk_model not in BULK_MODELS:
+        raise ValueError(f"bulk_model={bulk_model!r}; allowed: {', '.join(BULK_MODELS)}")
     g, d, h = model.grid, model.dim, model.spacing
     n = g.n_interior
     lam, mu = moduli
@@ -124,6 +140,8 @@ def pddo_system(model, face_dirichlet, exact, traction, moduli, body_load=None):
                         for f in range(2 * d)], axis=1)
     outer = touches.any(axis=1)
     layer = ~outer & (g.distance_to_surface(x) <= 2.0 * model.horizon * (1 + 1e-12))
+    if bulk_model == "pddo":
+        layer = ~outer
     bulk = ~outer & ~layer
     # equilibrium with the PDDO operators: -(lam + mu) d_k d_j u_j - mu d_l d_l u_k, times V
     lap = sum(_d2(D, l, l) for l in range(d))

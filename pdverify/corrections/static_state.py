@@ -440,14 +440,15 @@ def _match(cells_s, anchors, axis, g):
 
 
 # ------------------------------------------------------------------------------ mirror, PDDO
-def assemble_mirror(problem, neumann: str, mirror_point: str) -> LinearSystem:
+def assemble_mirror(problem, neumann: str, mirror_point: str,
+                    gradient_at: str = "mirror") -> LinearSystem:
     """Seed 001 §5's mirror node method (``corrections.mirror_nodes``): the loads and
     constraints enter through the mirror relations only."""
     g = _grid(problem, problem.stencil.reach)
     mirror = MirrorNodes(g, problem.stencil, dirichlet=problem.prescribed(),
                          exact=problem.exact, traction=_traction_of(problem),
                          moduli=problem.constants.moduli(), neumann=neumann,
-                         mirror_point=mirror_point)
+                         mirror_point=mirror_point, gradient_at=gradient_at)
     model = _model(problem, g, mirror.closure())
     d, ni, nu_ = g.dim, g.n_interior, model.n_unknown_nodes
     solver = static_solver(problem.solver, d, d * nu_)
@@ -469,14 +470,16 @@ def assemble_mirror(problem, neumann: str, mirror_point: str) -> LinearSystem:
                         counts={"fictitious_nodes": int(g.n_ext - g.n_interior)}, offset=U_c)
 
 
-def assemble_pddo(problem) -> LinearSystem:
+def assemble_pddo(problem, bulk_model: str = "lps") -> LinearSystem:
     """Seed 001 §5's PDDO boundary layer (``corrections.pddo``): its own square,
-    nonsymmetric system on the uncorrected model, solved by a direct LU."""
+    nonsymmetric system on the uncorrected model, solved by a direct LU; ``bulk_model``
+    (``pddo.BULK_MODELS``) governs the nodes beyond 2 delta."""
     g = _grid(problem, 0)
     model = _model(problem, g, None)
     x_int = g.x[g.interior_ids]
     body = problem.body_load(x_int, model.node_volume[g.interior_ids][:, None])
     A, rhs, counts = pddo_system(model, problem.prescribed(), problem.exact,
-                                 _traction_of(problem), problem.constants.moduli(), body)
+                                 _traction_of(problem), problem.constants.moduli(), body,
+                                 bulk_model=bulk_model)
     return LinearSystem(model, A, rhs, np.zeros(0, dtype=int), np.zeros(0), g.n_interior,
                         solver="direct", counts=counts)

@@ -17,24 +17,25 @@ def _label(r) -> str:
              if (k == "quadrature" and v != "partial-volume") or (k == "m_ratio" and v != 3.0)
              or k == "load_point" or (k == "neumann" and v != "full-traction")
              or (k == "mirror_point" and v != "nearest")
+             or (k == "gradient_at" and v != "mirror")
+             or (k == "bulk_model" and v != "lps")
              or (k == "influence" and v != "gaussian")]
     return label(r) + "".join(", " + e for e in extra)
 
 
-
-
+def _paper_settings(r) -> bool:
+    """A run at seed 001's quadrature, influence function and m-ratio."""
+    return (r.params.get("quadrature") == "partial-volume"
+            and r.params.get("influence") == "gaussian" and r.params.get("m_ratio") == 3.0)
 
 
 def _columns_2d(scene, results):
     """The runs of the 2D plate's shared-scale figure, with their titles: the panels of
     seed 001 §5 (:data:`SECTION5`, at the paper's settings) in the paper's order, then
     every other method's run at its default parameters."""
-    def paper(r):
-        return (r.params.get("quadrature") == "partial-volume"
-                and r.params.get("influence") == "gaussian" and r.params.get("m_ratio") == 3.0)
     cols, seen = [], set()
     for method, want, title in SECTION5:
-        hit = [r for r in results if r.method == method and paper(r)
+        hit = [r for r in results if r.method == method and _paper_settings(r)
                and all(r.params.get(k) == v for k, v in want.items())]
         if hit and id(hit[0]) not in seen:
             cols.append((title, hit[0]))
@@ -181,6 +182,137 @@ def _cost(scene, results, folder):
              "afterwards not counted), one point per run.")]
 
 
+def where_max(fields, k, reach) -> str:
+    """Where component k's largest error sits: ``corner x+, y-`` within ``reach`` of two
+    faces, ``edge x+`` within reach of one, else ``inside``; ``round-off`` for errors
+    at round-off level (:func:`~pdverify.report.figures.round_off`)."""
+    if round_off(fields["error"][:, k], 100.0):
+        return "round-off"
+    x, L = fields["x"], np.asarray(fields["lengths"])
+    o = np.asarray(fields.get("origin", np.zeros_like(L)))
+    p = x[np.argmax(fields["error"][:, k])] - o
+    near = [f"{'xyz'[a]}{'-' if p[a] <= L[a] / 2 else '+'}"
+            for a in range(p.size) if min(p[a], L[a] - p[a]) <= reach]
+    if not near:
+        return "inside"
+    return ("edge " if len(near) == 1 else "corner ") + ", ".join(near)
+
+
+def mnm_pattern(run, pals, others) -> bool:
+    """Seed 001 §5.4's MNM pattern in a run's metrics: 'close in x' (u error below
+    PALS's, which §5.4 calls significant in x) and 'worst in y' (v error above every run
+    of ``others``: the other methods of Figs. 14-15 and the uncorrected model)."""
+    m = run.metrics if hasattr(run, "metrics") else run
+    close_x = m["max_error_u_pct"] < pals["max_error_u_pct"]
+    worst_y = m["max_error_v_pct"] > max(o["max_error_v_pct"] for o in others)
+    return bool(close_x and worst_y)
+
+
+#: the readings of seed 001 §5's MNM and PDDO (report cases of the plate), as
+#: (method, params that differ from the defaults, what the reading is)
+SECTION5_READINGS = (
+    ("mirror-nodes", {}, "MNM: full traction, nearest mirror node (default)"),
+    ("mirror-nodes", {"neumann": "normal-only"}, "MNM: normal derivatives only"),
+    ("mirror-nodes", {"mirror_point": "corrected"}, "MNM: mirror mismatch corrected"),
+    ("mirror-nodes", {"mirror_point": "at-mirror-point"},
+     "MNM: Neumann step from the mirror point"),
+    ("mirror-nodes", {"gradient_at": "boundary"}, "MNM: gradient at the boundary point"),
+    ("pddo", {}, "PDDO: LPS bulk (default)"),
+    ("pddo", {"bulk_model": "pddo"}, "PDDO: PDDO bulk (non-ordinary stand-in)"),
+)
+
+
+def _reading_run(results, method, want, spacing):
+    """The run of ``method`` at the paper's settings and ``spacing`` whose reading params
+    are ``want`` (the others at their defaults)."""
+    defaults = {"neumann": "full-traction", "mirror_point": "nearest",
+                "gradient_at": "mirror", "bulk_model": "lps", "order": 1}
+    for r in results:
+        if r.method == method and _paper_settings(r) and r.params["spacing"] == spacing and all(
+                r.params.get(k, defaults[k]) == want.get(k, defaults[k])
+                for k in defaults if k in r.params or k in want):
+            return r
+    return None
+
+
+def section5_readings(results):
+    """Rows of the §5 study: (name, run, where u max, where v max, matches the paper's MNM
+    pattern) for every reading run, then PALS, SNM and none as the yardstick, all at the
+    spacing of the first run at the paper's settings (the scene's cases come first; the
+    spacing sweeps after them)."""
+    first = next((r for r in results if _paper_settings(r)), None)
+    if first is None:
+        return []
+    h = first.params["spacing"]
+    pals = _reading_run(results, "pals", {}, h)
+    others = [r for r in (pals, _reading_run(results, "surface-nodes", {"order": 1}, h),
+                          _reading_run(results, "none", {}, h)) if r is not None]
+    rows = []
+    for method, want, name in SECTION5_READINGS + (
+            ("pals", {}, "PALS"), ("surface-nodes", {"order": 1}, "SNM (order 1)"),
+            ("none", {}, "none (uncorrected)")):
+        r = _reading_run(results, method, want, h)
+        if r is None:
+            continue
+        reach = r.params["m_ratio"] * r.params["spacing"]
+        match = (pals is not None and method in ("mirror-nodes", "pddo")
+                 and mnm_pattern(r, pals.metrics, [o.metrics for o in others]))
+        rows.append((name, r, where_max(r.fields, 0, reach), where_max(r.fields, 1, reach),
+                     match))
+    return rows
+
+
+def _readings_table(scene, results, folder):
+    """Seed 001 §5's readings of MNM and PDDO as a table figure: the largest Eq. (44)
+    errors, where they sit, and whether the reading shows the paper's MNM pattern."""
+    rows = section5_readings(results)
+    if not any(r.method in ("mirror-nodes", "pddo") for _, r, *_ in rows):
+        return []
+    cells = [[name, f"{r.metrics['max_error_u_pct']:.3g}", wu,
+              f"{r.metrics['max_error_v_pct']:.3g}", wv,
+              ("yes" if match else "no") if r.method in ("mirror-nodes", "pddo") else "-"]
+             for name, r, wu, wv, match in rows]
+    fig, ax = plt.subplots(figsize=(10.5, 0.22 * len(cells) + 0.6))
+    ax.set_axis_off()
+    tab = ax.table(cellText=cells, colLabels=["reading", "max eps_u [%]", "where",
+                                              "max eps_v [%]", "where",
+                                              "paper's MNM pattern"],
+                   loc="center", cellLoc="left", colLoc="left")
+    tab.auto_set_font_size(False)
+    tab.set_fontsize(7.5)
+    tab.auto_set_column_width(list(range(6)))
+    matched = [name for name, r, *_, match in rows if match]
+    h = rows[0][1].params["spacing"]
+    ax.set_title(f"{scene.id}: seed 001 §5 readings of MNM and PDDO (h = {h:g} m, m = 3); "
+                 f"matching the paper: {', '.join(matched) if matched else 'none'}",
+                 fontsize=9)
+    name = _save(fig, folder, f"{scene.id}-s5-readings.png")
+    verdict = (f"The reading that matches the paper: {', '.join(matched)}." if matched else
+               "No reading matches the paper. The plate's exact field (Eq. 43) is affine and "
+               "every real node has a complete neighbourhood, where an affine field carries "
+               "no force whatever the lattice: a reading whose boundary relations are exact "
+               "for affine fields gives round-off (full traction with the nearest or "
+               "corrected mirror node or the gradient at the boundary point; PDDO with "
+               "either bulk). A reading that is not either moves the whole plate to another "
+               "homogeneous state (normal-only: the free face x = l_x imposes the relation "
+               "that ties u to v, so both err, u more) or errs at the corners, where the "
+               "mirror node is only the nearest one (the step from the mirror point: in "
+               "both components, v below PALS). In a homogeneous state whose free-face "
+               "relation is exact the relative errors of u and v are equal, so 'close in "
+               "x except one corner, worst in y' can only come from errors local to the "
+               "boundary, and the readings' local errors are small in both components.")
+    return [(name, "Seed 001 §5.2-5.4, the readings of the mirror node method and the PDDO "
+                   "layer that the text allows, run on the plate at the paper's settings: "
+                   "the largest Eq. (44) error of each component, where it sits (within one "
+                   "horizon of one face: edge; of two: corner), and whether the run shows "
+                   "§5.4's MNM pattern, 'close in x' (u error below PALS's) and 'worst in y' "
+                   "(v error above PALS's, SNM's and the uncorrected model's). Not run: the "
+                   "2 delta layer with the fictitious nodes' dilatations from their own "
+                   "neighbourhoods, which is exact for affine fields whenever its "
+                   "displacement relations are (deviations: 001-s5-mnm-readings). "
+                   + verdict)]
+
+
 #: the panels of seed 001 Figs. 14 and 15 (§5), in the paper's order, then ours
 SECTION5 = (("pals", {}, "(a) PALS"), ("mirror-nodes", {"neumann": "full-traction"}, "(b) MNM"),
             ("pddo", {}, "(c) PDDO"), ("surface-nodes", {"order": 1}, "(d) SNM"),
@@ -205,5 +337,6 @@ def _renderings_3d(scene, results, folder):
 def surface_node_figures(scene, results, folder):
     dim = results[0].fields["x"].shape[1]
     maps = (_maps_3d(scene, results, folder) + _renderings_3d(scene, results, folder)
-            if dim == 3 else _maps_2d(scene, results, folder))
+            if dim == 3 else _maps_2d(scene, results, folder)
+            + _readings_table(scene, results, folder))
     return maps + _cost(scene, results, folder)
