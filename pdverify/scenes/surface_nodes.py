@@ -15,6 +15,7 @@ from ..pd import (QUADRATURES, BoxGrid, StateBasedConstants, StateBasedModel, ge
 from ..pd.problem import FACES, FaceCondition, StaticProblem
 from ..solvers.policy import ND3D_FROM_UNKNOWNS, ND_FROM_UNKNOWNS, STATIC_SOLVERS
 from . import Outcome, Published, influence_param, register, require_influence
+from .base import ExpectedFailure
 from .family import StaticStateScene
 
 
@@ -376,6 +377,11 @@ class Body3DManufactured(Body3D):
     so which rule wins at a given m is not a property of the method. With
     ``quadrature=moment-corrected`` N = 3 gives 0.24 %.
     Metrics as in ``body3d-traction``.
+
+    ``taylor-fictitious`` (seed 000's Taylor-extrapolated fictitious nodes, Lagrange rows;
+    on the 3D boxes too): order 2 gives 0.105 % at h = 0.05 (surface nodes N = 2: 0.32 %),
+    order 1 13.2 % (N = 1: 1.88 %); 35-40 s and 2.0-2.2 GB a run (benchmarks/taylor3d.py).
+    On the quick 10 x 5 x 5 box its constraint rows are dependent (an expected failure).
     """
 
     id = "body3d-manufactured"
@@ -440,7 +446,18 @@ class Body3DManufactured(Body3D):
         return ([("none", dict(over)), ("none", {"load_point": "surface", **over})]
                 + [("surface-nodes", {"order": n, **over}) for n in (1, 2, 3)]
                 + [("surface-nodes", {"order": 3, **MOMENT, **over}),
-                   ("surface-nodes", {"order": 3, "surface_load": "centre", **over})])
+                   ("surface-nodes", {"order": 3, "surface_load": "centre", **over}),
+                   # order 3 needs more than 6 cells a side (the quick box has 5); order
+                   # 2 is the one the quick grid could run (docstring)
+                   ("taylor-fictitious", {"order": 2, **over})])
+
+    expected_failures = (
+        ExpectedFailure("seed 000's fictitious nodes on the quick 10 x 5 x 5-cell box: two of "
+                        "the Lagrange constraint rows stay dependent after the edge rule of "
+                        "assemble_taylor (a near-singular system; cause not found; the "
+                        "default grid and body3d-traction's quick box are regular)",
+                        method="taylor-fictitious", where={"spacing": 0.1}),
+    )
 
 
 # =============================================================================== 2D

@@ -97,3 +97,14 @@ def test_rates_and_figures_are_in_the_report(quick_report):
         assert (out / "figures" / f"{scene}-convergence-studies.png").stat().st_size > 0
     e = next(e for e in doc["convergence"] if e["rate"] is not None)
     assert f"{e['rate']:.2f}" in page
+
+
+def test_a_study_leaves_out_its_costly_methods():
+    """body3d-manufactured's studies leave seed 000's 3D fictitious nodes out (35-40 s and
+    2 GB a run: convergence.COSTLY_3D); the scene's own cases still run them."""
+    from pdverify import convergence
+    from pdverify.scenes import get_scene
+    runs = convergence.cases(["body3d-manufactured"])
+    assert runs and not any(m in convergence.COSTLY_3D for _, m, _ in runs)
+    assert any(m == "taylor-fictitious"
+               for m, _ in get_scene("body3d-manufactured").report_cases())
