@@ -152,7 +152,8 @@ class NewtonReport:
 
 
 def newton(model, u, solver: DirichletLinearSolver, *, where: str, previous=None,
-           rtol: float = NEWTON_RTOL, maxiter: int = NEWTON_MAXITER) -> NewtonReport:
+           rtol: float = NEWTON_RTOL, maxiter: int = NEWTON_MAXITER,
+           line_search: bool = True) -> NewtonReport:
     """Solve model.internal_force(u) = 0 on the free unknowns of ``solver`` in place,
     starting from ``u`` (whose prescribed entries hold their values).
 
@@ -169,7 +170,9 @@ def newton(model, u, solver: DirichletLinearSolver, *, where: str, previous=None
     by ``model.residual_weight`` when it has one (a half model's: the whole body's norms).
     A step the line
     search cannot make, or ``maxiter`` iterations, raise :class:`NumericalError` naming
-    ``where`` and the residual reached.
+    ``where`` and the residual reached. ``line_search=False``: every full step is taken
+    (plain Newton, as a solver without a line search would), so a residual that grows is
+    left to the iteration limit or to non-finite forces.
     """
     free = ~solver.fixed
     weight = getattr(model, "residual_weight", None)
@@ -208,7 +211,7 @@ def newton(model, u, solver: DirichletLinearSolver, *, where: str, previous=None
         for _ in range(LINE_SEARCH_HALVINGS + 1):
             trial = u + step * du
             f_t, n_t = residual(trial)
-            if n_t <= (1.0 - 1e-4 * step) * norm:
+            if not line_search or n_t <= (1.0 - 1e-4 * step) * norm:
                 break
             step *= 0.5
             report.line_search_cuts += 1
