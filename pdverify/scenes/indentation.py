@@ -43,6 +43,11 @@ NONLINEAR = {**PAPER, "kinematics": "nonlinear", "spacing": 0.00025, "horizon": 
 #: 0.08 % between them) and 4 increments per output depth (8 changed it by 0.01 %), so the
 #: study takes ~100 s once and is cached.
 FINITE_REFERENCE = {"kinematics": "finite", "levels": 2, "substeps": 4}
+#: where the paper's numbers are shown: the paper's grid and kinematics with our solver
+#: choices (the sweep's runs change one of them: not the paper's reading of its solver)
+OUR_SOLVER = {"predictor": "tangent", "line_search": "on", "newton_rtol": NEWTON_RTOL,
+              "node_volumes": "partial"}
+PUBLISHED_AT = {**NONLINEAR, **OUR_SOLVER}
 #: the sweep of seed 003 §4.2's unstated solver choices on the uncorrected run (the paper
 #: ran Peridigm's quasi-static solver and says nothing of its predictor, line search,
 #: stopping rule or surface-node volumes): one change from our defaults each
@@ -196,15 +201,15 @@ class Indentation(FemAndPD):
         # finite-strain reference ours is 5.3 % (a known difference, both readings shown),
         # against the small-strain one 6.3 % (checked)
         Published("force_error_pct", 6, "seed 003 §4.2 (about 6 %)", method="energy-directional",
-                  where=NONLINEAR, deviation="003-indentation-reference"),
+                  where=PUBLISHED_AT, deviation="003-indentation-reference"),
         Published("force_error_pct_vs_small_strain", 6, "seed 003 §4.2 (about 6 %), against "
-                  "the small-strain FEM", method="energy-directional", where=NONLINEAR),
+                  "the small-strain FEM", method="energy-directional", where=PUBLISHED_AT),
         Published("force_bias_pct", -30, "seed 003 §4.2 (about 30 % too soft)", method="none",
-                  where=NONLINEAR, tolerance=5.0,
+                  where=PUBLISHED_AT, tolerance=5.0,
                   tolerance_source="half a unit in the one printed significant digit "
                                    "('about 30 %')"),
         Published("failure_depth_mm", 0.4, "seed 003 §4.2 (about 0.4 mm)", method="none",
-                  where=NONLINEAR, deviation="003-indentation-failure"),
+                  where=PUBLISHED_AT, deviation="003-indentation-failure"),
     )
 
     #: the documented collapses (deviations: seed 003 findings): failures, as expected
