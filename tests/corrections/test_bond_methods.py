@@ -173,7 +173,8 @@ def test_every_bond_method_on_its_scenes():
 
 def test_unsupported_method_lists_the_scene_methods():
     with pytest.raises(InputError, match="not supported by this scene; allowed: none, "
-                                         "surface-nodes, mirror-nodes, energy, volume, pals"):
+                                         "taylor-fictitious, surface-nodes, mirror-nodes, "
+                                         "energy, volume, pals"):
         get_scene("stiffness3d-box").resolve("energy-directional")
 
 

@@ -70,6 +70,12 @@ def test_the_indentation_findings_are_documented():
     # perifit's collapse (a fifth) is planned only where the optional extra is installed
     from pdverify.corrections.registry import treatments
     peers = [] if treatments()["perifit"].unavailable else ["perifit"]
-    assert [m for m, _ in expected] == ["none", "none", "energy", "volume"] + peers
+    # none: ours, the linear one, and the sweep of the paper's unstated solver choices
+    # (UNSTATED_CHOICES: each fails too, at 0.5-1.3 mm)
+    from pdverify.scenes.indentation import UNSTATED_CHOICES
+    nones = ["none"] * (2 + len(UNSTATED_CHOICES))
+    assert [m for m, _ in expected] == nones + ["energy", "volume"] + peers
     assert all(e.method != "energy-directional" for e in scene.expected_failures)
-    assert {s.id for s in all_scenes() if s.expected_failures} == {"block2d-indentation"}
+    # and the 3D Taylor run on body3d-manufactured's quick box (dependent constraint rows)
+    assert {s.id for s in all_scenes() if s.expected_failures} == {"block2d-indentation",
+                                                                   "body3d-manufactured"}

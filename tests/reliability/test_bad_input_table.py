@@ -34,7 +34,7 @@ CASES = [
      "not supported by this scene; allowed: none"),
     ("method-not-on-scene", ["run", "stiffness3d-box", "--method", "energy-directional"], {},
      "stiffness3d-box: method 'energy-directional' is not supported by this scene; allowed: "
-     "none, energy, volume"),
+     "none, taylor-fictitious, surface-nodes, mirror-nodes, energy, volume"),
     ("unknown-command", ["frobnicate"], {}, "invalid choice"),
     ("unknown-flag", ["run", "bar1d-traction", "--fast"], {}, "unrecognized"),
     # ---------------------------------------------------------------- run: --set syntax
