@@ -18,7 +18,9 @@ from fractions import Fraction
 PRINTED = "printed"
 FIGURE = "read off a figure"
 KINDS = (PRINTED, FIGURE)
-CHECKS = ("equal", "below", "above", "none")
+#: the check of a statement without a number (shown, not checked)
+NO_CHECK = "none"
+CHECKS = ("equal", "below", "above", NO_CHECK)
 
 #: an exact printed value (a fraction, an integer of an exact table, a closed-form 0 or 1)
 #: is checked to round-off: 1e-9 relative (at least 1e-12 absolute) lies far above the

@@ -10,11 +10,14 @@ from ..params import Param, at_least
 from ..pd.problem import LOAD_POINTS
 from .mirror_nodes import GRADIENT_AT, MIRROR_POINTS, NEUMANN_READINGS
 from .pddo import BULK_MODELS
-from .surface_nodes import MAX_ORDER
+from .surface_nodes import MAX_ORDER, check_wave_order, wave_extension
 from .taylor_fictitious import CORNER_RULES
-from .treatment import Treatment
+from .treatment import Role, Treatment
+from .virtual_nodes import check_layers, clamp
 
 FAMILY = ("static-state",)
+#: the uncorrected baseline's name (``Treatment.baseline``)
+BASELINE = "none"
 
 
 @dataclass(frozen=True)
@@ -127,14 +130,32 @@ PDDO_PARAMS = (
           "bulk; both exact for affine fields)", choices=BULK_MODELS),)
 
 STATE = ("state-based",)
+WAVE_ORDER = Param("order", 1, "Taylor order of the fictitious-node extrapolation (1 = Eqs. 8-9)",
+                   at_least(1))
+
+
+def _truncated(_problem, _params):
+    """The baseline's role in the ``wave-bar`` and ``flux-bar`` families: no extension
+    (truncated neighbourhoods)."""
+    return None
+
+
+def _flux_order(_problem, params):
+    """Taylor's role in the ``flux-bar`` family: the extrapolation order of its layer."""
+    return params["order"]
+
+
+def _check_flux_order(nodes, params, where):
+    _check_taylor((nodes,), params, where)
 
 
 def family_treatments() -> list[Treatment]:
     return [
         FamilyTreatment(
-            "none", "uncorrected PD: truncated neighbourhoods, BCs on the nodes nearest "
+            BASELINE, "uncorrected PD: truncated neighbourhoods, BCs on the nodes nearest "
             "the boundary", "the papers' baseline (seed 000 §5, seed 001 §4)",
-            params=(LOAD_POINT,), families=FAMILY, build=_none),
+            params=(LOAD_POINT,), families=FAMILY, build=_none, baseline=True,
+            roles=(("wave-bar", Role(_truncated)), ("flux-bar", Role(_truncated)))),
         FamilyTreatment(
             "taylor-fictitious", "seed 000: fictitious layer by nearest-node Taylor "
             "extrapolation (1D series along the normal; corners by Eq. 69), Dirichlet and "
@@ -148,13 +169,15 @@ def family_treatments() -> list[Treatment]:
                   "static_state.assemble_taylor). body3d-manufactured's quick grid "
                   "(10 x 5 x 5 cells) keeps 2 dependent constraint rows and fails as "
                   "near-singular",
-            build=_taylor, checker=_check_taylor),
+            build=_taylor, checker=_check_taylor,
+            roles=(("flux-bar", Role(_flux_order, (ORDER,), _check_flux_order)),)),
         FamilyTreatment(
             "surface-nodes", "seeds 001/002: surface nodes carry the boundary conditions, "
             "fictitious layer by Taylor extrapolation about the nearest surface node",
             "Scabbia, Zaccariotto, Galvanetto 2023 (seed 001); seed 002",
             params=(SURFACE_ORDER,), theories=STATE, families=FAMILY, footprint="surface",
-            build=_surface, checker=_check_surface),
+            build=_surface, checker=_check_surface,
+            roles=(("wave-bar", Role(wave_extension, (WAVE_ORDER,), check_wave_order)),)),
         FamilyTreatment(
             "mirror-nodes", "seed 001 §5: a delta-thick fictitious layer whose nodes copy "
             "mirror nodes inside the body (odd reflection for Dirichlet components, the "
@@ -174,18 +197,17 @@ def family_treatments() -> list[Treatment]:
     ]
 
 
+CORRECT_SIDES = Param("correct_sides", False, "apply the directional correction on the free "
+                      "sides (variant 4)")
+
+
 def hand_wired() -> list[Treatment]:
     """Treatments only their own scenes implement; ``scope`` says where and why."""
     return [
-        Treatment("homogenized", "seed 004: stiffness factors on the end bonds (1, 1+k), "
-                  "(N, N-k) so that a linear field satisfies every equilibrium equation "
-                  "(1D bond-based)", "Eriksson, Tulkki 2020 (seed 004)",
-                  theories=("bond-based",), dims=(1,),
-                  scope="1D bond-based bars only (seed 004 derives its factors for the "
-                        "triangular micromodulus in 1D)"),
         Treatment("virtual-nodes", "seed 003 §4.1.2: buffer layers of thickness delta "
                   "outside the clamped edges, displaced rigidly (bond-based)",
-                  "seed 003 §4.1.2", theories=("bond-based",),
+                  "seed 003 §4.1.2", theories=("bond-based",), footprint="fictitious",
+                  roles=(("clamped-sheet", Role(clamp, (CORRECT_SIDES,), check_layers)),),
                   scope="the clamped sheet only (rigid buffers need a clamped edge, which "
                         "no other bond-based scene has)"),
         Treatment("fem", "classical-elasticity FEM reference (reference_fem)",

@@ -84,11 +84,7 @@ def end_bond_closure(nodes: int, end_factors) -> Closure:
     factors = np.asarray(end_factors, dtype=float)
 
     def bond_factor(a, b, _n):
-        alpha = np.ones(a.size)
-        for k, f in enumerate(factors, start=1):  # at most m - 1 offsets, not a loop over bonds
-            alpha[(a == 0) & (b == k)] = f
-            alpha[(b == nodes - 1) & (a == nodes - 1 - k)] = f
-        return alpha
+        return end_bond_factors(a, b, nodes, factors)
 
     return Closure(bond_factor=bond_factor if factors.size else None)
 
@@ -199,3 +195,36 @@ def homogenization_factors(horizon_ratio: float, end_weight: str = "full",
                          f"m - 1 end bonds make a linear field satisfy every equilibrium "
                          f"equation (point {worst} keeps a relative residual {left:.2g})")
     return tuple(float(a) for a in 1.0 + delta)
+
+
+def end_bond_factors(a, b, nodes: int, end_factors) -> np.ndarray:
+    """The factor of each bond (a, b) of an N-point bar under :func:`end_bond_closure`."""
+    alpha = np.ones(a.size)
+    for k, f in enumerate(np.asarray(end_factors, dtype=float), start=1):
+        # at most m - 1 offsets, not a loop over bonds
+        alpha[(a == 0) & (b == k)] = f
+        alpha[(b == nodes - 1) & (a == nodes - 1 - k)] = f
+    return alpha
+
+
+def homogenized_closure(params) -> Closure:
+    """The ``homogenized`` treatment as a closure of the uncorrected bar: the factors of
+    :func:`homogenization_factors` for the run's ``horizon_ratio``, ``end_weight`` and
+    ``micromodulus`` on the end bonds of whatever bar it closes (the node count is the
+    model's, so one closure serves a sweep over N)."""
+    factors = homogenization_factors(float(params["horizon_ratio"]), params["end_weight"],
+                                     params["micromodulus"])
+    if not len(factors):
+        return Closure()
+    return Closure(geometric_factor=lambda model: end_bond_factors(
+        model.bond_a, model.bond_b, model.grid.n_interior, factors),
+        info={"end_factors": tuple(float(a) for a in factors)})
+
+
+def check_homogenized(cells, params, where) -> None:
+    """Refuse parameters for which the end-bond factors do not exist (one line)."""
+    try:
+        homogenization_factors(float(params["horizon_ratio"]), params["end_weight"],
+                               params["micromodulus"])
+    except InputError as exc:
+        raise InputError(f"{where}: {exc}") from None

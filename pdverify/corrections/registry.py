@@ -55,6 +55,12 @@ class BondMethod(Treatment):
 
     closure: Callable[[Mapping], Closure] | None = None
     families: tuple[str, ...] = ("static-state",)
+    #: ``checker(cells, params, where)``: refuses parameters before any work
+    checker: Callable[[tuple, Mapping, str], None] | None = None
+
+    def check(self, cells, params, where):
+        if self.checker is not None:
+            self.checker(cells, params, where)
 
     @property
     def kind(self) -> str:
@@ -76,6 +82,10 @@ class BondMethod(Treatment):
         return assemble_plain(problem, self.make_closure(params))
 
 
+#: the seed-004 bars, where the end-bond factors are derived
+SEED004_BARS = ("bar1d-homogenization", "bar1d-constraints", "bar1d-vibration")
+
+
 def _builtin() -> list[Treatment]:
     from .builtin import family_treatments, hand_wired
     from .energy import energy_closure
@@ -84,7 +94,15 @@ def _builtin() -> list[Treatment]:
     from .perifit_weights import INSTALL, SCENES, installed_version, perifit_closure
     from .volume import volume_closure
     pv = installed_version()
-    return family_treatments() + hand_wired() + [
+    from .homogenized import check_homogenized, homogenized_closure
+    return family_treatments() + [
+        BondMethod("homogenized", "seed 004: stiffness factors on the end bonds (1, 1+k), "
+                   "(N, N-k) so that a linear field satisfies every equilibrium equation "
+                   "(1D bond-based)", "Eriksson, Tulkki 2020 (seed 004)",
+                   closure=homogenized_closure, checker=check_homogenized,
+                   theories=("bond-based",), dims=(1,), scenes=SEED004_BARS,
+                   scope="1D bond-based bars only (seed 004 derives its factors for the "
+                         "triangular micromodulus in 1D)")] + hand_wired() + [
         BondMethod("energy", "Le and Bobaru 2018 energy correction: per axis the ratio of a "
                    "complete to the node's uniaxial-stretch energy, bonds by the ellipse of "
                    "their ends' mean factors, applied to the bond force",

@@ -239,3 +239,20 @@ def flux_rows(model, flux) -> sp.csr_matrix:
     end (``sign``), placed after the interior equations of each component."""
     s, bond, alpha, sign = flux
     return model.bond_force_rows(model.grid.n_interior + s, bond, alpha * sign)
+
+
+def wave_extension(_problem, params):
+    """The ``wave-bar`` role: the fictitious layer's displacements from the real nodes and
+    the two surface nodes, extrapolated about the nearest surface node at Taylor order
+    ``params["order"]`` (seed 002 Eqs. 8-9 at order 1), as a function of the bar's grid."""
+    order = params["order"]
+    return lambda grid: surface_node_displacement_map(grid, order)
+
+
+def check_wave_order(real_nodes, params, where) -> None:
+    """Each end's extrapolation stencil needs order + 1 real nodes of its own half."""
+    from ..errors import InputError
+    order = params["order"]
+    if 2 * (order + 1) > real_nodes:
+        raise InputError(f"{where}: order={order} needs 2 (order + 1) <= "
+                         f"{real_nodes} real nodes (order <= {real_nodes // 2 - 1})")

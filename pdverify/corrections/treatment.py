@@ -14,9 +14,17 @@ one line where it applies (``scope``). It serves a scene in one of three ways:
   boxes and bars with boundary conditions keyed by face and component). It may add
   nodes, unknowns and rows (surface nodes, fictitious or mirror nodes, flux or boundary
   rows): the returned :class:`~pdverify.pd.problem.LinearSystem` carries all of it.
-- **hand-wired** (``families=()``, no closure): the scenes that list it in their own
-  ``methods`` implement it (the seed-003 and seed-004 corrections, whose scenes are not
-  yet problem descriptions). Its ``scope`` names them.
+  A treatment may also have a :class:`Role` in further families (``roles``), each with
+  its own parameters, ``build`` and checks: the smaller families of scenes that are not
+  static boxes (``wave-bar``: seed 002's wave, whose treatments give the bar's
+  fictitious extension; ``flux-bar``: seed 000's force flux, the extrapolation order;
+  ``clamped-sheet``: seed 003's clamped sheet, where virtual nodes bring their own grid
+  and clamp nodes). A scene asks ``scene.treatment(method)`` for it by role, never by
+  name (``tests/treatments/test_contract.py`` greps every scene module).
+- the **baseline** (``baseline=True``: ``none``): the uncorrected model; it serves
+  every closure scene with the scene's ``baseline_params``, which the closures take too.
+- **hand-wired** (``families=()``, no closure, no role): only the ``fem`` reference,
+  which the FEM scenes run themselves.
 
 Registration: built-ins here and in ``registry.py``; other packages through the Python
 entry point group ``pdverify.methods`` (an entry point loads a :class:`Treatment` or a
@@ -34,12 +42,26 @@ matrix is empty.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Mapping
+from typing import Any, Callable, Mapping
 
 from ..params import Param
 
 THEORIES = ("bond-based", "state-based")
 ENTRY_POINT_GROUP = "pdverify.methods"
+
+
+@dataclass(frozen=True)
+class Role:
+    """What a treatment does for one more problem family (``Treatment.roles``): its
+    parameters there, ``build(problem, params)`` (what the family's scenes ask of a
+    treatment: a system, a model's closure, an extrapolation order; the family's
+    docstring says which) and ``checker(context, params, where)`` (refuses parameters
+    before any work; ``context`` is what the family's scenes pass, e.g. a node count).
+    The family fixes the theory and dimension, so a role serves every scene of it."""
+
+    build: Callable[[Any, Mapping[str, Any]], Any]
+    params: tuple[Param, ...] = ()
+    checker: Callable[[Any, Mapping[str, Any], str], None] | None = None
 
 
 @dataclass(frozen=True)
@@ -70,6 +92,11 @@ class Treatment:
     footprint: str = "plain"
     #: True when it can impose a prescribed component only on whole faces
     whole_faces_only: bool = False
+    #: True for the uncorrected baseline (``none``): every scene that takes closures
+    #: runs it, with the scene's ``baseline_params``; the closures take them too
+    baseline: bool = False
+    #: ``((family, Role), ...)``: the problem families beyond ``families`` it serves
+    roles: tuple[tuple[str, Role], ...] = ()
 
     def __post_init__(self):
         bad = [t for t in self.theories if t not in THEORIES]
@@ -80,12 +107,46 @@ class Treatment:
     @property
     def kind(self) -> str:
         """``closure``, ``family`` or ``hand-wired`` (module docstring)."""
-        return "family" if self.families else "hand-wired"
+        return "family" if self.families or self.roles else "hand-wired"
+
+    def role(self, family: str | None) -> Role | None:
+        """Its :class:`Role` in ``family``, if it has one."""
+        return next((r for f, r in self.roles if f == family), None)
+
+    def params_for(self, scene) -> tuple[Param, ...]:
+        """Its parameters on ``scene``: its role's in the scene's family, the scene's
+        ``baseline_params`` for the baseline on a closure scene, else ``params``."""
+        role = self.role(getattr(scene, "family", None))
+        if role is not None:
+            return role.params
+        if self.baseline and self._closure_scene(scene):
+            return tuple(getattr(scene, "baseline_params", ()))
+        return self.params
+
+    def _closure_scene(self, scene) -> bool:
+        """Whether ``scene`` takes closures and is not of a family this treatment
+        assembles (there, the family's own form serves)."""
+        return (getattr(scene, "closure_theory", None) is not None
+                and getattr(scene, "family", None) not in self.families)
+
+    def build_for(self, family: str, problem, params: Mapping[str, Any]):
+        """What its role in ``family`` makes of ``problem`` (see :class:`Role`)."""
+        return self.role(family).build(problem, params)
+
+    def check_for(self, family: str, context, params: Mapping[str, Any], where: str):
+        """Its role's parameter check in ``family`` (nothing when it has none)."""
+        role = self.role(family)
+        if role is not None and role.checker is not None:
+            role.checker(context, params, where)
 
     def why_not(self, scene) -> str | None:
         """``None`` when this treatment runs on ``scene``, else a one-line reason."""
         if self.name in {m.name for m in scene.methods}:
             return None                                  # the scene implements it itself
+        if self.role(getattr(scene, "family", None)) is not None:
+            return None                      # a role in the scene's problem family
+        if self.baseline and self._closure_scene(scene):
+            return None                      # the uncorrected model of a closure scene
         if getattr(scene, "closed_to_treatments", None):
             return scene.closed_to_treatments
         if self.scenes is not None and scene.id not in self.scenes:
@@ -127,5 +188,6 @@ class Treatment:
                 "source": self.source, "theories": list(self.theories),
                 "dims": list(self.dims), "families": list(self.families),
                 "scenes": None if self.scenes is None else list(self.scenes),
+                "roles": [f for f, _ in self.roles],
                 "scope": self.scope, "params": {p.name: p.default for p in self.params},
                 "unavailable": self.unavailable, "origin": self.origin}

@@ -37,3 +37,22 @@ def virtual_nodes_closure(grid, lower, upper, horizon: float, influence, axis: i
         return Closure()
     sides = tuple(k for k in range(grid.dim) if k != axis)
     return directional_closure(grid, lower, upper, horizon, influence, axes=sides)
+
+
+def clamp(problem, params):
+    """The ``clamped-sheet`` role: ``(grid, closure, low, high)`` of a
+    :class:`~pdverify.pd.problem.ClampedBox` under virtual nodes (the clamps act on the
+    buffer layers)."""
+    grid, low, high = buffered_grid(problem.lower, problem.upper, problem.spacing,
+                                    problem.horizon, problem.axis)
+    closure = virtual_nodes_closure(grid, problem.lower, problem.upper, problem.horizon,
+                                    problem.influence, problem.axis, params["correct_sides"])
+    return grid, closure, low, high
+
+
+def check_layers(_context, params, where) -> None:
+    """Buffer layers of thickness delta must be whole numbers of cells."""
+    from ..errors import InputError
+    if abs(params["m_ratio"] - round(params["m_ratio"])) > 1e-12:
+        raise InputError(f"{where}: m_ratio={params['m_ratio']:g} must be a whole number for "
+                         "virtual-nodes (buffer layers of thickness delta)")

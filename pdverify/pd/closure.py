@@ -1,7 +1,7 @@
 """The engine's side of the correction contract: what a boundary treatment hands a model."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
@@ -59,7 +59,8 @@ class Closure:
       model's own (LPS).
 
     Flux and constraint rows are built by the correction from the model's bonds after
-    construction (e.g. :meth:`StateBasedModel.bond_force_rows`).
+    construction (e.g. :meth:`StateBasedModel.bond_force_rows`). ``info``: what the
+    treatment reports about itself (no effect on the model).
     """
 
     keep: np.ndarray | Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
@@ -73,6 +74,9 @@ class Closure:
     weight_factor: Callable[[object], np.ndarray] | None = None
     force_factor: Callable[[object], np.ndarray] | None = None
     constitutive: object | None = None
+    #: facts the treatment reports beside the run's metrics (e.g. seed 004's
+    #: ``end_factors``); no effect on the model
+    info: dict = field(default_factory=dict, compare=False)
 
     def __post_init__(self):
         if self.weighted_volume not in WEIGHTED_VOLUMES:

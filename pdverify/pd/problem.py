@@ -68,6 +68,23 @@ def face_resultant(traction, centres, normals, spacing):
 
 
 @dataclass(frozen=True)
+class ClampedBox:
+    """The ``clamped-sheet`` family's description: the box ``[lower, upper]`` clamped on
+    both faces normal to ``axis`` (a bond-based sheet of node ``spacing``, ``horizon``
+    and ``influence``). A treatment with a role in the family (virtual nodes) returns
+    ``(grid, closure, low, high)``: its grid, its closure and the nodes that carry the
+    clamps below and above; the baseline and the closures keep the scene's own grid
+    with nodes on the clamped faces."""
+
+    lower: tuple
+    upper: tuple
+    spacing: float
+    horizon: float
+    influence: object
+    axis: int
+
+
+@dataclass(frozen=True)
 class FaceCondition:
     """What one face prescribes (module docstring)."""
 

@@ -21,11 +21,10 @@ from ..params import Param, at_least, positive
 from ..solvers.explicit import central_difference
 from ..solvers.modal import exact_stability_limit, min_angular_frequency
 from ..solvers.static import solve_constrained
-from . import MethodSpec, Outcome, Published, Scene, register
+from ..corrections.registry import plugin_call
+from . import Outcome, Published, Scene, register
 from .base import truncation_problem
 
-NONE = MethodSpec("none")
-HOMOGENIZED = MethodSpec("homogenized")
 
 #: Cross-section A [m^2]. It cancels in every metric (c1 ~ 1/A, forces ~ A); kept so that
 #: forces, stiffnesses and masses carry their units.
@@ -80,7 +79,8 @@ class BondBar:
                               closure=closure)
         self.nodes, self.spacing, self.E, self.area = nodes, spacing, E, area
         self.m, self.beta = split_horizon_ratio(horizon_ratio)
-        self.end_factors = tuple(float(a) for a in end_factors)
+        self.end_factors = (tuple(float(a) for a in end_factors) if len(end_factors)
+                            else tuple((closure.info if closure else {}).get("end_factors", ())))
         self.c1 = self.model.c
         self.K = self.model.K
         self.x = self.model.grid.x[:, 0]
@@ -141,7 +141,6 @@ class BondBarScene(Scene):
     seed = "004"
     dim = 1
     closure_theory = "bond-based"
-    methods = (NONE, HOMOGENIZED)
 
     def min_nodes(self, m: int) -> int:
         """Smallest allowed ``nodes``: every bar needs 2m + 1 points, one horizon family."""
@@ -154,29 +153,19 @@ class BondBarScene(Scene):
             raise InputError(f"{where}: nodes={p['nodes']} must be >= {self.min_nodes(m)} for "
                              f"horizon_ratio={p['horizon_ratio']:g} (every bar needs "
                              f"2m + 1 = {2 * m + 1} points, one horizon family)")
-        if method == HOMOGENIZED.name:
-            try:
-                self.factors(method, p)
-            except InputError as exc:
-                raise InputError(f"{where}: {exc}") from None
+        t = self.bond_methods().get(method)
+        if t is not None:
+            plugin_call(t, "check", t.check, (p["nodes"],), p, where)
 
     def estimate(self, method, p):
         m, _ = split_horizon_ratio(p["horizon_ratio"])
         return budget.linear_system(p["nodes"], 1, 1, m + 1)
 
-    def factors(self, method, p) -> tuple:
-        if method != HOMOGENIZED.name:
-            return ()
-        return homogenization_factors(float(p["horizon_ratio"]), p["end_weight"],
-                                      p["micromodulus"])
-
     def bar(self, method, p, nodes, spacing) -> "BondBar":
         return BondBar(nodes=nodes, spacing=spacing, horizon_ratio=float(p["horizon_ratio"]),
                        E=p["E"], area=AREA, end_weight=p["end_weight"],
                        micromodulus=p["micromodulus"], calibration=p["calibration"],
-                       end_factors=self.factors(method, p),
-                       closure=None if method == HOMOGENIZED.name
-                       else self.bond_closure(method, p))
+                       closure=self.bond_closure(method, p))
 
 
 # --------------------------------------------------------------------------- Sec. 6.1
@@ -262,7 +251,7 @@ def _factor_tables():
         for ratio, factors in rows.items():
             for k, value in enumerate(factors, start=1):
                 yield Published(f"end_factor_{k}", value, f"seed 004 Table {table}",
-                                method=HOMOGENIZED.name, exact=True,
+                                method="homogenized", exact=True,
                                 where={"horizon_ratio": ratio, "end_weight": weight,
                                        "micromodulus": "triangular"})
 
@@ -343,24 +332,24 @@ class Homogenization(BondBarScene):
         cells = sorted([*TABLE12, (2.0, "full")], key=lambda c: (c[0] % 1, c[0], c[1] != "half"))
         for ratio, weight in cells:
             params = {"horizon_ratio": ratio, "end_weight": weight}
-            for method in (NONE.name, HOMOGENIZED.name):
+            for method in ("none", "homogenized"):
                 out.append((method, {**params, "nodes": 2 * int(ratio) + 1}))
             if not quick:
-                out.append((HOMOGENIZED.name, {**params, "nodes": 1001}))
+                out.append(("homogenized", {**params, "nodes": 1001}))
         # the rest of Tables 6, 7, 11 (m = 5) and Table 14 (half weight between elements,
         # uncorrected: homogenisation has no factors there)
         for _table, weight, rows in FACTOR_TABLES:
             for ratio in rows:
                 if (ratio, weight) not in cells:
-                    out.append((HOMOGENIZED.name, {"horizon_ratio": ratio, "end_weight": weight,
+                    out.append(("homogenized", {"horizon_ratio": ratio, "end_weight": weight,
                                                    "nodes": 2 * int(ratio) + 1}))
         for ratio, weight in TABLE14:
             if (ratio, weight) not in cells:
-                out.append((NONE.name, {"horizon_ratio": ratio, "end_weight": weight,
+                out.append(("none", {"horizon_ratio": ratio, "end_weight": weight,
                                         "nodes": 2 * int(ratio) + 1}))
         if not quick:
             for ratio in (6.0, 8.0, 6.5, 8.5):
-                out.append((HOMOGENIZED.name, {"horizon_ratio": ratio, "nodes": 1001}))
+                out.append(("homogenized", {"horizon_ratio": ratio, "nodes": 1001}))
         return out
 
     def strain_factor(self, bar: BondBar, stress: float) -> tuple[float, np.ndarray]:
@@ -629,7 +618,7 @@ class Vibration(BondBarScene):
     def cases(self, quick=False):
         return [(method, {"horizon_ratio": ratio, **extra}) for extra in
                 ({}, self.TABLE13["mid"], self.TABLE13["end-points"]) for ratio in (4.0, 6.0)
-                for method in (NONE.name, HOMOGENIZED.name)]
+                for method in ("none", "homogenized")]
 
     def check(self, method, p):
         where = f"{self.id} --method {method}"

@@ -5,11 +5,9 @@ import numpy as np
 
 from manufactured import bar1d as closed
 
-from ..corrections.builtin import ORDER
-from ..corrections.registry import from_name
 from ..params import Param, positive
 from ..pd import INFLUENCES
-from . import MethodSpec, Outcome, Published, Scene, register
+from . import Outcome, Published, Scene, register
 from .bar1d import BAR_PARAMS, StateBar, bar_estimate, check_bar_grid
 
 _FEATURES = closed.flux_features()  # (1.26285..., 0.77160..., 0.39403...)
@@ -23,8 +21,6 @@ CONTINUUM = ("the paper's values are the continuum's (m -> infinity); compared a
 FIG8 = "seed 000 §2.2, Fig. 8 and the text under Fig. 7 (hardening, then softening)"
 #: the m-ratio of the Fig. 8 runs (the full report; the quick report uses 12)
 FIG8_M = 24.0
-NONE = MethodSpec("none")
-TAYLOR = MethodSpec("taylor-fictitious", (ORDER,))
 
 
 @register
@@ -63,7 +59,9 @@ class ForceFlux(Scene):
     figure = "bar1d-flux"
     dim = 1
     params = BAR_PARAMS + (Param("strain", 1e-3, "imposed constant strain", positive),)
-    methods = (NONE, TAYLOR)
+    #: the treatments with a role here give the bar's fictitious extrapolation order
+    #: (the baseline: none, truncated neighbourhoods)
+    family = "flux-bar"
     published = (
         # the text under Fig. 7 prints the continuum's features; the discrete flux approaches
         # them as m grows, so they stand beside the report's finest grid (m = 48) only
@@ -91,8 +89,7 @@ class ForceFlux(Scene):
 
     def check(self, method, p):
         n = check_bar_grid(self.id, method, p, min_horizons=4.0)
-        if method == TAYLOR.name:
-            from_name(method).check((n,), p, f"{self.id} --method {method}")
+        self.treatment(method).check_for(self.family, n, p, f"{self.id} --method {method}")
 
     def estimate(self, method, p):
         return bar_estimate(p)
@@ -103,11 +100,12 @@ class ForceFlux(Scene):
         m = 12.0 if quick else FIG8_M
         out += [("none", {"m_ratio": m, "spacing": self.horizon_default / m, "influence": inf})
                 for inf in INFLUENCES if inf != "hyperbolic"]
-        return out + [(TAYLOR.name, {"order": 1})]
+        return out + [("taylor-fictitious", {"order": 1})]
 
     def solve(self, method, p, timer):
         with timer.phase("setup"):
-            order = p.get("order") if method == TAYLOR.name else None
+            # None: truncated neighbourhoods, compared with Table 2's features
+            order = self.treatment(method).build_for(self.family, None, p)
             bar = StateBar(p, order)
         with timer.phase("solve"):
             eps, delta, L = p["strain"], bar.horizon, p["length"]

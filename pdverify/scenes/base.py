@@ -201,7 +201,7 @@ class Published:
             tol, source = pub.exact_tolerance(number), pub.EXACT_SOURCE
         if self.tolerance is not None:
             tol, source = float(self.tolerance), self.tolerance_source
-        if check == "none":
+        if check == pub.NO_CHECK:
             number, tol, source = None, None, "a statement without a number: shown, not checked"
         elif tol is None:
             raise ValueError(f"{self.source}: {self.value!r} is exact; say exact=True")
@@ -292,6 +292,10 @@ class Scene:
         self.__dict__["_offered_cache"] = (known, out)
         return out
 
+    def treatment(self, method: str):
+        """The registry's treatment ``method`` as this scene offers it."""
+        return self.offered()[method]
+
     def bond_methods(self) -> dict:
         """The registry's closure treatments (bond methods) this scene offers."""
         return {k: t for k, t in self.offered().items() if t.kind == "closure"}
@@ -313,11 +317,10 @@ class Scene:
         own)."""
         own = tuple(self.methods)
         offered = self.offered()
-        base = next((m.params for m in own if m.name == "none"),
-                    offered["none"].params if "none" in offered else ())
+        base = next((t.params_for(self) for t in offered.values() if t.baseline), ())
         return own + tuple(
             MethodSpec(k, self._with_defaults((base if t.kind == "closure" else ())
-                                              + t.params))
+                                              + t.params_for(self)))
             for k, t in offered.items())
 
     def method(self, name: str) -> MethodSpec:
@@ -331,11 +334,17 @@ class Scene:
         if self._broken_plugin(name):
             # accepted as a bond method (the params of ``none``): its run is a failed run
             # naming the plugin and what it did (see :meth:`run`)
-            base = next((m.params for m in self.all_methods if m.name == "none"), ())
-            return MethodSpec(name, base)
+            return MethodSpec(name, self.baseline_spec().params)
         allowed = [m.name for m in self.all_methods]
         raise InputError(f"{self.id}: method {name!r}{did_you_mean(name, allowed)} is not "
                          f"supported by this scene; allowed: {', '.join(allowed)}")
+
+    def baseline_spec(self) -> MethodSpec:
+        """The uncorrected baseline among the offered treatments (the registry's
+        ``baseline``), with its parameters here; an empty spec when none is offered."""
+        offered = self.offered()
+        name = next((k for k, t in offered.items() if t.baseline), None)
+        return next((m for m in self.all_methods if m.name == name), MethodSpec(""))
 
     def _broken_plugin(self, name: str) -> str | None:
         """Why the plugin method ``name`` failed to load, for a scene that takes bond
@@ -353,7 +362,10 @@ class Scene:
 
     @property
     def default_method(self) -> str:
-        return (self.methods or self.all_methods)[0].name
+        """The method of the scene's first (quick) report case: the run its papers
+        show first; the first offered method when it lists none."""
+        first = self.cases(quick=True)
+        return first[0][0] if first else self.all_methods[0].name
 
     def resolve(self, method: str, overrides: Mapping[str, Any] | None = None) -> dict:
         """Effective parameters (scene + method) with ``overrides`` applied and checked."""

@@ -60,9 +60,6 @@ class StaticStateScene(Scene):
         return cached
 
     # ----------------------------------------------------------------- checks
-    def treatment(self, method: str):
-        return self.offered()[method]
-
     def check(self, method, p):
         from ..corrections.registry import plugin_call
         where = f"{self.id} --method {method}"
@@ -136,11 +133,6 @@ class StaticStateScene(Scene):
         return U[:ni], (U[ni:] if system.extra_x is not None else None)
 
 
-#: the treatment whose parameters the closure treatments (bond methods) take: the
-#: uncorrected baseline, which imposes the conditions as they do
-BASELINE = "none"
-
-
 class FemStaticStateScene(StaticStateScene, FemAndPD):
     """A scene of the ``static-state`` family whose reference is a converged FEM solution
     (``reference_fem``), run as the scene's own method ``fem``.
@@ -172,7 +164,7 @@ class FemStaticStateScene(StaticStateScene, FemAndPD):
         out = []
         for m in Scene.all_methods.fget(self)[len(own):]:
             t = offered[m.name]
-            extra = self.baseline_params if (t.kind == "closure" or m.name == BASELINE) else ()
+            extra = self.baseline_params if (t.kind == "closure" or t.baseline) else ()
             out.append(MethodSpec(m.name, self.pd_params + extra + m.params))
         return own + tuple(out)
 

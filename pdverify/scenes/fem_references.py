@@ -102,13 +102,32 @@ class FemAndPD(FemReference):
 
     Scene params are the ones both sides share (``shared``, names of the reference's
     dataclass fields); the FEM study's own params belong to ``fem``, the discretisation's
-    (``pd_params``) to the PD methods, listed in ``pd_methods`` as (name, extra params).
+    (``pd_params``) to the PD methods: the registry's baseline and closures, and the
+    treatments with a role in the scene's ``family``.
     Subclasses implement ``check_pd`` and ``solve_pd``.
     """
 
     shared: tuple = ()
     pd_params: tuple = ()
-    pd_methods: tuple = ()
+    #: the uncorrected baseline's parameters beside ``pd_params`` (the closures take
+    #: them too)
+    baseline_extra: tuple = ()
+
+    @property
+    def baseline_params(self):
+        return self.pd_params + self.baseline_extra
+
+    @property
+    def all_methods(self):
+        """``fem``, then the offered treatments; a treatment with a role in the scene's
+        family takes ``pd_params`` beside its role's (the baseline and the closures
+        have them through ``baseline_params``)."""
+        own = tuple(self.methods)
+        offered = self.offered()
+        return own + tuple(
+            MethodSpec(m.name, (self.pd_params if offered[m.name].role(self.family)
+                                else ()) + m.params)
+            for m in Scene.all_methods.fget(self)[len(own):])
 
     def _fields(self):
         return {f.name: f for f in dataclasses.fields(self._cls())}
@@ -123,8 +142,7 @@ class FemAndPD(FemReference):
         fem = MethodSpec(FEM.name, tuple(_field_param(n, f, self.params_class)
                                          for n, f in self._fields().items()
                                          if n not in self.shared))
-        return (fem,) + tuple(MethodSpec(name, self.pd_params + extra)
-                              for name, extra in self.pd_methods)
+        return (fem,)
 
     def check(self, method, p):
         if method == FEM.name:

@@ -17,7 +17,7 @@ from ..solvers.iterative import Lattice
 from ..solvers.newton import NEWTON_RTOL, DirichletLinearSolver, newton
 from . import Outcome, Published, register
 from .base import ExpectedFailure
-from .fem_references import FemAndPD, _reference_module
+from .fem_references import FEM, FemAndPD, _reference_module
 from .sheets import PAPER, PD_COMMON, SheetScene, _grid_check
 
 #: Output depths left out of the force comparison: the first one (0.1 mm), where the
@@ -194,7 +194,6 @@ class Indentation(FemAndPD):
         Param("node_volumes", "partial", "volume of the nodes on the surface: half on edges, "
               "a quarter at corners, or a full cell", choices=("partial", "full")),
     )
-    pd_methods = (("none", ()),)   # energy-directional: the registry's, on this box
     published = (
         # "about 6 %", "about 30 %": one significant digit, so half a unit in that digit
         # the paper does not say which FEM its 6 % is measured against: against our
@@ -281,7 +280,7 @@ class Indentation(FemAndPD):
         finest one (its stepping check), held to ``budget.MAX_LOAD_INCREMENTS``; a PD run
         computes the study first unless it is cached."""
         est = super().estimate(method, p)
-        ref = p if method == "fem" else self.reference_params(p)
+        ref = p if method == FEM.name else self.reference_params(p)
         increments = ref["n_steps"] * ref["substeps"] * (ref["levels"] + 2)
         return est + budget.Estimate(0.0, f"FEM study: {increments:.3g} load increments "
                                           f"(n_steps x substeps x (levels + 2))",

@@ -4,12 +4,12 @@ from __future__ import annotations
 import numpy as np
 
 from .. import budget
-from ..corrections.virtual_nodes import buffered_grid, virtual_nodes_closure
 from ..errors import InputError
 from ..metrics import rel_l2_error
 from ..params import Param, at_least, positive
 from ..pd import BondBasedModel, BoxGrid, bond_micromodulus, build_stencil, get_influence
 from ..pd.influence import bond_based_nu
+from ..pd.problem import ClampedBox
 from ..solvers.dense import AUTO_ITERATIVE_UNKNOWNS, SPD_LATTICE_SOLVERS, solve_with_dirichlet
 from ..solvers.iterative import Lattice
 from . import Outcome, Published, register, whole_cells
@@ -148,7 +148,6 @@ class TensionSheet(SheetScene):
         Param("load_sharing", "tributary", "end force per end node: by tributary length "
               "(corners half) or equal", choices=("tributary", "equal")),
     )
-    pd_methods = (("none", ()),)   # energy-directional: the registry's, on this box
     published = (
         Published("max_error_pct", "closed form", "seed 003 §4.1.1", method="fem"),
         Published("max_error_ux_pct", 82, "seed 003 Table 1", method="none",
@@ -295,9 +294,9 @@ class ClampedSheet(SheetScene):
     NODE_VOLUMES = Param("node_volumes", "partial", "volume of the nodes on the surface: half "
                          "on edges, a quarter at corners (ERRATA), or a full cell",
                          choices=("partial", "full"))
-    pd_methods = (("none", (NODE_VOLUMES,)),
-                  ("virtual-nodes", (Param("correct_sides", False, "apply the directional "
-                                           "correction on the free sides (variant 4)"),)))
+    baseline_extra = (NODE_VOLUMES,)
+    #: virtual nodes clamp through buffer layers (their role in this family)
+    family = "clamped-sheet"
     published = (
         Published("tensile_stress_mpa", 10.32, "seed 003 Table 2, row 1 (FEM)", method="fem",
                   where=TABLE2_GRID),
@@ -319,7 +318,7 @@ class ClampedSheet(SheetScene):
     def estimate_pd(self, method, p):
         m = p["m_ratio"]
         n = p["side_factor"] * m + 1                  # nodes along a side
-        rows = n + 2 * m if method == "virtual-nodes" else n
+        rows = n + 2 * m if self.treatment(method).footprint != "plain" else n
         return budget.linear_system(n * rows, 2, 2, m, dense_allowed=True)
 
     def check_sheet(self, where, method, p):
@@ -328,9 +327,7 @@ class ClampedSheet(SheetScene):
             raise InputError(f"{where}: m_ratio={p['m_ratio']:g} must be >= 2 (the paper uses 6)")
         L = p["side_factor"] * delta
         _grid_check(where, (("side", L),), delta / p["m_ratio"], delta, "horizon/m_ratio")
-        if method == "virtual-nodes" and abs(p["m_ratio"] - round(p["m_ratio"])) > 1e-12:
-            raise InputError(f"{where}: m_ratio={p['m_ratio']:g} must be a whole number for "
-                             "virtual-nodes (buffer layers of thickness delta)")
+        self.treatment(method).check_for(self.family, None, p, where)
 
     def cases(self, quick=False):
         out = [("fem", {}), ("none", {}), ("energy-directional", {}), ("virtual-nodes", {}),
@@ -352,10 +349,10 @@ class ClampedSheet(SheetScene):
         uy = p["strain"] * L / 2
         with timer.phase("setup"):
             inf = get_influence(p["micromodulus"])
-            if method == "virtual-nodes":
-                grid, bottom, top = buffered_grid(lo, hi, h, delta, axis=1)
-                closure = virtual_nodes_closure(grid, lo, hi, delta, inf, 1,
-                                                p["correct_sides"])
+            treatment = self.treatment(method)
+            if treatment.role(self.family) is not None:      # its own grid and clamp nodes
+                grid, closure, bottom, top = treatment.build_for(
+                    self.family, ClampedBox(lo, hi, h, delta, inf, axis=1), p)
             else:
                 grid = BoxGrid((L, L), lo, h, placement="on-surface",
                                boundary_volume=p["node_volumes"])

@@ -9,25 +9,19 @@ from manufactured import wave1d as analytic
 import scipy.sparse as sp
 
 from .. import budget
-from ..corrections.surface_nodes import surface_node_displacement_map
+from ..corrections.surface_nodes import wave_extension
 from ..errors import InputError, NumericalError
 from ..metrics import max_error_of_peak_pct, rel_l2_error
 from ..params import Param, at_least, positive
 from ..pd import BondBasedModel, BoxGrid, Closure, bond_micromodulus, build_stencil, get_influence
 from ..pd.closure import real_identity, with_rows
 from ..solvers.explicit import central_difference
-from . import MethodSpec, Outcome, Published, Scene, cell_count, register
+from . import Outcome, Published, Scene, cell_count, register
 from .base import truncation_problem
 
 #: The instants of Fig. 5 at which the error is measured [s].
 SAMPLE_TIMES = (0.05e-3, 0.10e-3, 0.15e-3, 0.20e-3)
 
-SURFACE_NODES = MethodSpec("surface-nodes", (
-    Param("order", 1, "Taylor order of the fictitious-node extrapolation (1 = Eqs. 8-9)",
-          at_least(1)),))
-NONE = MethodSpec("none")
-
-BOUNDARIES = ("surface-nodes", "none", "odd-image")
 
 
 def lattice_symbol(k, *, horizon: float, m_ratio: float):
@@ -55,50 +49,38 @@ class WaveBar:
     nodes sit at the cell centres x_i = (i - 1/2) Delta, i = 1..N, Delta = delta / m
     (Fig. 2; N = 100, 250, 1000 for m = 10, 25, 100).
 
-    ``boundary="surface-nodes"`` (seed 002 Figs. 3-4): surface nodes at x = 0 and x = l carry
-    the Dirichlet values and have no bonds; a fictitious layer of m cells beyond each end
-    completes the neighbourhoods, its displacements extrapolated about the nearest surface
-    node by a Taylor series of order ``taylor_order`` through the surface node and the
-    ``taylor_order`` nearest real nodes (order 1 = Eqs. 8-9; the surface node method's
-    displacement map, ``pdverify.corrections.surface_nodes``). All N real nodes are unknowns.
-
-    ``boundary="none"``: no fictitious nodes, neighbourhoods truncated at the ends, and the
-    end nodes (the first and last real node, Delta/2 inside the bar) held at the Dirichlet
-    value; the N - 2 others are unknowns.
-
-    ``boundary="odd-image"`` (a reference model, not a method of the paper): like
-    surface nodes, but the fictitious layer is the odd image about the surface value,
-    u(x_s - xi) = 2 u_s - u(x_s + xi). This is the extension the sine series of Eq. (11)
-    implies, so it isolates the quadrature error from the extrapolation's model error.
+    ``extension`` (what a treatment's ``wave-bar`` role gives): a function of the grid
+    returning the fictitious layer's displacement map from the real nodes and two
+    surface nodes at x = 0 and x = l, which carry the Dirichlet values and have no bonds
+    (seed 002 Figs. 3-4: surface nodes, :func:`~pdverify.corrections.surface_nodes.
+    wave_extension`; the default is theirs at ``taylor_order``), or ``None``: truncated
+    neighbourhoods, the first and last real node held at the end values.
+    :meth:`odd_image` is the extension the sine series of Eq. (11) implies,
+    u(x_s - xi) = 2 u_s - u(x_s + xi), which isolates the quadrature error from the
+    extrapolation's model error.
 
     In every case the free accelerations are ``a = A u_free + A_bc u_bc`` with
     ``A = -diag(1/V) K_real @ map`` multiplied out once (N x N, a banded matrix plus the
     few columns the extrapolation adds): one sparse product per time step.
     """
 
-    def __init__(self, length, horizon, m_ratio, wave_speed, boundary="surface-nodes",
-                 taylor_order=1):
-        if boundary not in BOUNDARIES:
-            raise ValueError(f"boundary={boundary!r}; allowed: {', '.join(BOUNDARIES)}")
-        self.length, self.horizon, self.boundary = length, horizon, boundary
+    def __init__(self, length, horizon, m_ratio, wave_speed, extension=..., taylor_order=1):
+        if extension is ...:
+            extension = wave_extension(None, {"order": taylor_order})
+        self.length, self.horizon = length, horizon
+        self.surface = surface = extension is not None
         self.spacing = horizon / m_ratio
         n = length / self.spacing
         if abs(n - round(n)) > 1e-9 * n:
             raise ValueError(f"spacing {self.spacing} does not divide length {length}")
         self.n_real = nr = int(round(n))
-        surface = boundary != "none"
         if surface and nr < taylor_order + 1:
             raise ValueError(f"order {taylor_order} needs at least {taylor_order + 1} "
                              f"real nodes, got {nr}")
         stencil = build_stencil(1, m_ratio)
         grid = BoxGrid((length,), (0.0,), self.spacing, stencil.reach if surface else 0)
-        if boundary == "surface-nodes":
-            closure = Closure(displacement_map=surface_node_displacement_map(grid, taylor_order),
-                              n_unknown_nodes=nr + 2)
-        elif boundary == "odd-image":
-            closure = Closure(displacement_map=self._odd_image(grid), n_unknown_nodes=nr + 2)
-        else:
-            closure = None
+        closure = (Closure(displacement_map=extension(grid), n_unknown_nodes=nr + 2)
+                   if surface else None)
         c = bond_micromodulus("hyperbolic", 1, wave_speed ** 2, horizon)
         self.model = BondBasedModel(grid, stencil, c, get_influence("hyperbolic"), closure)
         self.x_lattice = grid.x[:, 0]
@@ -118,7 +100,7 @@ class WaveBar:
         self.A.sort_indices()
 
     @staticmethod
-    def _odd_image(grid):
+    def odd_image(grid):
         """Fictitious node at -(j + 1/2) Delta (and its mirror at the right end) from
         2 u_s - u_j, unknowns [real u (N), surface values (2)]."""
         nr, nf = grid.n_interior, grid.layers
@@ -140,9 +122,10 @@ class WaveBar:
         return self.x_real[self.free]
 
     def real_displacements(self, u_free, u_bc=(0.0, 0.0)) -> np.ndarray:
-        """All real nodes' displacements from the free ones (``none``: the end nodes get ``u_bc``)."""
+        """All real nodes' displacements from the free ones (truncated: the end nodes get
+        ``u_bc``)."""
         u_free = np.asarray(u_free, dtype=float)
-        if self.boundary != "none":
+        if self.surface:
             return u_free
         out = np.empty(u_free.shape[:-1] + (self.n_real,))
         out[..., self.free] = u_free
@@ -150,7 +133,7 @@ class WaveBar:
         return out
 
     def size(self) -> dict:
-        surface = 2 if self.boundary != "none" else 0
+        surface = 2 if self.surface else 0
         return {"nodes": int(self.n_real + 2 * self.n_fict + surface),
                 "real_nodes": int(self.n_real), "fictitious_nodes": int(2 * self.n_fict),
                 "dofs": int(self.free.size), "bonds": self.model.n_bonds(),
@@ -191,7 +174,7 @@ class Wave1DSurfaceNodes(Scene):
     Findings: the error falls at first order in 1/m because the one-point quadrature of
     Eq. (3) leaves out the node's own cell (psi - psi_h = k^2 / (2m), see
     ``lattice_symbol``). Order-1 extrapolation is not the odd extension the
-    analytic series implies (``WaveBar(boundary="odd-image")``): the two discrete solutions
+    analytic series implies (``WaveBar(extension=WaveBar.odd_image)``): the two discrete solutions
     differ by about 0.27-0.28 % of the peak at m = 25 and 100 alike (order 2: 0.11-0.09 %).
     That gap is below the quadrature error for m <= 100, so the paper's convergence shows,
     but it bounds it beyond a few hundred (at m = 400 the order-1 error, 0.33 %, already
@@ -217,7 +200,9 @@ class Wave1DSurfaceNodes(Scene):
         Param("dt", 2e-7, "time step [s]", positive),
         Param("n_terms", 40, "modes m = 1..n_terms of the analytic series", at_least(1)),
     )
-    methods = (SURFACE_NODES, NONE)
+    #: the treatments with a role here (the baseline and surface nodes) give the bar's
+    #: fictitious extension
+    family = "wave-bar"
     published = (
         Published("max_error_pct", "decreases with m, no number printed", "seed 002 Fig. 5",
                   method="surface-nodes", kind="read off a figure"),
@@ -245,9 +230,7 @@ class Wave1DSurfaceNodes(Scene):
         if p["dt"] > SAMPLE_TIMES[0]:
             raise InputError(f"{where}: dt={p['dt']} must be <= {SAMPLE_TIMES[0]:g} s "
                              "(the first sampled instant)")
-        if method == SURFACE_NODES.name and 2 * (p["order"] + 1) > round(n):
-            raise InputError(f"{where}: order={p['order']} needs 2 (order + 1) <= "
-                             f"{round(n)} real nodes (order <= {round(n) // 2 - 1})")
+        self.treatment(method).check_for(self.family, round(n), p, where)
 
     def cases(self, quick=False):
         if quick:
@@ -262,8 +245,9 @@ class Wave1DSurfaceNodes(Scene):
         length, horizon = p["length"], p["horizon"]
         wave_speed = float(np.sqrt(p["E"] / p["rho"]))
         with timer.phase("setup"):
+            extension = self.treatment(method).build_for(self.family, None, p)
             bar = WaveBar(length, horizon, float(p["m_ratio"]), wave_speed,
-                          boundary=method, taylor_order=p.get("order", 1))
+                          extension=extension, taylor_order=p.get("order", 1))
             u0 = analytic.gaussian_pulse(bar.x_free, length=length)
             steps = [int(round(t / p["dt"])) for t in SAMPLE_TIMES]
         with timer.phase("solve"):

@@ -16,13 +16,27 @@ from pdverify.scenes import all_scenes
 PACKAGE = Path(pdverify.__file__).parent
 
 
-def _family_modules():
-    mods = {inspect.getsourcefile(type(s)) for s in all_scenes() if s.family is not None}
-    return sorted(mods)
+SCENES = PACKAGE / "scenes"
+
+
+def _scene_modules():
+    """Every module of ``pdverify/scenes`` (the family bases and the scenes alike)."""
+    return sorted(str(p) for p in SCENES.glob("*.py"))
+
+
+def _is_call(node, name):
+    f = node.func if isinstance(node, ast.Call) else None
+    return (isinstance(f, ast.Name) and f.id == name) or (
+        isinstance(f, ast.Attribute) and f.attr == name)
 
 
 def _allowed_nodes(tree):
-    """Nodes under a ``cases`` method or a ``published = (...)`` assignment."""
+    """Nodes where a method name belongs: a ``cases`` method, the published numbers (a
+    ``published = (...)`` assignment or a ``Published(...)`` call), the documented
+    findings (``expected_failures``), and strings that are not method names although
+    they may read like one: a parameter's definition (``Param(...)``: a choice such as
+    ``predictor="none"``) and dictionaries' keys and values other than a ``"method"``
+    key's (field names such as ``"energy"``, parameter values)."""
     allowed = set()
     for node in ast.walk(tree):
         if isinstance(node, ast.FunctionDef) and node.name == "cases":
@@ -31,31 +45,104 @@ def _allowed_nodes(tree):
                 isinstance(t, ast.Name) and t.id in ("published", "expected_failures")
                 for t in node.targets):
             allowed |= {id(n) for n in ast.walk(node)}
+        if _is_call(node, "Published") or _is_call(node, "Param"):
+            allowed |= {id(n) for n in ast.walk(node)}
+        if isinstance(node, ast.Dict):
+            for k, v in zip(node.keys, node.values):
+                if k is not None:
+                    allowed.add(id(k))
+                if not (isinstance(k, ast.Constant) and k.value == "method"):
+                    allowed |= {id(n) for n in ast.walk(v)} if isinstance(v, ast.Constant) \
+                        else set()
     return allowed
 
 
-def test_family_scenes_name_no_method_outside_cases_and_published():
-    names = set(treatments())
-    mods = _family_modules()
-    assert {Path(m).name for m in mods} >= {"bar1d.py", "surface_nodes.py", "plate2d.py"}
+def _names():
+    """The registry's treatments, less the scenes' references (``fem``: a scene states
+    its reference, which is no boundary treatment)."""
+    return set(treatments()) - {s.reference for s in all_scenes()}
+
+
+def _reference_test(node) -> bool:
+    """``FEM.name`` or ``self.reference``: a branch on the scene's reference run."""
+    return isinstance(node, ast.Attribute) and (
+        (node.attr == "name" and isinstance(node.value, ast.Name) and node.value.id == "FEM")
+        or node.attr == "reference")
+
+
+def _method_branches(tree):
+    """Comparisons of a ``method`` variable with anything but the reference or a kind
+    test (``method in self.bond_methods()``): a branch on a method's name."""
+    out = []
+    for node in ast.walk(tree):
+        if not isinstance(node, ast.Compare):
+            continue
+        sides = [node.left, *node.comparators]
+        if not any(isinstance(n, ast.Name) and n.id == "method" for n in sides):
+            continue
+        others = [n for n in sides if not (isinstance(n, ast.Name) and n.id == "method")]
+        if any(_names_a_method(n) for n in others):
+            out.append(node)
+    return out
+
+
+def _names_a_method(node) -> bool:
+    """A string, a collection of strings, a module constant (``NONE``) or a spec's name
+    (``HOMOGENIZED.name``) other than the reference's; not a variable (``method_of``,
+    matching a published entry to a run) and not a call (a kind test)."""
+    if _reference_test(node) or isinstance(node, ast.Call):
+        return False
+    if isinstance(node, ast.Constant):
+        return isinstance(node.value, str)
+    if isinstance(node, (ast.Tuple, ast.List, ast.Set)):
+        return any(_names_a_method(e) for e in node.elts)
+    if isinstance(node, ast.Name):
+        return node.id.isupper()
+    return isinstance(node, ast.Attribute) and node.attr == "name"
+
+
+def _offenders(path, tree, names):
+    allowed = _allowed_nodes(tree)
+    out = [f"{Path(path).name}:{n.lineno} {n.value!r}" for n in ast.walk(tree)
+           if isinstance(n, ast.Constant) and n.value in names and id(n) not in allowed]
+    out += [f"{Path(path).name}:{n.lineno} branches on the method"
+            for n in _method_branches(tree) if id(n) not in allowed]
+    return out
+
+
+def test_scene_modules_name_no_method_outside_cases_and_published():
+    names = _names()
+    mods = _scene_modules()
+    assert {Path(m).name for m in mods} >= {"bar1d.py", "surface_nodes.py", "plate2d.py",
+                                            "wave1d.py", "sheets.py", "indentation.py",
+                                            "bar1d_bondbased.py", "bar1d_flux.py", "base.py"}
     offenders = []
     for path in mods:
-        tree = ast.parse(Path(path).read_text())
-        allowed = _allowed_nodes(tree)
-        for node in ast.walk(tree):
-            if (isinstance(node, ast.Constant) and node.value in names
-                    and id(node) not in allowed):
-                offenders.append(f"{Path(path).name}:{node.lineno} {node.value!r}")
+        offenders += _offenders(path, ast.parse(Path(path).read_text()), names)
     assert not offenders, offenders
 
 
-def test_the_grep_can_fail():
-    """A literal method name in a scene body is found (the test above can fail)."""
-    tree = ast.parse("class S:\n    def solve(self, method):\n"
-                     "        return method == 'surface-nodes'\n")
-    hits = [n for n in ast.walk(tree) if isinstance(n, ast.Constant)
-            and n.value in set(treatments()) and id(n) not in _allowed_nodes(tree)]
-    assert len(hits) == 1
+@pytest.mark.parametrize("body", [
+    "        return method == 'surface-nodes'\n",
+    "        return method == HOMOGENIZED.name\n",
+    "        return method in ('none', 'virtual-nodes')\n",
+    "        x = {'method': 'pddo'}\n",
+])
+def test_the_grep_can_fail(body):
+    """A method name or a branch on it in a scene body is found (the test above can
+    fail), whether literal or through a constant."""
+    tree = ast.parse("class S:\n    def solve(self, method):\n" + body)
+    assert _offenders("s.py", tree, _names())
+
+
+@pytest.mark.parametrize("body", [
+    "        return method == FEM.name\n",
+    "        return method in self.bond_methods()\n",
+    "        return {'energy': 1.0, 'predictor': 'none'}\n",
+])
+def test_the_grep_passes_the_reference_and_kind_tests(body):
+    tree = ast.parse("class S:\n    def solve(self, method):\n" + body)
+    assert _offenders("s.py", tree, _names()) == []
 
 
 def test_every_empty_cell_has_a_reason():

@@ -12,7 +12,8 @@ STEPS = [int(round(t / DT)) for t in SAMPLE_TIMES]
 
 
 def solve(m, boundary, order=1):
-    bar = WaveBar(1.0, DELTA, m, V, boundary=boundary, taylor_order=order)
+    extension = WaveBar.odd_image if boundary == "odd-image" else ...  # else surface nodes
+    bar = WaveBar(1.0, DELTA, m, V, extension=extension, taylor_order=order)
     run = central_difference(-bar.A, gaussian_pulse(bar.x_free), 0.0, DT, STEPS[-1],
                              sample_steps=STEPS)
     return bar.x_real, bar.real_displacements(run.u)

@@ -6,6 +6,9 @@ from numpy.testing import assert_allclose
 from manufactured.wave1d import nonlocal_factor
 from pdverify.scenes.wave1d import WaveBar, lattice_symbol
 
+#: the bar's extensions by name: surface nodes (the default), truncated (``None``)
+EXTENSIONS = {"surface-nodes": ..., "none": None}
+
 EPS = np.finfo(float).eps
 V, DELTA, L = 5000.0, 0.1, 1.0  # seed 002
 
@@ -24,7 +27,7 @@ def test_paper_grid_sizes(m):
     assert_allclose(bar.spacing, DELTA / m, rtol=4 * EPS)
     assert bar.n_fict == m  # the fictitious layer is delta deep
     assert bar.size()["dofs"] == 10 * m
-    assert WaveBar(L, DELTA, m, V, boundary="none").size()["dofs"] == 10 * m - 2
+    assert WaveBar(L, DELTA, m, V, extension=None).size()["dofs"] == 10 * m - 2
 
 
 def test_lattice_symbol_converges_to_psi_at_first_order_in_one_over_m():
@@ -46,7 +49,7 @@ def test_lattice_symbol_converges_to_psi_at_first_order_in_one_over_m():
 def test_operator_on_sine_away_from_the_ends_is_minus_v2_psi_h(boundary):
     # Nodes at least delta from both ends see a complete lattice neighbourhood, so sin(kx)
     # is an eigenvector there with eigenvalue -v^2 psi_h (closed form, to round-off).
-    bar = WaveBar(L, DELTA, 25, V, boundary=boundary)
+    bar = WaveBar(L, DELTA, 25, V, extension=EXTENSIONS[boundary])
     x = bar.x_free
     k = 3 * np.pi
     u, s = np.sin(k * x), np.sin(k * bar.x_bc)  # "none" fixes nodes at Delta/2 from the ends
@@ -98,7 +101,7 @@ def test_surface_node_spectrum_is_real_and_positive_at_order_one():
 def test_odd_image_makes_every_sine_mode_an_exact_eigenvector(j):
     # The odd image about the surface nodes is the extension the series of Eq. (11)
     # implies: sin(j pi x / l) is then an eigenvector at every real node, ends included.
-    bar = WaveBar(L, DELTA, 10, V, boundary="odd-image")
+    bar = WaveBar(L, DELTA, 10, V, extension=WaveBar.odd_image)
     k = j * np.pi / L
     u = np.sin(k * bar.x_real)
     a = bar.A @ u
