@@ -17,6 +17,7 @@ from ..corrections.homogenized import (bond_bar, homogenization_factors, micromo
                                        split_horizon_ratio)
 from ..errors import InputError, NumericalError
 from ..metrics import fitted_frequency, max_error_of_peak_pct, rel_l2_error
+from ..papers_data import Formula, load_tables
 from ..params import Param, at_least, positive
 from ..solvers.explicit import central_difference
 from ..solvers.modal import exact_stability_limit, min_angular_frequency
@@ -180,7 +181,8 @@ class Table12Cell:
     """One non-homogenised cell of seed 004 Table 12 as printed.
 
     ``printed`` is f(2m + 1) as a number, ``text`` as printed; ``formula`` the printed
-    closed or fitted f(N) (``None`` where the table gives only a value); ``erratum`` the
+    closed or fitted f(N) (``formula_text`` as printed, ``None`` where the table gives
+    only a value), evaluated by :class:`pdverify.papers_data.Formula`; ``erratum`` the
     ERRATA note and ``exact`` the correct value where the printed one is wrong.
     """
 
@@ -193,22 +195,21 @@ class Table12Cell:
     exact: str = ""
 
 
-#: Seed 004 Table 12, non-homogenised columns, triangular micromodulus.
-TABLE12 = {
-    (2.0, "half"): Table12Cell(5, 1.5, "3/2", "(N+1)/(N-1)", lambda n: (n + 1) / (n - 1)),
-    (3.0, "half"): Table12Cell(7, 1.043, "1.043", "(17N+24)/(17(N-1))",
-                               lambda n: (17 * n + 24) / (17 * (n - 1)),
-                               "ERRATA: exact f(N) = (N+3)/(N-1), f(7) = 5/3", "5/3"),
-    (4.0, "half"): Table12Cell(9, 1.8161, "1.8161", "(19(N+5)+10)/(19(N-1))",
-                               lambda n: (19 * (n + 5) + 10) / (19 * (n - 1))),
-    (3.0, "full"): Table12Cell(7, 1.1178, "1.1178", "(17N-5)/(17(N-1))",
-                               lambda n: (17 * n - 5) / (17 * (n - 1))),
-    (4.0, "full"): Table12Cell(9, 1.2178, "1.2178", "(27N+20)/(27(N-1))",
-                               lambda n: (27 * n + 20) / (27 * (n - 1))),
-    (2.5, "full"): Table12Cell(5, 1.129, "1.129"),
-    (3.5, "full"): Table12Cell(7, 1.2304, "1.2304"),
-    (4.5, "full"): Table12Cell(9, 1.3189, "1.3189"),
-}
+#: Seed 004's printed tables (``pdverify/data/seed004_tables.toml``, format at its top)
+_TABLES = load_tables("004")
+
+
+def _table12_cell(row) -> Table12Cell:
+    text, formula = row["printed"], row.get("formula")
+    return Table12Cell(row["nodes"], float(Fraction(text)), text, formula,
+                       Formula(formula) if formula else None, row.get("erratum", ""),
+                       row.get("exact", ""))
+
+
+#: Seed 004 Table 12, non-homogenised columns, triangular micromodulus, by (horizon
+#: ratio, end weight), in the printed order.
+TABLE12 = {(row["horizon_ratio"], row["end_weight"]): _table12_cell(row)
+           for row in _TABLES["table12"]}
 
 
 def _table12_published(key, cell: Table12Cell) -> Published:
@@ -230,18 +231,17 @@ def _table12_published(key, cell: Table12Cell) -> Published:
 
 #: Seed 004 Tables 6, 7 and 11 as printed: the factor on the bond (1, 1 + k), k = 1, 2, ...
 #: (alpha, beta, gamma, ...), by horizon ratio; (table, end weight, {ratio: factors}).
-FACTOR_TABLES = (
-    (6, "half", {2.0: ("2",), 3.0: ("3", "2"), 4.0: ("4", "3", "2"), 5.0: ("5", "4", "3", "2")}),
-    (7, "full", {3.0: ("3/2", "1"), 4.0: ("2", "3/2", "1"), 5.0: ("5/2", "2", "3/2", "1")}),
-    (11, "full", {2.5: ("4/3",), 3.5: ("9/5", "4/3"), 4.5: ("16/7", "9/5", "4/3"),
-                  5.5: ("25/9", "16/7", "9/5", "4/3")}),
-)
+FACTOR_TABLES = tuple((t["table"], t["end_weight"],
+                       {row["horizon_ratio"]: tuple(row["factors"]) for row in t["rows"]})
+                      for t in _TABLES["factors"])
 #: Seed 004 Table 14 as printed: C of the end equations' right-hand side b_1 / (c1 A) =
 #: C sigma Delta / E (App. 1, Eq. A1.7), by (horizon ratio, end weight); (2, full): "-".
-TABLE14 = {(2.0, "half"): "1", (3.0, "half"): "8/3", (4.0, "half"): "5",
-           (2.5, "half"): "2", (3.5, "half"): "4", (4.5, "half"): "20/3",
-           (3.0, "full"): "4/3", (4.0, "full"): "5/2",
-           (2.5, "full"): "1", (3.5, "full"): "2", (4.5, "full"): "10/3"}
+TABLE14 = {(row["horizon_ratio"], row["end_weight"]): row["C"] for row in _TABLES["table14"]["rows"]}
+#: Seed 004 Tables 1 and 2 as printed: f_1(m) = c1(m)/c_inf (Eqs. 27/31), kept as printed
+#: text so that 1.0125 stays; (table, ((horizon ratio, f_1), ...)).
+MICROMODULUS_TABLES = tuple((t["table"], tuple((row["horizon_ratio"], row["f1"])
+                                               for row in t["rows"]))
+                            for t in _TABLES["micromodulus"])
 #: the adjusted bonds reported as metrics (the tables print at most four)
 FACTOR_METRICS = 4
 
@@ -311,11 +311,8 @@ class Homogenization(BondBarScene):
                   exact=True),
         Published("strain_factor", 1, "seed 004 Table 12 (every N)", method="homogenized",
                   where={"micromodulus": "triangular", "calibration": "discrete"}, exact=True),
-        *(_micromodulus_table(float(m), v, 1) for m, v in  # printed text, so 1.0125 stays
-          ((2, "1.333"), (3, "1.125"), (4, "1.067"), (5, "1.042"), (6, "1.029"), (10, "1.01"),
-           (32, "1.001"))),
-        *(_micromodulus_table(m + 0.5, v, 2) for m, v in
-          ((2, "1.042"), (3, "1.021"), (4, "1.0125"), (5, "1.0083"), (15, "1.001"))),
+        *(_micromodulus_table(ratio, v, table) for table, rows in MICROMODULUS_TABLES
+          for ratio, v in rows),
         *_factor_tables(),
         *(Published("end_load_C", v, "seed 004 Table 14",
                     where={"horizon_ratio": r, "end_weight": w, "micromodulus": "triangular",
