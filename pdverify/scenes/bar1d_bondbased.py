@@ -236,7 +236,8 @@ FACTOR_TABLES = tuple((t["table"], t["end_weight"],
                       for t in _TABLES["factors"])
 #: Seed 004 Table 14 as printed: C of the end equations' right-hand side b_1 / (c1 A) =
 #: C sigma Delta / E (App. 1, Eq. A1.7), by (horizon ratio, end weight); (2, full): "-".
-TABLE14 = {(row["horizon_ratio"], row["end_weight"]): row["C"] for row in _TABLES["table14"]["rows"]}
+TABLE14 = {(row["horizon_ratio"], row["end_weight"]): row["C"]
+           for row in _TABLES["table14"]["rows"]}
 #: Seed 004 Tables 1 and 2 as printed: f_1(m) = c1(m)/c_inf (Eqs. 27/31), kept as printed
 #: text so that 1.0125 stays; (table, ((horizon ratio, f_1), ...)).
 MICROMODULUS_TABLES = tuple((t["table"], tuple((row["horizon_ratio"], row["f1"])
