@@ -98,7 +98,7 @@ def _builtin() -> list[Treatment]:
     return family_treatments() + [
         BondMethod("homogenized", "seed 004: stiffness factors on the end bonds (1, 1+k), "
                    "(N, N-k) so that a linear field satisfies every equilibrium equation "
-                   "(1D bond-based)", "Eriksson, Tulkki 2020 (seed 004)",
+                   "(1D bond-based)", "Eriksson, Stenström 2020 (seed 004)",
                    closure=homogenized_closure, checker=check_homogenized,
                    theories=("bond-based",), dims=(1,), scenes=SEED004_BARS,
                    scope="1D bond-based bars only (seed 004 derives its factors for the "
