@@ -1,8 +1,10 @@
 """A report's run fields on disk instead of in the report process (issue 32).
 
 A report collects hundreds of runs; their ``fields`` (node coordinates, displacements,
-errors, energies: for the 3D boxes and the indentation tens of MB each) are read only
-by the figures, the scene pages and the VTU export, one scene or one run at a time.
+errors, energies, load curves) are read only by the figures, the scene pages and the VTU
+export, one scene or one run at a time. (Measured: up to about 1 MB pickled per run, for
+block2d-indentation; 16 MB over the 319 runs of ``report --quick``:
+``benchmarks/report_cost.py``.)
 As each result arrives from its worker, :meth:`Spill.spill` writes its fields once
 into a folder of the report's own staging folder and puts a :class:`SpilledFields`
 in their place: a read-only mapping with the same keys, which loads the file on first
