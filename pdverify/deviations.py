@@ -59,7 +59,7 @@ DEVIATIONS = (
               "(61.4 and 55.8 % against 39.4 %; perifit in six readings): LPS with m over the "
               "truncated family already gives a flat face's node the ball's moment ratios. "
               "In bond-based PD (stiffness3d-box-bond) all three beat none.",
-              "scene docstring; tests/corrections/test_bond_methods.py"),
+              "scene docstring; tests/corrections/test_bond_methods.py", key='001-lps-box-peers'),
     Deviation(("body3d-manufactured",), "erratum",
               "Appendix transcription slips (Eqs. 60, 63, 64, Sec. 2.1/2.4, Fig. 8) corrected; "
               "Eqs. (40), (41) as printed are right (checked by quadrature).", "ERRATA 001"),
@@ -94,7 +94,7 @@ DEVIATIONS = (
               "so surface nodes are judged with quadrature=moment-corrected (round-off) or at "
               "m >= 5; the paper's ordering of PALS, MNM and PDDO only partly holds (mirror "
               "nodes with the full traction relation and PDDO are exact for the affine field).",
-              "ERRATA 001; scene docstring"),
+              "ERRATA 001; scene docstring", key='001-plate-lattice'),
     Deviation(("plate2d-plane-strain",), "finding",
               "Seed 001 §5.4's MNM pattern ('close in x except one corner', 'worst in y') "
               "is shown by none of the readings we run (h = 0.02, not tuned): full traction "
@@ -139,7 +139,7 @@ DEVIATIONS = (
               "(corrected: 150.3 %). Under delta-refinement at m = 3 PDDO converges (fitted "
               "rate 2.1 from 1.23 to 0.28 in rel_l2) and mirror nodes do not (0.74, 0.95, "
               "0.90). Not yet chased further.",
-              "tests/treatments/test_static_family.py"),
+              "tests/treatments/test_static_family.py", key='001-body3d-mirror-pddo'),
     # --- seed 002 ------------------------------------------------------------------------
     Deviation(("wave1d-surface-nodes",), "erratum",
               "Eq. (11) sign: the time factor is cos(v sqrt(psi) t), psi > 0; its Fourier "
@@ -163,7 +163,7 @@ DEVIATIONS = (
               "directional factor: the power law phi = (delta/d)^(D+1) cannot make up a "
               "horizon of which half is missing at d = 0. A property of the method, reported "
               "as the paper asks; phi is exact only for a constant micromodulus (other "
-              "micromoduli: the integral ratio of Eq. 14).", "ERRATA 003"),
+              "micromoduli: the integral ratio of Eq. 14).", "ERRATA 003", key='003-directional-surface'),
     Deviation(("sheet2d-*", "stiffness2d-sheet", "block2d-indentation"), "choice",
               "d(x, e) for an axis-aligned rectangle (the paper defines it for a general "
               "surface): d = min(a, delta), a = the smallest positive ray distance from x "
@@ -201,7 +201,7 @@ DEVIATIONS = (
               "The peers' corrections (energy, volume, perifit) delay the uncorrected collapse "
               "but do not prevent it: at the paper's grid each fails by a Newton stall at "
               "1.0-1.1 mm (none: 0.7 mm); seed 003's directional factor reaches 2 mm.",
-              "scene docstring"),
+              "scene docstring", key='003-indentation-peers'),
     Deviation(("block2d-indentation",), "finding",
               "The uncorrected nonlinear run fails at 0.7 mm (Newton finds no descent as the "
               "lattice under the indenter is about to fold), the paper's at about 0.4 mm; the "
@@ -254,7 +254,7 @@ DEVIATIONS = (
               "74.3 -> 55.3 %) but not its maximum (83.2 -> 79.7 %): at the cell-centred "
               "box's edges and corners the directions that leave the body within h/2 have no "
               "discrete bond for phi to scale; the bulk stays exact.",
-              "tests/treatments/test_energy_directional_cells.py"),
+              "tests/treatments/test_energy_directional_cells.py", key='001-box-bond-directional'),
 )
 
 

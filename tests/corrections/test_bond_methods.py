@@ -252,6 +252,7 @@ def _largest_surface_error(model):
                for _, eps in strain_states(3))
 
 
+# finding 001-lps-box-peers (pdverify.deviations): the peers on the LPS box
 @pytest.mark.slow  # slow tier (issue 32): a finding at the default box, 11 s and 9 s (loaded machine)
 @pytest.mark.parametrize("quadrature", ["partial-volume", "full-cells"])
 def test_perifit_does_not_beat_none_on_the_lps_box_in_any_reading(quadrature):

@@ -60,6 +60,7 @@ def test_the_overview_shows_an_expected_failure_grey():
     assert "failed as expected" in text and 'class="expected"' in text
 
 
+# findings 003-indentation-peers and 003-indentation-failure (pdverify.deviations)
 def test_the_indentation_findings_are_documented():
     """The four collapses of the full report (stop 28; five with perifit installed) are
     expected failures there, and

@@ -1,6 +1,10 @@
 """The report's data files: the seed papers and the deviations from them."""
 from __future__ import annotations
 
+from pathlib import Path
+
+import pytest
+
 from pdverify.deviations import DEVIATIONS, for_scene
 from pdverify.papers import PAPERS, seed_of
 from pdverify.report import html
@@ -37,3 +41,35 @@ def test_the_scene_section_shows_its_deviations_and_paper():
     assert "Ritter" in text
     page_papers = html.papers(all_scenes())
     assert "doi:10.1007/s42102-022-00094-1" in page_papers
+
+
+def _cited_in_tests(key: str) -> bool:
+    here = Path(__file__).resolve()
+    return any(key in p.read_text() for p in Path(__file__).parents[1].rglob("*.py")
+               if p.resolve() != here)
+
+
+def test_every_finding_has_one_tested_source():
+    """Issue 30, one source per finding: every measured finding of ``deviations.py`` has
+    a unique key, and that key is cited where it is checked: by a published number of a
+    scene (``Published.deviation``: the report and ``compare --against-published`` check
+    it) or by the test that measures it (a test file naming the key)."""
+    from pdverify.deviations import DEVIATIONS
+    from pdverify.scenes import all_scenes
+    keys = [d.key for d in DEVIATIONS if d.key]
+    assert len(keys) == len(set(keys)), "duplicate deviation keys"
+    published = {p.deviation for s in all_scenes() for p in s.published if p.deviation}
+    assert published <= set(keys), published - set(keys)   # no citation of a missing key
+    untested = [d.text[:60] for d in DEVIATIONS if d.kind == "finding"
+                and not (d.key and (d.key in published or _cited_in_tests(d.key)))]
+    assert not untested, untested
+
+
+def test_the_finding_check_can_fail(monkeypatch):
+    """A finding without a key, or with a key nothing cites, is found."""
+    import pdverify.deviations as dv
+    fake = dv.Deviation(("bar1d-traction",), "finding", "made up", "nowhere",
+                        key="000-nothing-cites-this-" + "key")
+    monkeypatch.setattr(dv, "DEVIATIONS", dv.DEVIATIONS + (fake,))
+    with pytest.raises(AssertionError):
+        test_every_finding_has_one_tested_source()

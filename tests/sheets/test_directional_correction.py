@@ -121,6 +121,7 @@ def test_affine_energy_density_of_the_corrected_lattice(strain):
     # carries half volumes) is exact, the reference being the lattice's own moduli
     # (sums of ~100 bond energies: 1e-12 ~ 1e4 eps)
     assert dev[depth > 6].max() < 1e-12
+    # finding 003-directional-surface (pdverify.deviations):
     # on the surface the method's continuum property: a quarter at corners, half on the
     # edges; measured along an edge, the corner's truncation fades within a few spacings:
     # |W / W_bulk - 1/2| <= 0.16, 0.042, 0.02 at 1, 2, >= 3 spacings from a corner

@@ -68,6 +68,7 @@ def test_plate_surface_nodes_is_the_discrete_material_response(_run):
                                r.metrics["interior_rel_l2_error"], rtol=1e-6)
 
 
+# finding 001-plate-lattice (pdverify.deviations): the m = 3 lattice's own 1.2 %
 @pytest.mark.xfail(strict=True, reason="issue 7 expects < 0.1 %; with exact partial areas at "
                    "m = 3 the discrete 2D material itself is off by 1.2 % in u (lattice "
                    "anisotropy, see test above); it falls to 0.098 % at m = 5 and to "

@@ -63,6 +63,7 @@ def test_1d_factors_are_eq_14_in_closed_form():
     assert np.any(expected > 1.0) and np.any(expected == 1.0)
 
 
+# finding 001-box-bond-directional (pdverify.deviations)
 @pytest.mark.parametrize("scene_id,metric", [("bar1d-homogenization", "max_error_pct"),
                                              ("bar1d-constraints", "max_error_pct"),
                                              ("bar1d-vibration", "max_error_pct"),

@@ -102,6 +102,7 @@ def test_none_is_not_exact_so_the_affine_tests_can_fail(dim):
 
 
 
+# finding 001-body3d-mirror-pddo (pdverify.deviations)
 def test_finding_mirror_and_pddo_on_the_manufactured_box():
     """The finding in pdverify/deviations.py (body3d-manufactured): mirror nodes and PDDO
     stay far from surface nodes on the cubic manufactured field (h = 0.1: about 151 and
