@@ -6,6 +6,7 @@ Plain script (no test runner):
 
     python benchmarks/report_cost.py [--repeat N] [--json FILE] [--full] [--only SCENE ...]
                                      [--args "ARGS"] [--against SRC [--against-args "ARGS"]]
+                                     [--keep FILE]
 
 Runs ``python -m pdverify report --quick`` (``--full``: the full report; ``--args``:
 further report arguments, e.g. ``--jobs 1``) ``--repeat`` times (default 3) into a
@@ -34,6 +35,7 @@ import json
 import os
 import resource
 import shlex
+import shutil
 import statistics
 import subprocess
 import sys
@@ -106,7 +108,7 @@ def _sample_peak(proc, peak: list, tmp, every=0.1) -> None:
         time.sleep(every)
 
 
-def one_report(full: bool, only, src=None, args=()) -> dict:
+def one_report(full: bool, only, src=None, args=(), keep=None) -> dict:
     env = dict(os.environ)
     if src:
         env["PYTHONPATH"] = os.pathsep.join([os.path.abspath(src), env.get("PYTHONPATH", "")])
@@ -127,6 +129,8 @@ def one_report(full: bool, only, src=None, args=()) -> dict:
         sampler.join()
         with open(os.path.join(out, "results.json")) as fh:
             doc = json.load(fh)
+        if keep:    # the last round's results.json, e.g. for `pdverify compare`
+            shutil.copyfile(os.path.join(out, "results.json"), keep)
     scenes = {}
     for r in doc["runs"]:
         scenes[r["scene"]] = scenes.get(r["scene"], 0.0) + r["timings"]["total_s"]
@@ -172,6 +176,8 @@ def main(argv=None) -> int:
     ap.add_argument("--full", action="store_true", help="the full report (default: --quick)")
     ap.add_argument("--only", nargs="+", default=None, help="scenes (default: all)")
     ap.add_argument("--json", default=None, help="write the medians and every round here")
+    ap.add_argument("--keep", default=None, metavar="FILE",
+                    help="copy this tree's last report's results.json to FILE")
     ap.add_argument("--args", default="", help="further arguments of this tree's report")
     ap.add_argument("--against", default=None, metavar="SRC",
                     help="also time the report of this source tree, alternating")
@@ -185,7 +191,8 @@ def main(argv=None) -> int:
     rounds = {name: [] for name in trees}
     for _ in range(a.repeat):
         for name, (src, args) in trees.items():
-            rounds[name].append(one_report(a.full, a.only, src, args))
+            rounds[name].append(one_report(a.full, a.only, src, args,
+                                           keep=a.keep if src is None else None))
     out = {name: summary(f"report ({kind}), {name}", rs, a.repeat) for name, rs in rounds.items()}
     print(f"largest single process's peak resident size, all rounds: "
           f"{max(r['max_child_rss'] for rs in rounds.values() for r in rs) / 1e9:.3f} GB")
