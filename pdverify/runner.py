@@ -230,8 +230,7 @@ def run_line(case, res) -> str:
 
 
 def run_cases(cases, *, jobs: int | None = None, progress=None, client=None,
-              run_timeout: float | None = None, known=None, schedule=None,
-              on_result=None) -> list[RunResult]:
+              run_timeout: float | None = None, known=None, schedule=None) -> list[RunResult]:
     """Run ``cases`` in ``jobs`` supervised worker processes (default: the cores available
     to this process), showing their progress on the stream ``progress``
     (:class:`pdverify.progress.RunProgress`: a live display on a terminal, one line per
@@ -248,8 +247,6 @@ def run_cases(cases, *, jobs: int | None = None, progress=None, client=None,
     (:mod:`pdverify.schedule`; ``known``: earlier run times by run key). ``schedule``: a
     list that receives each worker's :class:`~pdverify.schedule.Slot`. Results come back
     in the order of ``cases``, the same numbers whatever ``jobs`` and the order they ran in.
-    ``on_result``: called with each result as it arrives, in this process, before it is
-    kept (the report sets its fields aside on disk: :mod:`pdverify.spill`).
     """
     from .progress import RunProgress
     from .schedule import case_costs, default_jobs
@@ -275,16 +272,12 @@ def run_cases(cases, *, jobs: int | None = None, progress=None, client=None,
                          costs=costs) as shown:
             for k in range(len(cases)):
                 shown.started(k, timed=False)   # queued on the cluster
-            def note(k, res):
-                if on_result is not None:
-                    on_result(res)
-                shown.finished(k, res)
-            return run_cases_on(client, cases, note, run_case, died_on_cluster)
+            return run_cases_on(client, cases, shown.finished, run_case, died_on_cluster)
 
     with RunProgress(cases, min(jobs, len(cases)), progress, line=line,
                      costs=costs) as shown:
         return _run_local(cases, jobs, shown, run_timeout, known,
-                          schedule if schedule is not None else [], on_result)
+                          schedule if schedule is not None else [])
 
 
 def _timed_out(case, seconds) -> RunResult:
@@ -295,8 +288,7 @@ def _timed_out(case, seconds) -> RunResult:
     return res
 
 
-def _run_local(cases, jobs, shown, run_timeout=None, known=None, slots=None,
-               on_result=None):
+def _run_local(cases, jobs, shown, run_timeout=None, known=None, slots=None):
     """The supervised local pool of :func:`run_cases`; ``shown`` (a
     :class:`~pdverify.progress.RunProgress`) hears of every start and finish here, in the
     main process, and is redrawn every ``shown.tick_s`` while no run finishes."""
@@ -350,8 +342,6 @@ def _run_local(cases, jobs, shown, run_timeout=None, known=None, slots=None,
         proc, _, slot, began, _ = workers[conn]
         slots[slot].runs.append((k, began - t0, time.monotonic() - t0))
         workers[conn][1] = None
-        if on_result is not None:
-            on_result(res)
         results[k] = res
         done += 1
         shown.finished(k, res)

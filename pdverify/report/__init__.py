@@ -279,15 +279,11 @@ def export_fields(results, out) -> None:
     """Every run's fields as VTU files in ``out/fields`` (:mod:`pdverify.export`), named
     by the run's place in ``results.json``; each run lists its files under ``files``."""
     from ..export import write_run_fields
-    from ..spill import release
     for k, r in enumerate(results):
         if not r.fields:
             continue
         stem = os.path.join(out, "fields", f"{k:03d}-{r.scene}-{r.method}")
-        try:
-            r.files = [os.path.relpath(p, out) for p in write_run_fields(r, stem)]
-        finally:
-            release([r])   # spilled fields: one run's in memory at a time
+        r.files = [os.path.relpath(p, out) for p in write_run_fields(r, stem)]
 
 
 class _Phases(dict):
@@ -413,17 +409,6 @@ def _drawing_process(parent: int) -> None:
     _die_with_parent(parent)
 
 
-def _released(draw, runs, *args):
-    """``draw(*args)``, then the fields of ``runs`` that it loaded from the report's spill
-    folder dropped again (:mod:`pdverify.spill`): a drawing process, or the report
-    process when it draws itself, holds the fields of one task at a time."""
-    from ..spill import release
-    try:
-        return draw(*args)
-    finally:
-        release(runs)
-
-
 def _draw_task(k: int):
     """One task of :data:`_TASKS`, in a drawing process (:func:`_attempt`)."""
     _, draw, args, _ = _TASKS[k]
@@ -449,22 +434,7 @@ def _build(cases, out, final, jobs, progress, client=None, quick=False,
 
 def _build_logged(cases, out, final, jobs, progress, client=None, quick=False,
                   run_timeout=None, kept=None) -> int:
-    """The report's body. Each run's fields go to disk as the run arrives
-    (:mod:`pdverify.spill`, in ``out``'s spill folder, removed at the end whatever
-    happens): the report process never holds every run's fields at once."""
-    from ..spill import Spill
-    spill = Spill(out)
-    try:
-        return _build_spilled(cases, out, final, jobs, progress, client, quick,
-                              run_timeout, kept, spill)
-    finally:
-        spill.close()
-
-
-def _build_spilled(cases, out, final, jobs, progress, client, quick, run_timeout, kept,
-                   spill) -> int:
     from ..schedule import critical_path, previous_times
-    from ..spill import release
     t0 = time.perf_counter()
     phase = _Phases()
     slots = []
@@ -472,8 +442,7 @@ def _build_spilled(cases, out, final, jobs, progress, client, quick, run_timeout
         # the previous report in this folder times each run, for the longest-first order
         known = previous_times(os.path.join(final, "results.json"))
         results = run_cases(cases, jobs=jobs, progress=progress, client=client,
-                            run_timeout=run_timeout, known=known, schedule=slots,
-                            on_result=spill.spill)
+                            run_timeout=run_timeout, known=known, schedule=slots)
     if kept is not None:     # report --failed: the new runs merged into the previous ones
         results = _merged(kept, results)
     figdir = os.path.join(out, "figures")
@@ -500,18 +469,15 @@ def _build_spilled(cases, out, final, jobs, progress, client, quick, run_timeout
     studies = collect(results, quick)
     with phase("figures_s"):
         drawn = _draw_all(
-            [(f"figure for {scene.id}", _released, (figures.draw, mine, scene, mine, figdir),
-              []) for scene, mine in owned]
-            + [("error-against-cost figures", _released,
-                (overview.pareto, results, scenes, results, figdir), []),
-               ("convergence figures", _released, (convergence.draw, results, studies, figdir),
-                {})],
+            [(f"figure for {scene.id}", figures.draw, (scene, mine, figdir), [])
+             for scene, mine in owned]
+            + [("error-against-cost figures", overview.pareto, (scenes, results, figdir), []),
+               ("convergence figures", convergence.draw, (studies, figdir), {})],
             jobs, progress)
     front, conv = drawn[-2:]
     with phase("pages_s"):
         for (scene, mine), figs in zip(owned, drawn):
             sections.append((scene, html.scene_section(scene, mine, figs)))
-            release(mine)
     with phase("fields_s"):
         export_fields(results, out)
         if kept is not None:
