@@ -4,7 +4,7 @@ import pytest
 import scipy.sparse as sp
 
 from pdverify.errors import NumericalError
-from pdverify.solvers.dense import solve_square
+from pdverify.solvers.front import solve_square
 
 EPS = np.finfo(float).eps
 
