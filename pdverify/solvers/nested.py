@@ -55,10 +55,10 @@ def solve_nested(A, rhs, coords, *, where: str = "static solve", mixed: bool | N
     ~1/eps_single = 8e6 or worse) is solved by the double LU instead, with the reason in
     the diagnostics (``mixed_precision``). A random right-hand side is refined alongside
     (a near-singular system cannot converge on it) and gives the condition estimate
-    (:func:`~pdverify.solvers.mixed.probe_condition_estimate`). The diagnostics record the refinement's steps and
-    relative residuals (``refinement_steps``, ``refinement_residuals``, the probe's final
-    residual ``refinement_probe_residual``), the top separator's size and the separator
-    rows pivoted into a half.
+    (:func:`~pdverify.solvers.mixed.probe_condition_estimate`). The diagnostics record
+    the refinement's steps and relative residuals (``refinement_steps``,
+    ``refinement_residuals``, the probe's final residual ``refinement_probe_residual``),
+    the top separator's size and the separator rows pivoted into a half.
     """
     A = sp.csr_matrix(A)
     rhs = np.asarray(rhs, dtype=float)
