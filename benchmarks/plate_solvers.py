@@ -21,7 +21,7 @@ from _splu_timing import time_splu
 from pdverify.pd import StateBasedConstants
 from pdverify.scenes import get_scene
 from pdverify.scenes.plate2d import StatePlate
-from pdverify.solvers.static import equilibrate
+from pdverify.solvers.checks import equilibrate
 
 ORDERINGS = ("COLAMD", "MMD_AT_PLUS_A", "MMD_ATA")
 

@@ -2,7 +2,7 @@
 
 Plain script (no test runner): python benchmarks/sheet_solvers.py [--repeat N]
 Prints the median time of each alternative on the same matrix and the ratios to the
-default (COLAMD) ordering; the choice it supports is ``pdverify.solvers.static.SPD_OPTIONS``.
+default (COLAMD) ordering; the choice it supports is ``pdverify.solvers.lu.SPD_OPTIONS``.
 """
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ import numpy as np
 
 from _splu_timing import time_splu
 from pdverify.scenes import get_scene
-from pdverify.solvers.static import SPD_OPTIONS
+from pdverify.solvers.lu import SPD_OPTIONS
 
 
 def sheet_matrix(method="energy-directional"):

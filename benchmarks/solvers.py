@@ -46,9 +46,10 @@ import scipy.sparse.linalg as spla
 from pdverify.pd import BondBasedModel, BoxGrid, build_stencil, get_influence
 from pdverify.pd.influence import bond_micromodulus
 from pdverify.scenes import get_scene
-from pdverify.solvers.dense import eliminate_dirichlet, solve_with_dirichlet
+from pdverify.solvers.condense import condense
+from pdverify.solvers.front import solve_with_dirichlet
 from pdverify.solvers.iterative import Lattice, TwoLevelPreconditioner, cg_solve
-from pdverify.solvers.static import solve_nested
+from pdverify.solvers.nested import solve_nested
 
 try:
     import pypardiso
@@ -181,11 +182,12 @@ def bench_state(args, out, scene_id, spacing, key):
                        coords=coords: solve_with_dirichlet(A, rhs, fixed, values, "bench",
                                                            solver=solver, coords=coords))
         if pypardiso is not None:
-            Af, bf, _, _ = eliminate_dirichlet(A, rhs, fixed, values)
+            Af, bf, _ = condense(A, rhs, fixed, values)
             alts[f"PARDISO on {'K' if solver == 'direct' else 'the augmented system'}"] = (
                 lambda Af=Af, bf=bf: pardiso_factor_solve(Af, bf))
     model, A, rhs, fixed, values, _ = systems["nested-dissection"]
-    Af, bf, free, u_fixed = eliminate_dirichlet(A, rhs, fixed, values)
+    Af, bf, expand = condense(A, rhs, fixed, values)
+    free = expand.free
     coords_free = np.asarray(model.coords)[free]
     if args.with_double:
         alts["ours before: nested dissection, float64 LU"] = (
@@ -205,9 +207,7 @@ def bench_state(args, out, scene_id, spacing, key):
     print(f"  ours vs the float64 LU of the same ordering: max |du| / max |u| = {diff:.1e}")
     for name, (t, r) in res.items():
         if name.startswith("ours before"):   # the free unknowns only
-            full = u_fixed.copy()
-            full[free] = r[0]
-            x = full[:ref.size]
+            x = expand(r[0])[:ref.size]
             agree = np.linalg.norm(x - ref) / np.linalg.norm(ref)
             note = f"solution vs today's {agree:.1e}"
         elif isinstance(r, tuple):

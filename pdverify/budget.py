@@ -228,13 +228,13 @@ def linear_system(nodes: float, dim: int, dofs_per_node: int, reach: float,
     """Memory of assembling and factoring a static system on ``nodes`` lattice nodes in
     ``dim`` dimensions whose stencil reaches ``reach`` node spacings (see the module
     docstring); ``dense_allowed``: the solver switches to dense LU when it is full."""
-    # solve_square's switch to its dense path (imported here: the CLI imports this module
-    # and must stay light)
-    from .solvers.dense import DENSE_FILL, DENSE_MIN_UNKNOWNS
+    # the direct solver's switch to its dense path (solvers.policy; imported here: the CLI
+    # imports this module and must stay light)
+    from .solvers.policy import dense_lu
     n, nnz = _unknowns_and_nonzeros(nodes, dim, dofs_per_node, reach)
     sep = reach * float(nodes) ** ((dim - 1) / dim)
     factor = dofs_per_node ** 2 * max(float(nodes) * reach, sep * sep)
-    dense = dense_allowed and n >= DENSE_MIN_UNKNOWNS and nnz >= DENSE_FILL * n * n
+    dense = dense_allowed and dense_lu(n, nnz)
     memory = BYTES_PER_NONZERO * nnz + extra_bytes + (
         2 * 8.0 * n * n if dense else min(BYTES_PER_FACTOR_ENTRY * factor, 24.0 * n * n))
     how = "dense LU" if dense else "sparse LU"

@@ -21,7 +21,7 @@ from ..papers_data import Formula, load_tables
 from ..params import Param, at_least, positive
 from ..solvers.explicit import central_difference
 from ..solvers.modal import exact_stability_limit, min_angular_frequency
-from ..solvers.static import solve_constrained
+from ..solvers.front import solve_constrained
 from ..corrections.registry import plugin_call
 from . import Outcome, Published, Scene, register
 from .base import truncation_problem

@@ -23,8 +23,8 @@ def what_it_did(exc: BaseException) -> str:
 
 def conditioning_warnings(diagnostics: Mapping) -> list[str]:
     """One warning for the worst ``*condition_estimate`` in ``diagnostics`` (nested
-    included) above :data:`~pdverify.solvers.static.WARN_CONDITION`."""
-    from ..solvers.static import WARN_CONDITION
+    included) above :data:`~pdverify.solvers.policy.WARN_CONDITION`."""
+    from ..solvers.policy import WARN_CONDITION
 
     def walk(d, path):
         for k, v in d.items():

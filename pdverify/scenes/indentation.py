@@ -12,9 +12,9 @@ from ..params import Param, at_least, open_interval, positive
 from ..pd import BondBasedModel, BoxGrid, get_influence
 from ..pd.influence import bond_based_nu
 from ..pd.nonlinear import LinearBondBased, NonlinearBondBased
-from ..solvers.dense import SPD_LATTICE_SOLVERS
 from ..solvers.iterative import Lattice
 from ..solvers.newton import NEWTON_RTOL, DirichletLinearSolver, newton
+from ..solvers.policy import NEWTON_CG_FROM_UNKNOWNS, SPD_LATTICE_SOLVERS, newton_solver
 from . import Outcome, Published, register
 from .base import ExpectedFailure
 from .fem_references import FEM, FemAndPD, _reference_module
@@ -33,9 +33,6 @@ KINEMATICS = ("nonlinear", "linear")
 #: ``half``: the PD model of the half block x >= 0 with mirrored neighbours (exact for the
 #: symmetric solution, :mod:`pdverify.pd.nonlinear`); ``full``: the whole block
 SYMMETRY = ("half", "full")
-#: ``solver=auto`` uses CG from this many unknowns: on the quick grid (41 x 41 nodes, m = 6,
-#: 3,362 unknowns) a sparse LU per Newton step made the corrected curve 13 s, CG 2.6 s.
-CG_FROM_UNKNOWNS = 1000
 #: The paper's runs: its micromodulus and quadrature (as §4.1), nonlinear kinematics.
 NONLINEAR = {**PAPER, "kinematics": "nonlinear", "spacing": 0.00025, "horizon": 0.0015}
 #: The like-for-like reference of a nonlinear PD run: the finite-strain FEM (St Venant-
@@ -174,7 +171,7 @@ class Indentation(FemAndPD):
         Param("solver", "auto", "linear solver of each Newton step: direct (sparse LU), cg "
               "(conjugate gradients, two-level smoothed aggregation one horizon wide, built "
               "once and rebuilt when a solve slows down) or auto (cg from "
-              f"{CG_FROM_UNKNOWNS} unknowns)", choices=SPD_LATTICE_SOLVERS),
+              f"{NEWTON_CG_FROM_UNKNOWNS} unknowns)", choices=SPD_LATTICE_SOLVERS),
         Param("substeps", 1, "depth increments per output depth (n_steps * substeps in all)",
               at_least(1)),
         Param("kinematics", "nonlinear", "nonlinear (current bond lengths and directions) "
@@ -292,8 +289,7 @@ class Indentation(FemAndPD):
         m = p["horizon"] / h
         bonds = nodes * budget.lattice_neighbours(2, m) / 2
         # the tangent's pattern positions and data, bond vectors, the CG preconditioner
-        if p["solver"] == "direct" or (p["solver"] == "auto"
-                                       and 2 * nodes < CG_FROM_UNKNOWNS):
+        if newton_solver(p["solver"], 2 * nodes) == "direct":
             return budget.linear_system(nodes, 2, 2, m, extra_bytes=400.0 * bonds)
         # CG never factors: the whole block's tangent (the half model's setup builds the
         # whole block's bonds), once more for the preconditioner's K P and its smoothed
@@ -330,8 +326,7 @@ class Indentation(FemAndPD):
                 model, mirror_axis=0 if p["symmetry"] == "half" else None)
             kin.pattern                  # the tangent's pattern, built in the setup phase
             unknowns = 2 * kin.n
-            use_cg = p["solver"] == "cg" or (p["solver"] == "auto"
-                                             and unknowns >= CG_FROM_UNKNOWNS)
+            use_cg = newton_solver(p["solver"], unknowns) == "cg"
             ids = kin.node_ids
             lin = DirichletLinearSolver(kin.pattern, "cg" if use_cg else "direct",
                                         Lattice.component_major(grid.index[ids], grid.x[ids], 2),

@@ -13,8 +13,7 @@ from ..params import Param, at_least, positive
 from ..pd import (QUADRATURES, BoxGrid, StateBasedConstants, StateBasedModel, get_influence,
                   state_based_stencil)
 from ..pd.problem import FACES, FaceCondition, StaticProblem
-from ..solvers.dense import solve_with_dirichlet
-from ..solvers.static import solve_constrained
+from ..solvers.front import solve_constrained, solve_with_dirichlet
 from . import Outcome, Published, influence_param, register, whole_cells
 from .family import FemStaticStateScene
 

@@ -10,8 +10,9 @@ from ..params import Param, at_least, positive
 from ..pd import BondBasedModel, BoxGrid, bond_micromodulus, build_stencil, get_influence
 from ..pd.influence import bond_based_nu
 from ..pd.problem import ClampedBox
-from ..solvers.dense import AUTO_ITERATIVE_UNKNOWNS, SPD_LATTICE_SOLVERS, solve_with_dirichlet
+from ..solvers.front import solve_with_dirichlet
 from ..solvers.iterative import Lattice
+from ..solvers.policy import AUTO_ITERATIVE_UNKNOWNS, SPD_LATTICE_SOLVERS
 from . import Outcome, Published, register, whole_cells
 from .fem_references import FemAndPD
 
@@ -69,7 +70,7 @@ class SheetScene(FemAndPD):
     def solve_fixed(model, fixed, values, where, f=None, solver="direct"):
         """K u = f with the given DOFs prescribed; returns (u, reactions K u - f, info).
 
-        ``solver``: see :func:`~pdverify.solvers.dense.solve_with_dirichlet`; CG's
+        ``solver``: see :func:`~pdverify.solvers.front.solve_with_dirichlet`; CG's
         aggregates are one horizon (m nodes) wide."""
         K = model.K
         rhs = np.zeros(K.shape[0]) if f is None else f

@@ -6,12 +6,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-#: Below this many free unknowns the eigenvalues come from a dense solver.
-DENSE_LIMIT = 400
-#: Up to this bandwidth the largest eigenvalue comes from LAPACK's banded solver (exact
-#: and O(n b^2)); Lanczos converges slowly when the top of the spectrum is clustered, as
-#: it is for the interior modes of a long bar.
-BANDED_LIMIT = 64
+from . import policy
 
 
 def _scaled(stiffness, mass, fixed):
@@ -36,9 +31,9 @@ def max_angular_frequency(stiffness, mass, *, fixed=()) -> float:
     coo = A.tocoo()
     lower = coo.row >= coo.col
     band = int(np.max(coo.row - coo.col)) if coo.nnz else 0
-    if n <= DENSE_LIMIT:
+    if n <= policy.EIGEN_DENSE_LIMIT:
         lam = sla.eigvalsh(A.toarray(), subset_by_index=[n - 1, n - 1])[0]
-    elif band <= BANDED_LIMIT:
+    elif band <= policy.EIGEN_BANDED_LIMIT:
         ab = np.zeros((band + 1, n))
         np.add.at(ab, (coo.row[lower] - coo.col[lower], coo.col[lower]), coo.data[lower])
         lam = sla.eigvals_banded(ab, lower=True, select="i", select_range=(n - 1, n - 1))[0]
@@ -54,7 +49,7 @@ def min_angular_frequency(stiffness, mass, *, fixed=()) -> float:
     n = A.shape[0]
     if n == 0:
         return 0.0
-    if n <= DENSE_LIMIT:
+    if n <= policy.EIGEN_DENSE_LIMIT:
         lam = sla.eigvalsh(A.toarray(), subset_by_index=[0, 0])[0]
     else:
         lam = spla.eigsh(A, k=1, sigma=0.0, which="LM", tol=0, return_eigenvectors=False)[0]

@@ -14,7 +14,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import NumericalError
-from .dense import eliminate_dirichlet, solve_square
+from .condense import condense
+from .front import solve_square
 from .iterative import Lattice, TwoLevelPreconditioner, cg_solve
 
 #: Newton stops when ||f_free|| <= NEWTON_RTOL * max(||f_free|| at its start, ||reactions||):
@@ -57,7 +58,7 @@ class DirichletLinearSolver:
     """Solves T du = -f with du = 0 on the prescribed unknowns, for tangents T given as data
     on one CSR ``pattern`` (see :mod:`pdverify.pd.nonlinear`).
 
-    ``method``: ``direct`` (:func:`~pdverify.solvers.dense.solve_square` on the free block,
+    ``method``: ``direct`` (:func:`~pdverify.solvers.front.solve_square` on the free block,
     a fresh factorisation per solve) or
     ``cg`` (conjugate gradients on the full-size system with the prescribed rows and
     columns replaced by their diagonal, preconditioned by :class:`TwoLevelPreconditioner`
@@ -114,9 +115,9 @@ class DirichletLinearSolver:
         r = np.where(free, rhs, 0.0)
         if self.method == "direct":       # the solver layer's checked sparse LU (SPD mode)
             t0 = time.perf_counter()
-            K_free, r_free, idx, du = eliminate_dirichlet(
+            K_free, r_free, expand = condense(
                 self.pattern.matrix(data), r, np.flatnonzero(self.fixed), 0.0)
-            du[idx], _ = solve_square(K_free, r_free, where=where, spd=True)
+            du = expand(solve_square(K_free, r_free, where=where, spd=True)[0])
             self.stats.solves += 1
             self.stats.solve_s += time.perf_counter() - t0
             return du

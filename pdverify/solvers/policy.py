@@ -1,11 +1,91 @@
-"""Which linear solver a static run uses: every threshold of ``solver=auto`` in one place.
+"""Which solver a run uses: every threshold of the choice in one place.
 
-The solvers themselves live beside this module (``static``: sparse LU with constraints,
-nested dissection, mixed precision; ``dense``: dense LU and Dirichlet elimination;
-``iterative``: CG with the lattice preconditioner); :func:`pdverify.solvers.front.solve`
-is the one front door the problem families call.
+The front door (:func:`pdverify.solvers.front.solve`, :func:`~pdverify.solvers.front.
+solve_with_dirichlet`) asks this module which implementation to call; the implementations
+(``lu``: sparse LU with constraints; ``dense``: LAPACK LU; ``nested``: nested dissection
+and its split LU; ``mixed``: single-precision factor refined in double; ``iterative``: CG
+with the lattice preconditioner; ``modal``: eigenvalues) read their crossovers from here
+at call time, so a test can move one by patching this module. Nothing here solves, and
+this module imports no other module of the package.
 """
 from __future__ import annotations
+
+import numpy as np
+
+# -- the solvers a run can ask for ----------------------------------------------------
+
+#: every solver name :func:`pdverify.solvers.front.solve_with_dirichlet` knows
+SOLVERS = ("auto", "direct", "cg", "nested-dissection")
+#: the choices of a scene whose system is SPD on a lattice (bond-based): no coordinates
+#: are passed, so nested dissection is not among them
+SPD_LATTICE_SOLVERS = ("auto", "direct", "cg")
+#: the solvers a static state-based problem can ask for
+STATIC_SOLVERS = ("auto", "direct", "nested-dissection")
+
+# -- refusing a system ----------------------------------------------------------------
+
+#: Above this 1-norm condition estimate the solution has lost (almost) every digit of
+#: double precision (eps ~ 2.2e-16), so the run is refused as near-singular.
+CONDITION_LIMIT = 1e14
+#: Above this condition estimate a run stays ``ok`` but carries a warning: its solution is
+#: trustworthy only to about kappa * eps >= 1e-6 relative, so smaller errors it reports
+#: are round-off, not the method (e.g. bar1d-traction order 20 at 100 cells: 2.3e12).
+WARN_CONDITION = 1e-6 / np.finfo(float).eps
+
+# -- direct: dense or sparse LU -------------------------------------------------------
+
+#: Above this fill (nnz / n^2) a dense LAPACK LU beats SuperLU: in 3D state-based PD every
+#: node couples to all nodes within two horizons, i.e. to a large part of a small body.
+DENSE_FILL = 0.1
+#: ... and below this many unknowns SuperLU is used whatever the fill
+DENSE_MIN_UNKNOWNS = 2000
+
+
+def dense_lu(n, nnz) -> bool:
+    """Whether ``direct`` factors an n x n matrix with ``nnz`` stored entries by the dense
+    LAPACK LU (:data:`DENSE_MIN_UNKNOWNS`, :data:`DENSE_FILL`) rather than SuperLU."""
+    return n >= DENSE_MIN_UNKNOWNS and nnz >= DENSE_FILL * n * n
+
+
+# -- auto on SPD lattices: CG or direct -----------------------------------------------
+
+#: ``solver="auto"`` picks CG (SPD systems with a lattice) from this many free unknowns:
+#: below it the direct solve takes about a second (1.2 s at the sheets' default 10,150
+#: unknowns) and is exact to round-off, and the report's default-size runs keep their
+#: direct solutions bit for bit.
+AUTO_ITERATIVE_UNKNOWNS = 20000
+
+
+def lattice_uses_cg(requested: str, iterative_ok: bool, free_unknowns: int) -> bool:
+    """Whether a linear solve of an SPD lattice system runs CG: asked for, or ``auto`` on
+    a system CG applies to (``iterative_ok``) from :data:`AUTO_ITERATIVE_UNKNOWNS` free
+    unknowns."""
+    return requested == "cg" or (requested == "auto" and iterative_ok
+                                 and free_unknowns >= AUTO_ITERATIVE_UNKNOWNS)
+
+
+def lattice_note(use_cg: bool, free_unknowns: int) -> str:
+    """The ``solver_choice`` a linear solve records when ``auto`` chose."""
+    return (f"auto: {'cg' if use_cg else 'direct'} ({free_unknowns} free "
+            f"unknowns; cg from {AUTO_ITERATIVE_UNKNOWNS} on SPD systems)")
+
+
+#: The indentation's Newton steps (:class:`~pdverify.solvers.newton.DirichletLinearSolver`):
+#: ``solver=auto`` uses CG from this many unknowns: on the quick grid (41 x 41 nodes,
+#: m = 6, 3,362 unknowns) a sparse LU per Newton step made the corrected curve 13 s, CG
+#: 2.6 s.
+NEWTON_CG_FROM_UNKNOWNS = 1000
+
+
+def newton_solver(requested: str, unknowns) -> str:
+    """The linear solver of a Newton run's tangents: ``requested`` (``cg`` or ``direct``),
+    or for ``auto`` ``cg`` from :data:`NEWTON_CG_FROM_UNKNOWNS` unknowns."""
+    return ("cg" if requested == "cg" or (requested == "auto"
+                                          and unknowns >= NEWTON_CG_FROM_UNKNOWNS)
+            else "direct")
+
+
+# -- auto on state-based problems: nested dissection or direct ------------------------
 
 #: ``solver=auto`` solves the augmented system (dilatations as unknowns) under nested
 #: dissection from this many displacement unknowns in 2D; below it the direct solve of K
@@ -18,8 +98,6 @@ ND_FROM_UNKNOWNS = 8000
 #: at 3,528, 4.22 / 2.99 s at 4,992 (where the float32 factor starts), and at the default
 #: 9,000 15.7 / 7.9 s with peak memory 2.67 / 1.33 GB (``pdverify run``, /usr/bin/time)
 ND3D_FROM_UNKNOWNS = 4000
-#: the solvers a static state-based problem can ask for
-STATIC_SOLVERS = ("auto", "direct", "nested-dissection")
 
 
 def static_solver(requested: str, dim: int, unknowns: int) -> str:
@@ -39,3 +117,46 @@ def auto_note(solver: str, unknowns: int) -> str:
     """The ``solver_choice`` a run records when ``auto`` chose."""
     return (f"auto: {solver} ({unknowns} unknowns; nested dissection from "
             f"{ND_FROM_UNKNOWNS} in 2D, {ND3D_FROM_UNKNOWNS} in 3D)")
+
+
+# -- nested dissection: single or double precision, split or whole --------------------
+
+#: From this many unknowns :func:`~pdverify.solvers.nested.solve_nested` factors in single
+#: precision (two halves in parallel, see :class:`~pdverify.solvers.nested.SplitLU`) and
+#: refines in double. Measured on the plane-strain plate (augmented system; float64 LU
+#: against mixed, medians of 5): 2,025 unknowns 0.065 s / 0.083 s; 5,040: 0.22 / 0.20;
+#: 7,800: 0.45 / 0.32; 19,680: 1.86 / 1.03; 30,600: 3.2 / 1.55.
+MIXED_FROM_UNKNOWNS = 5000
+
+
+def mixed_precision(unknowns: int) -> bool:
+    """Whether nested dissection factors in single precision by default
+    (:data:`MIXED_FROM_UNKNOWNS`)."""
+    return unknowns >= MIXED_FROM_UNKNOWNS
+
+
+#: :class:`~pdverify.solvers.nested.SplitLU` splits at the top separator only while its
+#: dense blocks (s^2 entries, s^3 work) stay small against the halves: s^2 <= this many
+#: times the unknowns. The 2D plates have s^2 / n ~ 28 at every h (m = 3; 921 of 30,600
+#: unknowns at h = 0.01), the 3D bodies 236 (h = 0.1) and 336 (h = 0.05), where the split
+#: gains nothing over one float32 LU of the whole matrix (h = 0.05, quiet machine, the
+#: whole solve: 7.8-8.1 s against 7.5-8.5 s; each half's factor with the separator 1.9 s
+#: and 3.3 s against 0.5 s for a half alone: the separator's coupling, not the parallel
+#: factors, costs).
+SPLIT_MAX_SEPARATOR = 100
+
+
+def split_too_large(separator: int, unknowns: int) -> bool:
+    """Whether a top separator of ``separator`` unknowns is too large to split at
+    (:data:`SPLIT_MAX_SEPARATOR`): the whole matrix is then factored in one piece."""
+    return separator ** 2 > SPLIT_MAX_SEPARATOR * unknowns
+
+
+# -- eigenvalues (modal) ----------------------------------------------------------------
+
+#: Below this many free unknowns the eigenvalues come from a dense solver.
+EIGEN_DENSE_LIMIT = 400
+#: Up to this bandwidth the largest eigenvalue comes from LAPACK's banded solver (exact
+#: and O(n b^2)); Lanczos converges slowly when the top of the spectrum is clustered, as
+#: it is for the interior modes of a long bar.
+EIGEN_BANDED_LIMIT = 64

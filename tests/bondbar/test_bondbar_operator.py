@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from pdverify.scenes.bar1d_bondbased import BondBar
-from pdverify.solvers.static import solve_constrained
+from pdverify.solvers.lu import solve_constrained
 
 EPS = np.finfo(float).eps
 

@@ -9,7 +9,7 @@ from pdverify.pd import (BoxGrid, StateBasedConstants, StateBasedModel, get_infl
                          state_based_stencil)
 from pdverify.report.figures.surface_nodes import mnm_pattern, where_max
 from pdverify.scenes import get_scene
-from pdverify.solvers.dense import solve_with_dirichlet
+from pdverify.solvers.front import solve_with_dirichlet
 
 H, L = 0.1, (1.0, 0.8)
 C = StateBasedConstants("plane-strain", 200e9, 0.3)

@@ -7,7 +7,7 @@ import scipy.sparse.linalg as spla
 from pdverify.errors import NumericalError
 from pdverify.pd import BondBasedModel, BoxGrid, build_stencil, get_influence
 from pdverify.pd.influence import bond_micromodulus
-from pdverify.solvers.dense import solve_with_dirichlet
+from pdverify.solvers.front import solve_with_dirichlet
 from pdverify.solvers.iterative import (CG_RTOL, Lattice, TwoLevelPreconditioner, cg_solve,
                                         solver_error_warnings)
 

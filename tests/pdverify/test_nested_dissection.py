@@ -10,7 +10,7 @@ from pdverify.scenes import get_scene
 from pdverify.scenes.surface_nodes import StateBox
 from pdverify.solvers.policy import ND3D_FROM_UNKNOWNS, ND_FROM_UNKNOWNS, static_solver
 from pdverify.solvers.ordering import nested_dissection
-from pdverify.solvers.static import solve_nested
+from pdverify.solvers.nested import solve_nested
 
 EPS = np.finfo(float).eps
 
@@ -127,9 +127,9 @@ def test_augmented_schur_complement_is_the_stiffness(order):
 @pytest.mark.parametrize("mixed_from", [None, 0])
 def test_plate_nested_dissection_agrees_with_direct(monkeypatch, mixed_from):
     """Also with the single-precision factor and refinement forced on (mixed_from = 0)."""
-    from pdverify.solvers import static
+    from pdverify.solvers import policy
     if mixed_from is not None:
-        monkeypatch.setattr(static, "MIXED_FROM_UNKNOWNS", mixed_from)
+        monkeypatch.setattr(policy, "MIXED_FROM_UNKNOWNS", mixed_from)
     scene = get_scene("plate2d-plane-strain")
     small = {"spacing": 0.05}
     a = scene.run("surface-nodes", {**small, "solver": "nested-dissection"})
@@ -161,9 +161,9 @@ def test_3d_auto_nested_dissection_agrees_with_the_dense_lu(monkeypatch, scene_i
     compare gate's 1e-8 (issue 12: metrics unchanged at --rtol 1e-8). Both are direct
     solves (condition ~1e6 after equilibration): the solutions agree to ~1e-12, and an
     error metric ~1e-3 of the solution (max_error_pct 0.077 %) to ~1e-9 relative."""
-    from pdverify.solvers import policy, static
+    from pdverify.solvers import policy
     monkeypatch.setattr(policy, "ND3D_FROM_UNKNOWNS", 1000)
-    monkeypatch.setattr(static, "MIXED_FROM_UNKNOWNS", 0)
+    monkeypatch.setattr(policy, "MIXED_FROM_UNKNOWNS", 0)
     scene = get_scene(scene_id)
     a = scene.run("surface-nodes", {"spacing": 0.1})
     b = scene.run("surface-nodes", {"spacing": 0.1, "solver": "direct"})

@@ -1,12 +1,14 @@
-"""Single-precision split LU with refinement in double (pdverify.solvers.static.SplitLU)."""
+"""Single-precision split LU with refinement in double (pdverify.solvers.nested.SplitLU)."""
 import numpy as np
 import pytest
 import scipy.sparse as sp
 
 from pdverify.errors import NumericalError
-from pdverify.solvers import static
+from pdverify.solvers import nested, policy
+from pdverify.solvers.checks import equilibrate
+from pdverify.solvers.mixed import refine
+from pdverify.solvers.nested import SplitLU, solve_nested
 from pdverify.solvers.ordering import nested_dissection
-from pdverify.solvers.static import SplitLU, equilibrate, refine, solve_nested
 
 EPS = np.finfo(float).eps
 EPS32 = np.finfo(np.float32).eps
@@ -92,7 +94,7 @@ def test_crossed_pivots_in_float32_and_beyond_the_limit(monkeypatch):
     assert lu.crossed_pivots >= 1
     x, _, _, ok = refine(A, b, lu.solve)
     assert ok and np.abs(x - exact).max() / np.abs(exact).max() < 1e4 * EPS
-    monkeypatch.setattr(static, "MAX_CROSSED_PIVOTS", 0)
+    monkeypatch.setattr(nested, "MAX_CROSSED_PIVOTS", 0)
     with pytest.raises(RuntimeError, match="separator rows into a half"):
         SplitLU(A, n1, n2)
 
@@ -217,9 +219,9 @@ def test_equilibrate_unchanged():
 def test_default_switch_is_by_size(monkeypatch):
     A, x = lattice_operator(12, 2)
     b = np.ones(A.shape[0])
-    monkeypatch.setattr(static, "MIXED_FROM_UNKNOWNS", A.shape[0] + 1)
+    monkeypatch.setattr(policy, "MIXED_FROM_UNKNOWNS", A.shape[0] + 1)
     assert "mixed_precision" not in solve_nested(A, b, x, where="test")[1]
-    monkeypatch.setattr(static, "MIXED_FROM_UNKNOWNS", A.shape[0])
+    monkeypatch.setattr(policy, "MIXED_FROM_UNKNOWNS", A.shape[0])
     assert solve_nested(A, b, x, where="test")[1]["mixed_precision"].startswith("float32")
 
 

@@ -91,7 +91,7 @@ def test_ok_but_ill_conditioned_runs_carry_a_warning_in_json_and_report():
     """Order 20 at 100 cells: condition estimate 2.3e12, so kappa * eps = 5e-4 relative,
     above the 1e-6 of WARN_CONDITION; order 10 (2.3e8, 5e-8) stays clean."""
     from pdverify.report.html import scene_section
-    from pdverify.solvers.static import WARN_CONDITION
+    from pdverify.solvers.policy import WARN_CONDITION
     scene = get_scene("bar1d-traction")
     warned = scene.run("taylor-fictitious", {"order": 20, "spacing": 0.01})
     clean = scene.run("taylor-fictitious", {"order": 10, "spacing": 0.01})

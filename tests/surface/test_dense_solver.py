@@ -1,16 +1,18 @@
-"""pdverify/solvers/dense.py: the dense LAPACK path used for full 3D state-based systems."""
+"""pdverify/solvers/dense.py, reached through the direct solver of the front door
+(front.solve_square; the switch is policy.dense_lu): the dense LAPACK path used for full 3D
+state-based systems."""
 import numpy as np
 import pytest
 import scipy.sparse as sp
 
 from pdverify.errors import NumericalError
-from pdverify.solvers.dense import solve_square
+from pdverify.solvers.front import solve_square
 
 EPS = np.finfo(float).eps
 
 
 def test_dense_path_solves_to_round_off(rng):
-    n = 2100  # above the dense threshold (n >= 2000 and fill > 10 %)
+    n = 2100  # above the dense threshold (policy: n >= 2000 and fill > 10 %)
     A = rng.uniform(-1, 1, (n, n)) + n * np.eye(n)
     A[:, 5] *= 1e8  # badly scaled columns are equilibrated away
     x = rng.uniform(-1, 1, n)

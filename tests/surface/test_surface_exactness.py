@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from pdverify.corrections.taylor import monomial_exponents
-from pdverify.solvers.dense import solve_with_dirichlet
+from pdverify.solvers.front import solve_with_dirichlet
 from pdverify.pd import StateBasedConstants
 from pdverify.scenes.surface_nodes import StateBox
 

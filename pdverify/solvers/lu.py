@@ -1,0 +1,69 @@
+"""Direct sparse LU (SuperLU) of a square system, with constraints by Lagrange multipliers
+(seed 000 Eq. 63), under the checks of :mod:`pdverify.solvers.checks`."""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ..errors import NumericalError
+from .checks import checked_condition, equilibrate, relative_residual
+
+
+#: SuperLU options for a symmetric positive definite K (no constraint rows): minimum
+#: degree on A + A^T and diagonal pivots, which keep the symmetric fill; on a 2D
+#: bond-based sheet (10k unknowns, 1.5 M non-zeros) 0.74 s against 1.87 s with the
+#: default COLAMD column ordering (benchmarks/sheet_solvers.py).
+SPD_OPTIONS = dict(permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                   options=dict(SymmetricMode=True))
+
+# ``ordering`` of solve_constrained is SuperLU's permc_spec (COLAMD, MMD_AT_PLUS_A,
+# MMD_ATA, NATURAL). Measured, not assumed (benchmarks/plate_solvers.py): minimum degree
+# on A + A^T is ~3x faster than the default COLAMD on the seed-000 plate's Lagrange system,
+# but ~1.6x slower on the seed-001 surface-node plate, so each scene states its choice.
+
+
+def solve_constrained(K, f, B=None, c=None, *, where: str = "static solve", spd: bool = False,
+                      ordering: str = "COLAMD"):
+    """Solve [[K, B^T], [B, 0]] [u; lam] = [f; c] with a sparse LU factorisation.
+
+    ``spd=True`` (only without constraints) declares K symmetric positive definite and
+    factors it in SuperLU's symmetric mode (:data:`SPD_OPTIONS`); the residual and
+    condition checks below guard the claim. Otherwise ``ordering`` is SuperLU's column
+    ordering (``permc_spec``), with partial pivoting.
+
+    Returns ``(u, lam, info)``; ``info`` holds the system size, the relative residual
+    and a 1-norm condition estimate. Singular or near-singular systems, and non-finite
+    solutions, raise :class:`NumericalError` naming ``where``.
+    """
+    K = sp.csr_matrix(K)
+    n = K.shape[0]
+    if B is not None and np.size(B):
+        B = sp.csr_matrix(np.atleast_2d(B) if not sp.issparse(B) else B)
+        c = np.atleast_1d(np.asarray(c, dtype=float))
+        A = sp.bmat([[K, B.T], [B, None]], format="csc")
+        rhs = np.concatenate([np.asarray(f, dtype=float), c])
+    else:
+        A = K.tocsc()
+        rhs = np.asarray(f, dtype=float)
+    if not np.all(np.isfinite(A.data)) or not np.all(np.isfinite(rhs)):
+        raise NumericalError(f"{where}: the system has non-finite entries")
+    A_s, row_max, col_max = equilibrate(A, where)
+    A_s = A_s.tocsc()
+    lu = factor(A_s, where, **(SPD_OPTIONS if spd and B is None else {"permc_spec": ordering}))
+    sol = lu.solve(rhs / row_max) / col_max
+    cond = checked_condition(sol, A_s, lu, where)
+    info = {"unknowns": int(A.shape[0]), "relative_residual": relative_residual(A, sol, rhs),
+            "condition_estimate": float(cond),  # of the equilibrated system
+            "solver": "sparse LU (SuperLU, " + ("symmetric mode)" if spd and B is None
+                                                else f"{ordering} ordering)")}
+    return sol[:n], sol[n:], info
+
+
+def factor(A, where: str, **options):
+    """SuperLU of the equilibrated ``A``; an exactly singular factor is a NumericalError."""
+    try:
+        return spla.splu(A, **options)
+    except RuntimeError as exc:  # "Factor is exactly singular"
+        raise NumericalError(f"{where}: singular system of size {A.shape[0]} ({exc})") from None
+

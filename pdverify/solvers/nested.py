@@ -1,0 +1,283 @@
+"""Sparse LU under a geometric nested-dissection ordering
+(:func:`pdverify.solvers.ordering.nested_dissection`), in double precision or, from
+:data:`~pdverify.solvers.policy.MIXED_FROM_UNKNOWNS` unknowns, as a single-precision
+:class:`SplitLU` (the two halves of the top split factored in parallel) refined in double
+(:mod:`pdverify.solvers.mixed`)."""
+from __future__ import annotations
+
+import os
+from concurrent import futures
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ..errors import NumericalError
+from . import policy
+from .checks import checked_condition, equilibrate, refuse_near_singular, relative_residual
+from .lu import factor
+from .mixed import refine_with_probe
+from .ordering import nested_dissection
+
+#: SuperLU's diagonal pivot threshold under the nested-dissection ordering: a diagonal
+#: entry is kept as pivot unless it is below 1e-3 of its column's largest, so the ordering
+#: survives. Measured on the plane-strain plate's augmented system at h = 0.01 (a side
+#: measurement): 1e-3 and 1e-2 give the same accuracy (solution error 7e-13, PARDISO's
+#: 6e-13); 0.1 is 1.7x slower, and 1.0 (full partial pivoting) 9.8x slower with 3.3x the
+#: fill.
+ND_PIVOT_THRESHOLD = 1e-3
+ND_OPTIONS = dict(permc_spec="NATURAL", diag_pivot_thresh=ND_PIVOT_THRESHOLD,
+                  options=dict(SymmetricMode=True))
+
+#: Shift of the separator blocks of the two halves' matrices (see :class:`SplitLU`; the
+#: factorisation is exact for any shift, it only sets how much float32 round-off the
+#: separator's Schur complement picks up). Measured on the plate at h = 0.01 (entries
+#: <= 1 after equilibration; condition of the halves' Schur complements / refinement
+#: steps to LAPACK's test): 0 -> 8.5e4, stalls at 1e-5 relative residual; 1 -> 110, 3;
+#: 2 -> 19, 3; 4 -> 5.5, 3; 8 -> 2.4, 3.
+SEPARATOR_SHIFT = 2.0
+#: At most this many separator rows may be pivoted into a half by SuperLU's threshold
+#: pivoting (each costs two solves and a rank-one term in :class:`SplitLU`); beyond it the
+#: whole matrix is factored in one piece. The plate at h = 0.0125: 1 of 741.
+MAX_CROSSED_PIVOTS = 32
+
+
+def solve_nested(A, rhs, coords, *, where: str = "static solve", mixed: bool | None = None):
+    """Solve the square system A x = rhs by sparse LU under a geometric nested-dissection
+    ordering (:func:`pdverify.solvers.ordering.nested_dissection`; ``coords``: one row
+    per unknown). Same checks and diagnostics as
+    :func:`~pdverify.solvers.lu.solve_constrained`: equilibration,
+    a 1-norm condition estimate, :class:`NumericalError` on (near-)singular systems.
+
+    ``mixed`` (default: :func:`~pdverify.solvers.policy.mixed_precision`): factor in single
+    precision (:class:`SplitLU`) and refine in double as LAPACK's dsgesv does; a system
+    whose single-precision factor fails or whose refinement does not converge (condition
+    ~1/eps_single = 8e6 or worse) is solved by the double LU instead, with the reason in
+    the diagnostics (``mixed_precision``). A random right-hand side is refined alongside
+    (a near-singular system cannot converge on it) and gives the condition estimate
+    (:func:`~pdverify.solvers.mixed.probe_condition_estimate`). The diagnostics record
+    the refinement's steps and relative residuals (``refinement_steps``,
+    ``refinement_residuals``, the probe's final residual ``refinement_probe_residual``),
+    the top separator's size and the separator rows pivoted into a half.
+    """
+    A = sp.csr_matrix(A)
+    rhs = np.asarray(rhs, dtype=float)
+    if not np.all(np.isfinite(A.data)) or not np.all(np.isfinite(rhs)):
+        raise NumericalError(f"{where}: the system has non-finite entries")
+    n = A.shape[0]
+    A_s, row_max, col_max = equilibrate(A, where)
+    perm, (n1, n2) = nested_dissection(A_s, coords, top_split=True)
+    A_p = A_s[perm][:, perm].tocsr()
+    b_p = (rhs / row_max)[perm]
+    use_mixed = policy.mixed_precision(n) if mixed is None else mixed
+    info: dict = {"unknowns": int(n)}
+    y = None
+    if use_mixed:
+        y, cond, diag = _solve_mixed(A_p, b_p, n1, n2)
+        info.update(diag)
+    if y is None:
+        lu = factor(A_p.tocsc(), where, **ND_OPTIONS)
+        y = lu.solve(b_p)
+        cond = checked_condition(y, A_p, lu, where)
+        info["factor_entries"] = int(lu.L.nnz + lu.U.nnz)
+        info["solver"] = "sparse LU (SuperLU, nested-dissection ordering)"
+    else:
+        refuse_near_singular(cond, where)
+    sol = np.empty_like(y)
+    sol[perm] = y
+    sol /= col_max
+    info["relative_residual"] = relative_residual(A, sol, rhs)
+    info["condition_estimate"] = float(cond)   # of the equilibrated system
+    return sol, info
+
+
+def _solve_mixed(A_p, b_p, n1: int, n2: int):
+    """Single-precision LU of the equilibrated, permuted ``A_p`` (:class:`SplitLU`: the
+    two halves of the top split in parallel, or, when SuperLU's pivoting crosses between
+    the blocks or the separator is too large to split at
+    (:func:`~pdverify.solvers.policy.split_too_large`), the whole matrix in one piece)
+    and refinement in double
+    (:func:`~pdverify.solvers.mixed.refine_with_probe`): ``(y, condition estimate,
+    diagnostics)``, or ``(None, None, diagnostics)`` with the reason in
+    ``diagnostics['mixed_precision']`` when the double LU must take over."""
+    note = ""
+    separator = A_p.shape[0] - n1 - n2
+    if n1 and n2 and policy.split_too_large(separator, A_p.shape[0]):
+        n1 = n2 = 0
+        note = f" (whole matrix: separator of {separator} unknowns too large to split at)"
+    try:
+        lu = SplitLU(A_p, n1, n2)
+    except RuntimeError as exc:
+        note = f" (whole matrix: {exc})"
+        try:
+            lu = SplitLU(A_p, 0, 0)
+        except RuntimeError as exc:  # "Factor is exactly singular" in single precision
+            return None, None, {"mixed_precision": f"not used: single-precision factor "
+                                                   f"failed ({exc}); double LU"}
+    y, cond, diag = refine_with_probe(A_p, b_p, lu)
+    if y is None:
+        return None, None, diag
+    diag.update(mixed_precision="float32 LU" + note + ", refined in float64 (LAPACK "
+                                "dsgesv's test)",
+                factor_entries=lu.factor_entries, separator_unknowns=lu.separator,
+                separator_rows_pivoted_into_halves=lu.crossed_pivots,
+                solver="sparse LU (SuperLU in float32 + refinement, nested-dissection "
+                       "ordering)")
+    return y, cond, diag
+
+
+class SplitLU:
+    """A single-precision LU of ``A = [[A11, 0, A1s], [0, A22, A2s], [As1, As2, Ass]]`` (the
+    top split of a nested-dissection ordering) whose two halves are factored in parallel.
+
+    Each half is factored by SuperLU with the separator last, ``M_i = [[Aii, Ais],
+    [Asi, D_i]]``, ``D_i = Ass / 2 + g I`` (g = :data:`SEPARATOR_SHIFT`); the trailing block
+    of its LU is ``T_i = D_i - Asi Aii^-1 Ais``, read off the factor and multiplied out in
+    double. The Schur complement of the separator is then ``S = Ass - sum (D_i - T_i)
+    = T_1 + T_2 - 2 g I`` (SuperLU in double). A solve: ``M_i [z_i; w_i] = [b_i; 0]`` gives
+    ``Asi Aii^-1 b_i = -T_i w_i``, so ``x_s = S^-1 (b_s + T_1 w_1 + T_2 w_2)``, and then
+    ``M_i [x_i; x_s] = [b_i; T_i (x_s - w_i)]``. Should SuperLU's threshold pivoting take
+    a separator row as pivot of a half's column, the trailing block is the Schur complement
+    for the rows so pivoted; T_i follows from it by a rank-c correction (c such rows, at
+    most :data:`MAX_CROSSED_PIVOTS`; two solves each).
+
+    Without a split (``n1 = 0`` or ``n2 = 0``) it is one SuperLU factor of the whole
+    matrix. ``solve(B, trans="N")`` takes one or several right-hand sides; ``trans="T"``
+    solves with A^T (SuperLU's convention). Raises RuntimeError (from SuperLU, also for a
+    singular S, or for more crossed pivots).
+    """
+
+    def __init__(self, A, n1: int, n2: int, dtype=np.float32):
+        A = sp.csr_matrix(A)
+        n = A.shape[0]
+        self.dtype = dtype
+        self.sizes = (n1, n2)
+        self.separator = n - n1 - n2 if n1 and n2 else 0
+        self.crossed_pivots = 0
+        if not self.separator:
+            self.lus = [spla.splu(A.tocsc().astype(dtype), **ND_OPTIONS)]
+            self.factor_entries = int(self.lus[0].L.nnz + self.lus[0].U.nnz)
+            return
+        s, g = self.separator, SEPARATOR_SHIFT
+        C = A.tocsc()
+        # M_i = the half's and the separator's rows and columns, with D_i in the corner
+        corner = (0.5 * C[n1 + n2:, n1 + n2:] - g * sp.identity(s, format="csc")).tocsc()
+        jobs = [_pool().submit(self._factor_half, C, np.r_[a:a + m, n1 + n2:n], corner, m,
+                               dtype) for a, m in ((0, n1), (n1, n2))]
+        futures.wait(jobs)      # both halves done (or failed) before anything is raised
+        out = [job.result() for job in jobs]
+        self.lus = [o[0] for o in out]
+        self.factor_entries = int(sum(lu.L.nnz + lu.U.nnz for lu in self.lus))
+        blocks = [self._separator_block(lu, L_ss, U_ss, m)
+                  for (lu, L_ss, U_ss), m in zip(out, (n1, n2))]
+        self.T = [T for T, _ in blocks]
+        self.crossed_pivots = int(sum(c for _, c in blocks))
+        # S by SuperLU (partial pivoting) in double, as LAPACK's threads stall when the
+        # machine is shared (measured, 921 unknowns, one of two cores busy: scipy's
+        # lu_factor 0.21 s, SuperLU 0.08 s, lu_factor with one BLAS thread 0.02 s)
+        S = self.T[0] + self.T[1] - 2 * g * np.eye(s)
+        self.S_lu = spla.splu(sp.csc_matrix(S), permc_spec="NATURAL")
+
+    @staticmethod
+    def _factor_half(C, idx, corner, m: int, dtype):
+        """SuperLU of M_i (in a worker thread): ``(lu, L_ss, U_ss)``, the trailing blocks of
+        its factors in double."""
+        M = C[:, idx][idx, :]
+        M = (M - sp.block_diag([sp.csc_matrix((m, m)), corner], format="csc")).astype(dtype)
+        lu = spla.splu(M, **ND_OPTIONS)
+        if np.any(lu.perm_c[:m] >= m):
+            raise RuntimeError("SuperLU's column order mixed a half with the separator")
+        L, U = lu.L, lu.U
+        return lu, L[m:, m:].toarray().astype(float), U[m:, m:].toarray().astype(float)
+
+    @staticmethod
+    def _separator_block(lu, L_ss, U_ss, m: int):
+        """T_i of a factored M_i: ``(T_i, separator rows pivoted into the half)``. The
+        products run here, after both halves are factored: BLAS's threads would compete
+        with the other half's factorisation."""
+        s = L_ss.shape[0]
+        pr, pc = lu.perm_r, lu.perm_c
+        # P_r M P_c = L U: the trailing L_ss U_ss is the Schur complement T' of M with
+        # respect to its rows pivoted into the leading positions and the half's columns,
+        # rows the rows pivoted to the trailing positions R', columns the separator's
+        trailing = L_ss @ U_ss
+        rows = np.argsort(pr)[m:]           # R', in trailing order
+        cols = np.argsort(pc)[m:] - m       # separator unknowns, in trailing order
+        moved_in = np.setdiff1d(np.arange(m, m + s), rows)   # separator rows now leading
+        if moved_in.size > MAX_CROSSED_PIVOTS:
+            raise RuntimeError(f"pivoting moved {moved_in.size} separator rows into a half")
+        moved_out = np.sort(rows[rows < m])                  # half rows now trailing
+        # B: T' with each row placed at its separator unknown; a half row j in R' takes the
+        # place of the separator row k it is paired with (moved_out[i] with moved_in[i])
+        slot = rows - m
+        slot[rows < m] = moved_in[np.searchsorted(moved_out, rows[rows < m])] - m
+        B = np.empty((s, s))
+        B[np.ix_(slot, cols)] = trailing
+        if not moved_in.size:
+            return B, 0
+        # T_i^-1 = (M^-1)[S, S], whose columns at the pairs' slots are (M^-1 e_k)[S] where
+        # T'^-1 = (M^-1)[S, R'] has (M^-1 e_j)[S]: a rank-c change of B^-1, inverted by
+        # the Woodbury identity
+        E = np.zeros((m + s, 2 * moved_in.size), dtype=lu.L.dtype)
+        E[moved_in, np.arange(moved_in.size)] = 1.0
+        E[moved_out, moved_in.size + np.arange(moved_in.size)] = 1.0
+        Z = lu.solve(E)[m:].astype(float)
+        W = Z[:, :moved_in.size] - Z[:, moved_in.size:]
+        BW = B @ W
+        K = moved_in - m
+        core = np.eye(moved_in.size) + BW[K]
+        return B - BW @ np.linalg.solve(core, B[K]), moved_in.size
+
+    def _half(self, i, rhs, trans):
+        return self.lus[i].solve(np.asarray(rhs, dtype=self.dtype), trans=trans).astype(float)
+
+    def solve(self, b, trans: str = "N"):
+        b = np.asarray(b, dtype=float)
+        if trans not in ("N", "T"):
+            raise ValueError(f"trans={trans!r}: 'N' or 'T'")
+        # each column scaled by a power of two near its largest entry (exact), so that
+        # single precision neither overflows nor underflows: refinement residuals are
+        # ~1e-16 of the solution, the equilibrated right-hand side can be of any size
+        big = np.abs(b).max(axis=0)
+        scale = np.exp2(np.round(np.log2(np.where(big > 0, big, 1.0))))
+        return self._solve(b / scale, trans) * scale
+
+    def _solve(self, b, trans):
+        if not self.separator:
+            return self._half(0, b, trans)
+        n1, n2 = self.sizes
+        s = self.separator
+        T = [t.T for t in self.T] if trans == "T" else self.T
+        parts = (b[:n1], b[n1:n1 + n2])
+        b_s = b[n1 + n2:]
+        zero = np.zeros((s,) + b.shape[1:])
+        # the halves' solves run in two threads (SuperLU releases the GIL)
+        w = list(_pool().map(lambda i: self._half(i, np.concatenate([parts[i], zero]),
+                                                  trans)[-s:], (0, 1)))
+        x_s = self.S_lu.solve(b_s + _matvec(T[0], w[0]) + _matvec(T[1], w[1]), trans=trans)
+        x = list(_pool().map(lambda i: self._half(i, np.concatenate(
+            [parts[i], _matvec(T[i], x_s - w[i])]), trans)[:-s], (0, 1)))
+        return np.concatenate([x[0], x[1], x_s])
+
+
+def _matvec(M, v):
+    """M @ v for the separator's dense blocks by numpy's own loops, one column of ``v`` at
+    a time: BLAS would run them on its threads, which stall when the machine is shared
+    (measured, one of two cores busy: a solve 0.15 s against 0.07 s)."""
+    if v.ndim == 1:
+        return np.einsum("ij,j->i", M, v)
+    return np.stack([np.einsum("ij,j->i", M, c) for c in v.T], axis=1)
+
+
+_POOL: dict = {}
+
+
+def _pool():
+    """Two worker threads for :class:`SplitLU` (one per half), made on first use in each
+    process (a pool inherited through fork has no threads behind it)."""
+    pid = os.getpid()
+    if pid not in _POOL:
+        _POOL.clear()
+        _POOL[pid] = futures.ThreadPoolExecutor(max_workers=2, thread_name_prefix="splitlu")
+    return _POOL[pid]
+
