@@ -231,6 +231,19 @@ DEVIATIONS = (
               "decimal, not rounded (1.2179); the paper's fitted (27N + 20)/(27(N - 1)) gives "
               "1.2176. The published check reads the print as cut: [1.2178, 1.2179].",
               "tests/pdverify/test_published.py", key="004-table12-f9-digits"),
+    Deviation(("bar1d-homogenization",), "finding",
+              "§7 says that with a constant micromodulus (its ref. [1]) the classical limit "
+              "f(inf) = 1 is reached only with full-weight end elements. In our bar the "
+              "limit is a bulk property: f(N) = f(inf) + b/(N - 1) exactly (the ends add a "
+              "fixed elongation), and f(inf) does not depend on the end weight in either "
+              "calibration: 1 for both with c1 from the discrete horizon, and with the "
+              "continuum's c = 2E/(A delta^2) the bulk's softening c1(m)/c, Eq. (27)'s "
+              "f_1(m): 1.0125 for both at delta = 4.5 Delta (1 at 4 Delta). "
+              "Only b does (full 2.75, half 7.66 at N = 1001, discrete). Reproducing the "
+              "claim needs ref. [1]'s conventions, which this paper does not give; both "
+              "readings are report runs (micromodulus=constant, end_weight and calibration "
+              "each both ways).", "tests/bondbar/test_constant_limit.py",
+              key="004-constant-limit"),
     Deviation(("bar1d-homogenization",), "erratum",
               "App. 2, Eqs. (A2.1.1.4) and (A2.1.1.5) miss the factor 1/m; the homogenising "
               "factors are computed from the equilibrium equations, so they do not inherit it.",

@@ -171,6 +171,31 @@ class BondBarScene(Scene):
 
 # --------------------------------------------------------------------------- Sec. 6.1
 
+#: f(N) = f_inf + b / (N - 1) holds exactly once every bond set of the ends is present
+#: (each end adds a fixed elongation; Table 12's printed formulas all have this form):
+#: the limit from the sweep's last two points agrees with the one from the two before to
+#: this much (round-off of the cut system's solve: condition < 1e6 x eps, rounded up), or
+#: it is not reported
+LIMIT_AGREEMENT = 1e-9
+
+
+def strain_factor_limit(nodes, f) -> tuple[float | None, float]:
+    """f(N -> infinity) from the last two points of a sweep under f = f_inf + b / (N - 1),
+    and the spread against the same from the two points before (None: the form does
+    not hold to :data:`LIMIT_AGREEMENT`, or the sweep is too short)."""
+    n = np.asarray(nodes, dtype=float) - 1.0
+    f = np.asarray(f, dtype=float)
+    if n.size < 4:
+        return None, float("nan")
+
+    def two_point(i, j):
+        return (f[j] * n[j] - f[i] * n[i]) / (n[j] - n[i])
+
+    last, before = two_point(-2, -1), two_point(-4, -3)
+    spread = float(abs(last - before))
+    return (float(last) if spread <= LIMIT_AGREEMENT * abs(last) else None), spread
+
+
 #: the check of a printed "non-zero": above the round-off of an exact zero (1e-12 with
 #: displacements of order 1, the exact-value tolerance of :mod:`pdverify.published`)
 NONZERO = "'non-zero': above round-off, 1e-12 (displacements of order 1: sigma/E = 1)"
@@ -243,6 +268,9 @@ TABLE14 = {(row["horizon_ratio"], row["end_weight"]): row["C"]
 MICROMODULUS_TABLES = tuple((t["table"], tuple((row["horizon_ratio"], row["f1"])
                                                for row in t["rows"]))
                             for t in _TABLES["micromodulus"])
+#: §7's constant-micromodulus remark: the bar of the report's runs (m + 1/2 = 4.5, where
+#: the continuum calibration differs from the discrete one, and N = 1001)
+CONSTANT_LIMIT = {"micromodulus": "constant", "horizon_ratio": 4.5, "nodes": 1001}
 #: the adjusted bonds reported as metrics (the tables print at most four)
 FACTOR_METRICS = 4
 
@@ -319,6 +347,16 @@ class Homogenization(BondBarScene):
                     where={"horizon_ratio": r, "end_weight": w, "micromodulus": "triangular",
                            "calibration": "discrete"}, exact=True)
           for (r, w), v in TABLE14.items()),
+        # §7: "this limit value equals the strain of a classical continuum mechanics bar,
+        # both for half weight and full weight end elements (f(inf) = 1; Table 12)"
+        Published("strain_factor_limit", 1, "seed 004 §7 and Table 12, f(inf)",
+                  method="none", where={"micromodulus": "triangular",
+                                        "calibration": "discrete"}, exact=True),
+        # "... contrasting the behavior of a bar with constant micromodulus for which the
+        # classical limit is obtained only for full weight end elements [1]"
+        Published("strain_factor_limit", "1 for full-weight ends only", "seed 004 §7 (its "
+                  "ref. [1])", method="none", where=CONSTANT_LIMIT,
+                  deviation="004-constant-limit"),
     )
 
     table12 = TABLE12
@@ -348,6 +386,11 @@ class Homogenization(BondBarScene):
         if not quick:
             for ratio in (6.0, 8.0, 6.5, 8.5):
                 out.append(("homogenized", {"horizon_ratio": ratio, "nodes": 1001}))
+            # §7's remark on the constant micromodulus ([1]: the classical limit only with
+            # full-weight ends): both end weights, both calibrations (finding
+            # 004-constant-limit)
+            out += [("none", {**CONSTANT_LIMIT, "end_weight": w, "calibration": c})
+                    for c in ("discrete", "continuum") for w in ("full", "half")]
         return out
 
     def strain_factor(self, bar: BondBar, stress: float) -> tuple[float, np.ndarray]:
@@ -382,9 +425,13 @@ class Homogenization(BondBarScene):
             **{f"end_factor_{k}": a for k, a in
                enumerate(bar.end_factors[:FACTOR_METRICS], start=1)},
         }
+        limit, spread = strain_factor_limit(sweep_n, sweep_f)
+        if limit is not None:
+            metrics["strain_factor_limit"] = limit
         fields = {"x": x, "u": u, "u_ref": u_cl, "sweep_nodes": sweep_n, "sweep_f": sweep_f}
         return Outcome(metrics=metrics, size=bar.size(), fields=fields,
-                       diagnostics={"end_factors": list(bar.end_factors), "c1": bar.c1})
+                       diagnostics={"end_factors": list(bar.end_factors), "c1": bar.c1,
+                                    "strain_factor_limit_spread": spread})
 
 
 # --------------------------------------------------------------------------- Sec. 6.2
