@@ -309,6 +309,8 @@ class Homogenization(BondBarScene):
 
     Metrics: ``strain_factor`` f(N) = (u_N - u_1) E / ((N - 1) Delta sigma), the strain
     between the end points over sigma/E (Table 12; f = 1 for the classical bar);
+    ``strain_factor_limit`` f(inf) from the sweep's last points under the exact form
+    f = f(inf) + b/(N - 1) (:func:`strain_factor_limit`; §7: 1 for every Table 12 cell);
     ``micromodulus_factor`` c1(m)/c_inf (Eqs. 27/31, Tables 1-2); ``end_load_C`` the
     coefficient C of the end equations' right-hand side (App. 1, Table 14);
     ``end_factor_k`` the homogenising factor on the bond (1, 1 + k), k <= 4 (Tables 6, 7,
@@ -320,7 +322,9 @@ class Homogenization(BondBarScene):
     (f(N) does not depend on E, sigma, length or A). ERRATA: Table 12's half-weight
     3 Delta entry f(7) = 1.043 is wrong; f(N) = (N + 3)/(N - 1) exactly, f(7) = 5/3.
     Half-weight ends with the horizon between elements have no factors (Table 12: n/a);
-    asking for them is bad input.
+    asking for them is bad input. §7's remark on the constant micromodulus (the classical
+    limit only with full-weight ends, from its ref. [1]) does not reproduce in either
+    calibration: finding ``004-constant-limit`` (``pdverify.deviations``).
     """
 
     id = "bar1d-homogenization"
