@@ -288,3 +288,28 @@ def quadratic_elements(cells) -> Estimate:
     est = linear_system(nodes, len(cells), len(cells), 2)
     return Estimate(est.memory, f"FEM {' x '.join(str(int(n)) for n in cells)} Q2 elements, "
                                 + est.detail)
+
+
+def reset_peak_rss() -> bool:
+    """Linux: set this process's peak resident size (``VmHWM``) back to its current size
+    (``/proc/self/clear_refs``, value 5), so that :func:`peak_rss` measures from now.
+    False where the kernel does not offer it (the run then records no peak)."""
+    try:
+        with open("/proc/self/clear_refs", "w") as fh:
+            fh.write("5")
+        return True
+    except OSError:
+        return False
+
+
+def peak_rss() -> float | None:
+    """This process's peak resident size in bytes since its start or the last
+    :func:`reset_peak_rss` (``VmHWM`` of /proc/self/status); None where unavailable."""
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("VmHWM:"):
+                    return float(line.split()[1]) * 1024.0
+    except (OSError, ValueError, IndexError):
+        pass
+    return None

@@ -41,6 +41,10 @@ class RunResult:
     expected_failure: str = ""
     #: the papers' numbers for this method and these params (:mod:`pdverify.published`)
     published: list = field(default_factory=list)
+    #: what the run cost beside its time, not reproducible bit for bit (like
+    #: ``timings``): ``peak_rss_gb``, the peak resident size of the process that ran it,
+    #: from the run's start (:func:`pdverify.budget.reset_peak_rss`; Linux only)
+    resources: dict = field(default_factory=dict)
 
     @property
     def key(self) -> tuple:
@@ -75,6 +79,7 @@ class RunResult:
             **({"files": list(self.files)} if self.files else {}),
             **({"expected_failure": self.expected_failure} if self.expected_failure else {}),
             **({"published": _plain(self.published)} if self.published else {}),
+            **({"resources": _plain(self.resources)} if self.resources else {}),
         }
 
     @classmethod
@@ -86,7 +91,8 @@ class RunResult:
                    timings=dict(run.get("timings", {})), size=dict(run.get("size", {})),
                    diagnostics=dict(run.get("diagnostics", {})),
                    warnings=list(run.get("warnings", [])), files=list(run.get("files", [])),
-                   expected_failure=run.get("expected_failure", ""))
+                   expected_failure=run.get("expected_failure", ""),
+                   resources=dict(run.get("resources", {})))
 
 
 OUTCOMES = ("ok", "failed", "expected-failure", "unexpected-pass")

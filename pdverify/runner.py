@@ -43,8 +43,10 @@ def run_one(scene_id: str, *, method=None, overrides=None, json_path=None, vtu_p
     for text in result.warnings:
         print(f"  warning: {text}", file=stream)
     t = result.timings
+    peak = result.resources.get("peak_rss_gb")
     print(f"  time: setup {t['setup_s']:.4f} s, solve {t['solve_s']:.4f} s, "
-          f"total {t['total_s']:.4f} s; size {result.size}", file=stream)
+          f"total {t['total_s']:.4f} s" + (f"; peak memory {peak:.3g} GB" if peak else "")
+          + f"; size {result.size}", file=stream)
     if vtu_path:
         from .export import write_run_fields
         paths = write_run_fields(result, vtu_path[: -len(".vtu")])

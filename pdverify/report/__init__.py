@@ -503,6 +503,9 @@ def _build_logged(cases, out, final, jobs, progress, client=None, quick=False,
     print_summary(scenes, results, progress)  # one row per scene, before the last line
     if slots:                                 # the local pool (not a Dask cluster)
         print(critical_path(slots, cases), file=progress)
+    heaviest = largest_memory(results)
+    if heaviest:
+        print(heaviest, file=progress)
     for r in passed:   # strict: a documented failure that no longer happens
         print(f"unexpected pass: {r.scene}/{r.method} is ok, but it is documented to fail "
               f"({r.expected_failure}); update the finding", file=progress)
@@ -511,6 +514,17 @@ def _build_logged(cases, out, final, jobs, progress, client=None, quick=False,
           f"{time.perf_counter() - t0:.1f} s -> {os.path.join(final, 'index.html')}",
           file=progress)
     return exit_code(results)
+
+
+def largest_memory(results) -> str:
+    """The run with the largest peak memory (``resources.peak_rss_gb``), as a line; empty
+    where no run measured one."""
+    measured = [r for r in results if r.resources.get("peak_rss_gb")]
+    if not measured:
+        return ""
+    r = max(measured, key=lambda r: r.resources["peak_rss_gb"])
+    return (f"largest peak memory of a run: {r.resources['peak_rss_gb']:.3g} GB "
+            f"({r.scene} {r.method}, {r.timings.get('total_s', 0.0):.3g} s)")
 
 
 def _merged(kept, new) -> list:

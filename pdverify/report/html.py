@@ -125,6 +125,8 @@ def _row(scene, r, metrics) -> dict:
         "all_metrics": [(k, _num(v)) for k, v in r.metrics.items()],
         "setup": f"{t.get('setup_s', 0):.3g}", "solve": f"{t.get('solve_s', 0):.3g}",
         "total": f"{t.get('total_s', 0):.3g}", "solver": _solver(r.diagnostics),
+        "peak": (f", peak memory {r.resources['peak_rss_gb']:.3g} GB"
+                 if r.resources.get("peak_rss_gb") else ""),
         "size": ", ".join(f"{k} {v}" for k, v in r.size.items()),
     }
 

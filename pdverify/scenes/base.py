@@ -427,6 +427,7 @@ class Scene:
                            published=[p.entry() for p in
                                       self.published_for(method, params).values()])
         timer = Timer()
+        measured = budget.reset_peak_rss()   # the run's own peak memory, beside its time
         broken = self._broken_plugin(method)
         if broken:
             result.status = "failed"
@@ -468,6 +469,9 @@ class Scene:
             result.message = (f"internal error: {type(exc).__name__}: {exc} "
                               f"({frame.filename.rsplit('/', 1)[-1]}:{frame.lineno})")
         result.timings = timer.as_dict()
+        peak = budget.peak_rss() if measured else None
+        if peak is not None:
+            result.resources = {"peak_rss_gb": peak / 1e9}
         return result
 
     def published_for(self, method: str, params: dict) -> dict:
