@@ -269,7 +269,7 @@ def assemble_taylor(problem, order: int, corners: str = "normal-only") -> Linear
     width = d * ni if solver == "direct" else (d + 1) * ni
     rows, vals = [], []
     if flux is not None:   # force of each boundary cell face from the unknowns
-        Fs = (_surface_flux(model, flux, g.n_surface) @ _bond_forces(model, solver)).tocsr()
+        Fs = _flux_of_unknowns(model, flux, g.n_surface, solver)
     for face in range(2 * d):
         axis, side = divmod(face, 2)
         cond = problem.conditions.get(FACES[face])
@@ -359,7 +359,7 @@ def assemble_taylor(problem, order: int, corners: str = "normal-only") -> Linear
                         reaction=reaction, counts=counts)
 
 
-def _bond_forces(model, solver):
+def _bond_forces(model, solver, bonds=None):
     """Scalar bond forces (times beta V_a V_b) as a matrix on the solver's unknowns, the
     flux rows' factor. Direct: of the real displacements (``model.bond_force_matrix``,
     whose dilatation term couples nodes two horizons apart). Augmented (displacements,
@@ -369,14 +369,18 @@ def _bond_forces(model, solver):
     runs, /usr/bin/time; benchmarks/taylor3d.py times the parts); in 2D the bond forces of
     the displacements beside zero dilatation columns, as before: there the one-horizon
     form raised the plane-strain plate's condition estimate at h = 0.0125 from 2.1e5 to
-    6.8e9 and moved its errors by 3e-7 (relative)."""
+    6.8e9 and moved its errors by 3e-7 (relative). ``bonds``: only these rows
+    (ascending; the flux rows need the face-crossing bonds only)."""
     if solver == "direct":
-        return model.bond_force_matrix()
+        return model.bond_force_matrix(bonds)
     ni = model.A_theta.shape[0]
+    rows = model.bond_a.size if bonds is None else len(bonds)
     if model.dim != 3:
-        return sp.hstack([model.bond_force_matrix(), sp.csr_matrix((model.bond_a.size, ni))])
+        return sp.hstack([model.bond_force_matrix(bonds), sp.csr_matrix((rows, ni))])
     e = (model.A_e @ model.A_U_full).tocsr()
-    return sp.hstack([model.K_e @ e, model.K_theta @ model.A_Theta]).tocsr()
+    K_e, K_theta = ((model.K_e, model.K_theta) if bonds is None
+                    else (sp.csr_matrix(model.K_e)[bonds], sp.csr_matrix(model.K_theta)[bonds]))
+    return sp.hstack([K_e @ e, K_theta @ model.A_Theta]).tocsr()
 
 
 def _corner_lines(problem, g, anchors, axis, k):
@@ -415,6 +419,15 @@ def _shear_pair_lines(problem, g, anchors, axis, k):
             edge &= ~(np.ones_like(edge) if cond.where is None else cond.where(anchors))
         out |= edge
     return out
+
+
+def _flux_of_unknowns(model, flux, n_surface, solver):
+    """The force of each boundary cell face from the unknowns: :func:`_surface_flux`
+    times :func:`_bond_forces`, the latter of the face-crossing bonds only (the other
+    columns of the flux rows are zero; the same products, row by row)."""
+    used = np.unique(flux[1])
+    return (_surface_flux(model, flux, n_surface)[:, used]
+            @ _bond_forces(model, solver, used)).tocsr()
 
 
 def _surface_flux(model, flux, n_surface):
