@@ -1,6 +1,7 @@
 """The report a researcher reads at a glance: live progress (plain lines off a terminal),
 the end-of-report summary, choices in ``list``, the paper's value in ``run``."""
 import io
+import sys
 import re
 
 import pytest
@@ -151,6 +152,12 @@ def test_report_prints_the_summary_before_its_last_line(tmp_path):
                         only=["bar1d-traction", "sheet2d-clamped"], progress=stream) == 0
     lines = stream.getvalue().splitlines()
     assert lines[-1].startswith("report: ")
+    # the heaviest run by its measured peak memory (Linux: each run records it)
+    memory = [k for k, line in enumerate(lines)
+              if line.startswith("largest peak memory of a run: ")]
+    if sys.platform.startswith("linux"):
+        assert memory == [len(lines) - 2]
+    lines = [line for k, line in enumerate(lines) if k not in memory]
     # the critical path: the last worker's runs, the longest of them named
     assert lines[-2].startswith("critical path: worker ") and "sheet2d-clamped" in lines[-2]
     head = next(k for k, line in enumerate(lines) if line.startswith("scene "))
