@@ -23,7 +23,9 @@ def _strip(doc):
     doc = dict(doc)
     for key in ("created", "machine"):
         doc.pop(key)
-    doc["runs"] = [{k: v for k, v in r.items() if k != "timings"} for r in doc["runs"]]
+    # the costs (times, peak memory) are the machine's, not the run's numbers
+    doc["runs"] = [{k: v for k, v in r.items() if k not in ("timings", "resources")}
+                   for r in doc["runs"]]
     doc.pop("report_phases")          # times
     doc["convergence"] = [{**e, "levels": [{k: v for k, v in lv.items() if k != "total_s"}
                                            for lv in e["levels"]]}
