@@ -62,28 +62,26 @@ def _tree(pid) -> list[int]:
     return out
 
 
-def _pss(pid) -> int:
-    """Proportional set size of one process in bytes (0 if it is gone)."""
+def _kb_field(path, key) -> int:
+    """The ``key:`` line of a /proc file in bytes (its kB value; 0 if the process is gone)."""
     try:
-        with open(f"/proc/{pid}/smaps_rollup") as fh:
+        with open(path) as fh:
             for line in fh:
-                if line.startswith("Pss:"):
+                if line.startswith(key + ":"):
                     return int(line.split()[1]) * 1024
     except OSError:
         pass
     return 0
+
+
+def _pss(pid) -> int:
+    """Proportional set size of one process in bytes (0 if it is gone)."""
+    return _kb_field(f"/proc/{pid}/smaps_rollup", "Pss")
 
 
 def _hwm(pid) -> int:
     """Peak resident size of one process so far in bytes (0 if it is gone)."""
-    try:
-        with open(f"/proc/{pid}/status") as fh:
-            for line in fh:
-                if line.startswith("VmHWM:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    return 0
+    return _kb_field(f"/proc/{pid}/status", "VmHWM")
 
 
 def _sample_peak(proc, peak: list, tmp, every=0.1) -> None:

@@ -312,8 +312,7 @@ def _scene_param_clash(method: Treatment) -> str | None:
             return f"deciding whether it serves {scene.id} raised {what_it_did(exc)}"
         if not served:
             continue
-        base = next((m.params for m in scene.all_methods if m.name == "none"), ())
-        taken = mine & {p.name for p in tuple(scene.params) + tuple(base)}
+        taken = mine & {p.name for p in tuple(scene.params) + scene.baseline_spec().params}
         if taken:
             return (f"its parameter {sorted(taken)[0]!r} is a parameter of scene {scene.id} "
                     "(it would replace the scene's value); rename it")

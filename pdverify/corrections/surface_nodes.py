@@ -7,6 +7,7 @@ from itertools import product
 import numpy as np
 import scipy.sparse as sp
 
+from ..errors import InputError
 from ..pd.bonds import bond_pairs
 from ..pd.closure import Closure, real_identity, with_rows
 from .taylor import extrapolation_rows, taylor_weights, window_start
@@ -251,7 +252,6 @@ def wave_extension(_problem, params):
 
 def check_wave_order(real_nodes, params, where) -> None:
     """Each end's extrapolation stencil needs order + 1 real nodes of its own half."""
-    from ..errors import InputError
     order = params["order"]
     if 2 * (order + 1) > real_nodes:
         raise InputError(f"{where}: order={order} needs 2 (order + 1) <= "

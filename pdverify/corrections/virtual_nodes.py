@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InputError
 from ..pd import BoxGrid, Closure
 from .energy_directional import directional_closure
 
@@ -52,7 +53,6 @@ def clamp(problem, params):
 
 def check_layers(_context, params, where) -> None:
     """Buffer layers of thickness delta must be whole numbers of cells."""
-    from ..errors import InputError
     if abs(params["m_ratio"] - round(params["m_ratio"])) > 1e-12:
         raise InputError(f"{where}: m_ratio={params['m_ratio']:g} must be a whole number for "
                          "virtual-nodes (buffer layers of thickness delta)")

@@ -48,6 +48,8 @@ def test_the_limit_is_the_form_f_inf_plus_b_over_n_minus_1():
                   for k in n])
     limit, spread = strain_factor_limit(n, f)
     assert spread <= ROUND_OFF
+    # f - f(inf) ~ 1e-2 .. 1e-3 against f's round-off ~1e-12 (ROUND_OFF's argument):
+    # the ratio is 2 to ~1e-9; 1e-6 leaves that a thousandfold margin
     np.testing.assert_allclose((f[:-1] - limit) / (f[1:] - limit), 2.0, rtol=1e-6)
 
 
@@ -55,6 +57,7 @@ def test_the_limit_is_refused_where_the_form_does_not_hold():
     n = np.array([5, 9, 17, 33, 65])
     assert strain_factor_limit(n, 1.0 + 1.0 / (n - 1) ** 2)[0] is None  # 1/N^2: not the form
     assert strain_factor_limit(n[:3], 1.0 + 1.0 / (n[:3] - 1))[0] is None  # too short
+    # the exact form: the two-point limit is 1 to round-off (four terms of order 1)
     assert strain_factor_limit(n, 1.0 + 3.0 / (n - 1))[0] == pytest.approx(1.0, abs=1e-12)
 
 
