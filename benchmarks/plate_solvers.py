@@ -18,18 +18,19 @@ import numpy as np
 import scipy.sparse as sp
 
 from _splu_timing import time_splu
-from pdverify.pd import StateBasedConstants
+from pdverify.corrections.static_state import assemble_taylor
 from pdverify.scenes import get_scene
-from pdverify.scenes.plate2d import StatePlate
 from pdverify.solvers.checks import equilibrate
 
 ORDERINGS = ("COLAMD", "MMD_AT_PLUS_A", "MMD_ATA")
 
 
 def lagrange_system(spacing, order=2):
-    c = StateBasedConstants("plane-stress", 1e9, 0.2)
-    plate = StatePlate((3.0, 2.0), spacing, 3.0, c, "hyperbolic", order, thickness=0.05)
-    A = sp.bmat([[plate.K, plate.B.T], [plate.B, None]], format="csr")
+    """The scene's own Taylor system (``static_state.assemble_taylor`` of its problem)."""
+    scene = get_scene("plate2d-clamped")
+    problem = scene.problem({**scene.default_params(), "spacing": spacing}, "benchmark")
+    system = assemble_taylor(problem, order)
+    A = sp.bmat([[system.K, system.B.T], [system.B, None]], format="csr")
     A_s, _, _ = equilibrate(A, "benchmark")
     return A_s.tocsc()
 

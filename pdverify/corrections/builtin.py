@@ -2,6 +2,7 @@
 the descriptions of those that their scenes still wire by hand."""
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import Any, Callable, Mapping
 
@@ -11,7 +12,7 @@ from ..pd.problem import LOAD_POINTS
 from .mirror_nodes import GRADIENT_AT, MIRROR_POINTS, NEUMANN_READINGS
 from .pddo import BULK_MODELS
 from .surface_nodes import MAX_ORDER, check_wave_order, wave_extension
-from .taylor_fictitious import CORNER_RULES
+from .taylor_fictitious import CORNER_RULES, fictitious_closure
 from .treatment import Role, Treatment
 from .virtual_nodes import check_layers, clamp
 
@@ -141,8 +142,9 @@ def _truncated(_problem, _params):
 
 
 def _flux_order(_problem, params):
-    """Taylor's role in the ``flux-bar`` family: the extrapolation order of its layer."""
-    return params["order"]
+    """Taylor's role in the ``flux-bar`` family: its closure of the bar's grid (one
+    horizon of fictitious layers, extrapolated to ``order``)."""
+    return functools.partial(fictitious_closure, order=params["order"])
 
 
 def _check_flux_order(nodes, params, where):

@@ -6,7 +6,8 @@ from functools import lru_cache
 import numpy as np
 
 from ..errors import InputError
-from ..pd import BondBasedModel, BoxGrid, Closure, bond_micromodulus, build_stencil, get_influence
+from ..pd import BondBasedModel, Closure, bond_micromodulus, build_stencil, get_influence
+from ..pd.build import Body, BondMaterial, build_model
 
 MICROMODULI = ("triangular", "constant")
 END_WEIGHTS = ("full", "half")
@@ -94,7 +95,9 @@ def bond_bar(*, nodes: int, spacing: float, horizon_ratio: float, E: float, area
              calibration: str = "discrete", end_factors=(),
              closure: Closure | None = None) -> BondBasedModel:
     """The bar of seed 004 as an engine model: N points x_i = (i - 1) Delta on the surface
-    (``on-surface`` grid), linearised bond-based PD (Eq. 33).
+    (``on-surface`` grid), linearised bond-based PD (Eq. 33). The bar is described here
+    (body, stencil, material) and built by ``pdverify.pd.build``, with the end-bond
+    closure of this module or another treatment's.
 
     Each point carries the element volume A Delta, or A Delta / 2 at both ends with
     ``end_weight="half"`` (Fig. 1 shows full weight). A bond of length k Delta has the
@@ -120,14 +123,13 @@ def bond_bar(*, nodes: int, spacing: float, horizon_ratio: float, E: float, area
     if factors.size and closure is not None:
         raise ValueError("bond_bar: end_factors and closure are two boundary treatments; "
                          "give one")
-    grid = BoxGrid(((nodes - 1) * spacing,), (0.0,), spacing, placement="on-surface",
-                   boundary_volume="partial" if end_weight == "half" else "full")
-    stencil = build_stencil(1, float(horizon_ratio))
+    body = Body(((nodes - 1) * spacing,), (0.0,), spacing, placement="on-surface",
+                boundary_volume="partial" if end_weight == "half" else "full", thickness=area)
     c1 = micromodulus_c1(horizon_ratio, E=E, area=area, spacing=spacing,
                          micromodulus=micromodulus, calibration=calibration)
-    return BondBasedModel(grid, stencil, c1, get_influence(micromodulus),
-                          closure if closure is not None else end_bond_closure(nodes, factors),
-                          thickness=area)
+    return build_model(body, build_stencil(1, float(horizon_ratio)),
+                       BondMaterial(c1, get_influence(micromodulus)),
+                       closure if closure is not None else end_bond_closure(nodes, factors))
 
 
 #: A consistent system is solved to round-off (relative residual ~1e-16, the equations

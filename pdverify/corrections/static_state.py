@@ -28,6 +28,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..pd import BoxGrid, StateBasedModel
+from ..pd.build import build_model
 from ..pd.closure import Closure
 from ..pd.problem import FACES, LinearSystem
 from ..solvers.policy import static_solver
@@ -39,12 +40,11 @@ from .taylor_fictitious import boundary_value_rows, fictitious_closure, yields_c
 
 # ------------------------------------------------------------------------------ helpers
 def _grid(problem, layers: int) -> BoxGrid:
-    return BoxGrid(problem.lengths, problem.origin, float(problem.spacing), layers)
+    return problem.body.grid(layers)
 
 
 def _model(problem, grid, closure) -> StateBasedModel:
-    return StateBasedModel(grid, problem.stencil, problem.constants, problem.influence,
-                           closure, thickness=problem.thickness, complete_m=problem.complete_m)
+    return build_model(problem.body, problem.stencil, problem.material, closure, grid=grid)
 
 
 def _side_sign(face: int) -> float:

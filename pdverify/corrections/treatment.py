@@ -17,7 +17,7 @@ one line where it applies (``scope``). It serves a scene in one of three ways:
   A treatment may also have a :class:`Role` in further families (``roles``), each with
   its own parameters, ``build`` and checks: the smaller families of scenes that are not
   static boxes (``wave-bar``: seed 002's wave, whose treatments give the bar's
-  fictitious extension; ``flux-bar``: seed 000's force flux, the extrapolation order;
+  fictitious extension; ``flux-bar``: seed 000's force flux, the closure of the bar's grid;
   ``clamped-sheet``: seed 003's clamped sheet, where virtual nodes bring their own grid
   and clamp nodes). A scene asks ``scene.treatment(method)`` for it by role, never by
   name (``tests/treatments/test_contract.py`` greps every scene module).

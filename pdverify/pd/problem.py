@@ -23,6 +23,8 @@ from typing import Callable, Mapping
 
 import numpy as np
 
+from .build import Body, StateMaterial
+
 FACES = ("x-", "x+", "y-", "y+", "z-", "z+")
 
 #: Gauss-Legendre points per tangential axis of a face resultant (exact to degree 5).
@@ -136,6 +138,17 @@ class StaticProblem:
     @property
     def dim(self) -> int:
         return len(self.lengths)
+
+    @property
+    def body(self) -> Body:
+        """The box of cell-centred nodes (``pdverify.pd.build``)."""
+        return Body(tuple(self.lengths), tuple(self.origin), float(self.spacing),
+                    thickness=self.thickness)
+
+    @property
+    def material(self) -> StateMaterial:
+        """The state-based material (``pdverify.pd.build``)."""
+        return StateMaterial(self.constants, self.influence, self.complete_m)
 
     def faces(self):
         """``(face number, condition)`` of every listed face, in face order."""

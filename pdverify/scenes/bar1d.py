@@ -6,11 +6,11 @@ import numpy as np
 from manufactured import bar1d as closed
 
 from .. import budget
-from ..corrections.taylor_fictitious import boundary_value_rows, fictitious_closure
 from ..errors import InputError
 from ..metrics import max_relative_error_pct, nodal_relative_error_pct, rel_l2_error
 from ..params import Param, at_least, open_interval, positive
-from ..pd import BoxGrid, StateBasedConstants, StateBasedModel, build_stencil, get_influence
+from ..pd import StateBasedConstants, build_stencil, get_influence
+from ..pd.build import Body, StateMaterial, build_model
 from ..pd.problem import FaceCondition, StaticProblem
 from . import Outcome, Published, cell_count, influence_param, register
 from .base import check_load_scale
@@ -50,46 +50,21 @@ MACHINE_PRECISION = ("'machine precision': below 1e-10 relative (1e-8 %) = condi
 
 
 
-class StateBar:
-    """A seed-000 bar on the engine: real nodes at cell centres x_i = (i - 1/2) Delta
-    (Fig. 10), the 1D state-based model with ``influence`` (seed 000: hyperbolic), and
-    with ``order`` the fictitious layers of ``taylor-fictitious`` (else the uncorrected
-    model: truncated neighbourhoods, m_i from Eq. (50) over real neighbours).
-
-    ``K`` = -S K_b (Eq. 55) over the real displacements; K_b (the bond forces, D6) is
-    multiplied out once: in 1D it is banded, and both K and the section-force rows of
-    Eq. (60) need it. ``closure``: a bond method's closure on the uncorrected bar.
-    """
-
-    def __init__(self, p: dict, order: int | None = None, closure=None):
-        p = {**{q.name: q.default for q in BAR_PARAMS}, **p}  # unset keys: the paper's values
-        stencil = build_stencil(1, p["m_ratio"], quadrature=p["quadrature"])
-        layers = stencil.reach if order else 0
-        self.grid = g = BoxGrid((p["length"],), (0.0,), p["spacing"], layers)
-        closure = fictitious_closure(g, order) if order else closure
-        self.order = order
-        self.model = StateBasedModel(g, stencil, StateBasedConstants("1d", p["E"], p["nu"]),
-                                     get_influence(p["influence"]), closure,
-                                     thickness=p["area"], complete_m=p["complete_m"])
-        self.K_b = self.model.bond_force_matrix()
-        self.K = (self.model.equilibrium_rows() @ self.K_b).tocsr()
-        self.x_real = g.x[g.interior_ids, 0]
-        self.horizon = self.model.horizon
-        self.length = p["length"]
-
-    def boundary_value_row(self, side: str) -> np.ndarray:
-        """Row r with r @ u = u at the end ``side`` by Taylor extrapolation (Eq. 58)."""
-        face = 0 if side == "left" else 1
-        return boundary_value_rows(self.grid, self.order, face)[0].toarray()[0]
-
-    def flux_rows(self, planes):
-        """Rows r with r @ u = A * tau(x_p, +1) at each plane (force through the section,
-        Eq. 60): the summed force of the bonds crossing it."""
-        return (self.model.crossing_selector(planes) @ self.K_b).tocsr()
-
-    def size(self) -> dict:
-        return {"nodes": int(self.grid.n_ext), "real_nodes": int(self.grid.n_interior),
-                "dofs": int(self.grid.n_interior), "bonds": int(self.model.bond_a.size)}
+def bar_model(p: dict, closure=None, fictitious: bool = False):
+    """A seed-000 bar on the engine: real nodes at the cell centres x_i = (i - 1/2) Delta
+    (Fig. 10), the 1D state-based model with ``influence`` (seed 000: hyperbolic) and the
+    weights of ``quadrature``, cross-section ``area``; unset keys of ``p`` take the paper's
+    values (Table 3). ``closure``: ``None`` (truncated neighbourhoods, m_i from Eq. (50)
+    over real neighbours), a treatment's closure, or its closure of the grid
+    (``pdverify.pd.build``), extended by one horizon of fictitious layers at both ends
+    when ``fictitious``."""
+    p = {**{q.name: q.default for q in BAR_PARAMS}, **p}
+    stencil = build_stencil(1, p["m_ratio"], quadrature=p["quadrature"])
+    return build_model(Body((p["length"],), (0.0,), p["spacing"], thickness=p["area"]),
+                       stencil,
+                       StateMaterial(StateBasedConstants("1d", p["E"], p["nu"]),
+                                     get_influence(p["influence"]), p["complete_m"]),
+                       closure, layers=stencil.reach if fictitious else 0)
 
 
 def check_bar_grid(scene_id: str, method: str, p: dict, min_horizons: float = 0.0) -> int:

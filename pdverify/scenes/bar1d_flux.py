@@ -8,7 +8,7 @@ from manufactured import bar1d as closed
 from ..params import Param, positive
 from ..pd import INFLUENCES
 from . import Outcome, Published, Scene, register
-from .bar1d import BAR_PARAMS, StateBar, bar_estimate, check_bar_grid
+from .bar1d import BAR_PARAMS, bar_estimate, bar_model, check_bar_grid
 
 _FEATURES = closed.flux_features()  # (1.26285..., 0.77160..., 0.39403...)
 #: the paper's printed values of the continuum's features (tau_max / tau_inf at x/delta,
@@ -59,8 +59,8 @@ class ForceFlux(Scene):
     figure = "bar1d-flux"
     dim = 1
     params = BAR_PARAMS + (Param("strain", 1e-3, "imposed constant strain", positive),)
-    #: the treatments with a role here give the bar's fictitious extrapolation order
-    #: (the baseline: none, truncated neighbourhoods)
+    #: the treatments with a role here give their closure of the bar's grid with one
+    #: horizon of fictitious layers (the baseline: none, truncated neighbourhoods)
     family = "flux-bar"
     published = (
         # the text under Fig. 7 prints the continuum's features; the discrete flux approaches
@@ -104,27 +104,34 @@ class ForceFlux(Scene):
 
     def solve(self, method, p, timer):
         with timer.phase("setup"):
-            # None: truncated neighbourhoods, compared with Table 2's features
-            order = self.treatment(method).build_for(self.family, None, p)
-            bar = StateBar(p, order)
+            # None: truncated neighbourhoods, compared with Table 2's features; else the
+            # treatment's closure of the grid with one horizon of fictitious layers
+            closure = self.treatment(method).build_for(self.family, None, p)
+            corrected = closure is not None
+            model = bar_model(p, closure, fictitious=corrected)
+            # the bond forces (D6), multiplied out once: banded in 1D, K and the
+            # section-force rows of Eq. (60) both need them
+            K_b = model.bond_force_matrix()
         with timer.phase("solve"):
-            eps, delta, L = p["strain"], bar.horizon, p["length"]
-            x = bar.x_real
+            g = model.grid
+            eps, delta, L = p["strain"], model.horizon, p["length"]
+            x = g.x[g.interior_ids, 0]
             u = eps * x
             tau_inf = p["E"] * eps
-            faces = np.arange(bar.grid.n_interior + 1) * p["spacing"]
-            flux = (bar.flux_rows(faces) @ u) / p["area"] / tau_inf
+            faces = np.arange(g.n_interior + 1) * p["spacing"]
+            # force through each section: the summed force of the bonds crossing it
+            flux = (model.crossing_selector(faces) @ K_b @ u) / p["area"] / tau_inf
             # the closed forms (Tables 1, 2, B1) are derived for delta / |xi| only
-            tables = order is not None or p["influence"] == "hyperbolic"
+            tables = corrected or p["influence"] == "hyperbolic"
             nan = np.full_like(faces, np.nan)
-            if order is None:
+            if not corrected:
                 flux_ref = (closed.force_flux_ratio(faces, horizon=delta, length=L)
                             if tables else nan)
             else:
                 flux_ref = np.ones_like(faces)
             V = p["area"] * p["spacing"]
-            body = (bar.K @ u) / V / (tau_inf / delta)  # b_i = -(internal force)/V, Eq. (54)
-            model = bar.model
+            K = model.equilibrium_rows() @ K_b          # -S K_b, Eq. (55)
+            body = (K @ u) / V / (tau_inf / delta)  # b_i = -(internal force)/V, Eq. (54)
             m_ratio = model.m[model.grid.interior_ids] / model.m_inf
             if tables:
                 body_ref = closed.body_force_ratio(x, horizon=delta, length=L)
@@ -134,7 +141,7 @@ class ForceFlux(Scene):
         metrics = {"flux_max_ratio": float(flux.max())}
         if tables:
             metrics["flux_table_error"] = float(np.max(np.abs(flux - flux_ref)))
-        if order is None:
+        if not corrected:
             half = faces <= L / 2
             k = int(np.argmax(np.where(half, flux, -np.inf)))
             metrics["flux_argmax"] = float(faces[k] / delta)
@@ -148,7 +155,9 @@ class ForceFlux(Scene):
         fields = {"faces": faces, "flux": flux, "flux_ref": flux_ref, "x": x,
                   "body": body, "body_ref": body_ref, "m_ratio": m_ratio, "m_ref": m_ref,
                   "horizon": delta, "length": L}
-        return Outcome(metrics=metrics, size=bar.size(), fields=fields)
+        size = {"nodes": int(g.n_ext), "real_nodes": int(g.n_interior),
+                "dofs": int(g.n_interior), "bonds": int(model.bond_a.size)}
+        return Outcome(metrics=metrics, size=size, fields=fields)
 
 
 def _first_crossing(s, ratio) -> float:

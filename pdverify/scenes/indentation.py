@@ -9,7 +9,8 @@ import numpy as np
 from .. import budget
 from ..errors import InputError, NumericalError
 from ..params import Param, at_least, open_interval, positive
-from ..pd import BondBasedModel, BoxGrid, get_influence
+from ..pd import get_influence
+from ..pd.build import Body, BondMaterial, build_model
 from ..pd.influence import bond_based_nu
 from ..pd.nonlinear import LinearBondBased, NonlinearBondBased
 from ..solvers.iterative import Lattice
@@ -315,13 +316,13 @@ class Indentation(FemAndPD):
         W, H, h, delta = p["width"], p["height"], p["spacing"], p["horizon"]
         where = f"{self.id}/{method}"
         with timer.phase("setup"):
-            grid = BoxGrid((W, H), (-W / 2, -H), h, placement="on-surface",
-                           boundary_volume=p["node_volumes"])
-            inf = get_influence(p["micromodulus"])
-            closure = self.bond_closure(method, p)
-            model = BondBasedModel(grid, SheetScene.stencil(p, delta / h),
-                                   SheetScene.micromodulus(p, delta), inf, closure,
-                                   thickness=p["thickness"])
+            body = Body((W, H), (-W / 2, -H), h, placement="on-surface",
+                        boundary_volume=p["node_volumes"], thickness=p["thickness"])
+            material = BondMaterial(SheetScene.micromodulus(p, delta),
+                                    get_influence(p["micromodulus"]))
+            model = build_model(body, SheetScene.stencil(p, delta / h), material,
+                                self.bond_closure(method, p))
+            grid = model.grid
             kin = (NonlinearBondBased if p["kinematics"] == "nonlinear" else LinearBondBased)(
                 model, mirror_axis=0 if p["symmetry"] == "half" else None)
             kin.pattern                  # the tangent's pattern, built in the setup phase

@@ -1,19 +1,14 @@
 """Seed 000 §6: the clamped plate, 2D state-based PD against the converged FEM reference:
-a ``static-state`` description that every treatment of the family assembles.
-``StatePlate`` is the plate's own model wrapper (uncorrected, or Taylor fictitious nodes
-with the clamp's Lagrange rows), kept for the Taylor tests and the solver benchmark."""
+a ``static-state`` description that every treatment of the family assembles."""
 from __future__ import annotations
 
 import numpy as np
 
-from ..corrections.taylor_fictitious import clamped_rows, fictitious_closure
 from ..errors import InputError
 from ..metrics import plate_errors
 from ..params import Param, at_least, positive
-from ..pd import (QUADRATURES, BoxGrid, StateBasedConstants, StateBasedModel, get_influence,
-                  state_based_stencil)
+from ..pd import QUADRATURES, StateBasedConstants, get_influence, state_based_stencil
 from ..pd.problem import FACES, FaceCondition, StaticProblem
-from ..solvers.front import solve_constrained, solve_with_dirichlet
 from . import Outcome, Published, influence_param, register, whole_cells
 from .family import FemStaticStateScene
 
@@ -25,79 +20,6 @@ ALL_FACES = (0, 1, 2, 3)
 #: the paper's discretisation (Table 4; the published remarks sit beside these runs only)
 TABLE4 = {"spacing": 0.1, "m_ratio": 3.0, "quadrature": "partial-volume",
           "influence": "hyperbolic", "corners": "normal-only"}
-
-
-class StatePlate:
-    """A 2D state-based plate on the engine: cell-centred nodes on [0, l_x] x [0, l_y],
-    the constants of ``constants`` (energy equivalence, any influence function), weights
-    beta by ``quadrature``.
-
-    ``order=None``: the uncorrected model (truncated neighbourhoods, m_i over the bonds a
-    node has, Eq. 50). ``order=n``: the fictitious layer of thickness delta around the
-    plate extrapolated by ``taylor-fictitious`` (edges by 1D Taylor along the normal,
-    corners by the 2D expansion of Eq. 69 to order n; dilatations to order n - 1) and the
-    clamped edges as constraint rows (Eq. 58 for u and v, corner lines by ``corners``).
-    ``K`` = the equilibrium rows of the real nodes (component-major, u then v).
-    ``closure``: another treatment of the uncorrected model (``order=None``): a bond
-    method of the registry (``energy``, ``volume``, ``pals``), clamped as ``none`` is.
-    """
-
-    def __init__(self, lengths, spacing, m_ratio, constants, influence="hyperbolic",
-                 order=None, quadrature="partial-volume", thickness=1.0,
-                 corners="normal-only", closure=None):
-        inf = get_influence(influence)
-        stencil = state_based_stencil(2, m_ratio, spacing, inf, quadrature)
-        self.order = order
-        self.grid = g = BoxGrid(tuple(lengths), (0.0, 0.0), float(spacing),
-                                stencil.reach if order is not None else 0)
-        if order is not None:
-            closure = fictitious_closure(g, order)
-        self.model = StateBasedModel(g, stencil, constants, inf, closure, thickness=thickness)
-        self.horizon = self.model.horizon
-        self.x = g.x[g.interior_ids]
-        self.K = self.model.stiffness()
-        if order is not None:
-            self.B, self.constraint_points, self.constraint_components = clamped_rows(
-                g, order, ALL_FACES, corners)
-
-    def ring(self) -> np.ndarray:
-        """Real-node numbers of the nodes nearest the boundary (the outermost ring)."""
-        idx = self.grid.index[self.grid.interior_ids]
-        last = np.asarray(self.grid.nodes_per_axis) - 1
-        return np.flatnonzero(np.any((idx == 0) | (idx == last), axis=1))
-
-    def rows_of_state(self, u_fn) -> np.ndarray:
-        """K u for the exact field ``u_fn`` at every node (fictitious included), dilatations
-        of complete neighbourhoods: the discrete operator applied to the field itself."""
-        m, g = self.model, self.grid
-        return m.rows_of_state(u_fn(g.x), m.dilatation_of_field(u_fn, g.x))
-
-    def solve(self, f, boundary_values=None, ring_values=None, where="plate"):
-        """u (n_real, 2) with K u = f: constraint rows = ``boundary_values`` (default 0) with
-        Lagrange multipliers (corrected), or the ring nodes fixed at ``ring_values``
-        (n_ring, 2; default 0) by elimination (uncorrected)."""
-        n = self.grid.n_interior
-        if self.order is not None:
-            c = np.zeros(self.B.shape[0]) if boundary_values is None else boundary_values
-            u, _, info = solve_constrained(self.K, f, self.B, c, where=where, ordering=ORDERING)
-            info["constraints"] = int(self.B.shape[0])
-        else:
-            ring = self.ring()
-            vals = np.zeros((ring.size, 2)) if ring_values is None else ring_values
-            fixed = np.r_[ring, n + ring]
-            u, info = solve_with_dirichlet(self.K, f, fixed, vals.T.ravel(), where,
-                                           ordering=ORDERING)
-            info["constraints"] = int(fixed.size)
-        return u.reshape(2, n).T, info
-
-    def size(self) -> dict:
-        g = self.grid
-        out = {"real_nodes": int(g.n_interior), "bonds": int(self.model.bond_a.size),
-               "dofs": int(2 * g.n_interior), "stiffness_nnz": int(self.K.nnz)}
-        if self.order is not None:
-            out["fictitious_nodes"] = int(g.n_ext - g.n_interior)
-            out["constraints"] = int(self.B.shape[0])
-        return out
 
 
 @register

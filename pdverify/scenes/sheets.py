@@ -7,7 +7,8 @@ from .. import budget
 from ..errors import InputError
 from ..metrics import rel_l2_error
 from ..params import Param, at_least, positive
-from ..pd import BondBasedModel, BoxGrid, bond_micromodulus, build_stencil, get_influence
+from ..pd import bond_micromodulus, build_stencil, get_influence
+from ..pd.build import Body, BondMaterial, build_model
 from ..pd.influence import bond_based_nu
 from ..pd.problem import ClampedBox
 from ..solvers.front import solve_with_dirichlet
@@ -193,12 +194,11 @@ class TensionSheet(SheetScene):
         W, H, h, delta = p["width"], p["length"], p["spacing"], p["horizon"]
         sigma, t = p["traction"], p["thickness"]
         with timer.phase("setup"):
-            grid = BoxGrid((W, H), (-W / 2, -H / 2), h, placement="on-surface")
-            stencil = self.stencil(p, delta / h)
-            inf = get_influence(p["micromodulus"])
-            closure = self.bond_closure(method, p)
-            c = self.micromodulus(p, delta)
-            model = BondBasedModel(grid, stencil, c, inf, closure, thickness=t)
+            body = Body((W, H), (-W / 2, -H / 2), h, placement="on-surface", thickness=t)
+            material = BondMaterial(self.micromodulus(p, delta), get_influence(p["micromodulus"]))
+            model = build_model(body, self.stencil(p, delta / h), material,
+                                self.bond_closure(method, p))
+            grid = model.grid
             n, x = grid.n_ext, grid.x
             f = np.zeros(2 * n)
             for side in (-1, 1):
@@ -354,15 +354,19 @@ class ClampedSheet(SheetScene):
             if treatment.role(self.family) is not None:      # its own grid and clamp nodes
                 grid, closure, bottom, top = treatment.build_for(
                     self.family, ClampedBox(lo, hi, h, delta, inf, axis=1), p)
+                body = Body((L, L), lo, h, thickness=t)
             else:
-                grid = BoxGrid((L, L), lo, h, placement="on-surface",
-                               boundary_volume=p["node_volumes"])
+                body = Body((L, L), lo, h, placement="on-surface",
+                            boundary_volume=p["node_volumes"], thickness=t)
+                grid = body.grid()
                 y = grid.x[:, 1]
                 top = np.flatnonzero(np.isclose(y, L / 2))
                 bottom = np.flatnonzero(np.isclose(y, -L / 2))
                 closure = self.bond_closure(method, p)
-            model = BondBasedModel(grid, self.stencil(p, p["m_ratio"]),
-                                   self.micromodulus(p, delta), inf, closure, thickness=t)
+            # the grid: the body's, or the treatment's own (virtual nodes: buffer layers)
+            model = build_model(body, self.stencil(p, p["m_ratio"]),
+                                BondMaterial(self.micromodulus(p, delta), inf), closure,
+                                grid=grid)
             n = grid.n_ext
             fixed = np.r_[top, bottom, n + top, n + bottom]
             values = np.r_[np.zeros(top.size + bottom.size), np.full(top.size, uy),

@@ -34,8 +34,9 @@ import numpy as np
 from .. import budget
 from ..corrections.factors import uniaxial, work_density
 from ..params import Param, at_least, open_interval, positive
-from ..pd import (BondBasedModel, BoxGrid, StateBasedConstants, StateBasedModel,
-                  bond_micromodulus, build_stencil, get_influence, state_based_stencil)
+from ..pd import (StateBasedConstants, bond_micromodulus, build_stencil, get_influence,
+                  state_based_stencil)
+from ..pd.build import Body, BondMaterial, StateMaterial, build_model
 from ..pd.influence import INFLUENCES
 from ..pd.problem import FACES, FaceCondition, StaticProblem
 from . import MethodSpec, Outcome, Published, Scene, register, whole_cells
@@ -203,11 +204,10 @@ class SheetStiffness(StiffnessScene):
     def build(self, method, p, closure):
         W, H, h = p["width"], p["length"], p["spacing"]
         delta = self.horizon(p)
-        grid = BoxGrid((W, H), (0.0, 0.0), h, placement="on-surface")
-        inf = get_influence(p["micromodulus"])
         c = bond_micromodulus(p["micromodulus"], 2, p["E"], delta, plane="stress")
-        return BondBasedModel(grid, build_stencil(2, p["m_ratio"], quadrature=p["quadrature"]),
-                              c, inf, closure)
+        return build_model(Body((W, H), (0.0, 0.0), h, placement="on-surface"),
+                           build_stencil(2, p["m_ratio"], quadrature=p["quadrature"]),
+                           BondMaterial(c, get_influence(p["micromodulus"])), closure)
 
 
 #: why a treatment of the static-state family without fictitious or surface nodes
@@ -301,9 +301,9 @@ class _StateStiffness(StiffnessScene, StaticStateScene):
         inf = get_influence(p["influence"])
         stencil = state_based_stencil(len(lengths), p["m_ratio"], p["spacing"], inf,
                                       p["quadrature"])
-        grid = BoxGrid(lengths, (0.0,) * len(lengths), p["spacing"], 0)
-        return StateBasedModel(grid, stencil, StateBasedConstants(self.kind, p["E"], p["nu"]),
-                               inf, closure)
+        material = StateMaterial(StateBasedConstants(self.kind, p["E"], p["nu"]), inf)
+        return build_model(Body(lengths, (0.0,) * len(lengths), p["spacing"]), stencil,
+                           material, closure)
 
     def cases(self, quick=False):
         return [("none", dict(self.quick_overrides) if quick else {})]
@@ -404,11 +404,10 @@ class BondBoxStiffness(StiffnessScene):
 
     def build(self, method, p, closure):
         lengths = self.lengths(p)
-        inf = get_influence(p["micromodulus"])
-        grid = BoxGrid(lengths, (0.0,) * 3, p["spacing"], 0)
         c = bond_micromodulus(p["micromodulus"], 3, p["E"], self.horizon(p))
-        return BondBasedModel(grid, build_stencil(3, p["m_ratio"], quadrature=p["quadrature"]),
-                              c, inf, closure)
+        return build_model(Body(lengths, (0.0,) * 3, p["spacing"]),
+                           build_stencil(3, p["m_ratio"], quadrature=p["quadrature"]),
+                           BondMaterial(c, get_influence(p["micromodulus"])), closure)
 
 
 @register

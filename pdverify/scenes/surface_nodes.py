@@ -7,94 +7,15 @@ import numpy as np
 
 from manufactured import surface3d as closed
 
-from ..corrections.surface_nodes import flux_rows, surface_node_closure
 from ..metrics import error_metrics, surface_error_pct
 from ..params import Param, at_least, open_interval, positive
-from ..pd import (QUADRATURES, BoxGrid, StateBasedConstants, StateBasedModel, get_influence,
-                  state_based_stencil)
+from ..pd import QUADRATURES, StateBasedConstants, get_influence, state_based_stencil
 from ..pd.problem import FACES, FaceCondition, StaticProblem
 from ..solvers.policy import ND3D_FROM_UNKNOWNS, ND_FROM_UNKNOWNS, STATIC_SOLVERS
 from . import Outcome, Published, influence_param, register, require_influence
 from .base import ExpectedFailure
 from .family import StaticStateScene
 
-
-class StateBox:
-    """A seed-001 box on the engine: the state-based model, uncorrected or with surface nodes.
-
-    ``order=None``: the uncorrected model (seed 001 §4, 'without the fictitious and
-    surface nodes'): bonds only between interior nodes, m_i and theta_i over the
-    truncated neighbourhoods (Eqs. 22-23). ``order=N``: the surface node method's closure
-    (``pdverify.corrections.surface_nodes.surface_node_closure``): a fictitious layer of
-    thickness delta, one surface node per boundary cell face, order-N displacement and
-    order N - 1 dilatation extrapolation, m of a complete neighbourhood, and one
-    force-flux equation per surface node (Eq. 36) below the interior equations in P.
-    ``quadrature``: the weights beta of Eqs. (22)-(24) (``pdverify.pd.bonds``); the
-    moment correction uses the state-based weight omega |xi|^2. ``closure``: a bond
-    method's closure on the uncorrected grid (``order=None`` only). ``mirror(grid,
-    stencil) -> MirrorNodes``: the mirror node method's fictitious layer
-    (``pdverify.corrections.mirror_nodes``; ``order=None``).
-    """
-
-    def __init__(self, lengths, origin, spacing, m_ratio, constants: StateBasedConstants,
-                 order: int | None = None, quadrature: str = "partial-volume",
-                 influence: str = "gaussian", closure=None, mirror=None):
-        inf = get_influence(influence)
-        stencil = state_based_stencil(len(lengths), m_ratio, spacing, inf, quadrature)
-        self.order = order
-        self.grid = BoxGrid(lengths, origin, float(spacing),
-                            stencil.reach if order is not None or mirror is not None else 0)
-        closure, flux = (surface_node_closure(self.grid, stencil, order) if order is not None
-                         else (closure, None))
-        self.mirror = None
-        #: node counts a method reports beside the size (pddo: its three subdomains)
-        self.counts = {}
-        if mirror is not None:
-            self.mirror = mirror(self.grid, stencil)
-            closure = self.mirror.closure()
-        self.model = model = StateBasedModel(self.grid, stencil, constants, inf, closure)
-        self.P = model.equilibrium_rows()
-        if flux is not None:
-            self.P = (self.P + flux_rows(model, flux)).tocsr()
-        self.horizon = model.horizon
-        self.n_unknown_nodes = model.n_unknown_nodes
-        self.A_U_full = model.A_U_full
-
-    @property
-    def dim(self) -> int:
-        return self.grid.dim
-
-    def stiffness(self):
-        return self.model.stiffness(self.P)
-
-    def augmented(self):
-        """The system with dilatations as unknowns (StateBasedModel.augmented_stiffness)."""
-        return self.model.augmented_stiffness(self.P)
-
-    def unknown_coords(self):
-        """Coordinates of the augmented system's unknowns: the displacement components of
-        the interior then (surface nodes) surface nodes, then the interior dilatations (and
-        any further nodal scalars of the closure, e.g. PALS's second one), node-major."""
-        g = self.grid
-        x_int = g.x[g.interior_ids]
-        nodes = np.r_[x_int, g.surface_x] if self.order is not None else x_int
-        scalars = self.model.A_theta.shape[0] // len(x_int)
-        return np.r_[np.tile(nodes, (self.dim, 1)), np.tile(x_int, (scalars, 1))]
-
-    def rows_of_state(self, U_ext, Theta_ext):
-        return self.model.rows_of_state(U_ext, Theta_ext, self.P)
-
-    def dilatation_of_field(self, u_fn, points):
-        return self.model.dilatation_of_field(u_fn, points)
-
-    def size(self) -> dict:
-        g = self.grid
-        out = {"interior_nodes": int(g.n_interior), "bonds": int(self.model.bond_a.size),
-               "dofs": int(self.dim * self.n_unknown_nodes)}
-        if self.order is not None:
-            out["surface_nodes"] = int(g.n_surface)
-            out["fictitious_nodes"] = int(g.n_ext - g.n_interior)
-        return out
 
 def _next_to_x0(cells):
     """The boundary cells in the cell layer next to x = 0 (seed 001 Fig. 8's edge

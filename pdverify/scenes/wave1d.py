@@ -13,7 +13,8 @@ from ..corrections.surface_nodes import wave_extension
 from ..errors import InputError, NumericalError
 from ..metrics import max_error_of_peak_pct, rel_l2_error
 from ..params import Param, at_least, positive
-from ..pd import BondBasedModel, BoxGrid, Closure, bond_micromodulus, build_stencil, get_influence
+from ..pd import Closure, bond_micromodulus, build_stencil, get_influence
+from ..pd.build import Body, BondMaterial, build_model
 from ..pd.closure import real_identity, with_rows
 from ..solvers.explicit import central_difference
 from . import Outcome, Published, Scene, cell_count, register
@@ -78,11 +79,13 @@ class WaveBar:
             raise ValueError(f"order {taylor_order} needs at least {taylor_order + 1} "
                              f"real nodes, got {nr}")
         stencil = build_stencil(1, m_ratio)
-        grid = BoxGrid((length,), (0.0,), self.spacing, stencil.reach if surface else 0)
-        closure = (Closure(displacement_map=extension(grid), n_unknown_nodes=nr + 2)
-                   if surface else None)
-        c = bond_micromodulus("hyperbolic", 1, wave_speed ** 2, horizon)
-        self.model = BondBasedModel(grid, stencil, c, get_influence("hyperbolic"), closure)
+        material = BondMaterial(bond_micromodulus("hyperbolic", 1, wave_speed ** 2, horizon),
+                                get_influence("hyperbolic"))
+        self.model = build_model(
+            Body((length,), (0.0,), self.spacing), stencil, material,
+            (lambda g: Closure(displacement_map=extension(g), n_unknown_nodes=nr + 2))
+            if surface else None, layers=stencil.reach if surface else 0)
+        grid = self.model.grid
         self.x_lattice = grid.x[:, 0]
         self.n_fict = grid.layers
         full = (sp.diags(-1.0 / self.model.node_volume[grid.interior_ids])

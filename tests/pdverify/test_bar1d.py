@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from pdverify.scenes.bar1d import StateBar
+from engine_models import StateBar
 from pdverify.scenes import get_scene
 
 EPS = np.finfo(float).eps

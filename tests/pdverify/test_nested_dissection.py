@@ -7,7 +7,7 @@ import scipy.sparse.linalg as spla
 from pdverify.errors import NumericalError
 from pdverify.pd import StateBasedConstants
 from pdverify.scenes import get_scene
-from pdverify.scenes.surface_nodes import StateBox
+from engine_models import StateBox
 from pdverify.solvers.policy import ND3D_FROM_UNKNOWNS, ND_FROM_UNKNOWNS, static_solver
 from pdverify.solvers.ordering import nested_dissection
 from pdverify.solvers.nested import solve_nested

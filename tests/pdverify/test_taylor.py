@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from pdverify.corrections.taylor import taylor_extrapolation_weights
-from pdverify.scenes.bar1d import StateBar
+from engine_models import StateBar
 
 EPS = np.finfo(float).eps
 

@@ -8,7 +8,7 @@ from pdverify.corrections.taylor import monomial_exponents
 from pdverify.corrections.taylor_fictitious import clamped_rows, extrapolation_map
 from pdverify.errors import NumericalError
 from pdverify.pd import BoxGrid, StateBasedConstants
-from pdverify.scenes.plate2d import StatePlate
+from engine_models import StatePlate
 
 EPS = np.finfo(float).eps
 

@@ -6,7 +6,7 @@ from pdverify.pd.bonds import (fourth_moment_anisotropy, moment_corrected_volume
                                partial_volumes, stencil_offsets)
 from pdverify.pd.problem import face_resultant
 from pdverify.pd import StateBasedConstants
-from pdverify.scenes.surface_nodes import StateBox
+from engine_models import StateBox
 
 # Sums of a few hundred terms of size <= 1: 1e-13 is ~500 eps of summation round-off.
 SUM_ATOL = 1e-13

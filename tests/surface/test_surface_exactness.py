@@ -13,7 +13,7 @@ import pytest
 from pdverify.corrections.taylor import monomial_exponents
 from pdverify.solvers.front import solve_with_dirichlet
 from pdverify.pd import StateBasedConstants
-from pdverify.scenes.surface_nodes import StateBox
+from engine_models import StateBox
 
 EPS = np.finfo(float).eps
 

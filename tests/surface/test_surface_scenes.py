@@ -4,7 +4,7 @@ import pytest
 
 from pdverify.scenes import get_scene
 from pdverify.pd import StateBasedConstants
-from pdverify.scenes.surface_nodes import StateBox
+from engine_models import StateBox
 
 
 @pytest.fixture(scope="module")
