@@ -50,10 +50,11 @@ def solve_nested(A, rhs, coords, *, where: str = "static solve", mixed: bool | N
     a 1-norm condition estimate, :class:`NumericalError` on (near-)singular systems.
 
     ``mixed`` (default: :func:`~pdverify.solvers.policy.mixed_precision`): factor in single
-    precision (:class:`SplitLU`) and refine in double as LAPACK's dsgesv does; a system
-    whose single-precision factor fails or whose refinement does not converge (condition
-    ~1/eps_single = 8e6 or worse) is solved by the double LU instead, with the reason in
-    the diagnostics (``mixed_precision``). A random right-hand side is refined alongside
+    precision (:class:`SplitLU`) and refine in double as LAPACK's dsgesv does, or, when
+    that stalls (condition ~1/eps_single = 1.7e7), by GMRES preconditioned with the same
+    factor (:mod:`~pdverify.solvers.mixed`); a system whose single-precision factor fails
+    or that neither refinement solves is solved by the double LU instead, with the reason
+    in the diagnostics (``mixed_precision``). A random right-hand side is refined alongside
     (a near-singular system cannot converge on it) and gives the condition estimate
     (:func:`~pdverify.solvers.mixed.probe_condition_estimate`). The diagnostics record
     the refinement's steps and relative residuals (``refinement_steps``,
@@ -120,12 +121,15 @@ def _solve_mixed(A_p, b_p, n1: int, n2: int):
     y, cond, diag = refine_with_probe(A_p, b_p, lu)
     if y is None:
         return None, None, diag
-    diag.update(mixed_precision="float32 LU" + note + ", refined in float64 (LAPACK "
-                                "dsgesv's test)",
+    gmres = diag.get("refinement") == "GMRES-IR"
+    diag.update(mixed_precision="float32 LU" + note + (
+                    ", refined in float64 by GMRES-IR (plain refinement stalled)" if gmres
+                    else ", refined in float64 (LAPACK dsgesv's test)"),
                 factor_entries=lu.factor_entries, separator_unknowns=lu.separator,
                 separator_rows_pivoted_into_halves=lu.crossed_pivots,
-                solver="sparse LU (SuperLU in float32 + refinement, nested-dissection "
-                       "ordering)")
+                solver="sparse LU (SuperLU in float32 + " + ("GMRES-IR" if gmres else
+                                                             "refinement")
+                       + ", nested-dissection ordering)")
     return y, cond, diag
 
 

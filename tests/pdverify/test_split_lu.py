@@ -4,7 +4,7 @@ import pytest
 import scipy.sparse as sp
 
 from pdverify.errors import NumericalError
-from pdverify.solvers import nested, policy
+from pdverify.solvers import mixed, nested, policy
 from pdverify.solvers.checks import equilibrate
 from pdverify.solvers.mixed import refine
 from pdverify.solvers.nested import SplitLU, solve_nested
@@ -151,14 +151,40 @@ def ill_conditioned(kappa, n=24, reach=2):
     return sp.csr_matrix(S), x
 
 
-def test_ill_conditioned_system_falls_back_to_the_double_lu():
-    """kappa = 1e9 > 1/eps32: the float32 factor cannot be refined; the double LU solves
-    it to ~kappa n eps. Its estimate: the 1e9 built in, to within the estimator's usual
-    factor 3 and what the diagonal equilibration changes (> 1e8)."""
+def test_ill_conditioned_system_is_solved_by_gmres_ir():
+    """kappa = 1e9 > 1/eps32: plain refinement of the float32 factor stalls; GMRES
+    preconditioned with that factor (GMRES-IR) solves it to ~kappa n eps, backward stable,
+    without a double factor. Its estimate: the 1e9 built in, to within the estimator's
+    usual factor 3 (Higham, Accuracy and Stability, 15.3) of the equilibrated matrix's."""
     A, x = ill_conditioned(1e9)
     b = np.random.default_rng(6).normal(size=A.shape[0])
     u, info = solve_nested(A, b, x, where="test", mixed=True)
-    assert info["mixed_precision"].startswith("not used")
+    assert info["mixed_precision"] == ("float32 LU, refined in float64 by GMRES-IR (plain "
+                                       "refinement stalled)")
+    assert info["refinement"] == "GMRES-IR" and "GMRES-IR" in info["solver"]
+    # each correction's GMRES stopped at GMRES_INNER_TOL, well inside its iteration limit
+    assert 0 < max(info["gmres_ir_iterations"]) < mixed.GMRES_MAX_ITERATIONS
+    # the outer residual: REFINE_STOP = 2 eps (max-norm measure) or dsgesv's sqrt(n) eps
+    assert info["gmres_ir_residuals"][-1] <= np.sqrt(A.shape[0]) * EPS
+    # backward stable as the double LU: c eps with c ~ 1-10 in the scaled 2-norm measure
+    assert info["relative_residual"] < 1e2 * EPS
+    exact = np.linalg.solve(A.toarray(), b)
+    assert np.linalg.norm(u - exact) / np.linalg.norm(exact) < 1e9 * A.shape[0] * EPS
+    kappa = np.linalg.cond(equilibrate(A, "test")[0].toarray(), 1)
+    assert kappa / 3 <= info["condition_estimate"] <= kappa * (1 + 1e-6)
+
+
+def test_ill_conditioned_system_falls_back_to_the_double_lu(monkeypatch):
+    """When GMRES-IR fails too (here: GMRES held to one iteration per correction, so each
+    outer step gains ~kappa eps32 > 1), the double LU solves it to ~kappa n eps. Its
+    estimate: the 1e9 built in, to within the estimator's usual factor 3 and what the
+    diagonal equilibration changes (> 1e8)."""
+    monkeypatch.setattr(mixed, "GMRES_MAX_ITERATIONS", 1)
+    A, x = ill_conditioned(1e9)
+    b = np.random.default_rng(6).normal(size=A.shape[0])
+    u, info = solve_nested(A, b, x, where="test", mixed=True)
+    assert info["mixed_precision"] == ("not used: refinement of the single-precision factor "
+                                       "did not converge, nor GMRES-IR; double LU")
     assert "float32" not in info["solver"]
     assert info["condition_estimate"] > 1e8
     exact = np.linalg.solve(A.toarray(), b)
