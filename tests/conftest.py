@@ -17,6 +17,24 @@ def _strict_float_errors():
     np.seterr(**old)
 
 
+@pytest.fixture(scope="session", autouse=True)
+def fem_cache_dir(tmp_path_factory):
+    """One cache folder of FEM references (and manufactured loads) for the whole session,
+    never the user's: the tests see a cold cache on any machine, as CI does, and each
+    reference the session needs is computed once and read by every later test and
+    subprocess (issue 32: the references were computed per module, or read from whatever
+    the user's cache held). Tests of the cache itself set a folder of their own."""
+    from reference_fem.cache import ENV_VAR
+    old = os.environ.get(ENV_VAR)
+    path = tmp_path_factory.mktemp("pdverify-cache")
+    os.environ[ENV_VAR] = str(path)
+    yield path
+    if old is None:
+        os.environ.pop(ENV_VAR, None)
+    else:
+        os.environ[ENV_VAR] = old
+
+
 @pytest.fixture(autouse=True)
 def _one_blas_thread(request):
     """Every test computes with one BLAS thread, as every run does (pdverify.blas): the
