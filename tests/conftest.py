@@ -17,6 +17,40 @@ def _strict_float_errors():
     np.seterr(**old)
 
 
+@pytest.fixture(scope="session", autouse=True)
+def fem_cache_dir(tmp_path_factory):
+    """One cache folder of FEM references (and manufactured loads) for the whole session,
+    never the user's: the tests see a cold cache on any machine, as CI does, and each
+    reference the session needs is computed once and read by every later test and
+    subprocess (issue 32: the references were computed per module, or read from whatever
+    the user's cache held). Tests of the cache itself set a folder of their own."""
+    from reference_fem.cache import ENV_VAR
+    old = os.environ.get(ENV_VAR)
+    path = tmp_path_factory.mktemp("pdverify-cache")
+    os.environ[ENV_VAR] = str(path)
+    yield path
+    if old is None:
+        os.environ.pop(ENV_VAR, None)
+    else:
+        os.environ[ENV_VAR] = old
+
+
+@pytest.fixture(autouse=True)
+def _one_blas_thread(request):
+    """Every test computes with one BLAS thread, as every run does (pdverify.blas): the
+    numbers a test computes beside a run's are made the same way, and the suite does not
+    depend on OpenBLAS's threads, which on a busy 2-core machine turned the dense rank
+    checks of tests/treatments/test_taylor_3d.py (a 712 x 864 SVD: 0.17 s with one thread)
+    into 4.4 s each (issue 32). Tests of the thread setting itself opt out with
+    ``@pytest.mark.blas_default_threads`` and see the process's own setting."""
+    if request.node.get_closest_marker("blas_default_threads"):
+        yield
+        return
+    from pdverify import blas
+    with blas.one_thread():
+        yield
+
+
 @pytest.fixture
 def rng():
     return np.random.default_rng(20211121)
@@ -62,22 +96,92 @@ def run_once():
     return run
 
 
+#: the program behind ``cli_concurrently``: one interpreter imports the modules every
+#: ``python -m pdverify run`` imports (the command line, the runner, the scene modules), then
+#: forks one process per argv, at most one per core at a time. Each child runs
+#: ``python -m pdverify ARGV`` as the interpreter would (``runpy``, ``sys.argv``, an
+#: uncaught exception printed by ``sys.excepthook`` with exit status 1, ``SystemExit``'s
+#: code) with its stdout and stderr on files of its own; the parent reports each child's
+#: exit status as ``subprocess`` does (-N for a signal) and the two texts, as JSON.
+_FORK_SERVER = r"""
+import json, os, runpy, sys, tempfile
+import pdverify.cli, pdverify.runner, pdverify.scenes
+pdverify.scenes.all_scenes()        # the scene modules, which every run imports first
+argvs, cores = json.loads(sys.argv[1]), int(sys.argv[2])
+tmp = tempfile.mkdtemp(prefix="pdverify-cli-")
+files = [(os.path.join(tmp, f"{k}.out"), os.path.join(tmp, f"{k}.err")) for k in range(len(argvs))]
+sys.stdout.flush(); sys.stderr.flush()
+
+def child(k):
+    code = 1
+    try:
+        for fd, path in ((1, files[k][0]), (2, files[k][1])):
+            os.dup2(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600), fd)
+        sys.argv = ["pdverify", *argvs[k]]
+        try:
+            runpy.run_module("pdverify", run_name="__main__", alter_sys=True)
+            code = 0
+        except SystemExit as exc:
+            if exc.code is None:
+                code = 0
+            elif isinstance(exc.code, int):
+                code = exc.code
+            else:
+                print(exc.code, file=sys.stderr)
+                code = 1
+        except BaseException:
+            sys.excepthook(*sys.exc_info())
+            code = 1
+        sys.stdout.flush(); sys.stderr.flush()
+    finally:
+        os._exit(code & 0xFF)
+
+status, running, todo = {}, {}, list(range(len(argvs)))
+while todo or running:
+    while todo and len(running) < cores:
+        k = todo.pop(0)
+        pid = os.fork()
+        if pid == 0:
+            child(k)
+        running[pid] = k
+    pid, st = os.wait()
+    status[running.pop(pid)] = os.waitstatus_to_exitcode(st)
+out = []
+for k in range(len(argvs)):
+    texts = []
+    for path in files[k]:
+        with open(path) as fh:
+            texts.append(fh.read())
+        os.remove(path)
+    out.append([status[k], *texts])
+os.rmdir(tmp)
+print(json.dumps(out))
+"""
+
+
 @pytest.fixture(scope="session")
 def cli_concurrently():
-    """``cli_concurrently(argvs, env=None, cwd=None)``: each argv run as its own
-    ``python -m pdverify ARGV`` (a fresh interpreter: its real exit code and stderr), as
-    many at a time as the process has cores; returns ``{tuple(argv): CompletedProcess}``.
-    For the tables of bad-input cases, whose cost is the interpreter's start (issue 32)."""
+    """``cli_concurrently(argvs, env=None, cwd=None)``: each argv run as
+    ``python -m pdverify ARGV`` in a process of its own, as many at a time as the process
+    has cores; returns ``{tuple(argv): CompletedProcess}`` with each process's exit
+    status and its stdout and stderr. For the tables of bad-input cases, whose cost was
+    each interpreter's start (issue 32): the processes are forked from one interpreter
+    that has imported what ``run`` imports before reading its arguments (as the report's
+    workers are forked), so the cases no longer pay numpy's and scipy's import each
+    (0.8 s of CPU a case); what a case prints and its exit status are its own."""
+    import json
     import subprocess
     import sys
-    from concurrent.futures import ThreadPoolExecutor
 
     def run_all(argvs, env=None, cwd=None, timeout=120):
-        def one(argv):
-            return subprocess.run([sys.executable, "-m", "pdverify", *argv],
-                                  capture_output=True, text=True, env=env, cwd=cwd,
-                                  timeout=timeout)
         argvs = [tuple(a) for a in argvs]
-        with ThreadPoolExecutor(max_workers=len(os.sched_getaffinity(0))) as pool:
-            return dict(zip(argvs, pool.map(one, argvs)))
+        cores = len(os.sched_getaffinity(0))
+        server = subprocess.run([sys.executable, "-c", _FORK_SERVER, json.dumps(argvs),
+                                 str(cores)], capture_output=True, text=True, env=env,
+                                cwd=cwd, timeout=timeout * max(1, len(argvs) // cores))
+        assert server.returncode == 0, server.stderr
+        done = json.loads(server.stdout.splitlines()[-1])
+        return {argv: subprocess.CompletedProcess([sys.executable, "-m", "pdverify", *argv],
+                                                  code, out, err)
+                for argv, (code, out, err) in zip(argvs, done)}
     return run_all

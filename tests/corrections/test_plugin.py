@@ -35,12 +35,30 @@ def _install(target: Path, plugin: Path = PLUGIN, package: str = "pdverify_demo_
 
 
 @pytest.fixture(scope="module")
-def plugin_env(tmp_path_factory):
-    target = tmp_path_factory.mktemp("site")
-    _install(target)
+def installed(tmp_path_factory):
+    """Both demo plugins installed, each into a folder of its own, by two pip processes
+    at once (issue 32: each pip spent 4 to 7 s, one after the other)."""
+    from concurrent.futures import ThreadPoolExecutor
+    jobs = {"method": (tmp_path_factory.mktemp("site"), PLUGIN, "pdverify_demo_plugin",
+                       "demo-uniform = pdverify_demo_plugin:METHOD"),
+            "treatment": (tmp_path_factory.mktemp("site-treatment"), TREATMENT_PLUGIN,
+                          "pdverify_image_nodes", "image-nodes = pdverify_image_nodes:METHOD")}
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        done = {k: pool.submit(_install, *args) for k, args in jobs.items()}
+        for f in done.values():
+            f.result()
+    return {k: args[0] for k, args in jobs.items()}
+
+
+def _env(target):
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join([str(target), env.get("PYTHONPATH", "")])
     return env
+
+
+@pytest.fixture(scope="module")
+def plugin_env(installed):
+    return _env(installed["method"])
 
 
 def cli(env, *args):
@@ -110,16 +128,11 @@ def test_broken_plugin_is_listed_not_fatal(monkeypatch):
 
 # ------------------------------------------------------------ a treatment with nodes and rows
 @pytest.fixture(scope="module")
-def treatment_env(tmp_path_factory):
+def treatment_env(installed):
     """The plugin tests/plugins/demo_treatment_plugin: a mirror-node variant with
     surface-node unknowns (extra nodes) and their force-flux equations (extra rows),
     installed like a user's package; pdverify itself is unchanged."""
-    target = tmp_path_factory.mktemp("site-treatment")
-    _install(target, TREATMENT_PLUGIN, "pdverify_image_nodes",
-             "image-nodes = pdverify_image_nodes:METHOD")
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join([str(target), env.get("PYTHONPATH", "")])
-    return env
+    return _env(installed["treatment"])
 
 
 def test_treatment_plugin_serves_every_scene_of_its_family(treatment_env):
@@ -138,16 +151,23 @@ def test_treatment_plugin_serves_every_scene_of_its_family(treatment_env):
     assert served == family
 
 
-def test_treatment_plugin_runs_and_is_exact_for_a_linear_field(treatment_env):
+def test_treatment_plugin_runs_and_is_exact_for_a_linear_field(treatment_env,
+                                                               cli_concurrently):
     """The traction bar's solution is linear, and odd images about the surface nodes
     reproduce a linear field exactly: round-off (Eq. 64 relative to the largest
     displacement, times 1e3 eps per node row summed over ~40 bonds)."""
-    r = cli(treatment_env, "run", "bar1d-traction", "--method", "image-nodes")
+    # the four runs below, each its own process, started together (issue 32)
+    bar = ("run", "bar1d-traction", "--method", "image-nodes")
+    plate = ("run", "plate2d-plane-strain", "--method", "image-nodes", "--set",
+             "spacing=0.05")
+    stiff = {m: ("run", "stiffness2d-plate", "--method", m, "--set", "spacing=0.05")
+             for m in ("image-nodes", "none")}
+    runs = cli_concurrently([bar, plate, *stiff.values()], env=treatment_env)
+    r = runs[bar]
     assert r.returncode == 0, r.stderr
     err = float(r.stdout.split("max_error_pct", 1)[1].split()[0])
     assert err < 1e-9
-    r = cli(treatment_env, "run", "plate2d-plane-strain", "--method", "image-nodes",
-            "--set", "spacing=0.05")
+    r = runs[plate]
     assert r.returncode == 0, r.stderr
     assert "surface_max_error_pct" in r.stdout
     # on a stiffness scene it is judged by its nodal energy. Its odd images are exact for
@@ -156,8 +176,7 @@ def test_treatment_plugin_runs_and_is_exact_for_a_linear_field(treatment_env):
     # the bulk energy all lie within 2.5 h of a corner; 10.8 % at most, in shear): it
     # must still beat the truncated neighbourhoods there
     def energy_error(method):
-        r = cli(treatment_env, "run", "stiffness2d-plate", "--method", method,
-                "--set", "spacing=0.05")
+        r = runs[stiff[method]]
         assert r.returncode == 0, r.stderr
         return float(r.stdout.split("surface_energy_error_pct", 1)[1].split()[0])
     assert energy_error("image-nodes") < energy_error("none")

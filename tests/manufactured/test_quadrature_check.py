@@ -90,16 +90,19 @@ class Quadrature:
             out[start:start + 512] = np.einsum("krn,r,n->k", e, radial, self.w_in)
         return self.c["c_theta"] / self.weighted_volume * out
 
-    def _force(self, p, q, length, direction):
-        """Bond force f(p, q) for q - p = length * direction, arrays (..., dim)."""
+    def _force(self, p, q, length, direction, theta_p=None):
+        """Bond force f(p, q) for q - p = length * direction, arrays (..., dim).
+        ``theta_p``: theta at p where p is one point broadcast (body_force), computed once
+        there instead of at each of its copies."""
         e = np.einsum("...d,...d->...", self.u(q) - self.u(p), direction)
         om = self.omega(length)
         if self.model == "bond-based":
             mag = self.c["micromodulus"] * om * e / length
         else:
             m = self.weighted_volume
-            th = self.theta(p.reshape(-1, self.dim)).reshape(p.shape[:-1]) + \
-                self.theta(q.reshape(-1, self.dim)).reshape(q.shape[:-1])
+            if theta_p is None:
+                theta_p = self.theta(p.reshape(-1, self.dim)).reshape(p.shape[:-1])
+            th = theta_p + self.theta(q.reshape(-1, self.dim)).reshape(q.shape[:-1])
             mag = self.c["k_theta"] * om * length * th / m + 2 * self.c["k_e"] * om * e / m
         return mag[..., None] * direction
 
@@ -108,7 +111,8 @@ class Quadrature:
         ll = np.broadcast_to(self.l[:, None], (len(self.l), len(self.w_out)))
         mm = np.broadcast_to(self.m_out[None], ll.shape + (self.dim,))
         xs = np.broadcast_to(x, mm.shape)
-        f = self._force(xs, xs + ll[..., None] * mm, ll, mm)
+        theta_x = None if self.model == "bond-based" else self.theta(np.reshape(x, (1, -1)))[0]
+        f = self._force(xs, xs + ll[..., None] * mm, ll, mm, theta_p=theta_x)
         w = (self.wl * self.l ** (self.dim - 1))[:, None] * self.w_out[None, :]
         return -np.einsum("rnd,rn->d", f, w)
 

@@ -1,4 +1,6 @@
 """The FEM references as scenes (issue #5): metrics reach results.json and the report."""
+import os
+
 import pytest
 
 from pdverify.cli import main
@@ -6,8 +8,10 @@ from pdverify.scenes import get_scene
 
 
 @pytest.fixture(autouse=True)
-def _cache(tmp_path_factory, monkeypatch):
-    monkeypatch.setenv("PDVERIFY_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "fem-cache"))
+def _cache(fem_cache_dir):
+    """The session's cache folder (conftest; never the user's), shared with the other
+    tests that need these references (issue 32)."""
+    assert os.environ["PDVERIFY_CACHE_DIR"] == str(fem_cache_dir)
 
 
 def test_clamped_sheet_scene_reproduces_table_2():

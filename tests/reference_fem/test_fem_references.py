@@ -8,12 +8,11 @@ from reference_fem.field import midpoint_refined
 
 
 @pytest.fixture(scope="module")
-def cache_env(tmp_path_factory):
-    """A private cache folder for this module (never the user's cache)."""
-    mp = pytest.MonkeyPatch()
-    mp.setenv(rf.cache.ENV_VAR, str(tmp_path_factory.mktemp("fem_cache")))
-    yield
-    mp.undo()
+def cache_env(fem_cache_dir):
+    """The session's cache folder (conftest; never the user's cache): a reference another
+    test of the session computed with the same parameters is read, not computed again
+    (issue 32); the cache's round trip is tests/reference_fem/test_fem_cache.py's."""
+    assert rf.cache.cache_dir() == fem_cache_dir
 
 
 @pytest.fixture(scope="module")

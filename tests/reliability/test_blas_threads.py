@@ -8,6 +8,9 @@ from pdverify.runner import run_cases
 from pdverify.scenes import MethodSpec, Outcome, Scene, register
 from pdverify.scenes import _REGISTRY
 
+#: these tests need the caller's own BLAS threads (conftest runs the others with one)
+pytestmark = pytest.mark.blas_default_threads
+
 
 class _Threads(Scene):
     """Test-only scene: reports the BLAS threads its solve ran with, and a dot product

@@ -43,6 +43,39 @@ def cli(env, *args, cwd=None):
                           text=True, env=env, timeout=300, cwd=cwd)
 
 
+#: the ``run`` commands of the tests below, each a process of its own (the test of each
+#: reads its own): started together, one per core (conftest's cli_concurrently; issue 32)
+EXIT_IN_A_RUN = [
+    ("closure-exit", "plugin method closure-exit (pdverify_misbehaving:CLOSURE_EXIT): its "
+                     "closure raised SystemExit(0)"),
+    ("factor-exit", "plugin method factor-exit (pdverify_misbehaving:FACTOR_EXIT): "
+                    "force_factor raised SystemExit(4)"),
+    ("not-a-closure", "its closure returned str, not a pdverify Closure"),
+]
+BROKEN_RUN = [
+    ("exit-at-import", "stiffness2d-sheet/exit-at-import: the plugin failed to load: "
+                       "pdverify_exit_at_import:METHOD: SystemExit(3) at import"),
+    ("spacing-clash", "stiffness2d-sheet/spacing-clash: the plugin failed to load: plugin "
+                      "pdverify_misbehaving:SPACING_CLASH: its parameter 'spacing' is a "
+                      "parameter of scene"),
+]
+REFUSED = [
+    (["--method", "check-exit", "--set", "gain=2"],
+     "plugin method check-exit (pdverify_misbehaving:CHECK_EXIT): the check of its "
+     "parameter gain raised SystemExit(5)"),
+]
+RUNS = ([("run", "stiffness2d-sheet", "--method", m, "--set", "spacing=0.0025")
+         for m, _ in EXIT_IN_A_RUN]
+        + [("run", "stiffness2d-sheet", "--set", "spacing=0.0025")]
+        + [("run", "stiffness2d-sheet", "--method", m) for m, _ in BROKEN_RUN]
+        + [("run", "stiffness2d-sheet", *argv) for argv, _ in REFUSED])
+
+
+@pytest.fixture(scope="module")
+def runs(plugin_env, cli_concurrently):
+    return cli_concurrently(RUNS, env=plugin_env, timeout=300)
+
+
 def test_list_names_every_broken_plugin_and_goes_on(plugin_env):
     r = cli(plugin_env, "list")
     assert r.returncode == 0, r.stderr
@@ -58,16 +91,9 @@ def test_list_names_every_broken_plugin_and_goes_on(plugin_env):
     assert "bond method energy: built-in" in out and "bond method closure-exit: plugin" in out
 
 
-@pytest.mark.parametrize("method, needle", [
-    ("closure-exit", "plugin method closure-exit (pdverify_misbehaving:CLOSURE_EXIT): its "
-                     "closure raised SystemExit(0)"),
-    ("factor-exit", "plugin method factor-exit (pdverify_misbehaving:FACTOR_EXIT): "
-                    "force_factor raised SystemExit(4)"),
-    ("not-a-closure", "its closure returned str, not a pdverify Closure"),
-])
-def test_a_plugin_that_exits_in_a_run_is_a_failed_run(plugin_env, method, needle):
-    r = cli(plugin_env, "run", "stiffness2d-sheet", "--method", method, "--set",
-            "spacing=0.0025")
+@pytest.mark.parametrize("method, needle", EXIT_IN_A_RUN)
+def test_a_plugin_that_exits_in_a_run_is_a_failed_run(runs, method, needle):
+    r = runs[("run", "stiffness2d-sheet", "--method", method, "--set", "spacing=0.0025")]
     assert r.returncode == 1, (r.stdout, r.stderr)
     first = r.stdout.splitlines()[0]
     assert first.startswith(f"stiffness2d-sheet --method {method} (reference: analytic): "
@@ -75,33 +101,23 @@ def test_a_plugin_that_exits_in_a_run_is_a_failed_run(plugin_env, method, needle
     assert needle in first, first
 
 
-def test_built_in_methods_run_beside_broken_plugins(plugin_env):
-    r = cli(plugin_env, "run", "stiffness2d-sheet", "--set", "spacing=0.0025")
+def test_built_in_methods_run_beside_broken_plugins(runs):
+    r = runs[("run", "stiffness2d-sheet", "--set", "spacing=0.0025")]
     assert r.returncode == 0, r.stderr
     assert ": ok" in r.stdout.splitlines()[0]
 
 
-@pytest.mark.parametrize("method, needle", [
-    ("exit-at-import", "stiffness2d-sheet/exit-at-import: the plugin failed to load: "
-                       "pdverify_exit_at_import:METHOD: SystemExit(3) at import"),
-    ("spacing-clash", "stiffness2d-sheet/spacing-clash: the plugin failed to load: plugin "
-                      "pdverify_misbehaving:SPACING_CLASH: its parameter 'spacing' is a "
-                      "parameter of scene"),
-])
-def test_a_run_of_a_broken_plugin_is_a_failed_run_naming_it(plugin_env, method, needle):
-    r = cli(plugin_env, "run", "stiffness2d-sheet", "--method", method)
+@pytest.mark.parametrize("method, needle", BROKEN_RUN)
+def test_a_run_of_a_broken_plugin_is_a_failed_run_naming_it(runs, method, needle):
+    r = runs[("run", "stiffness2d-sheet", "--method", method)]
     assert r.returncode == 1, (r.stdout, r.stderr)
     first = r.stdout.splitlines()[0]
     assert ": failed (" in first and needle in first, first
 
 
-@pytest.mark.parametrize("argv, needle", [
-    (["--method", "check-exit", "--set", "gain=2"],
-     "plugin method check-exit (pdverify_misbehaving:CHECK_EXIT): the check of its "
-     "parameter gain raised SystemExit(5)"),
-])
-def test_a_broken_plugin_is_refused_in_one_line(plugin_env, argv, needle):
-    r = cli(plugin_env, "run", "stiffness2d-sheet", *argv)
+@pytest.mark.parametrize("argv, needle", REFUSED)
+def test_a_broken_plugin_is_refused_in_one_line(runs, argv, needle):
+    r = runs[("run", "stiffness2d-sheet", *argv)]
     assert r.returncode == 2, (r.stdout, r.stderr)
     assert r.stderr.count("\n") == 1 and needle in r.stderr, r.stderr
     assert r.stdout == ""
