@@ -19,6 +19,10 @@ of ``--repeat`` (default 1: each solve takes 30-90 s):
 Printed per case: wall time of ``solve_nested``, peak memory of the process, which path
 solved it, and the largest difference of the two solutions relative to the largest
 entry, so that the time is not bought with accuracy.
+
+``--stages``: in one process, the stages of the GMRES-IR path timed one by one (the
+float32 factor, plain refinement, GMRES-IR, the condition estimator with one GMRES pass
+per solve as ``GmresIR.solve`` does, and with each solve refined to round-off instead).
 """
 from __future__ import annotations
 
@@ -91,6 +95,56 @@ def _solve(folder, alternative, queue):
                "gmres_iterations": info.get("gmres_ir_iterations")})
 
 
+def _stages(folder, queue):
+    import scipy.sparse as sp
+    from threadpoolctl import threadpool_limits
+
+    from pdverify.solvers import mixed, policy
+    from pdverify.solvers.checks import equilibrate
+    from pdverify.solvers.nested import SplitLU
+    from pdverify.solvers.ordering import nested_dissection
+
+    A = sp.load_npz(os.path.join(folder, "A.npz")).tocsr()
+    b = np.load(os.path.join(folder, "b.npy"))
+    c = np.load(os.path.join(folder, "c.npy"))
+    out = {}
+    with threadpool_limits(1):
+        A_s, rows, _ = equilibrate(A, "stages")
+        perm, (n1, n2) = nested_dissection(A_s, c, top_split=True)
+        A_p, b_p = A_s[perm][:, perm].tocsr(), (b / rows)[perm]
+        if policy.split_too_large(A_p.shape[0] - n1 - n2, A_p.shape[0]):
+            n1 = n2 = 0
+        t = time.perf_counter()
+        lu = SplitLU(A_p, n1, n2)
+        out["factor_s"] = time.perf_counter() - t
+        probe = np.random.default_rng(20211121).standard_normal(b.size)
+        stop = [mixed.REFINE_STOP, np.sqrt(b.size) * np.finfo(float).eps]
+        rhs = np.column_stack([b_p, probe])
+        t = time.perf_counter()
+        Y, steps, _, ok = mixed.refine(A_p, rhs, lu.solve, stop=stop)
+        out["plain_s"], out["plain_converged"] = time.perf_counter() - t, ok
+        gm = mixed.GmresIR(A_p, lu)
+        t = time.perf_counter()
+        Y, _, _, ok = mixed.refine(A_p, rhs, gm.correction, stop=stop,
+                                   max_steps=mixed.GMRES_OUTER_STEPS, start=Y)
+        out["gmres_ir_s"], out["gmres_ir_converged"] = time.perf_counter() - t, ok
+        out["gmres_ir_iterations"] = list(gm.iterations)
+        t = time.perf_counter()
+        out["estimate_one_pass"] = mixed.probe_condition_estimate(A_p, gm, probe, Y[:, 1])
+        out["estimator_one_pass_s"] = time.perf_counter() - t
+
+        class Refined:
+            def solve(self, B, trans="N"):
+                At = A_p if trans == "N" else A_p.T.tocsr()
+                return mixed.refine(At, B, lambda R: gm.correction(R, trans),
+                                    max_steps=mixed.GMRES_OUTER_STEPS)[0]
+
+        t = time.perf_counter()
+        out["estimate_refined"] = mixed.probe_condition_estimate(A_p, Refined(), probe, Y[:, 1])
+        out["estimator_refined_s"] = time.perf_counter() - t
+    queue.put(out)
+
+
 def _in_fresh_process(target, *args):
     ctx = mp.get_context("spawn")
     queue = ctx.Queue()
@@ -114,6 +168,7 @@ def main(argv=None):
                     help="default: manufactured-snm3")
     ap.add_argument("--repeat", type=int, default=1)
     ap.add_argument("--json", default=None)
+    ap.add_argument("--stages", action="store_true", help="time the GMRES-IR path's stages")
     args = ap.parse_args(argv)
     out = {}
     for case in args.case or ["manufactured-snm3"]:
@@ -124,6 +179,13 @@ def main(argv=None):
             p.start()
             q.get()
             p.join()
+            if args.stages:
+                st = _in_fresh_process(_stages, folder)
+                print(f"{case}: stages " + ", ".join(
+                    f"{k} {v:.3g}" if isinstance(v, float) else f"{k} {v}"
+                    for k, v in st.items()))
+                out[case] = st
+                continue
             runs = {a: [] for a in ALTERNATIVES}
             for _ in range(args.repeat):
                 for a in ALTERNATIVES:
