@@ -132,6 +132,7 @@ def _stages(folder, queue):
         t = time.perf_counter()
         out["estimate_one_pass"] = mixed.probe_condition_estimate(A_p, gm, probe, Y[:, 1])
         out["estimator_one_pass_s"] = time.perf_counter() - t
+        out["estimator_worst_residual"] = gm.worst_residual
 
         class Refined:
             def solve(self, B, trans="N"):

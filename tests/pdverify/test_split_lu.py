@@ -162,16 +162,54 @@ def test_ill_conditioned_system_is_solved_by_gmres_ir():
     assert info["mixed_precision"] == ("float32 LU, refined in float64 by GMRES-IR (plain "
                                        "refinement stalled)")
     assert info["refinement"] == "GMRES-IR" and "GMRES-IR" in info["solver"]
-    # each correction's GMRES stopped at GMRES_INNER_TOL, well inside its iteration limit
+    # each correction's GMRES stopped at GMRES_INNER_TOL, well inside its iteration limit,
+    # and so did each of the estimator's three solves
     assert 0 < max(info["gmres_ir_iterations"]) < mixed.GMRES_MAX_ITERATIONS
+    assert len(info["gmres_ir_estimator_iterations"]) == 3
+    assert max(info["gmres_ir_estimator_iterations"]) < mixed.GMRES_MAX_ITERATIONS
     # the outer residual: REFINE_STOP = 2 eps (max-norm measure) or dsgesv's sqrt(n) eps
     assert info["gmres_ir_residuals"][-1] <= np.sqrt(A.shape[0]) * EPS
     # backward stable as the double LU: c eps with c ~ 1-10 in the scaled 2-norm measure
     assert info["relative_residual"] < 1e2 * EPS
     exact = np.linalg.solve(A.toarray(), b)
     assert np.linalg.norm(u - exact) / np.linalg.norm(exact) < 1e9 * A.shape[0] * EPS
+    # Hager-Higham's factor 3 below; above, the estimate's rounding to ESTIMATE_DIGITS = 6
+    # digits (up to 5e-6 relative) and the solves' residual (3 ESTIMATOR_RESIDUAL)
     kappa = np.linalg.cond(equilibrate(A, "test")[0].toarray(), 1)
-    assert kappa / 3 <= info["condition_estimate"] <= kappa * (1 + 1e-6)
+    assert kappa / 3 <= info["condition_estimate"] <= kappa * (1 + 1e-5 + 3 * mixed.ESTIMATOR_RESIDUAL)
+
+
+def test_near_singular_system_is_refused_on_the_gmres_path():
+    """Two rows equal but for 1e-12 on the diagonal (kappa_1 7e14 after equilibration, above
+    CONDITION_LIMIT = 1e14): GMRES-IR converges on b and the probe, but the estimator's
+    solves do not reach ESTIMATOR_RESIDUAL (the float32 factor preconditions nothing in
+    the near-null direction), so the double LU decides, and refuses it, as with
+    mixed=False. Before that check the mixed path accepted it with an estimate of 9.5e11
+    (the probe's term alone: about kappa / n for a localised near-null vector)."""
+    A, x = lattice_operator(24, 2)
+    A = A.tolil()
+    A[5, :] = A[4, :]
+    A[5, 5] += 1e-12
+    A = A.tocsr()
+    b = np.random.default_rng(11).normal(size=A.shape[0])
+    for mixed_precision in (True, False):
+        with pytest.raises(NumericalError, match="test: near-singular"):
+            solve_nested(A, b, x, where="test", mixed=mixed_precision)
+
+
+@pytest.mark.parametrize("size", [1e-300, 1e300])
+def test_gmres_ir_takes_right_hand_sides_of_any_size(size):
+    """GMRES's norms are taken of the residual scaled by a power of two (exact), so a
+    right-hand side of 1e+-300 is solved by GMRES-IR as at size 1 (before: its norm
+    under- or overflowed, the pass returned zero and the double LU took over); the same
+    solution, scaled, to kappa n eps (kappa 1e9, n = 576)."""
+    A, x = ill_conditioned(1e9)
+    b = np.random.default_rng(6).normal(size=A.shape[0])
+    u, info = solve_nested(A, size * b, x, where="test", mixed=True)
+    assert info["refinement"] == "GMRES-IR"
+    assert info["mixed_precision"].startswith("float32 LU")
+    ref = np.linalg.solve(A.toarray(), b)
+    assert np.linalg.norm(u / size - ref) / np.linalg.norm(ref) < 1e9 * A.shape[0] * EPS
 
 
 def test_ill_conditioned_system_falls_back_to_the_double_lu(monkeypatch):
