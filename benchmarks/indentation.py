@@ -3,6 +3,7 @@
 Plain script (no test runner):
 
     python benchmarks/indentation.py [--repeat N] [--before REV] [--scene] [--quick]
+    python benchmarks/indentation.py --phases [--repeat N] [--before REV] [--method M]
 
 Each timed run is a fresh ``python`` process (so no run inherits another's caches or
 grown memory) running ``get_scene('block2d-indentation').run(METHOD, OVERRIDES)``; the
@@ -23,6 +24,18 @@ Cases: the corrected nonlinear curve (``energy-directional``; budget, issue 32: 
 a quiet 2-core machine); with ``--scene`` every PD run the full report makes of the scene
 (budget: <= 60 s together), each variant's sum printed at the end; ``--quick`` adds the
 quick grid (41 x 41 nodes) of the corrected curve.
+
+``--phases``: where the time of one curve goes (default the corrected one; ``--method``
+and ``--set name=value`` choose another), this tree and ``--before REV`` alternating in
+fresh processes, medians of ``--repeat``: the wall time of the run, the process's CPU time
+(the steadier on a busy machine), the wall time of its solve phase,
+and within it the summed wall time of each phase of Newton, timed by wrapping the
+functions that do them (the same names in both trees): residual evaluation
+(``internal_force``), tangent assembly (``tangent_data``), CG iterations (``cg_solve``),
+preconditioner setup (``TwoLevelPreconditioner``), the prescribed set (``set_fixed``) and the
+breakdown check (``bond_extremes``); "rest" is the solve phase's remainder (the line
+search's trial points are residual evaluations). The metrics of the variants are compared
+bit for bit.
 """
 from __future__ import annotations
 
@@ -52,6 +65,87 @@ print(json.dumps({"status": r.status, "message": r.message, "timings": r.timings
 """
 
 
+#: one run in a fresh process with its Newton phases timed: prints them as JSON
+PHASE_RUNNER = """
+import json, resource, sys, time
+from pdverify.pd import nonlinear
+from pdverify.scenes import get_scene
+from pdverify.solvers import newton
+spent = {}
+
+def timed(name, f):
+    def wrapper(*args, **kw):
+        t0 = time.perf_counter()
+        try:
+            return f(*args, **kw)
+        finally:
+            spent[name] = spent.get(name, 0.0) + time.perf_counter() - t0
+    return wrapper
+
+NB, DL = nonlinear.NonlinearBondBased, newton.DirichletLinearSolver
+NB.internal_force = timed("residual", NB.internal_force)
+NB.tangent_data = timed("tangent", NB.tangent_data)
+NB.bond_extremes = timed("breakdown check", NB.bond_extremes)
+DL.set_fixed = timed("prescribed set", DL.set_fixed)
+newton.cg_solve = timed("CG", newton.cg_solve)
+newton.TwoLevelPreconditioner = timed("preconditioner setup", newton.TwoLevelPreconditioner)
+method, over = sys.argv[1], json.loads(sys.argv[2])
+t0 = time.perf_counter()
+r = get_scene("block2d-indentation").run(method, over)
+wall = time.perf_counter() - t0
+cpu = resource.getrusage(resource.RUSAGE_SELF)
+print(json.dumps({"status": r.status, "wall_s": wall, "solve_s": r.timings["solve_s"],
+                  "cpu_s": cpu.ru_utime + cpu.ru_stime,
+                  "phases": spent, "metrics": {k: float(v).hex() if isinstance(v, float)
+                                               else v for k, v in r.metrics.items()},
+                  "cg_iterations": r.diagnostics.get("cg_iterations")}))
+"""
+PHASES = ("residual", "tangent", "CG", "preconditioner setup", "prescribed set",
+          "breakdown check")
+
+
+def phases(args):
+    """The ``--phases`` table (module docstring)."""
+    over = {"spacing": 0.00025}
+    for kv in args.set:
+        k, v = kv.split("=", 1)
+        try:
+            over[k] = json.loads(v)
+        except json.JSONDecodeError:
+            over[k] = v
+    with tempfile.TemporaryDirectory() as tmp:
+        variants = [("this tree", ROOT)]
+        if args.before:
+            variants.append((f"before ({args.before})", Path(args.before) if Path(
+                args.before).is_dir() else extract(args.before, Path(tmp))))
+        runs = {name: [] for name, _ in variants}
+        for _ in range(args.repeat):
+            for name, path in variants:
+                env = {**os.environ, "PYTHONPATH": str(path)}
+                out = subprocess.run([sys.executable, "-c", PHASE_RUNNER, args.method,
+                                      json.dumps(over)], env=env, cwd=path, check=True,
+                                     capture_output=True, text=True).stdout
+                runs[name].append(json.loads(out.strip().splitlines()[-1]))
+                print(f"  {name}: {runs[name][-1]['wall_s']:.1f} s", file=sys.stderr,
+                      flush=True)
+    print(f"{args.method} {over}, medians of {args.repeat} (wall s)")
+    cols = ("wall", "cpu", "solve", *PHASES, "rest")
+    print(f"{'variant':20s} " + " ".join(f"{c[:12]:>12s}" for c in cols))
+    for name, rs in runs.items():
+        med = {"wall": statistics.median(r["wall_s"] for r in rs),
+               "cpu": statistics.median(r["cpu_s"] for r in rs),
+               "solve": statistics.median(r["solve_s"] for r in rs)}
+        med.update({c: statistics.median(r["phases"].get(c, 0.0) for r in rs) for c in PHASES})
+        med["rest"] = statistics.median(r["solve_s"] - sum(r["phases"].values()) for r in rs)
+        print(f"{name:20s} " + " ".join(f"{med[c]:12.2f}" for c in cols))
+    first = next(iter(runs.values()))[0]
+    same = all(r["metrics"] == first["metrics"] and r["status"] == first["status"]
+               and r["cg_iterations"] == first["cg_iterations"]
+               for rs in runs.values() for r in rs)
+    print(f"status {first['status']}, CG iterations {first['cg_iterations']}; metrics "
+          f"{'bitwise identical' if same else 'DIFFER'} across all runs")
+
+
 def extract(rev: str, into: Path) -> Path:
     """The ``pdverify`` package (and what it reads at run time) of git revision ``rev``."""
     data = subprocess.run(["git", "-C", str(ROOT), "archive", "--format=tar", rev, "pdverify",
@@ -79,7 +173,14 @@ def main():
                     help="every PD run of the scene in the full report, not only the "
                          "corrected curve")
     ap.add_argument("--quick", action="store_true", help="also the quick grid")
+    ap.add_argument("--phases", action="store_true",
+                    help="time the phases of one curve at the paper grid instead")
+    ap.add_argument("--method", default="energy-directional", help="the --phases curve")
+    ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                    help="a parameter of the --phases curve (repeatable)")
     args = ap.parse_args()
+    if args.phases:
+        return phases(args)
     cases = [("energy-directional", {})]
     if args.scene:
         sys.path.insert(0, str(ROOT))

@@ -82,6 +82,40 @@ def test_internal_force_is_the_energy_gradient_and_rigid_motions_are_free():
     assert np.abs(lin.internal_force(u_rigid)).max() > 1e-3 * scale
 
 
+def test_kept_state_gives_the_numbers_of_a_fresh_evaluation():
+    """The engine keeps its last state's bond vectors and forces (issue 32): evaluations at
+    the same u, also after Newton changed its array in place and back, are those of a model
+    that never saw another state, bit for bit (the same operations on the same numbers:
+    equality is the exactness claim), the tangent included; and what a caller does to the
+    arrays handed out does not reach the kept state."""
+    model = _model()
+    for mirror in (None, 0):
+        if mirror is not None:
+            model = _model(nx=8, ny=6)         # an odd node count across the mirror axis
+        nl = NonlinearBondBased(model, mirror_axis=mirror)
+        u = _large_displacement(model)
+        u = u.reshape(2, -1)[:, nl.node_ids].ravel()
+        if mirror is not None:
+            u[nl.plane_unknowns] = 0.0
+        v = u * 0.5
+        f_u, f_v = nl.internal_force(u), nl.internal_force(v)
+        work = u.copy()
+        assert nl.internal_force(work).tobytes() == f_u.tobytes()
+        y, _ = nl.bond_vectors(work)
+        y *= 3.0                                  # a caller's change of its copy
+        nl.internal_force(work)[:] = 0.0
+        for state, f in ((work, f_u), (v, f_v), (u, f_u)):
+            if state is not work:
+                work[:] = state                   # Newton's u[:] = trial
+            state = work
+            fresh = NonlinearBondBased(model, mirror_axis=mirror)
+            assert nl.internal_force(state).tobytes() == f.tobytes()
+            assert nl.internal_force(state).tobytes() == fresh.internal_force(state).tobytes()
+            assert (nl.tangent_data(state).tobytes()
+                    == fresh.tangent_data(state).tobytes())
+            assert nl.bond_extremes(state) == fresh.bond_extremes(state)
+
+
 def _pressed_block():
     """A 17 x 9 block, bottom fixed, the middle top nodes pushed down by 0.3 spacing."""
     model = _model(16, 8, 3)
