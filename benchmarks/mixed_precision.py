@@ -99,23 +99,17 @@ def _stages(folder, queue):
     import scipy.sparse as sp
     from threadpoolctl import threadpool_limits
 
-    from pdverify.solvers import mixed, policy
-    from pdverify.solvers.checks import equilibrate
-    from pdverify.solvers.nested import SplitLU
-    from pdverify.solvers.ordering import nested_dissection
+    from pdverify.solvers import mixed
+    from pdverify.solvers.nested import ordered_system, single_precision_factor
 
     A = sp.load_npz(os.path.join(folder, "A.npz")).tocsr()
     b = np.load(os.path.join(folder, "b.npy"))
     c = np.load(os.path.join(folder, "c.npy"))
     out = {}
     with threadpool_limits(1):
-        A_s, rows, _ = equilibrate(A, "stages")
-        perm, (n1, n2) = nested_dissection(A_s, c, top_split=True)
-        A_p, b_p = A_s[perm][:, perm].tocsr(), (b / rows)[perm]
-        if policy.split_too_large(A_p.shape[0] - n1 - n2, A_p.shape[0]):
-            n1 = n2 = 0
+        A_p, b_p, _, (n1, n2), _ = ordered_system(A, b, c, "stages")
         t = time.perf_counter()
-        lu = SplitLU(A_p, n1, n2)
+        lu, _ = single_precision_factor(A_p, n1, n2)
         out["factor_s"] = time.perf_counter() - t
         probe = np.random.default_rng(20211121).standard_normal(b.size)
         stop = [mixed.REFINE_STOP, np.sqrt(b.size) * np.finfo(float).eps]

@@ -66,11 +66,7 @@ def solve_nested(A, rhs, coords, *, where: str = "static solve", mixed: bool | N
     if not np.all(np.isfinite(A.data)) or not np.all(np.isfinite(rhs)):
         raise NumericalError(f"{where}: the system has non-finite entries")
     n = A.shape[0]
-    A_s, row_max, col_max = equilibrate(A, where)
-    perm, (n1, n2) = nested_dissection(A_s, coords, top_split=True)
-    A_p = A_s[perm][:, perm].tocsr()
-    del A_s     # memory: one copy of the system fewer while it is factored (issue 32)
-    b_p = (rhs / row_max)[perm]
+    A_p, b_p, perm, (n1, n2), col_max = ordered_system(A, rhs, coords, where)
     use_mixed = policy.mixed_precision(n) if mixed is None else mixed
     info: dict = {"unknowns": int(n)}
     y = None
@@ -95,6 +91,35 @@ def solve_nested(A, rhs, coords, *, where: str = "static solve", mixed: bool | N
     return sol, info
 
 
+def ordered_system(A, rhs, coords, where: str):
+    """``(A_p, b_p, perm, (n1, n2), col_max)``: ``A x = rhs`` equilibrated
+    (:func:`~pdverify.solvers.checks.equilibrate`) and permuted to the geometric
+    nested-dissection order (``perm``; the top split's halves ``n1``, ``n2``); the
+    solution is ``x[perm] = y / col_max`` for ``A_p y = b_p``."""
+    A_s, row_max, col_max = equilibrate(A, where)
+    perm, halves = nested_dissection(A_s, coords, top_split=True)
+    A_p = A_s[perm][:, perm].tocsr()
+    del A_s     # memory: one copy of the system fewer while it is factored (issue 32)
+    return A_p, (rhs / row_max)[perm], perm, halves, col_max
+
+
+def single_precision_factor(A_p, n1: int, n2: int):
+    """``(lu, note)``: the :class:`SplitLU` of ``A_p`` on its top split, or of the whole
+    matrix (``note`` says why) when the separator is too large to split at
+    (:func:`~pdverify.solvers.policy.split_too_large`) or SuperLU's pivoting crosses
+    between the blocks. Raises RuntimeError when the whole matrix's float32 factor fails
+    too."""
+    note = ""
+    separator = A_p.shape[0] - n1 - n2
+    if n1 and n2 and policy.split_too_large(separator, A_p.shape[0]):
+        n1 = n2 = 0
+        note = f" (whole matrix: separator of {separator} unknowns too large to split at)"
+    try:
+        return SplitLU(A_p, n1, n2), note
+    except RuntimeError as exc:
+        return SplitLU(A_p, 0, 0), f" (whole matrix: {exc})"
+
+
 def _solve_mixed(A_p, b_p, n1: int, n2: int):
     """Single-precision LU of the equilibrated, permuted ``A_p`` (:class:`SplitLU`: the
     two halves of the top split in parallel, or, when SuperLU's pivoting crosses between
@@ -104,20 +129,11 @@ def _solve_mixed(A_p, b_p, n1: int, n2: int):
     (:func:`~pdverify.solvers.mixed.refine_with_probe`): ``(y, condition estimate,
     diagnostics)``, or ``(None, None, diagnostics)`` with the reason in
     ``diagnostics['mixed_precision']`` when the double LU must take over."""
-    note = ""
-    separator = A_p.shape[0] - n1 - n2
-    if n1 and n2 and policy.split_too_large(separator, A_p.shape[0]):
-        n1 = n2 = 0
-        note = f" (whole matrix: separator of {separator} unknowns too large to split at)"
     try:
-        lu = SplitLU(A_p, n1, n2)
-    except RuntimeError as exc:
-        note = f" (whole matrix: {exc})"
-        try:
-            lu = SplitLU(A_p, 0, 0)
-        except RuntimeError as exc:  # "Factor is exactly singular" in single precision
-            return None, None, {"mixed_precision": f"not used: single-precision factor "
-                                                   f"failed ({exc}); double LU"}
+        lu, note = single_precision_factor(A_p, n1, n2)
+    except RuntimeError as exc:  # "Factor is exactly singular" in single precision
+        return None, None, {"mixed_precision": f"not used: single-precision factor "
+                                               f"failed ({exc}); double LU"}
     y, cond, diag = refine_with_probe(A_p, b_p, lu)
     if y is None:
         return None, None, diag
