@@ -27,7 +27,7 @@ import math
 import numpy as np
 import scipy.sparse as sp
 
-from ..pd import BoxGrid, StateBasedModel
+from ..pd import StateBasedModel
 from ..pd.build import build_model
 from ..pd.closure import Closure
 from ..pd.problem import FACES, LinearSystem
@@ -39,10 +39,6 @@ from .taylor_fictitious import boundary_value_rows, fictitious_closure, yields_c
 
 
 # ------------------------------------------------------------------------------ helpers
-def _grid(problem, layers: int) -> BoxGrid:
-    return problem.body.grid(layers)
-
-
 def _model(problem, grid, closure) -> StateBasedModel:
     return build_model(problem.body, problem.stencil, problem.material, closure, grid=grid)
 
@@ -103,7 +99,7 @@ def footprint(kind: str, cells, m_ratio: float):
 # ------------------------------------------------------------------------------ none
 def assemble_plain(problem, closure: Closure | None = None) -> LinearSystem:
     """The uncorrected model (with a closure treatment's ``closure``), module docstring."""
-    g = _grid(problem, 0)
+    g = problem.body.grid(0)
     model = _model(problem, g, closure)
     d, ni, nu_ = g.dim, g.n_interior, model.n_unknown_nodes
     solver = static_solver(problem.solver, d, d * nu_)
@@ -166,7 +162,7 @@ def _sorted(fixed, values):
 # ------------------------------------------------------------------------------ surface nodes
 def assemble_surface_nodes(problem, order: int) -> LinearSystem:
     """Seed 001's surface node method (module docstring)."""
-    g = _grid(problem, problem.stencil.reach)
+    g = problem.body.grid(problem.stencil.reach)
     closure, flux = surface_node_closure(g, problem.stencil, order)
     return impose_on_surface_nodes(problem, g, closure, flux)
 
@@ -240,7 +236,7 @@ def assemble_taylor(problem, order: int, corners: str = "normal-only") -> Linear
     0.105 % (surface nodes N = 2: 0.32 %); why order 1 is that far off is not yet
     investigated. body3d-manufactured's quick grid
     (10 x 5 x 5) keeps 2 dependent rows and fails as near-singular."""
-    g = _grid(problem, problem.stencil.reach)
+    g = problem.body.grid(problem.stencil.reach)
     d = g.dim
     # a face that prescribes every component on its whole face needs no flux rows; a box
     # clamped all round (seed 000's plate) then needs neither them nor the face-crossing
@@ -457,7 +453,7 @@ def assemble_mirror(problem, neumann: str, mirror_point: str,
                     gradient_at: str = "mirror") -> LinearSystem:
     """Seed 001 §5's mirror node method (``corrections.mirror_nodes``): the loads and
     constraints enter through the mirror relations only."""
-    g = _grid(problem, problem.stencil.reach)
+    g = problem.body.grid(problem.stencil.reach)
     mirror = MirrorNodes(g, problem.stencil, dirichlet=problem.prescribed(),
                          exact=problem.exact, traction=_traction_of(problem),
                          moduli=problem.constants.moduli(), neumann=neumann,
@@ -487,7 +483,7 @@ def assemble_pddo(problem, bulk_model: str = "lps") -> LinearSystem:
     """Seed 001 §5's PDDO boundary layer (``corrections.pddo``): its own square,
     nonsymmetric system on the uncorrected model, solved by a direct LU; ``bulk_model``
     (``pddo.BULK_MODELS``) governs the nodes beyond 2 delta."""
-    g = _grid(problem, 0)
+    g = problem.body.grid(0)
     model = _model(problem, g, None)
     x_int = g.x[g.interior_ids]
     body = problem.body_load(x_int, model.node_volume[g.interior_ids][:, None])
