@@ -37,12 +37,23 @@ the cells of a ``sample_spacing`` grid on [0, W]^2 (the PD default grid, 0.025 m
 in the domain; and ``scf`` = sigma_xx(0, a) / sigma, the stress concentration factor (the
 stress of the element at (0, a), the node where the arc meets x = 0).
 
+Measured with the defaults (4 x 4 elements per block at level 0, five levels, finest
+64 x 64 per block, 66 306 DOFs, the whole study about 5 s on one core): the field
+changes on the sample points fall 0.195, 0.055, 0.0117, 0.0018 % (toward the h^3 factor
+8), u_x(W, 0) = 1.22584e-3 m changes by 1.6e-4 % over the last refinement, and the stress
+concentration is 3.3601 (changes falling by ~4, O(h^2)). The finite plate (W/a = 5)
+concentrates more than Kirsch's infinite one (3); see :func:`large_plate_check`.
+
 The Kirsch checks (:func:`kirsch_check`, :func:`large_plate_check`): Kirsch's solution of
 the infinite plate with a hole (Kirsch 1898;
 Timoshenko & Goodier Sec. 35) is an exact solution of this quarter with Kirsch's own
 traction on x = W and y = W, so the FEM must converge to it at the rate of Q2 (O(h^3) in
-the displacement); and a plate with W/a large under uniform tension must approach
-Kirsch's stress concentration 3 and displacement near the hole.
+the displacement; measured: 0.070, 0.0072, 0.00095, 0.000115 % of max |u| at 4..32
+elements along each block's arc, a fitted rate 3.07, and the stress concentration
+2.9914, 2.9981, 2.9995, 2.99988); and a plate with W/a large under uniform tension must
+approach Kirsch's stress concentration 3 and displacement near the hole (measured at
+W/a = 5, 10, 20, 40: 3.360, 3.085, 3.020, 3.004, i.e. 3 + ~8.5 (a/W)^2, and the
+displacement on r = a, 2a within 12.7, 2.9, 0.72, 0.18 % of Kirsch's).
 
 Evaluation: the field is a :class:`~reference_fem.mesh_field.MeshField`; a point of the
 exact domain that the discrete domain misses (between the arc and its parabolic
@@ -116,7 +127,8 @@ class HolePlateParams:
 
 def kirsch_stress(x, y, radius: float, sigma: float):
     """Kirsch's stress (sxx, syy, sxy) of the infinite plane stretched by sigma along x
-    with a traction-free hole r = radius (Kirsch 1898; Timoshenko & Goodier, Theory of Elasticity, 3rd ed., Art. 35)."""
+    with a traction-free hole r = radius (Kirsch 1898; Timoshenko & Goodier, Theory of
+    Elasticity, 3rd ed., Art. 35)."""
     r = np.hypot(x, y)
     th = np.arctan2(y, x)
     q2, q4 = (radius / r) ** 2, (radius / r) ** 4

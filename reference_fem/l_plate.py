@@ -13,9 +13,10 @@ y = L/2, x >= L/2).
 Singularities: at the re-entrant corner (interior angle 3 pi / 2, both faces free) the
 displacement goes like r^0.5445 (Williams 1952: for free faces meeting at the angle
 2 alpha the exponents solve sin(2 alpha lambda) = -+ lambda sin(2 alpha); at
-2 alpha = 3 pi / 2, lambda = 0.5445 (symmetric mode) and 0.9085); the corners where the clamp meets a free edge, (0, 0) and (0, L),
-and the ends of the loaded edge, (L, 0) and (L, L/2) (shear traction meeting a free
-edge), are singular too, more mildly.
+2 alpha = 3 pi / 2, lambda = 0.5445 (symmetric mode) and 0.9085); the corners where the
+clamp meets a free edge, (0, 0) and (0, L), and the ends of the loaded edge, (L, 0) and
+(L, L/2) (a shear traction meeting a free edge), are singular too (with exponents that
+depend on nu); the grading below refines toward all of them.
 
 Elements and mesh: 9-node biquadratic quadrilaterals (vector ``ElementQuad2``; the
 elements are rectangles, so the map is affine). The domain is three squares of side
@@ -36,6 +37,12 @@ between successive levels on the centres of the cells of a ``sample_spacing`` gr
 changes of the compared quantity. The result's ``fitted_rate`` is the least-squares
 slope of log |q_l - q_(l-1)| against l / log 2 over the levels (rate in powers of the
 refinement factor 2), and ``extrapolated`` the Richardson value q + d / (2^rate - 1).
+
+Measured with the defaults (4 elements per square side at level 0, five levels, finest
+64 per side, 12 288 elements, 99 330 DOFs, smallest element edge 2.4e-7 m; the study
+about 8 s on one core): u_y(L, 0) = -9.50326e-3 m, changing 1.72, 0.25, 0.024, 0.0020 %
+per level (rates 2.78, 3.36, 3.60; fitted 3.26), the field on the sample points 1.46,
+0.195, 0.018, 0.0023 %.
 
 Evaluation: :class:`~reference_fem.mesh_field.MeshField` (exact domain test; a point on
 an edge takes one of its elements); points outside the L raise ``ValueError``.

@@ -90,7 +90,8 @@ class MeshField:
         return np.asarray(self.box, dtype=float)
 
     def nodes(self) -> np.ndarray:
-        """Coordinates of the Q2 nodes, shape (n, 2), in the order of :meth:`nodal_displacement`."""
+        """Coordinates of the Q2 nodes, shape (n, 2), in the order of
+        :meth:`nodal_displacement`."""
         return self.node_coords
 
     def nodal_displacement(self) -> np.ndarray:
