@@ -336,3 +336,54 @@ def test_unknown_param_refused():
         rf.hole_plate(hole=0.1)
     with pytest.raises(TypeError, match="levels=2.5 is not a valid int"):
         rf.l_plate(levels=2.5)
+
+
+# --- the isoparametric path against the tensor-product one ------------------------------
+
+def test_mesh_elasticity_matches_tensor_elasticity_on_a_rectangle():
+    """On a box both paths discretise the same Q2 space with exact quadrature (3 x 3 Gauss
+    is exact for Q2 stiffness on rectangles): the same solution to round-off."""
+    from reference_fem.mesh_elasticity import MeshElasticity, mapped_mesh
+    mat = rf.Material(1e9, 0.3, "plane_stress", 0.5)
+    xs, ys = np.linspace(0, 2, 9) ** 1.2 * 2 ** -0.2, np.linspace(0, 1, 5)   # graded in x
+    ten = rf.TensorElasticity((xs, ys), mat)
+    f_t = ten.traction_load(lambda x, y: x > 2 - 1e-9, [2e5, -1e6])
+    u_t = ten.field(ten.solve(f_t, ten.dofs(lambda x, y: x < 1e-9)))
+    s, t = xs / 2, ys
+
+    def block(ls, lt):
+        return 2 * ls, lt
+
+    mesh = mapped_mesh([(s, t, block)], tol=1e-9)
+    me = MeshElasticity(mesh, mat, {"box": [[0, 2], [0, 1]]})
+    f_m = me.traction_load(lambda x, y: x > 2 - 1e-9, [2e5, -1e6])
+    u_m = me.field(me.solve(f_m, me.dofs(lambda x, y: x < 1e-9)))
+    pts = np.random.default_rng(5).uniform([0, 0], [2, 1], (500, 2))
+    scale = u_t.max_displacement()
+    # round-off of two assemblies and factorisations of a ~1e3-conditioned system
+    np.testing.assert_allclose(u_m.evaluate(pts), u_t.evaluate(pts), rtol=0, atol=1e-11 * scale)
+    np.testing.assert_allclose(u_m.gradient(pts), u_t.gradient(pts), rtol=0, atol=1e-10 * scale)
+
+
+def test_l_plate_load_resultant_and_moment():
+    """The reactions at the clamp balance the end load: force (0, sigma L/2 t) and its
+    moment about the origin (the load acts on x = L): round-off of K u - f."""
+    p = rf.LPlateParams(levels=2)
+    model, u, _, _, _ = lp.solve_level(p, 1)
+    tol = 1e-9
+    f = model.traction_load(lambda x, y: (x > 1 - tol) & (y < 0.5 + tol), [0.0, -p.traction])
+    r = model.stiffness @ u - f
+    x, y = model.dof_coords
+    comp = model.dof_component
+    load = p.traction * 0.5 * p.length * p.thickness
+    clamp = np.abs(x) < tol
+    assert np.sum(f[comp == 1]) == pytest.approx(-load, rel=1e-13)   # sum of the weights
+    np.testing.assert_allclose(np.abs(r[~clamp]).max(), 0, atol=1e-9 * load)
+    np.testing.assert_allclose(np.sum(r[clamp & (comp == 0)]), 0, atol=1e-9 * load)
+    np.testing.assert_allclose(np.sum(r[clamp & (comp == 1)]), load, rtol=1e-9)
+    # moment about the origin of the applied load, -sigma L/2 t * L, balanced by the
+    # clamp's reactions (at x = 0: moment -y r_x)
+    m_applied = np.sum(x[comp == 1] * f[comp == 1]) - np.sum(y[comp == 0] * f[comp == 0])
+    assert m_applied == pytest.approx(-load * p.length, rel=1e-13)
+    m_react = -np.sum(y[clamp & (comp == 0)] * r[clamp & (comp == 0)])
+    np.testing.assert_allclose(m_react, -m_applied, rtol=1e-9)
