@@ -74,7 +74,7 @@ from . import params as _p
 from .cache import cached
 from .elasticity import Material
 from .mesh_elasticity import MeshElasticity, mapped_mesh
-from .results import ReferenceResult, RefinementRow, change_pct
+from .results import ReferenceResult, RefinementRow, change_pct, field_change_pct
 
 REFERENCE = "plate-hole"
 
@@ -241,13 +241,6 @@ def sample_points(width: float, radius: float, spacing: float) -> np.ndarray:
     X, Y = np.meshgrid(c, c, indexing="ij")
     pts = np.stack([X.ravel(), Y.ravel()], axis=1)
     return pts[np.hypot(pts[:, 0], pts[:, 1]) >= radius]
-
-
-def field_change_pct(new: np.ndarray, old: np.ndarray) -> float:
-    """100 max |new - old| / max |new| over sample points (as ``plate.py``)."""
-    peak = np.max(np.abs(new))        # scale-free: normalise before squaring
-    scale = peak * np.max(np.linalg.norm(new / peak, axis=1))
-    return float(100 * np.max(np.abs(new - old)) / scale)
 
 
 def _scf(fld, radius: float, traction: float) -> float:

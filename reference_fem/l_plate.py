@@ -60,7 +60,7 @@ from .cache import cached
 from .elasticity import Material
 from .mesh_elasticity import MeshElasticity, mapped_mesh
 from .meshing import power_graded
-from .results import ReferenceResult, RefinementRow, change_pct
+from .results import ReferenceResult, RefinementRow, change_pct, field_change_pct
 
 REFERENCE = "plate-l"
 
@@ -188,12 +188,6 @@ class LPlateResult(ReferenceResult):
         return self.field.stress(points)
 
 
-def _field_change_pct(new, old) -> float:
-    peak = np.max(np.abs(new))        # scale-free: normalise before squaring (plate.py)
-    scale = peak * np.max(np.linalg.norm(new / peak, axis=1))
-    return float(100 * np.max(np.abs(new - old)) / scale)
-
-
 def compute(p: LPlateParams) -> LPlateResult:
     """Run the refinement study (no cache)."""
     t_start = time.perf_counter()
@@ -207,7 +201,7 @@ def compute(p: LPlateParams) -> LPlateResult:
         sample = fld.evaluate(pts)
         extra = {}
         if prev_sample is not None:
-            extra["field_change_pct"] = _field_change_pct(sample, prev_sample)
+            extra["field_change_pct"] = field_change_pct(sample, prev_sample)
         if len(qs) >= 2:
             d1, d2 = abs(qs[-1] - qs[-2]), abs(q - qs[-1])
             extra["quantity_rate"] = float(np.log2(d1 / d2)) if d1 > 0 and d2 > 0 else float("nan")

@@ -34,14 +34,9 @@ def mapped_mesh(blocks: Sequence[tuple], tol: float) -> MeshQuad2:
 
     Each block is ``(s, t, F)``: increasing logical coordinates s, t in [0, 1] (the
     element edges along each logical axis) and a vectorised map ``F(s, t) -> (x, y)``.
-    Blocks must meet node to node; coincident nodes (closer than ``tol``) are merged.
+    Blocks must meet node to node; coincident vertices (closer than ``tol``) are
+    merged, and every element's nine nodes are placed at F of their logical positions.
     """
-    return _merge(blocks, tol)
-
-
-def _merge(blocks, tol) -> MeshQuad2:
-    """Build the merged MeshQuad2: vertices of all blocks deduplicated, then every
-    element's 9 nodes set from its block's map."""
     elem_nodes = []          # (n_el, 9, 2) physical positions in the tensor order
     for (s, t, F) in blocks:
         s = np.asarray(s, float)

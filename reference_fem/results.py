@@ -42,6 +42,14 @@ class RefinementRow:
     extra: dict = field(default_factory=dict)
 
 
+def field_change_pct(new: np.ndarray, old: np.ndarray) -> float:
+    """100 max |new - old| / max_i |new_i| over sample points (rows: displacement
+    vectors), the field-change measure of the refinement tables (as ``plate.py``)."""
+    peak = np.max(np.abs(new))        # scale-free: normalise before squaring
+    scale = peak * np.max(np.linalg.norm(new / peak, axis=1))
+    return float(100 * np.max(np.abs(new - old)) / scale)
+
+
 def change_pct(new: float, old: float) -> float:
     """100 |new - old| / |new|; NaN without a previous value."""
     if old is None or not np.isfinite(old):
