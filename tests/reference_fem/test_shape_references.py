@@ -90,7 +90,6 @@ def test_kirsch_traction_converges_to_kirsch_at_rate_three():
 
 # --- (b) the large plate ----------------------------------------------------------------
 
-@pytest.mark.slow
 def test_large_plate_approaches_kirsch():
     """Uniform tension, W/a = 10 and 20: the stress concentration and the near-hole
     displacement approach Kirsch's with the finite-size error O((a/W)^2)."""
@@ -282,7 +281,9 @@ def test_small_studies_shrink(fem_cache_dir, small_l):
     """Fast tier: three levels of the plate with a hole, two of the L."""
     res = rf.hole_plate(levels=3)
     ch = _changes(res)
-    assert ch[1] < ch[0] / 3                          # O(h^3): ~4 at these levels
+    # O(h^3): the ratio tends to 8; measured 3.55 at these coarse levels (3.6, 4.7, 6.5
+    # over the default five)
+    assert ch[1] < ch[0] / 3
     assert small_l.refinement[-1].extra["field_change_pct"] > 0
 
 
