@@ -6,12 +6,16 @@ Public API: one function per reference, each returning its converged, cached res
     tension_sheet(**params)  -> TensionSheetResult    seed 003 Sec. 4.1.1
     clamped_sheet(**params)  -> ClampedSheetResult    seed 003 Sec. 4.1.2
     indentation(**params)    -> IndentationResult     seed 003 Sec. 4.2
+    hole_plate(**params)     -> HolePlateResult       issue 35: plate with a hole
+    l_plate(**params)        -> LPlateResult          issue 35: L-shaped bracket
 
 Keyword arguments override the fields of the matching ``*Params`` dataclass;
 ``use_cache=False`` recomputes. The cache lives in ``$PDVERIFY_CACHE_DIR`` (default
 ``~/.cache/pdverify/reference_fem``). Helpers: :class:`Material`,
 :class:`TensorElasticity` (assembly, condensation, reactions, energy), and
-:class:`FieldSolution` (evaluation at points, energy density, VTU export).
+:class:`FieldSolution` (evaluation at points, energy density, VTU export); on the
+domains that are not boxes, :class:`MeshElasticity` and :class:`MeshField` (isoparametric
+9-node quadrilaterals).
 """
 
 __version__ = "0.1.0"
@@ -20,7 +24,11 @@ from .cache import cache_dir, cache_key  # noqa: E402
 from .clamped_sheet import ClampedSheetParams, ClampedSheetResult, clamped_sheet  # noqa: E402
 from .elasticity import Material, TensorElasticity  # noqa: E402
 from .field import FieldSolution  # noqa: E402
+from .hole_plate import HolePlateParams, HolePlateResult, hole_plate  # noqa: E402
 from .indentation import IndentationParams, IndentationResult, indentation  # noqa: E402
+from .l_plate import LPlateParams, LPlateResult, l_plate  # noqa: E402
+from .mesh_elasticity import MeshElasticity  # noqa: E402
+from .mesh_field import MeshField  # noqa: E402
 from .plate import PlateParams, PlateResult, clamped_plate  # noqa: E402
 from .results import ReferenceResult, RefinementRow  # noqa: E402
 from .tension_sheet import TensionSheetParams, TensionSheetResult, tension_sheet  # noqa: E402
@@ -30,12 +38,17 @@ REFERENCES = {
     "sheet2d-tension": tension_sheet,
     "sheet2d-clamped": clamped_sheet,
     "block2d-indentation": indentation,
+    "plate-hole": hole_plate,
+    "plate-l": l_plate,
 }
 
 __all__ = [
     "__version__", "REFERENCES", "cache_dir", "cache_key",
-    "clamped_plate", "tension_sheet", "clamped_sheet", "indentation",
+    "clamped_plate", "tension_sheet", "clamped_sheet", "indentation", "hole_plate", "l_plate",
     "PlateParams", "TensionSheetParams", "ClampedSheetParams", "IndentationParams",
+    "HolePlateParams", "LPlateParams",
     "PlateResult", "TensionSheetResult", "ClampedSheetResult", "IndentationResult",
+    "HolePlateResult", "LPlateResult",
     "ReferenceResult", "RefinementRow", "Material", "TensorElasticity", "FieldSolution",
+    "MeshElasticity", "MeshField",
 ]

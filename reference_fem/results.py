@@ -10,6 +10,10 @@ from pathlib import Path
 import numpy as np
 
 from .field import FieldSolution
+from .mesh_field import MeshField
+
+#: the arrays of a MeshField, stored as ``<name>.<array>``
+_MESH_FIELD_ARRAYS = ("node_coords", "elements", "values", "box", "disks", "rects")
 
 
 @dataclass(frozen=True)
@@ -38,6 +42,14 @@ class RefinementRow:
     extra: dict = field(default_factory=dict)
 
 
+def field_change_pct(new: np.ndarray, old: np.ndarray) -> float:
+    """100 max |new - old| / max_i |new_i| over sample points (rows: displacement
+    vectors), the field-change measure of the refinement tables (as ``plate.py``)."""
+    peak = np.max(np.abs(new))        # scale-free: normalise before squaring
+    scale = peak * np.max(np.linalg.norm(new / peak, axis=1))
+    return float(100 * np.max(np.abs(new - old)) / scale)
+
+
 def change_pct(new: float, old: float) -> float:
     """100 |new - old| / |new|; NaN without a previous value."""
     if old is None or not np.isfinite(old):
@@ -59,7 +71,8 @@ class ReferenceResult:
     refinement_change_pct : change of ``quantity`` over the last refinement (percent).
     setup_s, solve_s : wall times of the converged level (s).
     study_s : wall time of the whole refinement study (s).
-    field : displacement field of the converged level.
+    field : displacement field of the converged level (a :class:`FieldSolution` on a
+        box, a :class:`MeshField` on any other domain).
     cache_key : hash of (reference, params, package version, package source).
     from_cache : True when this object was loaded from the on-disk cache.
     """
@@ -73,7 +86,7 @@ class ReferenceResult:
     setup_s: float
     solve_s: float
     study_s: float
-    field: FieldSolution
+    field: FieldSolution | MeshField
     cache_key: str = ""
     from_cache: bool = False
 
@@ -103,11 +116,21 @@ class ReferenceResult:
     def sample_grid(self, shape: tuple = (81, 81)) -> dict:
         """Fields on a regular grid over the domain box (for plots): ``x``, ``y`` of the
         given shape ('ij' indexing), displacement ``ux``, ``uy`` (m) and
-        ``strain_energy_density`` (J/m^3)."""
+        ``strain_energy_density`` (J/m^3); NaN at grid points outside a domain that is
+        not a box (a :class:`MeshField`)."""
         b = self.field.bounds
         axes = [np.linspace(lo, hi, n) for (lo, hi), n in zip(b, shape)]
         grids = np.meshgrid(*axes, indexing="ij")
         pts = np.stack([g.ravel() for g in grids], axis=1)
+        if isinstance(self.field, MeshField):
+            # a domain that is not its box: NaN at the grid points outside it
+            inside = self.field.contains(pts)
+            u = np.full((len(pts), 2), np.nan)
+            u[inside] = self.field.evaluate(pts[inside])
+            w = np.full(len(pts), np.nan)
+            w[inside] = self.field.strain_energy_density(pts[inside])
+            return {"x": grids[0], "y": grids[1], "ux": u[:, 0].reshape(shape),
+                    "uy": u[:, 1].reshape(shape), "strain_energy_density": w.reshape(shape)}
         u = self.field.evaluate(pts)
         out = {"x": grids[0], "y": grids[1], "ux": u[:, 0].reshape(shape),
                "uy": u[:, 1].reshape(shape),
@@ -134,6 +157,10 @@ def to_npz(result: ReferenceResult, path: Path) -> None:
                 arrays[f"{f.name}.coord{k}"] = c
             arrays[f"{f.name}.values"] = v.values
             meta[f.name] = {"__field__": len(v.coords), "lam": v.lam, "mu": v.mu}
+        elif isinstance(v, MeshField):
+            for a in _MESH_FIELD_ARRAYS:
+                arrays[f"{f.name}.{a}"] = np.asarray(getattr(v, a))
+            meta[f.name] = {"__mesh_field__": True, "lam": v.lam, "mu": v.mu}
         elif isinstance(v, np.ndarray):
             arrays[f.name] = v
             meta[f.name] = {"__array__": True}
@@ -174,6 +201,9 @@ def from_npz(path: Path, classes: dict) -> ReferenceResult:
             coords = tuple(z[f"{name}.coord{k}"] for k in range(v["__field__"]))
             kwargs[name] = FieldSolution(coords=coords, values=z[f"{name}.values"],
                                          lam=v["lam"], mu=v["mu"])
+        elif isinstance(v, dict) and "__mesh_field__" in v:
+            kwargs[name] = MeshField(**{a: z[f"{name}.{a}"] for a in _MESH_FIELD_ARRAYS},
+                                     lam=v["lam"], mu=v["mu"])
         elif isinstance(v, dict) and "__array__" in v:
             kwargs[name] = z[name]
         elif name in _ROW_TUPLES:
