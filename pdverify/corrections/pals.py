@@ -51,6 +51,7 @@ import scipy.sparse as sp
 
 from ..pd.bonds import homogeneous_extensions
 from ..pd.closure import Closure
+from ..pd.grid import KIND_FICTITIOUS
 from .factors import node_moments, node_sums, solve_per_node
 
 def _pairs(d: int) -> list[tuple[int, int]]:
@@ -103,7 +104,7 @@ class PalsConstitutive:
         if cached is not None:
             return cached
         g, a, b = model.grid, model.bond_a, model.bond_b
-        if g.n_ext != g.n_interior:
+        if np.any(g.kind == KIND_FICTITIOUS):
             raise ValueError("pals: plain grids only (no fictitious nodes)")
         E, DD = self.bases(model.bond_n * model.bond_x[:, None])
         om0, sg0 = self.reference(model, model.bond_x)
@@ -132,10 +133,17 @@ class PalsConstitutive:
         rhs_dil, rhs_dev = matching_targets(d)
         r_dil = rhs_dil[None, :] - node_sums(nodes, w * om0, E, n)
         r_dev = rhs_dev[None, :] - node_sums(nodes, w * sg0, DD, n)
-        lam = solve_per_node(node_moments(nodes, w, E, n), r_dil,
-                             "pals: the dilatation Lagrange system", x)
-        mu_ = solve_per_node(node_moments(nodes, w, DD, n), r_dev,
-                             "pals: the deviatoric Lagrange system", x)
+        M_dil, M_dev = node_moments(nodes, w, E, n), node_moments(nodes, w, DD, n)
+        has = np.bincount(nodes, minlength=n) > 0
+        if not has.all():    # a shape's void nodes have no bonds and no multipliers
+            lam, mu_ = np.zeros_like(r_dil), np.zeros_like(r_dev)
+            lam[has] = solve_per_node(M_dil[has], r_dil[has],
+                                      "pals: the dilatation Lagrange system", x[has])
+            mu_[has] = solve_per_node(M_dev[has], r_dev[has],
+                                      "pals: the deviatoric Lagrange system", x[has])
+            return lam, mu_
+        lam = solve_per_node(M_dil, r_dil, "pals: the dilatation Lagrange system", x)
+        mu_ = solve_per_node(M_dev, r_dev, "pals: the deviatoric Lagrange system", x)
         return lam, mu_
 
     def operators(self, model):

@@ -89,7 +89,7 @@ def _rows(nodes, weights, n_rows, n_cols, row_ids=None):
     return sp.csr_matrix((weights.ravel(), (rows, nodes.ravel())), shape=(n_rows, n_cols))
 
 
-def normal_closure(g, shape, order: int) -> Closure:
+def normal_closure(g, shape, order: int, stencil=None) -> Closure:
     """The closure of the fictitious layer of a ``ShapeGrid`` (module docstring)."""
     ni, h = g.n_interior, g.spacing
     x_real = g.x[g.interior_ids]
@@ -100,14 +100,15 @@ def normal_closure(g, shape, order: int) -> Closure:
     A_U = (eye + _rows(nodes, w, g.n_ext, ni, fict)).tocsr()
     nodes, w = fit(x_real, p, g.x[fict], order - 1, h)
     A_T = (eye + _rows(nodes, w, g.n_ext, ni, fict)).tocsr()
-    return Closure(weighted_volume="complete", displacement_map=A_U, dilatation_map=A_T,
-                   info={"fictitious_nodes": int(fict.size)})
+    keep = None if stencil is None else crossing_keep(g, shape, stencil)
+    return Closure(keep=keep, weighted_volume="complete", displacement_map=A_U,
+                   dilatation_map=A_T, info={"fictitious_nodes": int(fict.size)})
 
 
 def boundary_points(g, shape, samples):
     """One point per (boundary node, part) pair: the mean of that pair's samples moved onto
-    the part, its outward normal, part and node (``samples``: what
-    ``static_state.boundary_nodes`` returns)."""
+    the part, its outward normal, part and node, and each sample's point (``samples``:
+    what ``static_state.boundary_nodes`` returns)."""
     P, W, _, part, node = samples
     key = node * len(shape.parts) + part
     keys, inv = np.unique(key, return_inverse=True)
@@ -119,50 +120,169 @@ def boundary_points(g, shape, samples):
         on = kpart == k
         if on.any():
             pts[on], nrm[on] = q.closest(mean[on])
-    return pts, nrm, kpart, keys // len(shape.parts)
+    return pts, nrm, kpart, keys // len(shape.parts), inv
 
 
-def condition_rows(g, problem, order: int, samples, moduli):
+def crossing_keep(g, shape, stencil):
+    """The closure's bonds: every stencil pair with a real end (no void end), and the
+    pairs of fictitious nodes whose bond crosses a boundary part (near corners: they
+    carry part of the force flux through it, as seed 001's face-crossing bonds do)."""
+    from ..pd.bonds import bond_pairs
+    a, b, _ = bond_pairs(g.ext_shape, stencil.offsets[stencil.half])
+    keep = (g.is_interior[a] | g.is_interior[b]) & ~g.is_void[a] & ~g.is_void[b]
+    ff = np.flatnonzero((g.kind[a] == 1) & (g.kind[b] == 1))
+    seg = shape.crossings(g.x[a[ff]], g.x[b[ff]])[0]
+    keep[ff[np.unique(seg)]] = True
+    return keep
+
+
+def crossings(model, shape):
+    """Every crossing of a boundary part by a bond of the model whose ends both lie
+    within a horizon of the boundary: ``(bond, part, arc length, sign, alpha)``
+    (``Shape.crossings``: sign +1 when end a lies on the body's side of the part)."""
+    g = model.grid
+    a, b = model.bond_a, model.bond_b
+    near = shape.closest(g.x)[2] <= model.horizon * (1 + 1e-12)
+    cand = np.flatnonzero(near[a] & near[b])
+    seg, part, s, sign, alpha = shape.crossings(g.x[a[cand]], g.x[b[cand]])
+    return cand[seg], part, s, sign, alpha
+
+
+def condition_rows(model, problem, order: int, samples):
     """The constraint rows B u = c of the conditions (module docstring) on the real
-    displacements (component-major, 2 n_real columns)."""
-    shape = problem.shape
+    displacements (component-major, 2 n_real columns): a prescribed component's fitted
+    value at each boundary point; every other component's force flux through the
+    boundary near the point (the bonds from a real to a fictitious node crossing the
+    boundary nearer this point's samples than any other's: sum of sign f_b n_b, seed 001
+    Eqs. 35-36 with the cell face replaced by the point's stretch of boundary) equal to
+    the traction's resultant over that stretch (zero on a free part)."""
+    g, shape = model.grid, problem.shape
     ni, h = g.n_interior, g.spacing
     x_real = g.x[g.interior_ids]
-    pts, nrm, part, _ = boundary_points(g, shape, samples)
+    pts, nrm, part, _, group = boundary_points(g, shape, samples)
+    P, W = samples[0], samples[1]
     nodes, value, grad = fit(x_real, pts, pts, order, h, gradient=True)
-    lam, mu = moduli
+    curved = np.array([not hasattr(q, "a") for q in shape.parts])[part]
+    lam, mu = problem.constants.moduli()
     names = shape.part_names
     exact = problem.exact(pts)
+    # each crossing counts for the boundary point whose stretch of its part holds it
+    # (the stretch: the node's samples, to the midpoints between neighbouring points;
+    # on a straight face one cell face), half for each on the edge between two (seed
+    # 001's alpha = 1/2 on a cell face's edge); the traction's resultant over the
+    # stretch from the samples
+    bonds, cpart, cs, sign, alpha = crossings(model, shape)
+    spart = samples[3]
+    sign = sign * alpha
+    hat_c = stretches(shape, pts, part, _params(shape, P, spart), spart, group, cs, cpart, h)
+    hat_s = sp.csr_matrix((np.ones(len(P)), (np.arange(len(P)), group)),
+                          shape=(len(P), len(pts)))
+    used = np.unique(bonds)
+    forces = model.bond_force_matrix(used)           # rows: the crossing bonds, ascending
+    col = sp.csr_matrix((np.ones(bonds.size), (np.arange(bonds.size),
+                                               np.searchsorted(used, bonds))),
+                        shape=(bonds.size, used.size))
+    F = (col @ forces).tocsr()                       # each crossing's bond force
+    resultant = hat_s.T @ (W[:, None] * problem.thickness
+                           * _traction_at(problem, P, samples[2], spart, names))
+    traction_pts = _traction_at(problem, pts, nrm, part, names)
     rows, vals = [], []
     for k in range(2):
         pres = np.zeros(len(pts), dtype=bool)
         load = np.zeros(len(pts))
         for name, cond in problem.conditions.items():
-            on = part == names.index(name)
             if k in cond.prescribed:
-                pres |= on
-            elif cond.traction is not None and on.any():
-                load[on] = cond.traction(pts[on], nrm[on])[:, k]
+                pres |= part == names.index(name)
+        load = resultant[:, k]
         if pres.any():
             sel = np.flatnonzero(pres)
-            rows.append(_rows(nodes[sel], value[sel], sel.size, ni)
-                        @ _component(k, ni))
+            rows.append(_rows(nodes[sel], value[sel], sel.size, ni) @ _component(k, ni))
             vals.append(exact[sel, k])
-        free = np.flatnonzero(~pres)
+        free = np.flatnonzero(~pres & ~curved)
         if free.size:
-            # t_k = lam (du0/dx + du1/dy) n_k + mu sum_l (du_k/dx_l + du_l/dx_k) n_l
-            blocks = []
-            for a in range(2):          # the displacement component the row weighs
-                c = np.zeros((free.size, nodes.shape[1]))
-                c += lam * nrm[free, k][:, None] * grad[free, a]
-                c += mu * (nrm[free, a][:, None] * grad[free, k] if a != k else 0.0)
-                if a == k:
-                    c += mu * np.einsum("fl,flk->fk", nrm[free], grad[free])
-                    c += mu * nrm[free, k][:, None] * grad[free, k]
-                blocks.append(_rows(nodes[free], c, free.size, ni) @ _component(a, ni))
-            rows.append(blocks[0] + blocks[1])
+            S = (hat_c[:, free].T @ sp.diags(sign * model.bond_n[bonds, k])).tocsr()
+            rows.append((S @ F).tocsr())
             vals.append(load[free])
+        bent = np.flatnonzero(~pres & curved)
+        if bent.size:
+            rows.append(_traction_rows(nodes[bent], grad[bent], nrm[bent], k, lam, mu, ni))
+            vals.append(traction_pts[bent, k])
     return sp.vstack(rows).tocsr(), np.concatenate(vals), len(pts)
+
+
+def _params(shape, x, xpart):
+    """Arc length on its part of each point of ``x``."""
+    out = np.zeros(len(x))
+    for k, q in enumerate(shape.parts):
+        on = xpart == k
+        if on.any():
+            out[on] = q.param(x[on])
+    return out
+
+
+def stretches(shape, pts, part, s_samples, spart, group, s_all, xpart, h) -> sp.csr_matrix:
+    """(len(s_all) x len(pts)) weights of positions ``s_all`` (arc length on their parts
+    ``xpart``) over the boundary points: 1 for the point whose stretch holds it (the
+    arc-length range of the point's samples, extended to the midpoints between
+    neighbouring points; beyond a part's first or last point, that point), 1/2 for each
+    of two points within 1e-9 h of the edge between their stretches."""
+    rows, cols, vals = [], [], []
+    n = len(pts)
+    lo = np.full(n, np.inf)
+    hi = np.full(n, -np.inf)
+    np.minimum.at(lo, group, s_samples)
+    np.maximum.at(hi, group, s_samples)
+    for k in range(len(shape.parts)):
+        mine = np.flatnonzero(part == k)
+        on = np.flatnonzero(xpart == k)
+        if mine.size == 0 or on.size == 0:
+            continue
+        mine = mine[np.argsort(lo[mine])]
+        edges = 0.5 * (hi[mine[:-1]] + lo[mine[1:]])
+        s = s_all[on]
+        j = np.searchsorted(edges, s)
+        rows.append(on), cols.append(mine[j]), vals.append(np.ones(on.size))
+        # on an edge: half to each side
+        e = np.clip(j, 1, max(edges.size, 1)) - 1
+        if edges.size:
+            for side in (e, e + 1):
+                pass
+            tie_lo = np.abs(s - edges[np.clip(j - 1, 0, edges.size - 1)]) <= 1e-9 * h
+            tie_lo &= j > 0
+            tie_hi = np.abs(s - edges[np.clip(j, 0, edges.size - 1)]) <= 1e-9 * h
+            tie_hi &= j < edges.size
+            vals[-1] = np.where(tie_lo | tie_hi, 0.5, 1.0)
+            rows.append(on[tie_lo]), cols.append(mine[j[tie_lo] - 1])
+            vals.append(np.full(int(tie_lo.sum()), 0.5))
+            rows.append(on[tie_hi]), cols.append(mine[j[tie_hi] + 1])
+            vals.append(np.full(int(tie_hi.sum()), 0.5))
+    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                         shape=(len(s_all), n))
+
+
+def _traction_rows(nodes, grad, nrm, k, lam, mu, ni):
+    """Rows of the traction component k, sigma(grad u_fit) n with the continuum moduli
+    (plane: t_k = lam (div u) n_k + mu sum_l (d_l u_k + d_k u_l) n_l), over the fit's
+    nodes' displacements."""
+    blocks = []
+    F = len(nodes)
+    for a in range(2):          # the displacement component the row weighs
+        c = lam * nrm[:, k][:, None] * grad[:, a]
+        c = c + mu * nrm[:, a][:, None] * grad[:, k]
+        if a == k:
+            c = c + mu * np.einsum("fl,flk->fk", nrm, grad)
+        blocks.append(_rows(nodes, c, F, ni) @ _component(a, ni))
+    return (blocks[0] + blocks[1]).tocsr()
+
+
+def _traction_at(problem, x, n, xpart, names):
+    """The applied traction at boundary samples (zero on free parts)."""
+    out = np.zeros_like(x)
+    for name, cond in problem.conditions.items():
+        on = xpart == names.index(name)
+        if cond.traction is not None and on.any():
+            out[on] = cond.traction(x[on], n[on])
+    return out
 
 
 def _component(k, ni):

@@ -234,6 +234,9 @@ class LinearSystem:
     reaction: Callable[[np.ndarray, int], float] | None = None
     counts: dict = field(default_factory=dict)
     offset: np.ndarray | None = None
+    #: SuperLU's column ordering when the treatment's system wants another than the
+    #: scene's ``StaticProblem.ordering`` (None: the scene's)
+    ordering: str | None = None
 
     @property
     def dim(self) -> int:

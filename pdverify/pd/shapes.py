@@ -34,6 +34,9 @@ import numpy as np
 SAMPLES_PER_CELL = 8
 #: sub-grid per axis of the sampled cut-cell fractions
 FRACTION_SAMPLES = 16
+#: a crossing this close to a part's end (fraction of the part, or radians) is on the
+#: end: it counts half for each of the two parts that meet there
+END = 1e-12
 
 
 @dataclass(frozen=True)
@@ -56,6 +59,33 @@ class Segment:
     @property
     def length(self) -> float:
         return float(np.linalg.norm(np.subtract(self.b, self.a)))
+
+    def crossings(self, xa, xb):
+        """Segments xa -> xb that cross this part: ``(segment, arc length of the
+        crossing, sign, alpha)``: sign +1 when xa lies on the body's side of the part's
+        line, alpha 1/2 at either end of the part (exactly; seed 001's rule on a cell
+        face's edge), else 1."""
+        a, b = np.asarray(self.a, float), np.asarray(self.b, float)
+        e = b - a
+        d = xb - xa
+        den = d[:, 0] * e[1] - d[:, 1] * e[0]
+        ok = den != 0
+        den = np.where(ok, den, 1.0)
+        w = a - xa
+        t = (w[:, 0] * e[1] - w[:, 1] * e[0]) / den           # along the bond
+        u = (w[:, 0] * d[:, 1] - w[:, 1] * d[:, 0]) / den     # along the part
+        hit = np.flatnonzero(ok & (t > 0) & (t < 1) & (u >= -END) & (u <= 1 + END))
+        n = np.array([e[1], -e[0]])
+        sign = np.where((xa[hit] - a) @ n < 0, 1.0, -1.0)
+        u = np.clip(u[hit], 0.0, 1.0)
+        alpha = np.where((u <= END) | (u >= 1 - END), 0.5, 1.0)
+        return hit, u * self.length, sign, alpha
+
+    def param(self, x):
+        """Arc length from ``a`` of the closest point of each row of ``x``."""
+        a, b = np.asarray(self.a, float), np.asarray(self.b, float)
+        t = (b - a) / self.length
+        return np.clip((np.asarray(x, float) - a) @ t, 0.0, self.length)
 
     def point(self, s):
         """Points at arc-length fractions ``s`` in [0, 1] and their outward normals."""
@@ -94,6 +124,40 @@ class Arc:
     @property
     def length(self) -> float:
         return float(self.radius * (self.theta1 - self.theta0))
+
+    def crossings(self, xa, xb):
+        """As :meth:`Segment.crossings`, for the circle's arc (up to two per segment);
+        alpha 1/2 at either end angle (exactly)."""
+        c = np.asarray(self.centre, float)
+        d = xb - xa
+        f = xa - c
+        A = np.einsum("ij,ij->i", d, d)
+        Bq = 2 * np.einsum("ij,ij->i", f, d)
+        Cq = np.einsum("ij,ij->i", f, f) - self.radius ** 2
+        disc = Bq * Bq - 4 * A * Cq
+        real = disc > 0
+        root = np.sqrt(np.where(real, disc, 0.0))
+        out = []
+        for t in ((-Bq - root) / (2 * A), (-Bq + root) / (2 * A)):
+            idx = np.flatnonzero(real & (t > 0) & (t < 1))
+            p = xa[idx] + t[idx, None] * d[idx] - c
+            th = np.arctan2(p[:, 1], p[:, 0])
+            th = self.theta0 - END + np.mod(th - self.theta0 + END, 2 * np.pi)
+            on = (th >= self.theta0 - END) & (th <= self.theta1 + END)
+            idx, th = idx[on], np.clip(th[on], self.theta0, self.theta1)
+            outside_a = np.einsum("ij,ij->i", f[idx], f[idx]) > self.radius ** 2
+            sign = np.where(outside_a == self.hole, 1.0, -1.0)
+            alpha = np.where((th <= self.theta0 + END) | (th >= self.theta1 - END), 0.5, 1.0)
+            out.append((idx, self.radius * (th - self.theta0), sign, alpha))
+        return tuple(np.concatenate(v) for v in zip(*out))
+
+    def param(self, x):
+        """Arc length from ``theta0`` of the closest point of each row of ``x``."""
+        r = np.asarray(x, float) - np.asarray(self.centre, float)
+        th = self.theta0 + np.mod(np.arctan2(r[:, 1], r[:, 0]) - self.theta0, 2 * np.pi)
+        th = np.where(th > self.theta1, np.where(th - self.theta1 < np.pi + 0.5 * (
+            self.theta1 - self.theta0), self.theta1, self.theta0), th)
+        return self.radius * (th - self.theta0)
 
     def point(self, s):
         th = self.theta0 + s * (self.theta1 - self.theta0)
@@ -151,6 +215,15 @@ class Shape:
             pts = (centres[cut][:, None, :] + sub[None]).reshape(-1, 2)
             out[cut] = self.inside(pts).reshape(cut.size, -1).mean(axis=1)
         return out
+
+    def crossings(self, xa, xb):
+        """Every crossing of a part by the segments xa -> xb: ``(segment, part, arc
+        length on the part, sign, alpha)`` (the parts' ``crossings``)."""
+        out = []
+        for k, q in enumerate(self.parts):
+            idx, s, sign, alpha = q.crossings(xa, xb)
+            out.append((idx, np.full(idx.size, k), s, sign, alpha))
+        return tuple(np.concatenate(v) for v in zip(*out))
 
     def samples(self, h: float):
         """Gauss points along every part: ``(points, weights, normals, part index)``."""

@@ -25,7 +25,9 @@ def solve(system, *, where: str, ordering: str = "COLAMD"):
     prescribed unknowns then), else the prescribed unknowns eliminated and the rest
     solved by ``system.solver``; ``ordering``: SuperLU's column ordering of a direct
     solve. Returns ``(x, info)``; ``x`` holds every unknown of the system (multipliers
-    dropped)."""
+    dropped). A system that names its own ``ordering`` (``LinearSystem.ordering``) is
+    solved with that one."""
+    ordering = getattr(system, "ordering", None) or ordering
     if system.B is not None:
         if np.size(system.fixed):
             raise ValueError(f"{where}: a system with constraint rows has no eliminated "

@@ -175,9 +175,15 @@ def test_taylor_along_the_normal_is_exact_for_its_order(shape, field, mode):
     """Order 1 reproduces an affine field, order 2 a quadratic one with its body force
     (on the moment-corrected stencil, whose complete neighbourhoods are exact for
     quadratics), with every part prescribed or x- prescribed and the rest loaded by the
-    field's traction. Tolerance: round-off through the bordered system's condition
+    field's traction (force flux rows on the straight parts, the fit's traction on the
+    hole's arc). Tolerance: round-off through the bordered system's condition
     (estimates ~1.2e7; 1e-16 x 1e7 = 1e-9; measured <= 6e-13)."""
     u, b, t, order, quadrature = CASES[field]
+    if mode == "mixed":
+        # a traction holds exactly where the lattice's moduli are the continuum's: on
+        # partial volumes the flux of an affine field is off by the quadrature's moduli
+        # error (0.47 % on this rectangle's box twin, the same with seed 000's box rows)
+        quadrature = "moment-corrected"
     names = shape.part_names
     conds = ({k: FaceCondition(prescribed=(0, 1)) for k in names} if mode == "dirichlet"
              else {k: (FaceCondition(prescribed=(0, 1)) if k == "x-"
@@ -202,3 +208,59 @@ def test_taylor_along_the_normal_fails_the_quadratic_at_order_one():
     g = system.model.grid
     got, want = system.displacements(x)[:g.n_interior], u(g.x[g.interior_ids])
     assert np.abs(got - want).max() > 1e-6 * np.abs(want).max()
+
+
+def test_taylor_on_a_rectangle_shape_matches_the_box_rows():
+    """The shape's rows on a rectangle are seed 000/001's box rows: the Dirichlet value
+    at each face's boundary points and the force flux of each boundary cell face (the
+    bonds crossing it, half on its edges), so a cubic field with its body force under
+    mixed conditions comes out as on the box. Measured at h = 0.05, moment-corrected,
+    relative L2 errors: box 1.22e-2 / 7.17e-3 (orders 1 / 2), shape 1.17e-2 / 7.11e-3;
+    tolerance: a tenth of the error itself (they are different fits of the same
+    extrapolation: the box's along lattice lines, ours least squares about the point)."""
+    a, L, Hh = 1e-3, 1.0, 0.5
+
+    def u(x):
+        X, Y = x[:, 0], x[:, 1]
+        return a * np.c_[X ** 3 + X * Y * Y - 0.5 * Y ** 3, -X * X * Y + 0.3 * X ** 3 + 0.2 * Y ** 3]
+
+    def stress(x):
+        X, Y = x[:, 0], x[:, 1]
+        G = np.empty((len(x), 2, 2))
+        G[:, 0, 0], G[:, 0, 1] = a * (3 * X * X + Y * Y), a * (2 * X * Y - 1.5 * Y * Y)
+        G[:, 1, 0], G[:, 1, 1] = a * (-2 * X * Y + 0.9 * X * X), a * (-X * X + 0.6 * Y * Y)
+        eps = 0.5 * (G + np.transpose(G, (0, 2, 1)))
+        S = 2 * MU * eps
+        tr = eps[:, 0, 0] + eps[:, 1, 1]
+        S[:, 0, 0] += LAM * tr
+        S[:, 1, 1] += LAM * tr
+        return S
+
+    def body(x):     # -div sigma, exact: sigma is quadratic, its derivatives linear
+        X, Y = x[:, 0], x[:, 1]
+        # d/dx sigma_x., d/dy sigma_y. from the gradient's second derivatives
+        uxx, uxy, uyy = a * 6 * X, a * 2 * Y, a * (2 * X - 3 * Y)
+        vxx, vxy, vyy = a * (-2 * Y + 1.8 * X), a * (-2 * X), a * 1.2 * Y
+        bx = (LAM + 2 * MU) * uxx + MU * uyy + (LAM + MU) * vxy
+        by = (LAM + 2 * MU) * vyy + MU * vxx + (LAM + MU) * uxy
+        return -np.c_[bx, by]
+
+    def traction(x, n):
+        return np.einsum("nij,nj->ni", stress(x), n)
+
+    rect = polygon([(0, 0), (L, 0), (L, Hh), (0, Hh)], ("y-", "x+", "y+", "x-"))
+    conds = {"x-": FaceCondition(prescribed=(0, 1)), **{k: FaceCondition(traction=traction)
+                                                        for k in ("x+", "y-", "y+")}}
+    h = 0.05
+    st = state_based_stencil(2, 3.0, h, INF, "moment-corrected")
+    for order in (1, 2):
+        errors = []
+        for shape in (None, rect):
+            pr = StaticProblem((L, Hh), (0.0, 0.0), h, st, CONSTANTS, INF, conds, exact=u,
+                               body_force=body, solver="direct", shape=shape)
+            system = assemble_taylor(pr, order)
+            x, _ = solve(system, where="rectangle")
+            g = system.model.grid
+            got, want = system.displacements(x)[:g.n_interior], u(g.x[g.interior_ids])
+            errors.append(np.linalg.norm(got - want) / np.linalg.norm(want))
+        assert abs(errors[1] - errors[0]) < 0.1 * errors[0], (order, errors)
