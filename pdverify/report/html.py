@@ -298,7 +298,8 @@ def _value(scene, r, scale) -> dict:
     exact = is_exact(pct)
     return {"text": _pct_text(pct), "exact": exact, "params": _params(r, scene),
             "colour": "" if exact or scale is None else _colour(pct, scale),
-            "cost": f"{cost_s(r):.2g}"}
+            "cost": ("not measured" if r.method.startswith("external:")
+                     else f"{cost_s(r):.2g}")}
 
 
 def _overview_cell(scene, m, runs, best, scale) -> dict | None:
@@ -355,6 +356,8 @@ def overview(scenes, results) -> Markup:
     fit a 1400 px screen."""
     from ..listing import method_columns
     methods = method_columns(scenes)
+    # external codes' runs (pdverify score, report --include): a column each, last
+    methods += sorted({r.method for r in results if r.method.startswith("external:")})
     scale = overview_scale(scenes, results)
     rows = []
     for scene in scenes:
