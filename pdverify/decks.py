@@ -182,7 +182,7 @@ def write_vtu(ns: NodeSet, path: str) -> None:
         data[f"prescribed_u{AXES[k]}"], data[f"value_u{AXES[k]}"] = mask, val
     mesh = meshio.Mesh(_pad3(ns.x), [("vertex", np.arange(n).reshape(-1, 1))],
                        point_data=data)
-    meshio.write(path, mesh, file_format="vtu", binary=False)
+    meshio.write(path, mesh, file_format="vtu")   # binary: the doubles exactly
     with open(path, encoding="utf-8") as fh:
         text = fh.read()
     decl, _, rest = text.partition("\n")
