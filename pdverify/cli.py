@@ -280,7 +280,7 @@ def _dispatch(args) -> int:
                             scheduler=scheduler_address(args.scheduler),
                             include=args.include)
     if args.command == "export":
-        from .exchange import export_command
+        from .decks import export_command
         from .params import parse_assignments
         return export_command(args.scene, method=args.method,
                               overrides=parse_assignments(args.set), fmt=args.fmt, out=args.out)

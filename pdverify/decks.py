@@ -135,6 +135,27 @@ def write_export(ns: NodeSet, fmt: str, out: str) -> list[str]:
     return sorted(written)
 
 
+# ------------------------------------------------------------------------------ command
+def export_command(scene_id: str, *, method=None, overrides=None, fmt: str, out: str,
+                   stream=None) -> int:
+    """``pdverify export``: every check before any work, then assemble and write."""
+    import sys
+    from .exchange import check_method, node_set, scene_of
+    stream = stream or sys.stdout
+    scene = scene_of(scene_id)
+    check_method(method)
+    if fmt not in FORMATS:
+        raise InputError(f"--format {fmt!r}; allowed: {', '.join(FORMATS)}")
+    scene.resolve(METHOD, overrides)
+    folder = check_out(out)
+    ns = node_set(scene, overrides)
+    files = write_export(ns, fmt, folder)
+    print(f"{scene.id} --method {METHOD}: {len(ns.x)} nodes, {ns.dim}D, horizon "
+          f"{ns.horizon:.6g} m -> {out} ({len(files)} files: "
+          + ", ".join(files[:6]) + (", ..." if len(files) > 6 else "") + ")", file=stream)
+    return 0
+
+
 # ------------------------------------------------------------------------------ CSV
 def _rows(header, rows) -> str:
     return ",".join(header) + "\n" + "".join(",".join(r) + "\n" for r in rows)

@@ -355,26 +355,6 @@ def dumps(doc: dict) -> str:
 
 
 # ------------------------------------------------------------------------------ commands
-def export_command(scene_id: str, *, method=None, overrides=None, fmt: str, out: str,
-                   stream=None) -> int:
-    """``pdverify export``: every check before any work, then assemble and write."""
-    import sys
-    from . import decks
-    stream = stream or sys.stdout
-    scene = scene_of(scene_id)
-    check_method(method)
-    if fmt not in decks.FORMATS:
-        raise InputError(f"--format {fmt!r}; allowed: {', '.join(decks.FORMATS)}")
-    scene.resolve(METHOD, overrides)
-    folder = decks.check_out(out)
-    ns = node_set(scene, overrides)
-    files = decks.write_export(ns, fmt, folder)
-    print(f"{scene.id} --method {METHOD}: {len(ns.x)} nodes, {ns.dim}D, horizon "
-          f"{ns.horizon:.6g} m -> {out} ({len(files)} files: "
-          + ", ".join(files[:6]) + (", ..." if len(files) > 6 else "") + ")", file=stream)
-    return 0
-
-
 def score_command(scene_id: str, path: str, *, name: str, overrides=None, out=None,
                   force=False, stream=None) -> int:
     """``pdverify score``: check, read, match, measure, print, write the record."""

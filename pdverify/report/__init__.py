@@ -450,8 +450,9 @@ def _build_logged(cases, out, final, jobs, progress, client=None, quick=False,
     with phase("runs_s"):
         # the previous report in this folder times each run, for the longest-first order
         known = previous_times(os.path.join(final, "results.json"))
-        results = run_cases(cases, jobs=jobs, progress=progress, client=client,
-                            run_timeout=run_timeout, known=known, schedule=slots)
+        results = (run_cases(cases, jobs=jobs, progress=progress, client=client,
+                             run_timeout=run_timeout, known=known, schedule=slots)
+                   if cases else [])   # report --failed --include: only runs to add
     if kept is not None:     # report --failed: the new runs merged into the previous ones
         results = _merged(kept, results)
     if included:             # report --include: external runs (pdverify score) join them,
