@@ -104,8 +104,8 @@ def node_set(scene, overrides=None) -> NodeSet:
     g = system.model.grid
     ni, nu_, d = g.n_interior, system.n_unknown_nodes, g.dim
     if nu_ != ni or system.B is not None or system.offset is not None:
-        raise RuntimeError(f"{scene.id}: the uncorrected system has unknowns beyond the "
-                           "real nodes; it is not a node set")
+        raise InputError(f"{scene.id}: its uncorrected system has unknowns or rows beyond "
+                         "the real nodes, which a node set cannot state; it is not exported")
     x = g.x[g.interior_ids]
     volume = np.asarray(system.model.node_volume)[g.interior_ids]
     forces = np.asarray(system.rhs[:d * nu_]).reshape(d, nu_).T
@@ -269,14 +269,17 @@ def score(scene_id: str, path: str, *, name: str, overrides=None):
         raise InputError(f"--name {name!r}: give a non-empty name without spaces "
                          "(the run's method becomes external:NAME)")
     scene.resolve(METHOD, overrides)                 # bad --set before reading the file
-    given = read_displacements(path, len(scene.box(scene.resolve(METHOD, overrides))[0]))
+    given = read_displacements(path, scene.dim)
     ns = node_set(scene, overrides)
     order = match_nodes(ns, given)
     U = given.u[order]
     d, n = ns.dim, len(ns.x)
     x = U.T.ravel()
     K = ns.system.K
-    if K.shape[0] > d * n:   # the augmented system: its nodal scalars from the field
+    if K.shape[0] > d * n:
+        # the augmented system (solver=nested-dissection): its nodal scalars (dilatations)
+        # from the displacements, theta = A_theta A_e A_U u, so that K x - rhs (a
+        # reaction) is the direct system's; the displacement metrics do not read them
         model = ns.system.model
         x = np.r_[x, model.A_theta @ (model.A_e @ (model.A_U_full @ x))]
     deviation = 0.0
