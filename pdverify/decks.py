@@ -353,9 +353,36 @@ def perilab_files(ns: NodeSet) -> dict:
 
 
 # ------------------------------------------------------------------------------ README
+def _model_note(ns: NodeSet) -> str:
+    """The README's line on the material model and what each deck makes of it."""
+    c, d = ns.problem.constants, ns.dim
+    text = ("- The model: pdverify's is the linear ordinary state-based solid "
+            f"({c.kind}; c_theta = {c.c_theta:.6g}, k_theta = {c.k_theta:.6g} Pa, "
+            f"k_e = {c.k_e:.6g} Pa), m_i over the bonds a node has")
+    if d < 3:
+        text += (f", node volumes with the {'cross-section' if d == 1 else 'thickness'} "
+                 f"({f(ns.problem.thickness)} {'m^2' if d == 1 else 'm'})")
+    text += ". Peridigm's `Elastic` material is the 3D LPS; "
+    if d == 3:
+        text += "on a 3D body it is the same kind of model. "
+    else:
+        text += (f"on a {d}D node set it is not the {c.kind} model (its dilatation is 3D; "
+                 "`Plane Stress`/`Plane Strain` only convert the moduli), so expect a "
+                 "different answer. ")
+    if c.kind in ("plane-stress", "plane-strain"):
+        text += (f"PeriLab's `PD Solid Elastic` with `Symmetry: isotropic "
+                 f"{c.kind.replace('-', ' ')}` is its planar form (whether its constants "
+                 "are ours is not checked here).")
+    elif d == 3:
+        text += "PeriLab's `PD Solid Elastic` with `Symmetry: isotropic` is its 3D form."
+    else:
+        text += ("PeriLab has no 1D kind: the bar is written as a row of nodes in 2D "
+                 "plane stress, a different model.")
+    return text
+
+
 def readme(ns: NodeSet, fmt: str, files) -> str:
     """What the files are, what to run, and what a deck can and cannot express."""
-    c = ns.problem.constants
     d = ns.dim
     p = ns.params
     over = " ".join(f"--set {k}={v}" for k, v in sorted(p.items())
@@ -417,23 +444,13 @@ def readme(ns: NodeSet, fmt: str, files) -> str:
                "1e-3 spacings of one node of this set, one each. Then "
                "`python -m pdverify report --include mycode.json` shows it beside ours.", "",
              "## What the decks can and cannot express", "",
-             "- The model: pdverify's is the linear ordinary state-based solid "
-             f"({c.kind}; c_theta = {c.c_theta:.6g}, k_theta = {c.k_theta:.6g} Pa, "
-             f"k_e = {c.k_e:.6g} Pa), m_i over the bonds a node has. Peridigm's `Elastic` "
-             "material is the 3D LPS; on a "
-             + ("3D body it is the same model. " if d == 3 else
-                f"{d}D node set it is not the {c.kind} model (its dilatation is 3D; "
-                "`Plane Stress`/`Plane Strain` only convert the moduli), so expect a "
-                "different answer. ")
-             + "PeriLab's `PD Solid Elastic` with `Symmetry` "
-             + ("is the planar model." if c.kind in ("plane-stress", "plane-strain") else
-                "`isotropic` is the 3D model." if d == 3 else
-                "has no 1D kind: the bar is written as a row of nodes in 2D plane stress, "
-                "a different model."),
+             _model_note(ns),
              f"- Bond weights: pdverify weights each bond by its partial volume "
              f"(`quadrature={p.get('quadrature', 'partial-volume')}`: the cell's fraction "
-             "inside the horizon); Peridigm's `Elastic` and PeriLab's models use whole "
-             "neighbour volumes, so their lattice differs near the horizon's edge.",
+             "inside the horizon); the decks' materials have no such weights (as far as "
+             "their documentation shows, neighbours count with their whole volume), so "
+             "their lattice differs at the horizon's edge. pdverify's partial-volume "
+             "quadrature cannot be stated in either deck.",
              f"- Influence function `{ns.problem.influence.name}` "
              f"({ns.problem.influence.description}): written as an expression of the bond "
              "length (its scale cancels in the linear state-based force).",
