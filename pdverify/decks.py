@@ -148,6 +148,8 @@ def export_command(scene_id: str, *, method=None, overrides=None, fmt: str, out:
         raise InputError(f"--format {fmt!r}; allowed: {', '.join(FORMATS)}")
     scene.resolve(METHOD, overrides)
     folder = check_out(out)
+    from .outputs import check_cache
+    check_cache()       # a FEM scene's prescribed values come from its cached reference
     ns = node_set(scene, overrides)
     files = write_export(ns, fmt, folder)
     print(f"{scene.id} --method {METHOD}: {len(ns.x)} nodes, {ns.dim}D, horizon "
