@@ -156,7 +156,7 @@ def family_treatments() -> list[Treatment]:
         FamilyTreatment(
             BASELINE, "uncorrected PD: truncated neighbourhoods, BCs on the nodes nearest "
             "the boundary", "the papers' baseline (seed 000 §5, seed 001 §4)",
-            params=(LOAD_POINT,), families=FAMILY, build=_none, baseline=True,
+            params=(LOAD_POINT,), families=FAMILY, build=_none, baseline=True, shapes=True,
             roles=(("wave-bar", Role(_truncated)), ("flux-bar", Role(_truncated)))),
         FamilyTreatment(
             "taylor-fictitious", "seed 000: fictitious layer by nearest-node Taylor "
@@ -170,8 +170,10 @@ def family_treatments() -> list[Treatment]:
                   "complementary shear pair is dropped (else near-singular: "
                   "static_state.assemble_taylor). body3d-manufactured's quick grid "
                   "(10 x 5 x 5 cells) keeps 2 dependent constraint rows and fails as "
-                  "near-singular",
-            build=_taylor, checker=_check_taylor,
+                  "near-singular. On a shape (not a box) the series runs along the local "
+                  "normal with derivatives from a least-squares fit, the conditions at "
+                  "boundary points (corrections.shape_fictitious; corners unused)",
+            build=_taylor, checker=_check_taylor, shapes=True,
             roles=(("flux-bar", Role(_flux_order, (ORDER,), _check_flux_order)),)),
         FamilyTreatment(
             "surface-nodes", "seeds 001/002: surface nodes carry the boundary conditions, "
@@ -179,6 +181,9 @@ def family_treatments() -> list[Treatment]:
             "Scabbia, Zaccariotto, Galvanetto 2023 (seed 001); seed 002",
             params=(SURFACE_ORDER,), theories=STATE, families=FAMILY, footprint="surface",
             build=_surface, checker=_check_surface,
+            box_only="its surface nodes sit at the centres of boundary cell faces and its "
+                     "Taylor stencils run along lattice lines normal to a face (seed 001 "
+                     "§3); a curved or cut boundary has neither",
             roles=(("wave-bar", Role(wave_extension, (WAVE_ORDER,), check_wave_order)),)),
         FamilyTreatment(
             "mirror-nodes", "seed 001 §5: a delta-thick fictitious layer whose nodes copy "
@@ -188,14 +193,19 @@ def family_treatments() -> list[Treatment]:
             theories=STATE, families=FAMILY, footprint="fictitious",
             scope="state-based boxes; the mirror relation (Dirichlet or traction) is "
                   "chosen per boundary cell face",
-            build=_mirror, checker=_check_mirror),
+            build=_mirror, checker=_check_mirror,
+            box_only="its mirror nodes are reflections across a plane face (seed 001 §5.2); "
+                     "across a curved part the reflection needs the local normal and "
+                     "curvature, which this implementation does not take"),
         FamilyTreatment(
             "pddo", "seed 001 §5: peridynamic differential operator (moment matrices exact "
             "for quadratics) for the boundary rows and the equilibrium within 2 delta, LPS "
             "beyond", "Behera, Roy, Anicode, Madenci, Spencer 2022; seed 001 §5.3",
             params=PDDO_PARAMS, theories=STATE, families=FAMILY,
             scope="state-based boxes; the boundary row (Dirichlet or traction) is chosen "
-                  "per boundary node", build=_pddo),
+                  "per boundary node", build=_pddo,
+            box_only="its boundary rows take each node's box face and that face's normal "
+                     "(seed 001 §5.3); a curved part's normal turns within a horizon"),
     ]
 
 

@@ -55,6 +55,8 @@ class BondMethod(Treatment):
 
     closure: Callable[[Mapping], Closure] | None = None
     families: tuple[str, ...] = ("static-state",)
+    #: a closure changes bonds only; the uncorrected model's conditions serve any shape
+    shapes: bool = True
     #: ``checker(cells, params, where)``: refuses parameters before any work
     checker: Callable[[tuple, Mapping, str], None] | None = None
 

@@ -101,6 +101,8 @@ def assemble_plain(problem, closure: Closure | None = None) -> LinearSystem:
     """The uncorrected model (with a closure treatment's ``closure``), module docstring."""
     g = problem.body.grid(0)
     model = _model(problem, g, closure)
+    if problem.shape is not None:
+        return _plain_on_shape(problem, g, model)
     d, ni, nu_ = g.dim, g.n_interior, model.n_unknown_nodes
     solver = static_solver(problem.solver, d, d * nu_)
     P = model.equilibrium_rows()
@@ -130,6 +132,60 @@ def assemble_plain(problem, closure: Closure | None = None) -> LinearSystem:
         if k == face // 2:
             by_face[face] = k * nu_ + nodes
     return _eliminated(model, K, rhs, fixed, values, solver, x_int, by_face)
+
+
+def boundary_nodes(g, shape):
+    """The boundary of a shape's grid as the uncorrected model sees it: Gauss samples
+    along every part (``Shape.samples``: points, arc-length weights, outward normals,
+    part) and the real node each belongs to: the node of the cell that holds the sample
+    (the sample moved 1e-9 h inward, so a sample on a cell face counts for the cell
+    inside), or, where that cell's centre lies outside the shape (a sliver of a cut
+    cell), the nearest real node. On a box's face this is the layer of real nodes
+    nearest the face, as in :func:`assemble_plain`."""
+    from scipy.spatial import cKDTree
+    P, W, N, part = shape.samples(g.spacing)
+    inner = P - 1e-9 * g.spacing * N
+    cell = np.floor((inner - np.asarray(g.origin)) / g.spacing).astype(int)
+    cell = np.clip(cell, 0, np.asarray(g.nodes_per_axis) - 1)
+    node = g.interior_number[g.ext_id(cell)]
+    lost = node < 0
+    if np.any(lost):
+        tree = cKDTree(g.lattice_x[g.interior_ids])
+        node[lost] = tree.query(inner[lost])[1]
+    return P, W, N, part, node
+
+
+def _plain_on_shape(problem, g, model) -> LinearSystem:
+    """:func:`assemble_plain` on a shape (``problem.shape``): a part's prescribed
+    components on the real nodes its samples belong to (:func:`boundary_nodes`), at the
+    exact value at each node; a part's traction as the sum over its samples of
+    t(x, n) w thickness on the node each belongs to, x the sample (``load_point=surface``)
+    or the node (``node``)."""
+    d, ni, nu_ = g.dim, g.n_interior, model.n_unknown_nodes
+    solver = static_solver(problem.solver, d, d * nu_)
+    K = _matrix(model, model.equilibrium_rows(), solver)
+    x_int = g.x[g.interior_ids]
+    rhs = np.zeros((nu_, d))
+    rhs[:ni] = problem.body_load(x_int, model.node_volume[g.interior_ids][:, None])
+    P, W, N, part, node = boundary_nodes(g, problem.shape)
+    names = problem.shape.part_names
+    u_ref = problem.exact(x_int)
+    fixed, values = [], []
+    for name, cond in problem.conditions.items():
+        on = part == names.index(name)
+        if cond.traction is not None:
+            at = P[on] if problem.load_point == "surface" else x_int[node[on]]
+            force = cond.traction(at, N[on]) * (W[on] * problem.thickness)[:, None]
+            for k in range(d):
+                rhs[:ni, k] += np.bincount(node[on], force[:, k], ni)
+        nodes = np.unique(node[on])
+        for k in cond.prescribed:
+            fixed.append(k * nu_ + nodes)
+            values.append(u_ref[nodes, k])
+    counts = {"boundary_nodes": int(np.unique(node).size)}
+    if getattr(g, "jitter", 0):
+        counts["jitter_kept"] = int(g.jitter_kept)
+    return _eliminated(model, K, rhs, fixed, values, solver, x_int, {}, counts=counts)
 
 
 def _eliminated(model, K, rhs, fixed, values, solver, nodes, by_face, **extra):
@@ -235,7 +291,11 @@ def assemble_taylor(problem, order: int, corners: str = "normal-only") -> Linear
     h = 1/12, 1/16, 1/20 (surface nodes N = 1: 1.9 % at 1/20), order 2 0.54 / 0.22 /
     0.105 % (surface nodes N = 2: 0.32 %); why order 1 is that far off is not yet
     investigated. body3d-manufactured's quick grid
-    (10 x 5 x 5) keeps 2 dependent rows and fails as near-singular."""
+    (10 x 5 x 5) keeps 2 dependent rows and fails as near-singular.
+
+    A body that is not a box (``problem.shape``): :func:`_taylor_on_shape`."""
+    if problem.shape is not None:
+        return _taylor_on_shape(problem, order)
     g = problem.body.grid(problem.stencil.reach)
     d = g.dim
     # a face that prescribes every component on its whole face needs no flux rows; a box
@@ -353,6 +413,30 @@ def assemble_taylor(problem, order: int, corners: str = "normal-only") -> Linear
     return LinearSystem(model, M, np.r_[rhs, np.zeros(A.shape[0] - rhs.size + ni), c], *none,
                         ni, solver=solver, coords=np.r_[_coords(model, x_int), x_int, at],
                         reaction=reaction, counts=counts)
+
+
+def _taylor_on_shape(problem, order: int) -> LinearSystem:
+    """Taylor's fictitious nodes along the local normal of a shape, the conditions as
+    constraint rows by Lagrange multipliers (``corrections.shape_fictitious``)."""
+    from .shape_fictitious import condition_rows, normal_closure
+    g = problem.body.grid(problem.stencil.reach)
+    # the fictitious layer completes the lattice: every real node keeps its whole cell
+    # (a cut cell's outside part is the fictitious nodes'), so that an affine field, or
+    # a quadratic one on an isotropic stencil, is a solution as on the box
+    g.node_volume[g.interior_ids] = g.volume
+    model = _model(problem, g, normal_closure(g, problem.shape, order))
+    ni = g.n_interior
+    x_int = g.x[g.interior_ids]
+    rhs = problem.body_load(x_int, model.node_volume[g.interior_ids][:, None]).T.ravel()
+    B, c, points = condition_rows(g, problem, order, boundary_nodes(g, problem.shape),
+                                  problem.constants.moduli())
+    counts = {"fictitious_nodes": int(np.sum(g.kind == 1)), "constraints": int(B.shape[0]),
+              "boundary_points": int(points)}
+    if getattr(g, "jitter", 0):
+        counts["jitter_kept"] = int(g.jitter_kept)
+    none = np.zeros(0, dtype=int), np.zeros(0)
+    return LinearSystem(model, model.stiffness(model.equilibrium_rows()), rhs, *none, ni,
+                        B=B, c=c, counts=counts)
 
 
 def _bond_forces(model, solver, bonds=None):

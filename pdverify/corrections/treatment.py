@@ -97,6 +97,11 @@ class Treatment:
     baseline: bool = False
     #: ``((family, Role), ...)``: the problem families beyond ``families`` it serves
     roles: tuple[tuple[str, Role], ...] = ()
+    #: True when it can assemble a body that is not a box (a ``StaticProblem`` with a
+    #: ``shape``: conditions keyed by boundary parts, cut cells, curved parts);
+    #: ``box_only``: why not, when it cannot (``list`` shows it on the shape scenes)
+    shapes: bool = False
+    box_only: str = ""
 
     def __post_init__(self):
         bad = [t for t in self.theories if t not in THEORIES]
@@ -190,4 +195,5 @@ class Treatment:
                 "scenes": None if self.scenes is None else list(self.scenes),
                 "roles": [f for f, _ in self.roles],
                 "scope": self.scope, "params": {p.name: p.default for p in self.params},
-                "unavailable": self.unavailable, "origin": self.origin}
+                "unavailable": self.unavailable, "origin": self.origin,
+                "shapes": self.shapes, "box_only": self.box_only}

@@ -53,7 +53,7 @@ class BondBasedModel:
         a, b, which = bond_pairs(grid.ext_shape, offsets)
         keep = closure.bond_mask(grid, a, b) & live[which]
         a, b, which = a[keep], b[keep], which[keep]
-        xi = (grid.index[b] - grid.index[a]) * h
+        xi = grid.bond_vectors(a, b)
         x = np.linalg.norm(xi, axis=1)
         self.bond_a, self.bond_b, self.bond_which = a, b, which
         self.bond_x, self.bond_n = x, xi / x[:, None]

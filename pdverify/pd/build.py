@@ -5,7 +5,9 @@ Every PD model of pdverify is built here, from a description:
 - :class:`Body`: the box ``origin + [0, lengths]``, node ``spacing``, where the nodes sit
   (``placement``: cell centres or on the surface), the end cells' volumes
   (``boundary_volume``) and the ``thickness`` that multiplies volumes and face areas
-  (1D: the cross-section, 2D: the thickness, 3D: 1);
+  (1D: the cross-section, 2D: the thickness, 3D: 1); or a 2D ``shape``
+  (``pdverify.pd.shapes``) cut from the lattice of that box, its nodes moved by
+  ``jitter`` (a fraction of the spacing, seeded: :class:`~pdverify.pd.grid.ShapeGrid`);
 - the stencil (``pdverify.pd.bonds``: offsets and weights beta of one horizon);
 - the material: :class:`StateMaterial` (the linear state-based model: constants of energy
   equivalence, the influence function, m of a complete neighbourhood) or
@@ -28,14 +30,15 @@ from typing import Callable, Union
 from .bondbased import BondBasedModel
 from .bonds import Stencil
 from .closure import Closure
-from .grid import BoxGrid
+from .grid import BoxGrid, ShapeGrid
 from .influence import Influence, StateBasedConstants
 from .statebased import StateBasedModel
 
 
 @dataclass(frozen=True)
 class Body:
-    """A box of nodes (module docstring); :meth:`grid` lays them out."""
+    """A box of nodes, or a shape cut from one (module docstring); :meth:`grid` lays
+    them out."""
 
     lengths: tuple
     origin: tuple
@@ -43,9 +46,18 @@ class Body:
     placement: str = "cell-centred"
     boundary_volume: str = "partial"
     thickness: float = 1.0
+    shape: object = None
+    jitter: float = 0.0
+    jitter_seed: int = 0
 
     def grid(self, layers: int = 0) -> BoxGrid:
         """The body's nodes, extended by ``layers`` fictitious layers on every side."""
+        if self.shape is not None:
+            return ShapeGrid(tuple(self.lengths), tuple(self.origin), float(self.spacing),
+                             layers, shape=self.shape, jitter=float(self.jitter),
+                             jitter_seed=int(self.jitter_seed))
+        if self.jitter:
+            raise ValueError("jitter needs a shape's grid (a box: its shape's polygon)")
         return BoxGrid(tuple(self.lengths), tuple(self.origin), float(self.spacing), layers,
                        placement=self.placement, boundary_volume=self.boundary_volume)
 

@@ -24,7 +24,8 @@ class Closure:
 
     - ``keep``: which stencil pairs of the (extended) grid are bonds, as a mask over
       ``bond_pairs(grid.ext_shape, stencil.half_offsets)`` or a function ``keep(a, b)``
-      returning one; default: pairs with at least one real node.
+      returning one; default: pairs with at least one real node (and, on a shape's
+      grid, no void node: ``ShapeGrid.is_void``).
     - ``weighted_volume``: ``truncated`` or ``complete`` (see :data:`WEIGHTED_VOLUMES`).
     - ``displacement_map`` (n_ext x n_unknown_nodes): all node displacements from the
       unknowns, per component (identity on real nodes, extrapolation rows on fictitious
@@ -86,7 +87,9 @@ class Closure:
     def bond_mask(self, grid, a, b) -> np.ndarray:
         """Which of the candidate pairs a-b are bonds (see ``keep``)."""
         if self.keep is None:
-            return grid.is_interior[a] | grid.is_interior[b]
+            mask = grid.is_interior[a] | grid.is_interior[b]
+            void = getattr(grid, "is_void", None)   # a shape's lattice outside its layer
+            return mask if void is None else mask & ~void[a] & ~void[b]
         mask = self.keep(a, b) if callable(self.keep) else np.asarray(self.keep, dtype=bool)
         if mask.shape != a.shape:
             raise ValueError(f"keep: {mask.shape[0]} flags for {a.size} candidate pairs")

@@ -168,3 +168,95 @@ class BoxGrid:
         lo = x - np.asarray(self.origin)
         hi = np.asarray(self.origin) + np.asarray(self.lengths) - x
         return np.minimum(lo, hi).min(axis=-1)
+
+    # ------------------------------------------------------------------ bonds
+    def bond_vectors(self, a, b) -> np.ndarray:
+        """Bond vectors x_b - x_a of node pairs: on the lattice, index differences times
+        the spacing (exact multiples of h)."""
+        return (self.index[b] - self.index[a]) * self.spacing
+
+
+#: nodes of a shape's bounding lattice that are neither real nor fictitious
+KIND_VOID = 2
+
+
+@dataclass
+class ShapeGrid(BoxGrid):
+    """The nodes of a 2D :class:`~pdverify.pd.shapes.Shape` cut from the uniform lattice of
+    its bounding box ``origin + [0, lengths]`` (cell-centred).
+
+    A node is real when its cell centre lies inside the shape; its volume is the part of
+    its cell inside the shape (:meth:`Shape.fractions`; the slivers of cut cells whose
+    centre lies outside are left out, so the body's volume is short by at most half a cell
+    per boundary cell). The lattice nodes outside the shape within ``layers`` spacings of
+    a real node along every axis (the stencil's reach) are the fictitious layer (every bond of a real node within that reach
+    ends on a real or fictitious node); the others are void (no bonds, ``KIND_VOID``).
+
+    ``jitter``: every real node moves by a seeded random vector, uniform in the square of
+    side ``jitter * spacing`` about its lattice point (``jitter_seed``); a node the move
+    would take out of the shape stays at its lattice point (``jitter_kept`` counts them).
+    The bond family stays the lattice's (the stencil's offsets, weights and cell volumes);
+    the bonds' lengths and directions come from the moved positions
+    (:meth:`bond_vectors`).
+    """
+
+    shape: object = None
+    jitter: float = 0.0
+    jitter_seed: int = 0
+
+    def __post_init__(self):
+        if self.placement != "cell-centred":
+            raise ValueError("a shape is cut from a cell-centred lattice")
+        super().__post_init__()
+        if self.dim != 2 or getattr(self.shape, "dim", None) != 2:
+            raise ValueError("shapes are 2D")
+        s = self.shape
+        lattice = self.x.copy()
+        inside = s.inside(lattice)
+        self.is_interior = inside
+        fictitious = np.zeros_like(inside)
+        if self.layers:
+            from scipy.spatial import cKDTree
+            out = np.flatnonzero(~inside)
+            reach = self.layers * self.spacing * (1 + 1e-12)
+            dist = cKDTree(lattice[inside]).query(lattice[out], p=np.inf,
+                                                  distance_upper_bound=reach)[0]
+            fictitious[out[np.isfinite(dist)]] = True
+        self.is_void = ~inside & ~fictitious
+        self.kind = np.where(inside, KIND_INTERIOR,
+                             np.where(fictitious, KIND_FICTITIOUS, KIND_VOID))
+        self.interior_ids = np.flatnonzero(inside)
+        self.interior_number = np.full(self.index.shape[0], -1)
+        self.interior_number[self.interior_ids] = np.arange(self.interior_ids.size)
+        self.node_volume = np.full(self.index.shape[0], self.volume)
+        self.node_volume[self.interior_ids] = self.volume * s.fractions(
+            lattice[self.interior_ids], self.spacing)
+        self.lattice_x = lattice
+        self.jitter_kept = 0
+        if self.jitter:
+            rng = np.random.default_rng(self.jitter_seed)
+            ids = self.interior_ids
+            move = rng.uniform(-0.5, 0.5, size=(ids.size, 2)) * self.jitter * self.spacing
+            moved = lattice[ids] + move
+            stays = ~s.inside(moved)
+            moved[stays] = lattice[ids][stays]
+            self.x = lattice.copy()
+            self.x[ids] = moved
+            self.jitter_kept = int(stays.sum())
+
+    def _build_surface(self):
+        """No box surface nodes: a shape's boundary is its parts (``Shape.samples``)."""
+        self.faces = ()
+        self.face_start = np.zeros(1, dtype=int)
+        self.surface_cell = np.zeros((0, 2), dtype=int)
+        self.surface_x = np.zeros((0, 2))
+        self.surface_normal = np.zeros((0, 2))
+        self.surface_face = np.zeros(0, dtype=int)
+
+    def bond_vectors(self, a, b) -> np.ndarray:
+        if not self.jitter:
+            return super().bond_vectors(a, b)
+        return self.x[b] - self.x[a]
+
+    def distance_to_surface(self, x) -> np.ndarray:
+        return self.shape.closest(np.asarray(x, dtype=float))[2]

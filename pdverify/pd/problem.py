@@ -15,6 +15,10 @@ value its reference has); ``where(cells) -> mask`` restricts them to part of the
 normal) -> (n, d)`` is the applied traction (the other components; ``None``: free).
 Faces not listed are traction-free. A treatment that cannot impose a condition as
 stated (e.g. part of a face) says so through :meth:`StaticProblem.whole_faces`.
+
+A body that is not a box (``shape``, 2D: ``pdverify.pd.shapes``) keys its conditions by
+its boundary parts' names (``hole``, ``notch-x``, ...) instead of faces; a part's
+condition covers the whole part.
 """
 from __future__ import annotations
 
@@ -127,11 +131,22 @@ class StaticProblem:
     where: str = "static problem"
     #: m of a complete neighbourhood (``StateBasedModel``'s ``complete_m``)
     complete_m: str = "stencil"
+    #: a 2D body that is not the box (``pdverify.pd.shapes``): ``lengths``/``origin`` are
+    #: its bounding box, ``conditions`` are keyed by its boundary parts' names
+    shape: object = None
+    #: the real nodes' random displacement, a fraction of the spacing (shapes only)
+    jitter: float = 0.0
+    jitter_seed: int = 0
 
     def __post_init__(self):
-        bad = [f for f in self.conditions if f not in FACES[:2 * len(self.lengths)]]
+        allowed = (FACES[:2 * len(self.lengths)] if self.shape is None
+                   else self.shape.part_names)
+        bad = [f for f in self.conditions if f not in allowed]
         if bad:
-            raise ValueError(f"faces {bad}: allowed {FACES[:2 * len(self.lengths)]}")
+            raise ValueError(f"faces {bad}: allowed {allowed}")
+        if self.shape is not None and any(c.where is not None
+                                          for c in self.conditions.values()):
+            raise ValueError("a shape's conditions cover whole parts (no 'where')")
         if self.face_load not in FACE_LOADS or self.load_point not in LOAD_POINTS:
             raise ValueError(f"face_load={self.face_load!r}, load_point={self.load_point!r}")
 
@@ -143,7 +158,8 @@ class StaticProblem:
     def body(self) -> Body:
         """The box of cell-centred nodes (``pdverify.pd.build``)."""
         return Body(tuple(self.lengths), tuple(self.origin), float(self.spacing),
-                    thickness=self.thickness)
+                    thickness=self.thickness, shape=self.shape, jitter=self.jitter,
+                    jitter_seed=self.jitter_seed)
 
     @property
     def material(self) -> StateMaterial:

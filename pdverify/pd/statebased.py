@@ -90,7 +90,7 @@ class StateBasedModel:
         keep = closure.bond_mask(grid, a, b)
         a, b, which = a[keep], b[keep], which[keep]
         self.bond_a, self.bond_b = a, b
-        xi = (grid.index[b] - grid.index[a]) * h
+        xi = grid.bond_vectors(a, b)
         x = np.linalg.norm(xi, axis=1)
         self.bond_n = xi / x[:, None]
         self.bond_x = x

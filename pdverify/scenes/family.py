@@ -40,7 +40,13 @@ class StaticStateScene(Scene):
         """Metrics, fields and size of a solved system."""
         raise NotImplementedError
 
+    #: True for a scene whose body is not a box (``problem(...).shape``)
+    has_shape = False
+
     def family_refusal(self, treatment) -> str | None:
+        if self.has_shape and not getattr(treatment, "shapes", False):
+            return (f"box faces only: {treatment.box_only}" if treatment.box_only else
+                    "box faces only (the treatment does not declare shapes)")
         if treatment.whole_faces_only and not self._whole_faces():
             return (f"{treatment.scope or 'whole-face conditions only'}; this scene "
                     "prescribes a component on part of a face")
