@@ -100,7 +100,12 @@ def node_set(scene, overrides=None) -> NodeSet:
     p = scene.resolve(METHOD, overrides)
     problem = scene.problem(p, f"{scene.id}/{METHOD}")
     treatment = scene.treatment(METHOD)
-    system = treatment.assemble(problem, p)
+    return node_set_of(scene, p, problem, treatment.assemble(problem, p))
+
+
+def node_set_of(scene, p, problem, system) -> NodeSet:
+    """The arrays of an uncorrected ``system`` of ``problem`` (any body the family's
+    ``none`` assembles: a box, or a shape with cut volumes)."""
     g = system.model.grid
     ni, nu_, d = g.n_interior, system.n_unknown_nodes, g.dim
     if nu_ != ni or system.B is not None or system.offset is not None:

@@ -464,3 +464,46 @@ def test_report_include_and_compare(tmp_path):
     proc = cli("report", "--quick", "--only", "bar1d-traction", "--include",
                str(out / "results.json"), "--out", str(tmp_path / "rep2"))
     assert proc.returncode == 2 and "not an external run" in proc.stderr
+
+
+def test_a_shape_body_exports_its_cut_volumes_and_part_loads(tmp_path):
+    """A body that is not a box (pdverify.pd.shapes: the quarter plate with a hole), as
+    the family's uncorrected model assembles it: the node set holds its real nodes with
+    their cut volumes, its prescribed part's nodes, and the loads of its traction parts;
+    the CSV and PeriLab writers take it as a box's."""
+    from types import SimpleNamespace
+    from pdverify.corrections.static_state import assemble_plain
+    from pdverify.decks import csv_files, perilab_files
+    from pdverify.exchange import node_set_of
+    from pdverify.pd import StateBasedConstants, get_influence, state_based_stencil
+    from pdverify.pd.problem import FaceCondition, StaticProblem
+    from pdverify.pd.shapes import quarter_hole
+    h, t = 0.05, 0.01
+    shape = quarter_hole(1.0, 0.2)
+    inf = get_influence("hyperbolic")
+    pull = FaceCondition(traction=lambda x, n: np.c_[np.full(len(x), 1e6), np.zeros(len(x))])
+    conds = {k: (FaceCondition(prescribed=(0, 1)) if k == "x-" else
+                 pull if k == "x+" else FaceCondition()) for k in shape.part_names}
+    problem = StaticProblem(tuple(np.subtract(shape.upper, shape.lower)), (0.0, 0.0), h,
+                            state_based_stencil(2, 3.0, h, inf, "partial-volume"),
+                            StateBasedConstants("plane-stress", 1e9, 0.3), inf, conds,
+                            exact=lambda x: np.zeros_like(x), thickness=t, solver="direct",
+                            shape=shape)
+    system = assemble_plain(problem)
+    scene = SimpleNamespace(id="shape-test", title="quarter plate", reference="none",
+                            default_params=dict)
+    ns = node_set_of(scene, {}, problem, system)
+    g = system.model.grid
+    assert len(ns.x) == g.n_interior and ns.x.shape[1] == 2
+    # the cut volumes: each at most a whole cell, and together the plate's area times t
+    # (1 - pi 0.2^2 / 4: the sampled cut fractions, to their sampling error ~1e-3)
+    assert ns.volume.max() <= h * h * t * (1 + 1e-12) and ns.volume.min() < 0.9 * h * h * t
+    np.testing.assert_allclose(ns.volume.sum(), t * (1 - np.pi * 0.04 / 4), rtol=2e-3)
+    # the x+ part's traction: 1e6 Pa over its length 1 m times t, in x only
+    np.testing.assert_allclose(ns.forces.sum(axis=0), [1e6 * t, 0.0], rtol=1e-12, atol=1e-6)
+    assert set(ns.fixed) == {0, 1} and np.all(ns.x[ns.fixed[0][0], 0] < 2 * h)
+    files = {**csv_files(ns), **perilab_files(ns)}
+    rows = files["nodes.csv"].splitlines()
+    assert len(rows) == len(ns.x) + 1
+    np.testing.assert_array_equal([float(r.split(",")[3]) for r in rows[1:]], ns.volume)
+    assert files["perilab/mesh.txt"].splitlines()[0] == "header: x y block_id volume"
