@@ -194,15 +194,19 @@ def _read_csv(path: str, dim: int) -> Displacements:
 
 
 def _read_mesh(path: str, dim: int, kind: str) -> Displacements:
+    import contextlib
     import meshio
-    try:
-        mesh = meshio.read(path)
+    said = io.StringIO()
+    try:   # meshio prints its own error and calls sys.exit on a file it cannot read
+        with contextlib.redirect_stderr(said), contextlib.redirect_stdout(said):
+            mesh = meshio.read(path, file_format="vtu" if kind == "vtu" else "exodus")
     except ModuleNotFoundError as exc:
         raise InputError(f"displacement file {path!r}: reading {kind} needs the package "
                          f"{exc.name!r} (python -m pip install {exc.name})") from None
-    except Exception as exc:
+    except (Exception, SystemExit) as exc:
+        why = " ".join(said.getvalue().split()) or f"{type(exc).__name__}: {exc}"
         raise InputError(f"displacement file {path!r} cannot be read as {kind} "
-                         f"({type(exc).__name__}: {exc})") from None
+                         f"({why})") from None
     data = {k.lower(): np.asarray(v, dtype=float) for k, v in mesh.point_data.items()}
     u = next((data[k] for k in ("u", "displacement", "displacements") if k in data), None)
     if u is None:

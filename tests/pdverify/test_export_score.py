@@ -209,6 +209,12 @@ def test_bad_input_is_one_line_exit_2(tmp_path, capsys):
     _write_csv(good, x, u)
     nocols = tmp_path / "nocols.csv"
     nocols.write_text("x,uy\n0.025,0\n")
+    binary = tmp_path / "binary.csv"
+    binary.write_bytes(b"\xff\xfe\x00garbage")
+    badvtu = tmp_path / "bad.vtu"
+    badvtu.write_text("not xml")
+    native = tmp_path / "native.json"
+    assert main(["run", "bar1d-traction", "--method", "none", "--json", str(native)]) == 0
     cases = [
         (["export", "bar1d-tracton", "--format", "csv", "--out", str(tmp_path / "a")],
          "did you mean bar1d-traction"),
@@ -229,13 +235,22 @@ def test_bad_input_is_one_line_exit_2(tmp_path, capsys):
         (["score", "bar1d-traction", str(good), "--name", "c", "--out", str(good)],
          "displacement file"),
         (["score", "sheet2d-tension", str(good), "--name", "c"], "cannot be exported"),
+        (["score", "bar1d-traction", str(binary), "--name", "c"], "cannot be read"),
+        (["score", "bar1d-traction", str(badvtu), "--name", "c"], "cannot be read as vtu"),
+        (["score", "bar1d-traction", str(tmp_path), "--name", "c"], "is a folder"),
+        (["report", "--quick", "--only", "bar1d-traction", "--include",
+          str(tmp_path / "none.json"), "--out", str(tmp_path / "rep")], "does not exist"),
+        (["report", "--quick", "--only", "bar1d-traction", "--include", str(native),
+          "--out", str(tmp_path / "rep")], "not an external run"),
+        (["report", "--quick", "--only", "bar1d-traction", "--include", str(good),
+          "--out", str(tmp_path / "rep")], "not valid JSON"),
     ]
     for argv, needle in cases:
         assert main(argv) == 2, argv
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and needle in err, (argv, err)
     assert (foreign / "notes.txt").read_text() == "keep me"
-    assert not (tmp_path / "a").exists()
+    assert not (tmp_path / "a").exists() and not (tmp_path / "rep").exists()
 
 
 def test_export_replaces_only_its_own_folder(tmp_path, capsys):
