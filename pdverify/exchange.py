@@ -147,16 +147,19 @@ _U_NAMES = ("u{a}", "u_{a}", "displacement_{a}", "displacements_{a}", "displacem
 
 def read_displacements(path: str, dim: int) -> Displacements:
     """Positions and displacements from a CSV (header row: ``x, y, z`` and ``ux, uy,
-    uz`` or ``u_x``..., units in brackets allowed, ``#`` lines skipped), a VTU or an
-    Exodus file (meshio: points and a point array ``u``/``displacement(s)`` or its
-    components). Any problem is InputError naming the file."""
+    uz`` or ``u_x``..., units in brackets allowed, ``#`` lines skipped), a VTU (meshio:
+    points and a point array ``u``/``displacement(s)`` or its components) or an Exodus
+    file (:func:`_read_exodus`: its last time step). Any problem is InputError naming
+    the file."""
     from .validate import input_file
     input_file(path, "displacement file")
     ext = os.path.splitext(path)[1].lower()
     if ext in (".csv", ".txt"):
         return _read_csv(path, dim)
-    if ext in (".vtu", ".e", ".exo", ".ex2", ".exodus"):
-        return _read_mesh(path, dim, "exodus" if ext != ".vtu" else "vtu")
+    if ext == ".vtu":
+        return _read_mesh(path, dim, "vtu")
+    if ext in (".e", ".exo", ".ex2", ".exodus"):
+        return _read_exodus(path, dim)
     raise InputError(f"displacement file {path!r}: unknown kind {ext or '(no extension)'!r}; "
                      "allowed: .csv, .vtu, .e/.exo (Exodus, read through meshio)")
 
@@ -199,7 +202,7 @@ def _read_mesh(path: str, dim: int, kind: str) -> Displacements:
     said = io.StringIO()
     try:   # meshio prints its own error and calls sys.exit on a file it cannot read
         with contextlib.redirect_stderr(said), contextlib.redirect_stdout(said):
-            mesh = meshio.read(path, file_format="vtu" if kind == "vtu" else "exodus")
+            mesh = meshio.read(path, file_format=kind)
     except ModuleNotFoundError as exc:
         raise InputError(f"displacement file {path!r}: reading {kind} needs the package "
                          f"{exc.name!r} (python -m pip install {exc.name})") from None
@@ -208,24 +211,94 @@ def _read_mesh(path: str, dim: int, kind: str) -> Displacements:
         raise InputError(f"displacement file {path!r} cannot be read as {kind} "
                          f"({why})") from None
     data = {k.lower(): np.asarray(v, dtype=float) for k, v in mesh.point_data.items()}
+    u = _nodal_vectors(path, dim, data, list(mesh.point_data))
+    x = np.asarray(mesh.points, dtype=float)
+    _check_finite(path, np.c_[x[:, :dim], u])
+    return Displacements(path, kind, x[:, :dim], u)
+
+
+def _nodal_vectors(path, dim, data: dict, have) -> np.ndarray:
+    """The displacement among point arrays ``data`` (lower-case names): a vector ``u``
+    or ``displacement(s)``, or its components (``ux``, ``displacementx`` as Peridigm's
+    Exodus output names them, ``displacementsx`` as PeriLab's, ...)."""
     u = next((data[k] for k in ("u", "displacement", "displacements") if k in data), None)
     if u is None:
-        comps = []
-        for a in AXES[:dim]:
-            comps.append(next((data[n.format(a=a)] for n in _U_NAMES
-                               if n.format(a=a) in data), None))
+        comps = [next((data[n.format(a=a)] for n in _U_NAMES if n.format(a=a) in data),
+                      None) for a in AXES[:dim]]
         if all(c is not None for c in comps):
             u = np.column_stack(comps)
     if u is None:
         raise InputError(f"displacement file {path!r}: no point array 'u', 'displacement' "
-                         f"or its components; it has {', '.join(mesh.point_data) or 'none'}")
+                         f"or its components; it has {', '.join(have) or 'none'}")
+    u = np.asarray(u, dtype=float)
     u = u.reshape(len(u), -1)
     if u.shape[1] < dim:
         raise InputError(f"displacement file {path!r}: its displacement has {u.shape[1]} "
                          f"components, the scene {dim}")
-    x = np.asarray(mesh.points, dtype=float)
-    _check_finite(path, np.c_[x[:, :dim], u[:, :dim]])
-    return Displacements(path, kind, x[:, :dim], u[:, :dim])
+    return u[:, :dim]
+
+
+def _read_exodus(path: str, dim: int) -> Displacements:
+    """An Exodus II file's node coordinates and the displacement of its LAST time step
+    (a static run's output holds the initial state first; meshio's reader takes the
+    first step only, so it is not used). NetCDF classic and 64-bit-offset files are read
+    by scipy; NetCDF-4 (HDF5) files need the netCDF4 package."""
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(8)
+    except OSError as exc:
+        raise InputError(f"displacement file {path!r} cannot be read ({exc})") from None
+    try:
+        if head.startswith(b"CDF"):
+            from scipy.io import netcdf_file
+            with netcdf_file(path, "r", mmap=False) as nc:
+                found = {k: np.array(v[:]) for k, v in nc.variables.items()}
+        elif head.startswith(b"\x89HDF"):
+            import netCDF4
+            with netCDF4.Dataset(path) as nc:
+                found = {}
+                for k, v in nc.variables.items():
+                    v.set_auto_mask(False)
+                    found[k] = np.array(v[:])
+        else:
+            raise InputError(f"displacement file {path!r} is not an Exodus (NetCDF) file")
+    except ModuleNotFoundError as exc:
+        raise InputError(f"displacement file {path!r}: reading a NetCDF-4 Exodus file "
+                         f"needs the package {exc.name!r} (python -m pip install "
+                         f"{exc.name})") from None
+    except InputError:
+        raise
+    except Exception as exc:
+        raise InputError(f"displacement file {path!r} cannot be read as Exodus "
+                         f"({type(exc).__name__}: {exc})") from None
+
+    def text(rows):
+        return [b"".join(np.atleast_1d(r).astype("S1")).decode("utf-8", "replace")
+                .strip("\x00 ") for r in np.atleast_2d(rows)]
+
+    if "coord" in found:
+        x = np.asarray(found["coord"], dtype=float).T
+    elif "coordx" in found:
+        x = np.column_stack([found[k] for k in ("coordx", "coordy", "coordz") if k in found])
+    else:
+        raise InputError(f"displacement file {path!r}: no node coordinates (coordx / coord)")
+    names = text(found["name_nod_var"]) if "name_nod_var" in found else []
+    step = -1
+    data = {}
+    for k, name in enumerate(names):
+        if f"vals_nod_var{k + 1}" in found:
+            values = found[f"vals_nod_var{k + 1}"]
+            data[name.lower()] = values[step]
+        elif "vals_nod_var" in found:
+            data[name.lower()] = found["vals_nod_var"][step, k]
+    u = _nodal_vectors(path, dim, data, names)
+    times = found.get("time_whole")
+    x = x.reshape(len(x), -1)
+    if len(x) != len(u):
+        raise InputError(f"displacement file {path!r}: {len(x)} nodes but {len(u)} values")
+    _check_finite(path, np.c_[x[:, :dim], u])
+    return Displacements(path, "exodus", x[:, :dim], u,
+                         None if times is None or not len(times) else float(times[step]))
 
 
 def _check_finite(path, data) -> None:
@@ -296,6 +369,7 @@ def score(scene_id: str, path: str, *, name: str, overrides=None):
         if len(nodes):
             deviation = max(deviation, float(np.max(np.abs(U[nodes, k] - values))))
     source = {"file": os.path.abspath(path), "kind": given.kind, "nodes": n,
+              **({"time": given.time_s} if given.time_s is not None else {}),
               "match_tolerance_m": MATCH_TOLERANCE * ns.spacing,
               "prescribed_max_deviation_m": deviation,
               "cost_measured": False}

@@ -265,13 +265,60 @@ def test_export_replaces_only_its_own_folder(tmp_path, capsys):
     assert (out / "mine.txt").read_text() == "x"
 
 
-def test_exodus_needs_netcdf4(tmp_path, capsys):
-    """meshio reads Exodus through netCDF4; without it the message names the package."""
+def _write_exodus(path, x, u, names, layout):
+    """An Exodus II file as NetCDF classic (64-bit offset), the subset a reader needs:
+    coordinates, nodal variable names, and two time steps (zero, then ``u``) in
+    ``layout`` ``per-variable`` (vals_nod_var1, ...) or ``combined`` (vals_nod_var)."""
+    from scipy.io import netcdf_file
+    n, d = x.shape
+    with netcdf_file(path, "w", version=2) as nc:
+        nc.createDimension("num_nodes", n)
+        nc.createDimension("time_step", 2)
+        nc.createDimension("num_nod_var", d)
+        nc.createDimension("len_name", 33)
+        nc.createVariable("time_whole", "d", ("time_step",))[:] = [0.0, 1.0]
+        for k, a in enumerate("xyz"):
+            nc.createVariable(f"coord{a}", "d", ("num_nodes",))[:] = (
+                x[:, k] if k < d else np.zeros(n))
+        nc.createVariable("name_nod_var", "c", ("num_nod_var", "len_name"))[:] = np.array(
+            [list(name.ljust(33, "\0")) for name in names], dtype="S1")
+        steps = np.stack([np.zeros_like(u), u])            # (time, node, component)
+        if layout == "per-variable":
+            for k in range(d):
+                nc.createVariable(f"vals_nod_var{k + 1}", "d",
+                                  ("time_step", "num_nodes"))[:] = steps[:, :, k]
+        else:
+            nc.createVariable("vals_nod_var", "d", ("time_step", "num_nod_var",
+                                                    "num_nodes"))[:] = steps.transpose(0, 2, 1)
+
+
+@pytest.mark.parametrize("names, layout", [
+    (("DisplacementX", "DisplacementY"), "per-variable"),   # Peridigm's name + "X"
+    (("Displacementsx", "Displacementsy"), "combined"),     # PeriLab's name + "x"
+])
+def test_round_trip_exodus_last_step(tmp_path, capsys, names, layout):
+    """An Exodus result (NetCDF classic, read by scipy) scores the native metrics from
+    its last time step; its first (the initial zero state) would not."""
+    native, x, u = _native("plate2d-plane-strain", {"spacing": 0.1})
+    sent = tmp_path / "result.e"
+    _write_exodus(sent, x[::-1], u[::-1], names, layout)
+    record = tmp_path / "r.json"
+    assert main(["score", "plate2d-plane-strain", str(sent), "--set", "spacing=0.1",
+                 "--name", "exo", "--out", str(record)]) == 0, capsys.readouterr().err
+    run = json.loads(record.read_text())["runs"][0]
+    assert run["diagnostics"]["external"]["kind"] == "exodus"
+    assert run["diagnostics"]["external"]["time"] == 1.0
+    _assert_same_metrics(native, run)
+
+
+def test_exodus_netcdf4_file_needs_netcdf4(tmp_path, capsys):
+    """A NetCDF-4 (HDF5) Exodus file is read through netCDF4; without it the message
+    names the package (netCDF4 is not installed on the machine these tests ran on)."""
     import importlib.util
     if importlib.util.find_spec("netCDF4") is not None:
-        pytest.skip("netCDF4 is installed: Exodus is read")
+        pytest.skip("netCDF4 is installed: NetCDF-4 Exodus files are read")
     f = tmp_path / "result.e"
-    f.write_bytes(b"CDF\x01")
+    f.write_bytes(b"\x89HDF\r\n\x1a\n")
     assert main(["score", "bar1d-traction", str(f), "--name", "c"]) == 2
     assert "netCDF4" in capsys.readouterr().err
 
