@@ -441,8 +441,9 @@ def readme(ns: NodeSet, fmt: str, files) -> str:
              "RESULT: a CSV with a header row naming the columns "
              + ", ".join(AXES[:d]) + " and " + ", ".join(f"u{a}" for a in AXES[:d])
              + " (units in brackets allowed, any order of rows and columns), a VTU with a "
-               "point array `u` or `displacement(s)` (or its components), or an Exodus "
-               "file (read by meshio; needs the netCDF4 package). Every node must lie within "
+               "point array `u` or `displacement(s)` (or its components), or the Exodus "
+               "file the deck writes (its last time step; a NetCDF-4 file needs the "
+               "netCDF4 package). Every node must lie within "
                "1e-3 spacings of one node of this set, one each. Then "
                "`python -m pdverify report --include mycode.json` shows it beside ours.", "",
              "## What the decks can and cannot express", "",
