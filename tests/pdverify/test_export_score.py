@@ -103,6 +103,7 @@ def _round_trip(tmp_path, capsys, scene_id, overrides):
             assert run["method"] == "external:selftest"
             assert run["params"] == json.loads(json.dumps(native.params))
             assert run["diagnostics"]["external"]["prescribed_max_deviation_m"] == 0.0
+            assert run["warnings"] == []
             assert run["timings"] == {"setup_s": 0.0, "solve_s": 0.0, "total_s": 0.0}
             _assert_same_metrics(native, run)
     capsys.readouterr()
@@ -189,6 +190,22 @@ def test_node_mismatch_is_refused(bar_back, capsys, change, needle):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and needle in err, err
     assert not out.exists()
+
+
+def test_other_prescribed_values_are_scored_and_warned(bar_back, capsys):
+    """A code that imposed another value on the prescribed node: its displacements are
+    scored as given (the error shows it) and the record warns."""
+    tmp_path, x, u = bar_back
+    u = u.copy()
+    u[0, 0] = 0.0        # the bar's first node, prescribed at u_cl(x_1) = 2.5e-5 m
+    _write_csv(tmp_path / "back.csv", x, u)
+    out = tmp_path / "r.json"
+    assert main(["score", "bar1d-traction", str(tmp_path / "back.csv"), "--name", "c",
+                 "--out", str(out)]) == 0
+    run = json.loads(out.read_text())["runs"][0]
+    assert run["diagnostics"]["external"]["prescribed_max_deviation_m"] == pytest.approx(
+        2.5e-5, rel=1e-12)
+    assert len(run["warnings"]) == 1 and "prescribed nodes" in run["warnings"][0]
 
 
 def test_node_within_tolerance_is_accepted(bar_back, capsys):
@@ -511,6 +528,7 @@ def test_report_include_and_compare(tmp_path):
     doc = json.loads((out / "results.json").read_text())
     ext = [r for r in doc["runs"] if r["method"] == "external:mycode"]
     assert len(ext) == 1 and ext[0]["diagnostics"]["external"]["cost_measured"] is False
+    assert (out / "figures" / "overview-pareto.png").is_file()
     html = (out / "index.html").read_text()
     assert html.count("external:mycode") >= 2   # the overview's column and the table's row
     assert "external:mycode" in (out / "tables" / "bar1d-traction.csv").read_text()
