@@ -5,11 +5,15 @@ usage:
   python -m pdverify run SCENE [--method M] [--set KEY=VALUE ...] [--json FILE]
                           [--vtu FILE] [--force] [--max-memory SIZE] [--run-timeout SECONDS]
   python -m pdverify report [--out DIR] [--quick] [--only SCENE ...] [--method M ...]
-                          [--failed] [--jobs N]
+                          [--failed] [--jobs N] [--include FILE ...]
                           [--scheduler ADDRESS] [--max-memory SIZE] [--run-timeout SECONDS]
   python -m pdverify compare BASELINE.json NEW.json [--rtol R] [--atol A] [--summary FILE]
                           [--force]
   python -m pdverify compare --against-published RESULTS.json
+  python -m pdverify export SCENE [--method none] [--set KEY=VALUE ...]
+                          --format {csv,vtu,peridigm,perilab} --out DIR
+  python -m pdverify score SCENE FILE [--set KEY=VALUE ...] --name NAME [--out FILE.json]
+                          [--force]
 
 Exit codes: 0 success; 1 a run failed numerically, a regression was found, or an output
 could not be written after the work (one line naming it; a report stays in its staging
@@ -118,6 +122,10 @@ def build_parser() -> argparse.ArgumentParser:
     rep.add_argument("--max-memory", default=None, metavar="SIZE", help=MAX_MEMORY_HELP)
     rep.add_argument("--run-timeout", type=float, default=None, metavar="SECONDS",
                      help=RUN_TIMEOUT_HELP)
+    rep.add_argument("--include", nargs="+", default=None, metavar="FILE",
+                     help="add the external runs of these results files (written by "
+                          "pdverify score) to the report's tables, overview, figures and "
+                          "results.json")
     cmp_ = sub.add_parser("compare", help="compare a results file against a baseline")
     cmp_.add_argument("baseline", nargs="?", help="the stored results.json")
     cmp_.add_argument("new", nargs="?", help="the new results.json")
@@ -131,6 +139,29 @@ def build_parser() -> argparse.ArgumentParser:
     cmp_.add_argument("--summary", default=None, metavar="FILE",
                       help="also write the changes as JSON (FILE.json) or Markdown (else)")
     cmp_.add_argument("--force", action="store_true", help=FORCE_HELP)
+    exp = sub.add_parser("export", help="write a static-state scene's uncorrected problem "
+                                        "as a node set or input deck for another PD code")
+    exp.add_argument("scene", help="a static-state scene (see: python -m pdverify list)")
+    exp.add_argument("--method", default=None,
+                     help="only 'none' (the uncorrected problem) is exported")
+    exp.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                     help="override a scene parameter; repeat for several")
+    exp.add_argument("--format", required=True, dest="fmt",
+                     choices=("csv", "vtu", "peridigm", "perilab"),
+                     help="csv files, a VTU file, or a Peridigm / PeriLab.jl deck")
+    exp.add_argument("--out", required=True, metavar="DIR",
+                     help="output folder: new, empty or a previous export")
+    sco = sub.add_parser("score", help="measure displacements another code computed on an "
+                                       "exported node set, as pdverify measures its runs")
+    sco.add_argument("scene", help="the scene that was exported")
+    sco.add_argument("file", help="displacements: CSV (x, y, z, ux, uy, uz), VTU or Exodus")
+    sco.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                     help="the --set of the export; repeat for several")
+    sco.add_argument("--name", required=True,
+                     help="the code's name; the run's method becomes external:NAME")
+    sco.add_argument("--out", default=None, metavar="FILE.json",
+                     help="write the run record (a one-run results file)")
+    sco.add_argument("--force", action="store_true", help=FORCE_HELP)
     return parser
 
 
@@ -246,7 +277,19 @@ def _dispatch(args) -> int:
                             failed=args.failed,
                             jobs=validate.jobs(args.jobs),
                             run_timeout=validate.run_timeout(args.run_timeout),
-                            scheduler=scheduler_address(args.scheduler))
+                            scheduler=scheduler_address(args.scheduler),
+                            include=args.include)
+    if args.command == "export":
+        from .decks import export_command
+        from .params import parse_assignments
+        return export_command(args.scene, method=args.method,
+                              overrides=parse_assignments(args.set), fmt=args.fmt, out=args.out)
+    if args.command == "score":
+        from .exchange import score_command
+        from .params import parse_assignments
+        return score_command(args.scene, args.file, name=args.name,
+                             overrides=parse_assignments(args.set), out=args.out,
+                             force=args.force)
     if args.command == "compare" and args.against_published is not None:
         extra = [f for f, v in (("BASELINE", args.baseline), ("NEW", args.new),
                                 ("--rtol", args.rtol), ("--atol", args.atol),

@@ -57,8 +57,11 @@ class Change:
 
 
 def current_defaults(scene: str, method: str) -> dict:
-    """Every parameter of (scene, method) at its current default; {} if either is gone."""
+    """Every parameter of (scene, method) at its current default; {} if either is gone.
+    An external run (``external:NAME``, pdverify score) has the uncorrected problem's."""
     from .scenes import get_scene
+    if method.startswith("external:"):
+        method = "none"
     try:
         return get_scene(scene).resolve(method, {})
     except InputError:

@@ -14,6 +14,7 @@ from contextlib import contextmanager
 from .. import outputs
 from ..errors import STOP_REQUESTED, InputError, OutputError
 from ..results import atomic_write_text, run_key, umask_mode, write_results
+from ..exchange import is_external
 from ..runner import plan, run_cases
 from ..scenes import get_scene
 
@@ -123,7 +124,8 @@ def _swap_in(staging: str, out: str) -> None:
 
 
 def build_report(*, out=None, quick=False, only=None, jobs=None, progress=None,
-                 scheduler=None, run_timeout=None, methods=None, failed=False) -> int:
+                 scheduler=None, run_timeout=None, methods=None, failed=False,
+                 include=None) -> int:
     """Run the report; returns 0, or 1 if any run failed. Bad input raises before work.
 
     Figures, results.json and index.html are written into a staging folder next to
@@ -139,18 +141,25 @@ def build_report(*, out=None, quick=False, only=None, jobs=None, progress=None,
     seconds after which a run is killed and recorded as failed (None: no limit).
     ``methods``: only the runs of these methods. ``failed``: rerun only the planned runs
     that failed (unexpectedly) or are missing in the previous report in ``out``, and merge
-    them into it (:func:`rerun_plan`; InputError if there is none).
+    them into it (:func:`rerun_plan`; InputError if there is none). ``include``: results
+    files whose external runs (``pdverify score``) join the report's runs
+    (:func:`pdverify.exchange.load_external`; InputError before any work).
     """
     progress = progress or sys.stderr
     out = outputs.check_out_dir(out or default_out(only, quick, methods))  # links resolved
     cases = plan(only=only, quick=quick, methods=methods)  # InputError on unknown names
+    included = []
+    if include:
+        from ..exchange import load_external
+        included = load_external(include)
     kept = None
     if failed:
         cases, kept = rerun_plan(cases, out)
         if not cases:
             print(f"report --failed: nothing failed or is missing in {out!r}; it is "
                   "unchanged", file=progress)
-            return exit_code(kept)
+            if not included:
+                return exit_code(kept)
         print(f"report --failed: rerunning {len(cases)} run(s) that failed or were missing; "
               f"{len(kept)} kept from the previous report", file=progress)
     check_storage(cases, out)
@@ -165,7 +174,7 @@ def build_report(*, out=None, quick=False, only=None, jobs=None, progress=None,
     try:
         with output_lock(out):
             return _locked(cases, out, parent, name, jobs, progress, client, quick,
-                           run_timeout, kept)
+                           run_timeout, kept, included)
     finally:
         if client is not None:
             client.close()
@@ -223,7 +232,7 @@ def check_storage(cases, out: str) -> None:
 
 
 def _locked(cases, out, parent, name, jobs, progress, client, quick=False,
-            run_timeout=None, kept=None) -> int:
+            run_timeout=None, kept=None, included=()) -> int:
     """The report's body, under the output lock: stage, build, swap in.
 
     A report that could not be written whole (:class:`OutputError`: a figure, a VTU file,
@@ -245,7 +254,7 @@ def _locked(cases, out, parent, name, jobs, progress, client, quick=False,
                               f"({exc.strerror or exc}); nothing was run") from None
         try:
             code = _build(cases, staging, out, jobs, progress, client, quick, run_timeout,
-                          kept)
+                          kept, included)
             _write_marker(staging)
         except OutputError as exc:
             keep = True
@@ -419,7 +428,7 @@ LOG = "report.log"
 
 
 def _build(cases, out, final, jobs, progress, client=None, quick=False,
-           run_timeout=None, kept=None) -> int:
+           run_timeout=None, kept=None, included=()) -> int:
     """The report's work into the staging folder ``out``; the progress lines also go to
     ``out/report.log`` (:data:`LOG`)."""
     from ..progress import Tee
@@ -429,11 +438,11 @@ def _build(cases, out, final, jobs, progress, client=None, quick=False,
         raise OutputError(f"cannot write its log {LOG} ({_describe(exc)})") from None
     with log:
         return _build_logged(cases, out, final, jobs, Tee(progress, log), client, quick,
-                             run_timeout, kept)
+                             run_timeout, kept, included)
 
 
 def _build_logged(cases, out, final, jobs, progress, client=None, quick=False,
-                  run_timeout=None, kept=None) -> int:
+                  run_timeout=None, kept=None, included=()) -> int:
     from ..schedule import critical_path, previous_times
     t0 = time.perf_counter()
     phase = _Phases()
@@ -441,10 +450,14 @@ def _build_logged(cases, out, final, jobs, progress, client=None, quick=False,
     with phase("runs_s"):
         # the previous report in this folder times each run, for the longest-first order
         known = previous_times(os.path.join(final, "results.json"))
-        results = run_cases(cases, jobs=jobs, progress=progress, client=client,
-                            run_timeout=run_timeout, known=known, schedule=slots)
+        results = (run_cases(cases, jobs=jobs, progress=progress, client=client,
+                             run_timeout=run_timeout, known=known, schedule=slots)
+                   if cases else [])   # report --failed --include: only runs to add
     if kept is not None:     # report --failed: the new runs merged into the previous ones
         results = _merged(kept, results)
+    if included:             # report --include: external runs (pdverify score) join them,
+        new = {r.key for r in included}         # replacing a kept copy of the same run
+        results = _merged([r for r in results if r.key not in new], included)
     figdir = os.path.join(out, "figures")
     with phase("figures_s"):
         os.makedirs(figdir, exist_ok=True)
@@ -461,15 +474,17 @@ def _build_logged(cases, out, final, jobs, progress, client=None, quick=False,
         scene = get_scene(scene_id)
         # the scene's own cases; the convergence studies' extra levels have their section
         own = {run_key(scene_id, m, scene.resolve(m, o)) for m, o in scene.report_cases(quick)}
-        mine = [r for r in results if r.scene == scene_id and r.key in own]
+        mine = [r for r in results if r.scene == scene_id
+                and (r.key in own or is_external(r.method))]
         tabled.update(r.key for r in mine)
         owned.append((scene, mine))
     scenes = [scene for scene, _ in owned]
     from ..convergence import collect
-    studies = collect(results, quick)
+    studies = collect([r for r in results if not is_external(r.method)], quick)
     with phase("figures_s"):
         drawn = _draw_all(
-            [(f"figure for {scene.id}", figures.draw, (scene, mine, figdir), [])
+            [(f"figure for {scene.id}", figures.draw,
+              (scene, [r for r in mine if not is_external(r.method)], figdir), [])
              for scene, mine in owned]
             + [("error-against-cost figures", overview.pareto, (scenes, results, figdir), []),
                ("convergence figures", convergence.draw, (studies, figdir), {})],

@@ -35,8 +35,9 @@ def _num(v) -> str:
 
 def _params(result, scene) -> str:
     """The run's params that differ from the scene's and its method's defaults."""
-    try:
-        method_params = scene.method(result.method).params
+    try:   # an external run (pdverify score) holds the uncorrected problem's params
+        method_params = scene.method("none" if _external(result.method)
+                                     else result.method).params
     except InputError:  # a method the scene no longer offers: show everything
         method_params = ()
     defaults = {p.name: p.default for p in tuple(scene.params) + tuple(method_params)}
@@ -64,6 +65,18 @@ def key_metrics(scene, results) -> list[str]:
     return out[:KEY_METRICS]
 
 
+def _external(method: str) -> bool:
+    """A run of another code scored by ``pdverify score`` (``external:NAME``)."""
+    return method.startswith("external:")
+
+
+def _describe(method: str) -> str:
+    if _external(method):
+        return ("another code's displacements on the exported uncorrected problem, measured "
+                "by pdverify score (report --include); its cost is not measured")
+    return describe(method)
+
+
 def _solver(diagnostics) -> dict | None:
     """The linear solver a run used: a short tag for under its solve time and the full
     name (with CG's iteration count in the tag) for on hover."""
@@ -71,7 +84,9 @@ def _solver(diagnostics) -> dict | None:
     if not isinstance(solver, str):
         return None
     its = diagnostics.get("iterations")
-    if solver.startswith("CG"):
+    if solver == "external":
+        tag = "external"
+    elif solver.startswith("CG"):
         tag = f"CG {its} it" if isinstance(its, int) else "CG"
     elif solver.startswith("dense"):
         tag = "dense LU"
@@ -114,6 +129,8 @@ def run_anchor(result) -> str:
 def _row(scene, r, metrics) -> dict:
     """What the compact and the full table show of one run."""
     t = r.timings
+    if _external(r.method):   # no cost pdverify measured
+        t = {"setup_s": "n/a", "solve_s": "n/a", "total_s": "n/a"}
     paper = scene.published_for(r.method, r.params)
     return {
         "anchor": run_anchor(r), "ok": r.status == "ok", "method": r.method, "params": _params(r, scene),
@@ -123,12 +140,16 @@ def _row(scene, r, metrics) -> dict:
                    "paper": _paper_text(paper[m]) if m in paper else None,
                    "source": paper[m].source if m in paper else ""} for m in metrics],
         "all_metrics": [(k, _num(v)) for k, v in r.metrics.items()],
-        "setup": f"{t.get('setup_s', 0):.3g}", "solve": f"{t.get('solve_s', 0):.3g}",
-        "total": f"{t.get('total_s', 0):.3g}", "solver": _solver(r.diagnostics),
+        "setup": _num3(t.get('setup_s', 0)), "solve": _num3(t.get('solve_s', 0)),
+        "total": _num3(t.get('total_s', 0)), "solver": _solver(r.diagnostics),
         "peak": (f", peak memory {r.resources['peak_rss_gb']:.3g} GB"
                  if r.resources.get("peak_rss_gb") else ""),
         "size": ", ".join(f"{k} {v}" for k, v in r.size.items()),
     }
+
+
+def _num3(v) -> str:
+    return v if isinstance(v, str) else f"{v:.3g}"
 
 
 def _refinement(result) -> dict:
@@ -298,7 +319,8 @@ def _value(scene, r, scale) -> dict:
     exact = is_exact(pct)
     return {"text": _pct_text(pct), "exact": exact, "params": _params(r, scene),
             "colour": "" if exact or scale is None else _colour(pct, scale),
-            "cost": f"{cost_s(r):.2g}"}
+            "cost": ("not measured" if _external(r.method)
+                     else f"{cost_s(r):.2g}")}
 
 
 def _overview_cell(scene, m, runs, best, scale) -> dict | None:
@@ -355,6 +377,8 @@ def overview(scenes, results) -> Markup:
     fit a 1400 px screen."""
     from ..listing import method_columns
     methods = method_columns(scenes)
+    # external codes' runs (pdverify score, report --include): a column each, last
+    methods += sorted({r.method for r in results if _external(r.method)})
     scale = overview_scale(scenes, results)
     rows = []
     for scene in scenes:
@@ -408,5 +432,5 @@ def page(doc: dict, sections: list[tuple], total_time: float, results=None,
         overview=overview(scenes, results) if results is not None else "",
         failed=failed_runs(results, tabled),
         front_figures=front_figures, papers=papers(scenes),
-        methods=[(m, describe(m)) for m in sorted({r["method"] for r in runs})],
+        methods=[(m, _describe(m)) for m in sorted({r["method"] for r in runs})],
         sections=sections) + "\n"

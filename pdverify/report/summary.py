@@ -50,7 +50,9 @@ class SceneSummary:
 def summarise(scene, runs) -> SceneSummary:
     picked = {m: default_run(scene, m, runs) for m in dict.fromkeys(r.method for r in runs)}
     values = {m: headline_value(scene, r) for m, r in picked.items() if r is not None}
-    values = {m: v for m, v in values.items() if v is not None}
+    # an external code's run (report --include) is shown, never pdverify's best method
+    values = {m: v for m, v in values.items()
+              if v is not None and not m.startswith("external:")}
     best = min(values, key=values.get) if len(values) > 1 else None
     return SceneSummary(
         scene=scene.id, metric=headline(scene), best=best,

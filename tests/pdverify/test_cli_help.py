@@ -36,10 +36,10 @@ def test_top_level_options_and_every_subcommand_have_a_help_line():
     helped = {a.dest for a in subparsers._choices_actions if a.help}
     missing += [f"command {name}" for name in subparsers.choices if name not in helped]
     assert missing == []
-    assert set(subparsers.choices) == {"list", "run", "report", "compare"}
+    assert set(subparsers.choices) == {"list", "run", "report", "compare", "export", "score"}
 
 
-@pytest.mark.parametrize("command", ["list", "run", "report", "compare"])
+@pytest.mark.parametrize("command", ["list", "run", "report", "compare", "export", "score"])
 def test_each_subcommand_help_prints_and_exits_0(command):
     out = subprocess.run([sys.executable, "-m", "pdverify", command, "--help"],
                          capture_output=True, text=True)

@@ -38,16 +38,20 @@ def panels(scenes, results) -> list[dict]:
     factor 2 of margin; exact runs sit on its floor) and the front's indices."""
     out = []
     for scene in scenes:
-        pts = []
+        pts, external = [], []
         for r in results:
             if r.scene != scene.id:
                 continue
             v = headline_pct(scene, r)
-            if v is not None:
+            if v is None:
+                continue
+            if r.method.startswith("external:"):  # no cost measured: a level, not a point
+                external.append((abs(v), r.method, is_exact(v)))
+            else:
                 pts.append((max(cost_s(r), MIN_TIME_S), abs(v), r.method, is_exact(v)))
         if not pts:
             continue
-        real = [e for _, e, _, x in pts if not x]
+        real = [e for _, e, _, x in pts if not x] + [e for e, _, x in external if not x]
         if real:
             lo, hi = min(real) / 2, max(real) * 2
         else:   # every run exact: a band just above the round-off bound
@@ -55,7 +59,8 @@ def panels(scenes, results) -> list[dict]:
         floor = lo if real else lo * 2
         ranked = [(t, floor if x else e) for t, e, _, x in pts]
         out.append({"scene": scene.id, "metric": headline(scene), "points": pts,
-                    "ylim": (lo, hi), "floor": floor, "front": pareto_front(ranked)})
+                    "ylim": (lo, hi), "floor": floor, "front": pareto_front(ranked),
+                    "external": external})
     return out
 
 
@@ -82,6 +87,14 @@ def pareto(scenes, results, folder) -> list[tuple[str, str]]:
         pts = d["points"]
         ys = [d["floor"] if pts[k][3] else pts[k][1] for k in front]
         ax.plot([pts[k][0] for k in front], ys, "-", color="k", lw=1.0, zorder=2)
+        for e, m, exact in d.get("external", ()):
+            # an external code's run has no cost pdverify measured: its error is drawn as
+            # a level across the panel, named at the right, never on the front
+            y = d["floor"] if exact else e
+            ax.axhline(y, color="tab:red", lw=0.9, ls="--", zorder=2)
+            ax.annotate(m, (1.0, y), xycoords=("axes fraction", "data"), xytext=(-2, 2),
+                        textcoords="offset points", ha="right", fontsize=6.5,
+                        color="tab:red", zorder=4)
         named = []
         for k, y in zip(front, ys):
             m = pts[k][2]
@@ -110,6 +123,9 @@ def pareto(scenes, results, folder) -> list[tuple[str, str]]:
     handles.append(plt.Line2D([], [], ls="none", marker="v", color="0.6",
                               label="exact (round-off), on the floor"))
     handles.append(plt.Line2D([], [], color="k", lw=1.0, label="Pareto front"))
+    if any(d.get("external") for d in data):
+        handles.append(plt.Line2D([], [], color="tab:red", lw=0.9, ls="--",
+                                  label="external code (error; cost not measured)"))
     # above the panels (below them it ran into the bottom row's axis labels)
     fig.legend(handles=handles, loc="lower center", bbox_to_anchor=(0.5, 0.9 + 0.02 / rows),
                ncol=min(len(handles), 7), fontsize=7, frameon=False)
@@ -121,4 +137,6 @@ def pareto(scenes, results, folder) -> list[tuple[str, str]]:
                    "Pareto front, the runs no other run of the scene beats in both error and "
                    "time, the methods on it named. Each y range is clipped to the scene's "
                    "errors that are not round-off; exact runs (|error| at most 1e-8 %) are "
-                   "drawn as triangles on the panel's floor.")]
+                   "drawn as triangles on the panel's floor. A run of another code scored by "
+                   "pdverify (external:NAME) has no cost pdverify measured: its error is a "
+                   "dashed red level across its panel, named at the right, off the front.")]

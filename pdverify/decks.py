@@ -1,0 +1,473 @@
+"""Files of an exported node set (:mod:`pdverify.exchange`): CSV, VTU, and input decks
+for Peridigm (YAML deck + ``Text File`` discretisation) and PeriLab.jl (YAML deck + text
+mesh), written into a folder that holds nothing but pdverify's export (its marker lists
+every file it wrote). Floats are written with ``repr`` (17 significant digits at most,
+read back exactly).
+"""
+from __future__ import annotations
+
+import json
+import os
+
+import numpy as np
+
+from .errors import InputError, OutputError
+from .exchange import AXES, METHOD, NodeSet, describe_json, dumps
+
+FORMATS = ("csv", "vtu", "peridigm", "perilab")
+MARKER = ".pdverify-export"
+MARKER_SCHEMA = "pdverify.export-folder/1"
+#: Peridigm's and PeriLab's QuasiStatic/Static runs need a density (inertia is not used
+#: by a static solve); any positive value
+DENSITY = 1000.0
+#: influence functions as the other codes' expressions: Peridigm's RTC knows ``zeta``
+#: (bond length) and ``horizon``; PeriLab's ``xi`` (bond length); omega's scale cancels
+#: in the linear state-based force (it enters as omega / m)
+PERIDIGM_INFLUENCE = {"constant": "One", "hyperbolic": "horizon/zeta",
+                      "conical": "1.0 - zeta/horizon",
+                      "gaussian": "exp(-zeta*zeta/(horizon*horizon))"}
+
+
+def f(v) -> str:
+    """A float as text that reads back to the same double."""
+    return repr(float(v))
+
+
+# ------------------------------------------------------------------------------ folder
+def check_out(path: str) -> str:
+    """``--out DIR``: new, empty, or a previous export (its marker lists everything in
+    it); anything else is InputError before any work. Returns the absolute path."""
+    if not str(path).strip():
+        raise InputError(f"--out {path!r}: empty path; give a folder")
+    full = os.path.realpath(os.path.expanduser(str(path)))
+    if os.path.exists(full) and not os.path.isdir(full):
+        raise InputError(f"--out {path!r} is a file, not a folder")
+    if os.path.isdir(full):
+        entries = _tree(full)
+        if entries:
+            listed = _marker_entries(full)
+            if listed is None:
+                raise InputError(f"--out {path!r} is not empty and holds no pdverify export "
+                                 f"(no {MARKER}); choose a new or empty folder")
+            foreign = [e for e in entries if e not in listed]
+            if foreign:
+                raise InputError(f"--out {path!r} holds {foreign[0]!r}, which pdverify's "
+                                 "export did not write; move it or choose another folder")
+    parent = os.path.dirname(full)
+    probe = parent
+    while not os.path.exists(probe):
+        probe = os.path.dirname(probe)
+    if not os.access(probe, os.W_OK):
+        raise InputError(f"--out {path!r}: {probe!r} is not writable")
+    return full
+
+
+def _tree(folder: str) -> list[str]:
+    out = []
+    for dirpath, dirnames, filenames in os.walk(folder):
+        rel = os.path.relpath(dirpath, folder)
+        prefix = "" if rel == "." else rel.replace(os.sep, "/") + "/"
+        out += [prefix + d + "/" for d in dirnames] + [prefix + n for n in filenames]
+    return sorted(out)
+
+
+def _marker_entries(folder: str) -> set | None:
+    try:
+        with open(os.path.join(folder, MARKER), encoding="utf-8") as fh:
+            doc = json.load(fh)
+    except (OSError, ValueError):
+        return None
+    if not isinstance(doc, dict) or doc.get("schema") != MARKER_SCHEMA:
+        return None
+    entries = doc.get("entries")
+    if not isinstance(entries, list) or not all(isinstance(e, str) for e in entries):
+        return None
+    return set(entries) | {MARKER}
+
+
+def _clear(folder: str) -> None:
+    """Remove a previous export's files (only what its marker lists; checked before)."""
+    listed = _marker_entries(folder) or set()
+    for e in sorted(listed, key=len, reverse=True):
+        p = os.path.join(folder, e)
+        if e.endswith("/"):
+            if os.path.isdir(p) and not os.listdir(p):
+                os.rmdir(p)
+        elif os.path.isfile(p):
+            os.unlink(p)
+
+
+def write_export(ns: NodeSet, fmt: str, out: str) -> list[str]:
+    """Write the export of ``ns`` in ``fmt`` into ``out`` (checked by :func:`check_out`);
+    returns the files written, relative to ``out``. A write that fails raises
+    :class:`OutputError` naming the file."""
+    files = {"problem.json": dumps(describe_json(ns))}
+    if fmt == "csv":
+        files.update(csv_files(ns))
+    elif fmt == "peridigm":
+        files.update(peridigm_files(ns))
+    elif fmt == "perilab":
+        files.update(perilab_files(ns))
+    files["README.md"] = readme(ns, fmt, sorted(files) + (["nodes.vtu"] if fmt == "vtu" else []))
+    path = out
+    try:
+        os.makedirs(out, exist_ok=True)
+        _clear(out)
+        written = []
+        for rel, text in files.items():
+            path = os.path.join(out, rel)
+            os.makedirs(os.path.dirname(path), exist_ok=True)
+            with open(path, "w", encoding="utf-8", newline="\n") as fh:
+                fh.write(text)
+            written.append(rel)
+        if fmt == "vtu":
+            path = os.path.join(out, "nodes.vtu")
+            write_vtu(ns, path)
+            written.append("nodes.vtu")
+        entries = sorted(set(_tree(out)) | {MARKER})
+        path = os.path.join(out, MARKER)
+        from . import __version__
+        with open(path, "w", encoding="utf-8") as fh:
+            fh.write(json.dumps({"schema": MARKER_SCHEMA, "pdverify_version": __version__,
+                                 "entries": entries}, indent=1) + "\n")
+    except OSError as exc:
+        raise OutputError(f"cannot write {path!r} ({exc.strerror or exc})") from exc
+    return sorted(written)
+
+
+# ------------------------------------------------------------------------------ command
+def export_command(scene_id: str, *, method=None, overrides=None, fmt: str, out: str,
+                   stream=None) -> int:
+    """``pdverify export``: every check before any work, then assemble and write."""
+    import sys
+    from .exchange import check_method, node_set, scene_of
+    stream = stream or sys.stdout
+    scene = scene_of(scene_id)
+    check_method(method)
+    if fmt not in FORMATS:
+        raise InputError(f"--format {fmt!r}; allowed: {', '.join(FORMATS)}")
+    scene.resolve(METHOD, overrides)
+    folder = check_out(out)
+    from .outputs import check_cache
+    check_cache()       # a FEM scene's prescribed values come from its cached reference
+    ns = node_set(scene, overrides)
+    files = write_export(ns, fmt, folder)
+    print(f"{scene.id} --method {METHOD}: {len(ns.x)} nodes, {ns.dim}D, horizon "
+          f"{ns.horizon:.6g} m -> {out} ({len(files)} files: "
+          + ", ".join(files[:6]) + (", ..." if len(files) > 6 else "") + ")", file=stream)
+    return 0
+
+
+# ------------------------------------------------------------------------------ CSV
+def _rows(header, rows) -> str:
+    return ",".join(header) + "\n" + "".join(",".join(r) + "\n" for r in rows)
+
+
+def _pos(ns, i) -> list[str]:
+    return [f(v) for v in ns.x[i]]
+
+
+def csv_files(ns: NodeSet) -> dict:
+    """``nodes.csv`` (id, position, volume, block), one ``prescribed_u<k>.csv`` per
+    prescribed component (node, position, value), ``loads.csv`` (the loaded nodes'
+    forces and force densities)."""
+    d = ns.dim
+    pos = [f"{a} [m]" for a in AXES[:d]]
+    out = {"nodes.csv": _rows(["node"] + pos + ["volume [m^3]", "block_id"],
+                              ([str(i + 1)] + _pos(ns, i) + [f(ns.volume[i]), "1"]
+                               for i in range(len(ns.x))))}
+    for k, (nodes, values) in ns.fixed.items():
+        out[f"prescribed_u{AXES[k]}.csv"] = _rows(
+            ["node"] + pos + [f"u{AXES[k]} [m]"],
+            ([str(i + 1)] + _pos(ns, i) + [f(v)] for i, v in zip(nodes, values)))
+    loaded = np.flatnonzero(np.any(ns.forces != 0, axis=1))
+    out["loads.csv"] = _rows(
+        ["node"] + pos + [f"f{a} [N]" for a in AXES[:d]] + [f"b{a} [N/m^3]" for a in AXES[:d]],
+        ([str(i + 1)] + _pos(ns, i) + [f(v) for v in ns.forces[i]]
+         + [f(v / ns.volume[i]) for v in ns.forces[i]] for i in loaded))
+    return out
+
+
+# ------------------------------------------------------------------------------ VTU
+def write_vtu(ns: NodeSet, path: str) -> None:
+    """The node set as vertex cells with point data ``volume``, ``block_id``,
+    ``force`` [N], ``force_density`` [N/m^3], and per prescribed component
+    ``prescribed_u<k>`` (1 on its nodes) and ``value_u<k>`` [m]."""
+    import meshio
+    from .export import _pad3
+    from .outputs import VTU_MARK
+    n = len(ns.x)
+    data = {"volume": ns.volume, "block_id": np.ones(n), "force": _pad3(ns.forces),
+            "force_density": _pad3(ns.forces / ns.volume[:, None])}
+    for k, (nodes, values) in ns.fixed.items():
+        mask, val = np.zeros(n), np.zeros(n)
+        mask[nodes], val[nodes] = 1.0, values
+        data[f"prescribed_u{AXES[k]}"], data[f"value_u{AXES[k]}"] = mask, val
+    mesh = meshio.Mesh(_pad3(ns.x), [("vertex", np.arange(n).reshape(-1, 1))],
+                       point_data=data)
+    meshio.write(path, mesh, file_format="vtu")   # binary: the doubles exactly
+    with open(path, encoding="utf-8") as fh:
+        text = fh.read()
+    decl, _, rest = text.partition("\n")
+    with open(path, "w", encoding="utf-8") as fh:
+        fh.write(f"{decl}\n{VTU_MARK} -->\n{rest}")
+
+
+# ------------------------------------------------------------------------------ decks
+def groups(nodes, values):
+    """``[(value, nodes)]``: the nodes of each distinct value (a deck's condition takes
+    one value per node set), in order of first appearance."""
+    nodes, values = np.asarray(nodes), np.asarray(values, dtype=float)
+    uniq, first, inv = np.unique(values, return_index=True, return_inverse=True)
+    return [(float(uniq[j]), nodes[inv == j]) for j in np.argsort(first)]
+
+
+def _node_ids(nodes) -> str:
+    """A node set file: 1-based ids, one per line (Peridigm's and PeriLab's)."""
+    return "".join(f"{i + 1}\n" for i in nodes)
+
+
+def _conditions(ns: NodeSet, density: bool):
+    """``[(set name, file name, nodes, kind, axis, value)]`` of every prescribed group
+    and load group: kind ``displacement`` [m] or ``load`` (force density [N/m^3] if
+    ``density``, else force [N])."""
+    out = []
+    for k, (nodes, values) in ns.fixed.items():
+        for j, (v, grp) in enumerate(groups(nodes, values)):
+            out.append((f"u{AXES[k]} {j + 1}", f"ns_u{AXES[k]}_{j + 1}.txt", grp,
+                        "displacement", AXES[k], v))
+    prescribed = {k: set(v[0].tolist()) for k, v in ns.fixed.items()}
+    for k in range(ns.dim):
+        free = np.array([i for i in np.flatnonzero(ns.forces[:, k])
+                         if i not in prescribed.get(k, ())], dtype=int)
+        if not len(free):
+            continue
+        vals = ns.forces[free, k] / (ns.volume[free] if density else 1.0)
+        for j, (v, grp) in enumerate(groups(free, vals)):
+            out.append((f"f{AXES[k]} {j + 1}", f"ns_f{AXES[k]}_{j + 1}.txt", grp, "load",
+                        AXES[k], v))
+    return out
+
+
+def _q(text: str) -> str:
+    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def peridigm_files(ns: NodeSet) -> dict:
+    """``peridigm/pdverify.yaml`` (Peridigm's YAML deck, the layout of its
+    ``examples/wave_in_bar/wave_in_bar.yaml``), ``peridigm/nodes.txt`` (``Text File``
+    discretisation: ``x y z block_id volume``, 3D coordinates, the 1D/2D nodes at zero
+    y/z), and a node set file per condition. Loads as ``Body Force`` (force density)."""
+    c = ns.problem.constants
+    x3 = np.zeros((len(ns.x), 3))
+    x3[:, :ns.dim] = ns.x
+    nodes = "# x y z block_id volume\n" + "".join(
+        f"{f(p[0])} {f(p[1])} {f(p[2])} 1 {f(v)}\n" for p, v in zip(x3, ns.volume))
+    conds = _conditions(ns, density=True)
+    lines = ["Peridigm:", "",
+             f"#     pdverify export of {ns.scene.id} (method none); units SI (m, N, Pa)",
+             "#     see README.md: what this deck expresses and what it does not", "",
+             "  Discretization:",
+             '      Type: "Text File"',
+             '      Input Mesh File: "nodes.txt"',
+             f"      Influence Function: {_q(PERIDIGM_INFLUENCE[ns.problem.influence.name])}",
+             "", "  Materials:", "      pdverify material:",
+             '          Material Model: "Elastic"',
+             f"          Density: {f(DENSITY)}",
+             f"          Young's Modulus: {f(c.E)}",
+             f"          Poisson's Ratio: {f(c.nu)}"]
+    if c.kind in ("plane-stress", "plane-strain"):
+        lines.append(f"          Plane {'Stress' if c.kind == 'plane-stress' else 'Strain'}: true")
+    lines += ["", "  Blocks:", "      pdverify block:", '          Block Names: "block_1"',
+              '          Material: "pdverify material"', f"          Horizon: {f(ns.horizon)}",
+              "", "  Boundary Conditions:"]
+    files = {"peridigm/nodes.txt": nodes}
+    for name, fname, grp, _, _, _ in conds:
+        lines.append(f"      Node Set {name}: {_q(fname)}")
+        files[f"peridigm/{fname}"] = _node_ids(grp)
+    for name, _, _, kind, axis, v in conds:
+        lines += [f"      {'Prescribed Displacement' if kind == 'displacement' else 'Body Force'}"
+                  f" {name}:",
+                  f"          Type: {_q('Prescribed Displacement' if kind == 'displacement' else 'Body Force')}",
+                  f"          Node Set: {_q('Node Set ' + name)}",
+                  f"          Coordinate: {_q(axis)}",
+                  f"          Value: {_q(f(v))}"]
+    lines += ["", "  Solver:", "      Verbose: false", "      Initial Time: 0.0",
+              "      Final Time: 1.0", "      QuasiStatic:", "          Number of Load Steps: 1",
+              "          Absolute Tolerance: 1.0e-10", "          Maximum Solver Iterations: 10",
+              "", "  Output:", '      Output File Type: "ExodusII"',
+              '      Output Filename: "pdverify_result"', "      Output Frequency: 1",
+              "      Output Variables:", "          Displacement: true", "          Volume: true",
+              ""]
+    files["peridigm/pdverify.yaml"] = "\n".join(lines)
+    return files
+
+
+def perilab_files(ns: NodeSet) -> dict:
+    """``perilab/pdverify.yaml`` (PeriLab.jl's deck, the layout of its examples, e.g.
+    ``examples/ENFmodel/ENFmodel.yaml``), ``perilab/mesh.txt`` (``header: x y block_id
+    volume`` in 1D/2D, ``x y z ...`` in 3D) and node set files (``header: global_id``,
+    1-based). Loads as nodal ``Forces``; material ``PD Solid Elastic``."""
+    c = ns.problem.constants
+    d2 = max(ns.dim, 2)
+    xs = np.zeros((len(ns.x), d2))
+    xs[:, :ns.dim] = ns.x
+    cols = " ".join(AXES[:d2])
+    mesh = f"header: {cols} block_id volume\n" + "".join(
+        " ".join(f(v) for v in p) + f" 1 {f(v)}\n" for p, v in zip(xs, ns.volume))
+    symmetry = {"plane-stress": "isotropic plane stress", "plane-strain": "isotropic plane strain",
+                "3d": "isotropic", "1d": "isotropic plane stress"}[c.kind]
+    inf = ns.problem.influence.name
+    h = f(ns.horizon)
+    omega = {"constant": "1", "hyperbolic": "1/xi", "conical": f"1 - xi/{h}",
+             "gaussian": f"exp(-xi^2/{h}^2)"}[inf]
+    conds = _conditions(ns, density=False)
+    files = {"perilab/mesh.txt": mesh}
+    lines = [f"# pdverify export of {ns.scene.id} (method none); units SI (m, N, Pa)",
+             "# see README.md: what this deck expresses and what it does not", "",
+             "PeriLab:", "  Discretization:", "    Type: \"Text File\"",
+             "    Input Mesh File: \"mesh.txt\"", f"    Influence Function: {_q(omega)}"]
+    if conds:
+        lines.append("    Node Sets:")
+    for name, fname, grp, _, _, _ in conds:
+        lines.append(f"      Node Set {name}: {_q(fname)}")
+        files[f"perilab/{fname}"] = "header: global_id\n" + _node_ids(grp)
+    lines += ["  Models:", "    Material Models:", "      pdverify material:",
+              "        Material Model: \"PD Solid Elastic\"", f"        Symmetry: {_q(symmetry)}",
+              f"        Young's Modulus: {f(c.E)}", f"        Poisson's Ratio: {f(c.nu)}",
+              "  Blocks:", "    block_1:", "      Block ID: 1",
+              "      Material Model: \"pdverify material\"", f"      Density: {f(DENSITY)}",
+              f"      Horizon: {h}", "  Boundary Conditions:"]
+    for j, (name, _, _, kind, axis, v) in enumerate(conds):
+        lines += [f"    BC_{j + 1}:",
+                  f"      Variable: {_q('Displacements' if kind == 'displacement' else 'Forces')}",
+                  f"      Node Set: {_q('Node Set ' + name)}", f"      Coordinate: {_q(axis)}",
+                  f"      Value: {_q(f(v))}", "      Type: Dirichlet"]
+    lines += ["  Solver:", "    Material Models: true", "    Initial Time: 0.0",
+              "    Final Time: 1.0", "    Number of Steps: 1", "    Static:",
+              "      Residual tolerance: 1e-10", "      Solution tolerance: 1e-12",
+              "      Maximum number of iterations: 100", "  Outputs:", "    Output1:",
+              "      Output Filename: \"pdverify_result\"", "      Output File Type: Exodus",
+              "      Number of Output Steps: 1", "      Output Variables:",
+              "        Displacements: true", ""]
+    files["perilab/pdverify.yaml"] = "\n".join(lines)
+    return files
+
+
+# ------------------------------------------------------------------------------ README
+def _model_note(ns: NodeSet) -> str:
+    """The README's line on the material model and what each deck makes of it."""
+    c, d = ns.problem.constants, ns.dim
+    text = ("- The model: pdverify's is the linear ordinary state-based solid "
+            f"({c.kind}; c_theta = {c.c_theta:.6g}, k_theta = {c.k_theta:.6g} Pa, "
+            f"k_e = {c.k_e:.6g} Pa), m_i over the bonds a node has")
+    if d < 3:
+        text += (f", node volumes with the {'cross-section' if d == 1 else 'thickness'} "
+                 f"({f(ns.problem.thickness)} {'m^2' if d == 1 else 'm'})")
+    text += ". Peridigm's `Elastic` material is the 3D LPS; "
+    if d == 3:
+        text += "on a 3D body it is the same kind of model. "
+    else:
+        text += (f"on a {d}D node set it is not the {c.kind} model (its dilatation is 3D; "
+                 "`Plane Stress`/`Plane Strain` only convert the moduli), so expect a "
+                 "different answer. ")
+    if c.kind in ("plane-stress", "plane-strain"):
+        text += (f"PeriLab's `PD Solid Elastic` with `Symmetry: isotropic "
+                 f"{c.kind.replace('-', ' ')}` is its planar form (whether its constants "
+                 "are ours is not checked here).")
+    elif d == 3:
+        text += "PeriLab's `PD Solid Elastic` with `Symmetry: isotropic` is its 3D form."
+    else:
+        text += ("PeriLab has no 1D kind: the bar is written as a row of nodes in 2D "
+                 "plane stress, a different model.")
+    return text
+
+
+def readme(ns: NodeSet, fmt: str, files) -> str:
+    """What the files are, what to run, and what a deck can and cannot express."""
+    d = ns.dim
+    p = ns.params
+    over = " ".join(f"--set {k}={v}" for k, v in sorted(p.items())
+                    if v != ns.scene.default_params().get(k, v))
+    conds = _conditions(ns, density=fmt == "peridigm")
+    nvals = {AXES[k]: len(np.unique(v[1])) for k, v in ns.fixed.items()}
+    text = [f"# pdverify export: {ns.scene.id}, uncorrected (`{METHOD}`), format `{fmt}`", "",
+            f"{ns.scene.title}. {len(ns.x)} nodes in {d}D, spacing {f(ns.spacing)} m, "
+            f"horizon {f(ns.horizon)} m (m = {ns.horizon / ns.spacing:g}). Reference: "
+            f"{ns.scene.reference}. Units: SI (m, N, Pa); node ids are 1-based.", "",
+            "## Files", ""]
+    what = {
+        "problem.json": "the scene, every parameter, the material constants (E, nu, the "
+                        "state-based c_theta, k_theta, k_e), horizon, influence function",
+        "README.md": "this file",
+        "nodes.csv": "node id, position, volume (thickness or cross-section included), "
+                     "block id",
+        "loads.csv": "the loaded nodes: nodal force f [N] and the same as force density "
+                     "b = f / V [N/m^3]",
+        "nodes.vtu": "the nodes (vertex cells) with point data volume, block_id, force [N], "
+                     "force_density [N/m^3], prescribed_u<k> (1 on the prescribed nodes of "
+                     "component k) and value_u<k> [m]",
+        "peridigm/pdverify.yaml": "Peridigm input deck (YAML): Text File discretisation, "
+                                  "Elastic (LPS) material, horizon, node sets, prescribed "
+                                  "displacements and Body Force (force density) loads, "
+                                  "QuasiStatic solver, Exodus output",
+        "peridigm/nodes.txt": "Peridigm's Text File discretisation: x y z block_id volume",
+        "perilab/pdverify.yaml": "PeriLab.jl input deck: Text File discretisation, PD Solid "
+                                 "Elastic material, node sets, Dirichlet displacements and "
+                                 "nodal Forces, Static solver, Exodus output",
+        "perilab/mesh.txt": "PeriLab's text mesh: header `x y [z] block_id volume`",
+    }
+    for name in files:
+        if name in what:
+            text.append(f"- `{name}`: {what[name]}")
+        elif name.startswith("prescribed_u"):
+            text.append(f"- `{name}`: the nodes whose component {name[12]} is prescribed, "
+                        "with the value [m]")
+    if fmt in ("peridigm", "perilab"):
+        text.append(f"- `{fmt}/ns_*.txt`: {len(conds)} node sets, one per prescribed or "
+                    "loaded component and value (a deck's condition takes one value per set)")
+    text += ["", "## What to run", ""]
+    if fmt == "peridigm":
+        text.append("`cd peridigm && Peridigm pdverify.yaml` writes `pdverify_result.e`.")
+    elif fmt == "perilab":
+        text.append("`cd perilab && julia -e 'using PeriLab; PeriLab.main(\"pdverify.yaml\")'` "
+                    "writes `pdverify_result.e`.")
+    else:
+        text.append("Solve the problem in your code on exactly these nodes, with these "
+                    "conditions and loads.")
+    text += ["", "Then score the displacements (pdverify measures them as its own runs):", "",
+             f"    python -m pdverify score {ns.scene.id} RESULT {over} --name MYCODE "
+             "--out mycode.json".replace("  ", " "), "",
+             "RESULT: a CSV with a header row naming the columns "
+             + ", ".join(AXES[:d]) + " and " + ", ".join(f"u{a}" for a in AXES[:d])
+             + " (units in brackets allowed, any order of rows and columns), a VTU with a "
+               "point array `u` or `displacement(s)` (or its components), or the Exodus "
+               "file the deck writes (its last time step; a NetCDF-4 file needs the "
+               "netCDF4 package). Every node must lie within "
+               "1e-3 spacings of one node of this set, one each. Then "
+               "`python -m pdverify report --include mycode.json` shows it beside ours.", "",
+             "## What the decks can and cannot express", "",
+             _model_note(ns),
+             f"- Bond weights: pdverify weights each bond by its partial volume "
+             f"(`quadrature={p.get('quadrature', 'partial-volume')}`: the cell's fraction "
+             "inside the horizon); the decks' materials have no such weights (as far as "
+             "their documentation shows, neighbours count with their whole volume), so "
+             "their lattice differs at the horizon's edge. pdverify's partial-volume "
+             "quadrature cannot be stated in either deck.",
+             f"- Influence function `{ns.problem.influence.name}` "
+             f"({ns.problem.influence.description}): written as an expression of the bond "
+             "length (its scale cancels in the linear state-based force).",
+             "- Loads: the scene's body force times the node volume plus, on the loaded "
+             "faces, the traction's resultant over each boundary cell face on the node of "
+             "that cell (PD tractions become nodal forces on the loaded nodes). Peridigm's "
+             "deck gives them as `Body Force` (force density f / V), PeriLab's as nodal "
+             "`Forces`. Loads on prescribed components are left out of the decks.",
+             "- Boundary conditions: the uncorrected treatment prescribes a component on the "
+             "nodes nearest its face (the outermost ring of real nodes, h/2 inside the "
+             "surface), not on the surface. Values: " + (", ".join(
+                 f"u{a} takes {n} distinct value(s)" for a, n in nvals.items()) or "none")
+             + ". A value that varies from node to node (a reference field, e.g. the FEM "
+               "displacement on the ring) is written as one node set per value.",
+             "- The decks are written from these codes' documented example inputs; they "
+             "have not been run here.", ""]
+    return "\n".join(text)

@@ -1,0 +1,482 @@
+"""A static-state scene's uncorrected problem as a node set for another PD code, and the
+score of the displacements that code computed on it (``pdverify export``, ``score``).
+
+The node set is the ``none`` treatment's: the real nodes of the scene's grid with their
+volumes, the prescribed components of each boundary condition (the nodes nearest the
+face, at the value the scene prescribes there) and the loads as nodal forces (the
+right-hand side the uncorrected model assembles: body force times node volume plus the
+force of each loaded boundary cell face on its node). Scoring puts a file's displacements
+where the ``none`` solve would put its solution and calls the scene's own ``measure``, so
+an external code's numbers are measured exactly as ours. Writers of the files are in
+:mod:`pdverify.decks`. No printing, no drawing.
+"""
+from __future__ import annotations
+
+import csv
+import io
+import json
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import InputError
+
+#: The one method whose problem is exported: the uncorrected model (its conditions on
+#: real nodes only, which a node-set deck can state; the corrections add nodes, rows or
+#: bond factors no other code reads).
+METHOD = "none"
+#: A file's node matches ours within this fraction of the grid spacing. Nodes are one
+#: spacing apart, so any tolerance below 1/2 pairs them unambiguously; 1e-3 admits
+#: coordinates written in single precision (7 digits) for bodies up to ~1e4 spacings
+#: across, and refuses a node moved by a thousandth of a cell.
+MATCH_TOLERANCE = 1e-3
+AXES = "xyz"
+#: the file's values on prescribed nodes may differ from ours by this fraction of its
+#: largest displacement before the record warns: a result written with 9 significant
+#: digits or more stays below it; a code that imposed other values does not
+PRESCRIBED_RTOL = 1e-9
+
+
+def exportable(scene) -> bool:
+    """A scene of the ``static-state`` family that states its problem (the stiffness
+    scenes of the family prescribe every node and solve nothing)."""
+    from .scenes.family import StaticStateScene
+    return (isinstance(scene, StaticStateScene)
+            and type(scene).problem is not StaticStateScene.problem
+            and type(scene).measure is not StaticStateScene.measure)
+
+
+def exportable_ids() -> list[str]:
+    from .scenes import all_scenes
+    return [s.id for s in all_scenes() if exportable(s)]
+
+
+def scene_of(scene_id: str):
+    """The scene ``scene_id`` if it can be exported, else InputError naming those that
+    can (an unknown id: the registry's message with close matches)."""
+    from .scenes import get_scene
+    scene = get_scene(scene_id)
+    if not exportable(scene):
+        raise InputError(f"scene {scene_id!r} is not a static-state problem and cannot be "
+                         f"exported or scored; these can: {', '.join(exportable_ids())}")
+    return scene
+
+
+def check_method(method: str | None) -> str:
+    if method not in (None, METHOD):
+        raise InputError(f"--method {method!r}: only the uncorrected problem ('none') is "
+                         "exported; a correction's extra nodes, rows or bond factors are "
+                         "not part of a node set another code reads")
+    return METHOD
+
+
+@dataclass
+class NodeSet:
+    """The ``none`` problem of a scene as arrays (module docstring). ``fixed``: per
+    component k, ``(nodes, values)`` of its prescribed nodes (0-based, ascending)."""
+
+    scene: object
+    params: dict
+    problem: object
+    system: object
+    x: np.ndarray          # (n, d) positions [m]
+    volume: np.ndarray     # (n,) node volumes [m^3] (thickness or cross-section included)
+    forces: np.ndarray     # (n, d) nodal forces [N]
+    fixed: dict            # k -> (nodes, values [m])
+
+    @property
+    def dim(self) -> int:
+        return self.x.shape[1]
+
+    @property
+    def spacing(self) -> float:
+        return float(self.problem.spacing)
+
+    @property
+    def horizon(self) -> float:
+        return float(self.system.model.horizon)
+
+
+def node_set(scene, overrides=None) -> NodeSet:
+    """Assemble the ``none`` system of ``scene`` at ``overrides`` (bad input: InputError
+    from the scene's own checks, before any work)."""
+    p = scene.resolve(METHOD, overrides)
+    problem = scene.problem(p, f"{scene.id}/{METHOD}")
+    treatment = scene.treatment(METHOD)
+    return node_set_of(scene, p, problem, treatment.assemble(problem, p))
+
+
+def node_set_of(scene, p, problem, system) -> NodeSet:
+    """The arrays of an uncorrected ``system`` of ``problem`` (any body the family's
+    ``none`` assembles: a box, or a shape with cut volumes)."""
+    g = system.model.grid
+    ni, nu_, d = g.n_interior, system.n_unknown_nodes, g.dim
+    if nu_ != ni or system.B is not None or system.offset is not None:
+        raise InputError(f"{scene.id}: its uncorrected system has unknowns or rows beyond "
+                         "the real nodes, which a node set cannot state; it is not exported")
+    x = g.x[g.interior_ids]
+    volume = np.asarray(system.model.node_volume)[g.interior_ids]
+    forces = np.asarray(system.rhs[:d * nu_]).reshape(d, nu_).T
+    fixed = {}
+    comp, nodes = np.divmod(np.asarray(system.fixed), nu_)
+    for k in range(d):
+        on = comp == k
+        if on.any():
+            fixed[k] = (nodes[on], np.asarray(system.values)[on])
+    return NodeSet(scene, p, problem, system, x, volume, forces, fixed)
+
+
+# ------------------------------------------------------------------------------ reading
+@dataclass
+class Displacements:
+    """Positions (n, 3 or fewer) and displacements (n, <= 3) read from a file."""
+
+    path: str
+    kind: str
+    x: np.ndarray
+    u: np.ndarray
+    time_s: float | None = None
+
+
+def _column_name(text: str) -> str:
+    """``"ux [m]"`` -> ``"ux"``: the name before a unit in brackets, lower case."""
+    return text.split("[", 1)[0].strip().lower()
+
+
+#: names of a displacement component's column (CSV) or array (VTU, Exodus): ux, u_x, ...
+_U_NAMES = ("u{a}", "u_{a}", "displacement_{a}", "displacements_{a}", "displacement{a}",
+            "displacements{a}")
+
+
+def read_displacements(path: str, dim: int) -> Displacements:
+    """Positions and displacements from a CSV (header row: ``x, y, z`` and ``ux, uy,
+    uz`` or ``u_x``..., units in brackets allowed, ``#`` lines skipped), a VTU (meshio:
+    points and a point array ``u``/``displacement(s)`` or its components) or an Exodus
+    file (:func:`_read_exodus`: its last time step). Any problem is InputError naming
+    the file."""
+    from .validate import input_file
+    input_file(path, "displacement file")
+    ext = os.path.splitext(path)[1].lower()
+    if ext in (".csv", ".txt"):
+        return _read_csv(path, dim)
+    if ext == ".vtu":
+        return _read_mesh(path, dim, "vtu")
+    if ext in (".e", ".exo", ".ex2", ".exodus"):
+        return _read_exodus(path, dim)
+    raise InputError(f"displacement file {path!r}: unknown kind {ext or '(no extension)'!r}; "
+                     "allowed: .csv, .vtu, .e/.exo (Exodus, read through meshio)")
+
+
+def _read_csv(path: str, dim: int) -> Displacements:
+    try:
+        with open(path, encoding="utf-8", newline="") as fh:
+            lines = [ln for ln in fh if ln.strip() and not ln.lstrip().startswith("#")]
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"displacement file {path!r} cannot be read ({exc})") from None
+    rows = list(csv.reader(io.StringIO("".join(lines))))
+    if not rows:
+        raise InputError(f"displacement file {path!r} is empty (no header row)")
+    names = [_column_name(c) for c in rows[0]]
+    want_x = list(AXES[:dim])
+    want_u = []
+    for a in AXES[:dim]:
+        hit = next((n.format(a=a) for n in _U_NAMES if n.format(a=a) in names), None)
+        want_u.append(hit or f"u{a}")
+    missing = [c for c in want_x + want_u if c not in names]
+    if missing:
+        raise InputError(f"displacement file {path!r}: missing column(s) "
+                         f"{', '.join(missing)}; it has {', '.join(names) or 'none'} "
+                         f"(need {', '.join(want_x)} and {', '.join(f'u{a}' for a in AXES[:dim])})")
+    cols = [names.index(c) for c in want_x + want_u]
+    data = np.empty((len(rows) - 1, 2 * dim))
+    for i, row in enumerate(rows[1:]):
+        try:
+            data[i] = [float(row[c]) for c in cols]
+        except (ValueError, IndexError):
+            raise InputError(f"displacement file {path!r}: data row {i + 1} is not "
+                             f"{len(cols)} numbers in the named columns: {row!r}") from None
+    _check_finite(path, data)
+    return Displacements(path, "csv", data[:, :dim], data[:, dim:])
+
+
+def _read_mesh(path: str, dim: int, kind: str) -> Displacements:
+    import contextlib
+    import meshio
+    said = io.StringIO()
+    try:   # meshio prints its own error and calls sys.exit on a file it cannot read
+        with contextlib.redirect_stderr(said), contextlib.redirect_stdout(said):
+            mesh = meshio.read(path, file_format=kind)
+    except ModuleNotFoundError as exc:
+        raise InputError(f"displacement file {path!r}: reading {kind} needs the package "
+                         f"{exc.name!r} (python -m pip install {exc.name})") from None
+    except (Exception, SystemExit) as exc:
+        why = " ".join(said.getvalue().split()) or f"{type(exc).__name__}: {exc}"
+        raise InputError(f"displacement file {path!r} cannot be read as {kind} "
+                         f"({why})") from None
+    data = {k.lower(): np.asarray(v, dtype=float) for k, v in mesh.point_data.items()}
+    u = _nodal_vectors(path, dim, data, list(mesh.point_data))
+    x = np.asarray(mesh.points, dtype=float)
+    _check_finite(path, np.c_[x[:, :dim], u])
+    return Displacements(path, kind, x[:, :dim], u)
+
+
+def _nodal_vectors(path, dim, data: dict, have) -> np.ndarray:
+    """The displacement among point arrays ``data`` (lower-case names): a vector ``u``
+    or ``displacement(s)``, or its components (``ux``, ``displacementx`` as Peridigm's
+    Exodus output names them, ``displacementsx`` as PeriLab's, ...)."""
+    u = next((data[k] for k in ("u", "displacement", "displacements") if k in data), None)
+    if u is None:
+        comps = [next((data[n.format(a=a)] for n in _U_NAMES if n.format(a=a) in data),
+                      None) for a in AXES[:dim]]
+        if all(c is not None for c in comps):
+            u = np.column_stack(comps)
+    if u is None:
+        raise InputError(f"displacement file {path!r}: no point array 'u', 'displacement' "
+                         f"or its components; it has {', '.join(have) or 'none'}")
+    u = np.asarray(u, dtype=float)
+    u = u.reshape(len(u), -1)
+    if u.shape[1] < dim:
+        raise InputError(f"displacement file {path!r}: its displacement has {u.shape[1]} "
+                         f"components, the scene {dim}")
+    return u[:, :dim]
+
+
+def _read_exodus(path: str, dim: int) -> Displacements:
+    """An Exodus II file's node coordinates and the displacement of its LAST time step
+    (a static run's output holds the initial state first; meshio's reader takes the
+    first step only, so it is not used). NetCDF classic and 64-bit-offset files are read
+    by scipy; NetCDF-4 (HDF5) files need the netCDF4 package."""
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(8)
+    except OSError as exc:
+        raise InputError(f"displacement file {path!r} cannot be read ({exc})") from None
+    try:
+        if head.startswith(b"CDF"):
+            from scipy.io import netcdf_file
+            with netcdf_file(path, "r", mmap=False) as nc:
+                found = {k: np.array(v[:]) for k, v in nc.variables.items()}
+        elif head.startswith(b"\x89HDF"):
+            import netCDF4
+            with netCDF4.Dataset(path) as nc:
+                found = {}
+                for k, v in nc.variables.items():
+                    v.set_auto_mask(False)
+                    found[k] = np.array(v[:])
+        else:
+            raise InputError(f"displacement file {path!r} is not an Exodus (NetCDF) file")
+    except ModuleNotFoundError as exc:
+        raise InputError(f"displacement file {path!r}: reading a NetCDF-4 Exodus file "
+                         f"needs the package {exc.name!r} (python -m pip install "
+                         f"{exc.name})") from None
+    except InputError:
+        raise
+    except Exception as exc:
+        raise InputError(f"displacement file {path!r} cannot be read as Exodus "
+                         f"({type(exc).__name__}: {exc})") from None
+
+    def text(rows):
+        return [b"".join(np.atleast_1d(r).astype("S1")).decode("utf-8", "replace")
+                .strip("\x00 ") for r in np.atleast_2d(rows)]
+
+    if "coord" in found:
+        x = np.asarray(found["coord"], dtype=float).T
+    elif "coordx" in found:
+        x = np.column_stack([found[k] for k in ("coordx", "coordy", "coordz") if k in found])
+    else:
+        raise InputError(f"displacement file {path!r}: no node coordinates (coordx / coord)")
+    names = text(found["name_nod_var"]) if "name_nod_var" in found else []
+    step = -1
+    data = {}
+    for k, name in enumerate(names):
+        if f"vals_nod_var{k + 1}" in found:
+            values = found[f"vals_nod_var{k + 1}"]
+            data[name.lower()] = values[step]
+        elif "vals_nod_var" in found:
+            data[name.lower()] = found["vals_nod_var"][step, k]
+    u = _nodal_vectors(path, dim, data, names)
+    times = found.get("time_whole")
+    x = x.reshape(len(x), -1)
+    if len(x) != len(u):
+        raise InputError(f"displacement file {path!r}: {len(x)} nodes but {len(u)} values")
+    _check_finite(path, np.c_[x[:, :dim], u])
+    return Displacements(path, "exodus", x[:, :dim], u,
+                         None if times is None or not len(times) else float(times[step]))
+
+
+def _check_finite(path, data) -> None:
+    bad = np.argwhere(~np.isfinite(data))
+    if len(bad):
+        raise InputError(f"displacement file {path!r}: node {bad[0][0] + 1} holds a "
+                         "non-finite number")
+
+
+# ------------------------------------------------------------------------------ matching
+def _at(x) -> str:
+    return "(" + ", ".join(f"{v:.10g}" for v in x) + ")"
+
+
+def match_nodes(ns: NodeSet, given: Displacements) -> np.ndarray:
+    """``order`` with ``given.x[order[i]]`` the file's node at our node i: every node of
+    the file within :data:`MATCH_TOLERANCE` spacings of a distinct node of ours, and as
+    many nodes as ours. Else InputError naming the first mismatching node."""
+    from scipy.spatial import cKDTree
+    tol = MATCH_TOLERANCE * ns.spacing
+    n, m = len(ns.x), len(given.x)
+    dist, ours = cKDTree(ns.x).query(given.x)
+    owner = np.full(n, -1)
+    for j in range(m):   # one pass over the file's nodes, first offender reported
+        if dist[j] > tol:
+            raise InputError(f"{given.path}: node {j + 1} of the file at {_at(given.x[j])} "
+                             f"is {dist[j]:.3g} m from the nearest exported node (node "
+                             f"{ours[j] + 1} at {_at(ns.x[ours[j]])}); tolerance "
+                             f"{tol:.3g} m ({MATCH_TOLERANCE:g} spacings)")
+        if owner[ours[j]] >= 0:
+            raise InputError(f"{given.path}: node {j + 1} of the file at {_at(given.x[j])} "
+                             f"matches exported node {ours[j] + 1} at "
+                             f"{_at(ns.x[ours[j]])}, which node {owner[ours[j]] + 1} of the "
+                             "file matched already")
+        owner[ours[j]] = j
+    if m != n:
+        free = np.flatnonzero(owner < 0)
+        raise InputError(f"{given.path}: {m} nodes, the exported set has {n}; exported "
+                         f"node {free[0] + 1} at {_at(ns.x[free[0]])} has no node in the file")
+    return owner
+
+
+# ------------------------------------------------------------------------------ scoring
+def score(scene_id: str, path: str, *, name: str, overrides=None):
+    """The run record of the displacements in ``path`` on the exported node set of
+    ``scene_id`` (module docstring); bad input is InputError before the measure."""
+    from .results import RunResult
+    scene = scene_of(scene_id)
+    if not name or any(c.isspace() for c in name):
+        raise InputError(f"--name {name!r}: give a non-empty name without spaces "
+                         "(the run's method becomes external:NAME)")
+    scene.resolve(METHOD, overrides)                 # bad --set before reading the file
+    given = read_displacements(path, scene.dim)
+    ns = node_set(scene, overrides)
+    order = match_nodes(ns, given)
+    U = given.u[order]
+    d, n = ns.dim, len(ns.x)
+    x = U.T.ravel()
+    K = ns.system.K
+    if K.shape[0] > d * n:
+        # the augmented system (solver=nested-dissection): its nodal scalars (dilatations)
+        # from the displacements, theta = A_theta A_e A_U u, so that K x - rhs (a
+        # reaction) is the direct system's; the displacement metrics do not read them
+        model = ns.system.model
+        x = np.r_[x, model.A_theta @ (model.A_e @ (model.A_U_full @ x))]
+    deviation = 0.0
+    for k, (nodes, values) in ns.fixed.items():
+        if len(nodes):
+            deviation = max(deviation, float(np.max(np.abs(U[nodes, k] - values))))
+    source = {"file": os.path.abspath(path), "kind": given.kind, "nodes": n,
+              **({"time": given.time_s} if given.time_s is not None else {}),
+              "match_tolerance_m": MATCH_TOLERANCE * ns.spacing,
+              "prescribed_max_deviation_m": deviation,
+              "cost_measured": False}
+    info = {"solver": "external", "external": source}
+    outcome = ns.scene.measure(ns.params, ns.problem, ns.system, x, info)
+    record = RunResult(scene=scene.id, method=f"external:{name}", params=ns.params,
+                       reference=scene.reference, metrics=outcome.metrics,
+                       size=outcome.size, diagnostics=outcome.diagnostics,
+                       timings={"setup_s": 0.0, "solve_s": 0.0, "total_s": 0.0})
+    scale = float(np.max(np.abs(U))) if U.size else 0.0
+    if deviation > PRESCRIBED_RTOL * scale:
+        record.warnings.append(
+            f"the file's displacements on the prescribed nodes differ from the values the "
+            f"scene prescribes by up to {deviation:.3g} m ({deviation / scale:.2g} of the "
+            "largest displacement): the code imposed other conditions than the export's")
+    record.fields = outcome.fields
+    return record
+
+
+def is_external(method: str) -> bool:
+    return method.startswith("external:")
+
+
+def load_external(paths) -> list:
+    """The external runs (method ``external:NAME``) of the results files ``paths``, for
+    ``report --include``; anything else is InputError naming the file, before work."""
+    from .results import RunResult, load_results
+    from .scenes import get_scene
+    from .validate import input_file
+    out, seen = [], {}
+    for path in paths:
+        input_file(path, "--include")
+        try:
+            doc = load_results(path)
+        except (OSError, ValueError) as exc:
+            raise InputError(f"--include {path!r}: {exc}") from None
+        for k, run in enumerate(doc["runs"]):
+            if not is_external(run["method"]):
+                raise InputError(f"--include {path!r}: runs[{k}] has method "
+                                 f"{run['method']!r}, not an external run (external:NAME, "
+                                 "written by pdverify score)")
+            get_scene(run["scene"])          # an unknown scene: exit 2, close matches
+            r = RunResult.from_json(run)
+            if r.key in seen:
+                raise InputError(f"--include: {r.scene} {r.method} is in {seen[r.key]!r} "
+                                 f"and {path!r} with the same params")
+            seen[r.key] = path
+            out.append(r)
+    return out
+
+
+def describe_json(ns: NodeSet) -> dict:
+    """What ``problem.json`` holds: the scene, its params and the model's constants."""
+    from .results import _plain
+    c = ns.problem.constants
+    inf = ns.problem.influence
+    return _plain({
+        "schema": "pdverify.export/1", "scene": ns.scene.id, "method": METHOD,
+        "params": ns.params, "reference": ns.scene.reference, "dim": ns.dim,
+        "nodes": len(ns.x), "spacing_m": ns.spacing, "horizon_m": ns.horizon,
+        "m_ratio": ns.horizon / ns.spacing,
+        "thickness_m": float(ns.problem.thickness),
+        "material": {"model": "linear ordinary state-based (LPS)", "kind": c.kind,
+                     "E_Pa": c.E, "nu": c.nu, "c_theta": c.c_theta, "k_theta_Pa": c.k_theta,
+                     "k_e_Pa": c.k_e},
+        "influence": {"name": inf.name, "omega": inf.description},
+        "quadrature": ns.params.get("quadrature", "partial-volume"),
+        "prescribed": {AXES[k]: int(len(v[0])) for k, v in ns.fixed.items()},
+        "loaded_nodes": int(np.count_nonzero(np.any(ns.forces != 0, axis=1))),
+    })
+
+
+def dumps(doc: dict) -> str:
+    return json.dumps(doc, indent=1, allow_nan=False) + "\n"
+
+
+# ------------------------------------------------------------------------------ commands
+def score_command(scene_id: str, path: str, *, name: str, overrides=None, out=None,
+                  force=False, stream=None) -> int:
+    """``pdverify score``: check, read, match, measure, print, write the record."""
+    import sys
+    from . import validate
+    from .results import write_results
+    stream = stream or sys.stdout
+    scene_of(scene_id)
+    validate.input_file(path, "displacement file")
+    json_path = (validate.output_file(out, "--out", force=force,
+                                      inputs=((path, "displacement file"),))
+                 if out is not None else None)
+    from .outputs import check_cache
+    check_cache()       # a FEM reference is computed once and cached
+    record = score(scene_id, path, name=name, overrides=overrides)
+    src = record.diagnostics["external"]
+    print(f"{record.scene} --method {record.method} (reference: {record.reference}): "
+          f"{record.status}", file=stream)
+    for key, value in record.metrics.items():
+        print(f"  {key:24s} {value:.10g}" if isinstance(value, float)
+              else f"  {key:24s} {value}", file=stream)
+    for text in record.warnings:
+        print(f"  warning: {text}", file=stream)
+    print(f"  displacements: {path} ({src['kind']}, {src['nodes']} nodes matched within "
+          f"{src['match_tolerance_m']:.3g} m); prescribed values: largest deviation "
+          f"{src['prescribed_max_deviation_m']:.3g} m; cost not measured", file=stream)
+    if json_path:
+        write_results(json_path, [record])
+    return 0

@@ -1,0 +1,594 @@
+"""pdverify export / score / report --include: a scene's uncorrected problem for another
+PD code, and that code's displacements measured as pdverify measures its own runs."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import xml.etree.ElementTree as ET  # the Body Force example (XML)
+from pathlib import Path
+
+import meshio
+import numpy as np
+import pytest
+
+from pdverify.cli import main
+from pdverify.exchange import MATCH_TOLERANCE
+from pdverify.scenes import get_scene
+
+ROOT = Path(__file__).resolve().parents[2]
+DATA = ROOT / "tests" / "data" / "external_decks"
+FORMATS = ("csv", "vtu", "peridigm", "perilab")
+# Scoring puts the same doubles where the solve put its solution and runs the same
+# measure: the metrics agree to the last bit. The text formats hold each double with
+# repr (17 significant digits, read back exactly), so 1e-12 relative is a ceiling that
+# only a lost digit or a different arithmetic would break.
+METRIC_RTOL = 1e-12
+
+
+def _native(scene_id, overrides=None):
+    r = get_scene(scene_id).run("none", overrides or {})
+    assert r.status == "ok", r.message
+    x = np.asarray(r.fields["x"], dtype=float).reshape(len(r.fields["u"]), -1)
+    u = np.asarray(r.fields["u"], dtype=float).reshape(len(x), -1)
+    return r, x, u
+
+
+def _exported_positions(folder: Path, fmt: str, dim: int) -> np.ndarray:
+    """The node positions as a user reads them from the exported files of ``fmt``."""
+    if fmt == "csv":
+        rows = (folder / "nodes.csv").read_text().splitlines()
+        assert rows[0].split(",")[1:1 + dim] == [f"{a} [m]" for a in "xyz"[:dim]]
+        return np.array([[float(v) for v in r.split(",")[1:1 + dim]] for r in rows[1:]])
+    if fmt == "vtu":
+        return meshio.read(folder / "nodes.vtu").points[:, :dim]
+    if fmt == "peridigm":
+        lines = (folder / "peridigm" / "nodes.txt").read_text().splitlines()
+        return np.array([[float(v) for v in ln.split()[:dim]] for ln in lines[1:]])
+    lines = (folder / "perilab" / "mesh.txt").read_text().splitlines()
+    return np.array([[float(v) for v in ln.split()[:dim]] for ln in lines[1:]])
+
+
+def _write_csv(path, x, u, reverse=True):
+    """Positions and displacements as a user sends them back (rows in another order)."""
+    d = x.shape[1]
+    order = np.arange(len(x))[::-1] if reverse else np.arange(len(x))
+    with open(path, "w") as fh:
+        fh.write(",".join([f"{a} [m]" for a in "xyz"[:d]] + [f"u{a} [m]" for a in "xyz"[:d]])
+                 + "\n")
+        for i in order:
+            fh.write(",".join(repr(float(v)) for v in (*x[i], *u[i])) + "\n")
+
+
+def _write_vtu(path, x, u):
+    pts = np.zeros((len(x), 3))
+    pts[:, :x.shape[1]] = x
+    disp = np.zeros((len(x), 3))
+    disp[:, :u.shape[1]] = u
+    meshio.write(path, meshio.Mesh(pts, [("vertex", np.arange(len(x)).reshape(-1, 1))],
+                                   point_data={"displacement": disp}))
+
+
+def _solution_at(x_native, u_native, positions):
+    """pdverify's own solution at the exported positions (one match per node)."""
+    from scipy.spatial import cKDTree
+    dist, k = cKDTree(x_native).query(positions)
+    assert dist.max() == 0.0 and len(set(k.tolist())) == len(k)
+    return u_native[k]
+
+
+def _assert_same_metrics(native, scored):
+    assert set(scored["metrics"]) == set(native.metrics)
+    for name, value in native.metrics.items():
+        np.testing.assert_allclose(scored["metrics"][name], value, rtol=METRIC_RTOL,
+                                   atol=0.0, err_msg=name)
+
+
+def _round_trip(tmp_path, capsys, scene_id, overrides):
+    native, x, u = _native(scene_id, overrides)
+    sets = [a for k, v in overrides.items() for a in ("--set", f"{k}={v}")]
+    for fmt in FORMATS:
+        folder = tmp_path / f"export-{fmt}"
+        assert main(["export", scene_id, *sets, "--format", fmt, "--out", str(folder)]) == 0
+        positions = _exported_positions(folder, fmt, x.shape[1])
+        back = _solution_at(x, u, positions)
+        for kind in ("csv", "vtu"):
+            sent = tmp_path / f"{fmt}-back.{kind}"
+            (_write_csv if kind == "csv" else _write_vtu)(sent, positions, back)
+            record = tmp_path / f"{fmt}-{kind}.json"
+            assert main(["score", scene_id, str(sent), *sets, "--name", "selftest",
+                         "--out", str(record)]) == 0, capsys.readouterr().err
+            run = json.loads(record.read_text())["runs"][0]
+            assert run["method"] == "external:selftest"
+            assert run["params"] == json.loads(json.dumps(native.params))
+            assert run["diagnostics"]["external"]["prescribed_max_deviation_m"] == 0.0
+            assert run["warnings"] == []
+            assert run["timings"] == {"setup_s": 0.0, "solve_s": 0.0, "total_s": 0.0}
+            _assert_same_metrics(native, run)
+    capsys.readouterr()
+
+
+def test_round_trip_bar(tmp_path, capsys):
+    _round_trip(tmp_path, capsys, "bar1d-traction", {})
+
+
+@pytest.mark.slow   # the plate's FEM reference, cold in the session's cache: ~9 s
+def test_round_trip_plate(tmp_path, capsys):
+    _round_trip(tmp_path, capsys, "plate2d-clamped", {})
+
+
+def test_round_trip_plane_strain_plate(tmp_path, capsys):
+    """A 2D case in the fast tier (analytic reference, no FEM to compute): seed 001's
+    plane-strain plate, a traction face and prescribed components."""
+    _round_trip(tmp_path, capsys, "plate2d-plane-strain", {"spacing": 0.1})
+
+
+@pytest.mark.parametrize("scene_id, overrides", [
+    ("body3d-traction", {"spacing": 0.125}),           # 3D, a traction face
+    ("plate2d-plane-strain", {"solver": "nested-dissection"}),  # the augmented system
+    ("bar1d-sine-load", {}),                            # a load that varies node to node
+])
+def test_round_trip_csv_other_scenes(tmp_path, capsys, scene_id, overrides):
+    """3D, and a system with the dilatations as unknowns (score fills them from the
+    displacements; the metrics read only displacements and reactions of K x - rhs)."""
+    native, x, u = _native(scene_id, overrides)
+    sets = [a for k, v in overrides.items() for a in ("--set", f"{k}={v}")]
+    _write_csv(tmp_path / "back.csv", x, u)
+    assert main(["score", scene_id, str(tmp_path / "back.csv"), *sets, "--name", "c",
+                 "--out", str(tmp_path / "r.json")]) == 0, capsys.readouterr().err
+    _assert_same_metrics(native, json.loads((tmp_path / "r.json").read_text())["runs"][0])
+
+
+def test_loads_and_conditions_are_the_none_system(tmp_path):
+    """The exported forces and prescribed values are the uncorrected system's: the bar's
+    end force on its last node, u_cl(x_1) on its first; the plate's body load b V."""
+    assert main(["export", "bar1d-traction", "--format", "csv", "--out",
+                 str(tmp_path / "bar")]) == 0
+    loads = (tmp_path / "bar" / "loads.csv").read_text().splitlines()
+    assert loads[0] == "node,x [m],fx [N],bx [N/m^3]"
+    assert len(loads) == 2
+    node, x, fx, bx = loads[1].split(",")
+    # the last node's centre 0.975 m (one rounding of i h + h/2), the end force 1e4 N
+    # exactly, its density f / (A h) = 1e4 / 5e-4
+    assert node == "20" and float(x) == pytest.approx(0.975, rel=2 * np.finfo(float).eps)
+    assert float(fx) == 1e4 and float(bx) == pytest.approx(2e7, rel=2 * np.finfo(float).eps)
+    fixed = (tmp_path / "bar" / "prescribed_ux.csv").read_text().splitlines()
+    assert fixed[0] == "node,x [m],ux [m]" and len(fixed) == 2
+    # u_cl(x_1) = F x_1 / (E A) = 1e4 * 0.025 / (1e9 * 0.01), one rounding
+    assert float(fixed[1].split(",")[2]) == pytest.approx(2.5e-5, rel=4 * np.finfo(float).eps)
+
+
+# ------------------------------------------------------------------------------ mismatch
+@pytest.fixture
+def bar_back(tmp_path):
+    _, x, u = _native("bar1d-traction")
+    return tmp_path, x, u
+
+
+@pytest.mark.parametrize("change, needle", [
+    ("moved", "node 20 of the file at (0.97505"),
+    ("missing", "19 nodes, the exported set has 20; exported node 1 at (0.025)"),
+    ("extra", "node 21 of the file at (1.025)"),
+    ("duplicate", "node 21 of the file at (0.975) matches exported node 20"),
+])
+def test_node_mismatch_is_refused(bar_back, capsys, change, needle):
+    tmp_path, x, u = bar_back
+    x, u = x.copy(), u.copy()
+    if change == "moved":   # 1e-3 spacings is the tolerance: 1.1e-3 spacings off
+        x[-1, 0] += 1.1 * MATCH_TOLERANCE * 0.05
+    elif change == "missing":
+        x, u = x[1:], u[1:]
+    elif change == "extra":
+        x, u = np.r_[x, [[1.025]]], np.r_[u, u[-1:]]
+    else:
+        x, u = np.r_[x, x[-1:]], np.r_[u, u[-1:]]
+    sent = tmp_path / "back.csv"
+    _write_csv(sent, x, u, reverse=False)
+    out = tmp_path / "never.json"
+    assert main(["score", "bar1d-traction", str(sent), "--name", "c", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and needle in err, err
+    assert not out.exists()
+
+
+def test_other_prescribed_values_are_scored_and_warned(bar_back, capsys):
+    """A code that imposed another value on the prescribed node: its displacements are
+    scored as given (the error shows it) and the record warns."""
+    tmp_path, x, u = bar_back
+    u = u.copy()
+    u[0, 0] = 0.0        # the bar's first node, prescribed at u_cl(x_1) = 2.5e-5 m
+    _write_csv(tmp_path / "back.csv", x, u)
+    out = tmp_path / "r.json"
+    assert main(["score", "bar1d-traction", str(tmp_path / "back.csv"), "--name", "c",
+                 "--out", str(out)]) == 0
+    run = json.loads(out.read_text())["runs"][0]
+    # |0 - u_cl(x_1)|, u_cl(x_1) = 1e4 * 0.025 / (1e9 * 0.01): a few roundings
+    assert run["diagnostics"]["external"]["prescribed_max_deviation_m"] == pytest.approx(
+        2.5e-5, rel=4 * np.finfo(float).eps)
+    assert len(run["warnings"]) == 1 and "prescribed nodes" in run["warnings"][0]
+
+
+def test_node_within_tolerance_is_accepted(bar_back, capsys):
+    tmp_path, x, u = bar_back
+    x = x.copy()
+    x[-1, 0] += 0.9 * MATCH_TOLERANCE * 0.05
+    _write_csv(tmp_path / "back.csv", x, u)
+    assert main(["score", "bar1d-traction", str(tmp_path / "back.csv"), "--name", "c"]) == 0
+
+
+# ------------------------------------------------------------------------------ bad input
+def test_bad_input_is_one_line_exit_2(tmp_path, capsys):
+    foreign = tmp_path / "mine"
+    foreign.mkdir()
+    (foreign / "notes.txt").write_text("keep me")
+    good = tmp_path / "good.csv"
+    _, x, u = _native("bar1d-traction")
+    _write_csv(good, x, u)
+    nocols = tmp_path / "nocols.csv"
+    nocols.write_text("x,uy\n0.025,0\n")
+    binary = tmp_path / "binary.csv"
+    binary.write_bytes(b"\xff\xfe\x00garbage")
+    badvtu = tmp_path / "bad.vtu"
+    badvtu.write_text("not xml")
+    native = tmp_path / "native.json"
+    assert main(["run", "bar1d-traction", "--method", "none", "--json", str(native)]) == 0
+    cases = [
+        (["export", "bar1d-tracton", "--format", "csv", "--out", str(tmp_path / "a")],
+         "did you mean bar1d-traction"),
+        (["export", "sheet2d-tension", "--format", "csv", "--out", str(tmp_path / "a")],
+         "these can: bar1d-traction"),
+        (["export", "bar1d-traction", "--method", "taylor-fictitious", "--format", "csv",
+          "--out", str(tmp_path / "a")], "only the uncorrected problem"),
+        (["export", "bar1d-traction", "--format", "abaqus", "--out", str(tmp_path / "a")],
+         "invalid choice: 'abaqus'"),
+        (["export", "bar1d-traction", "--format", "csv", "--out", str(foreign)],
+         "holds no pdverify export"),
+        (["export", "bar1d-traction", "--set", "nu=0.5", "--format", "csv", "--out",
+          str(tmp_path / "a")], "nu"),
+        (["score", "bar1d-traction", str(tmp_path / "none.csv"), "--name", "c"],
+         "does not exist"),
+        (["score", "bar1d-traction", str(nocols), "--name", "c"], "missing column(s) ux"),
+        (["score", "bar1d-traction", str(good), "--name", ""], "--name"),
+        (["score", "bar1d-traction", str(good), "--name", "c", "--out", str(good)],
+         "displacement file"),
+        (["score", "sheet2d-tension", str(good), "--name", "c"], "cannot be exported"),
+        (["score", "bar1d-traction", str(binary), "--name", "c"], "cannot be read"),
+        (["score", "bar1d-traction", str(badvtu), "--name", "c"], "cannot be read as vtu"),
+        (["score", "bar1d-traction", str(tmp_path), "--name", "c"], "is a folder"),
+        (["report", "--quick", "--only", "bar1d-traction", "--include",
+          str(tmp_path / "none.json"), "--out", str(tmp_path / "rep")], "does not exist"),
+        (["report", "--quick", "--only", "bar1d-traction", "--include", str(native),
+          "--out", str(tmp_path / "rep")], "not an external run"),
+        (["report", "--quick", "--only", "bar1d-traction", "--include", str(good),
+          "--out", str(tmp_path / "rep")], "not valid JSON"),
+    ]
+    for argv, needle in cases:
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and needle in err, (argv, err)
+    assert (foreign / "notes.txt").read_text() == "keep me"
+    assert not (tmp_path / "a").exists() and not (tmp_path / "rep").exists()
+
+
+def test_export_replaces_only_its_own_folder(tmp_path, capsys):
+    out = tmp_path / "exp"
+    assert main(["export", "bar1d-traction", "--format", "peridigm", "--out", str(out)]) == 0
+    # a previous export is replaced as a whole: no peridigm/ files left by a csv export
+    assert main(["export", "bar1d-traction", "--format", "csv", "--out", str(out)]) == 0
+    assert not (out / "peridigm").exists() and (out / "nodes.csv").exists()
+    (out / "mine.txt").write_text("x")
+    assert main(["export", "bar1d-traction", "--format", "csv", "--out", str(out)]) == 2
+    assert "'mine.txt'" in capsys.readouterr().err
+    assert (out / "mine.txt").read_text() == "x"
+
+
+def _write_exodus(path, x, u, names, layout):
+    """An Exodus II file as NetCDF classic (64-bit offset), the subset a reader needs:
+    coordinates, nodal variable names, and two time steps (zero, then ``u``) in
+    ``layout`` ``per-variable`` (vals_nod_var1, ...) or ``combined`` (vals_nod_var)."""
+    from scipy.io import netcdf_file
+    n, d = x.shape
+    with netcdf_file(path, "w", version=2) as nc:
+        nc.createDimension("num_nodes", n)
+        nc.createDimension("time_step", 2)
+        nc.createDimension("num_nod_var", d)
+        nc.createDimension("len_name", 33)
+        nc.createVariable("time_whole", "d", ("time_step",))[:] = [0.0, 1.0]
+        for k, a in enumerate("xyz"):
+            nc.createVariable(f"coord{a}", "d", ("num_nodes",))[:] = (
+                x[:, k] if k < d else np.zeros(n))
+        nc.createVariable("name_nod_var", "c", ("num_nod_var", "len_name"))[:] = np.array(
+            [list(name.ljust(33, "\0")) for name in names], dtype="S1")
+        steps = np.stack([np.zeros_like(u), u])            # (time, node, component)
+        if layout == "per-variable":
+            for k in range(d):
+                nc.createVariable(f"vals_nod_var{k + 1}", "d",
+                                  ("time_step", "num_nodes"))[:] = steps[:, :, k]
+        else:
+            nc.createVariable("vals_nod_var", "d", ("time_step", "num_nod_var",
+                                                    "num_nodes"))[:] = steps.transpose(0, 2, 1)
+
+
+@pytest.mark.parametrize("names, layout", [
+    (("DisplacementX", "DisplacementY"), "per-variable"),   # Peridigm's name + "X"
+    (("Displacementsx", "Displacementsy"), "combined"),     # PeriLab's name + "x"
+])
+def test_round_trip_exodus_last_step(tmp_path, capsys, names, layout):
+    """An Exodus result (NetCDF classic, read by scipy) scores the native metrics from
+    its last time step; its first (the initial zero state) would not."""
+    native, x, u = _native("plate2d-plane-strain", {"spacing": 0.1})
+    sent = tmp_path / "result.e"
+    _write_exodus(sent, x[::-1], u[::-1], names, layout)
+    record = tmp_path / "r.json"
+    assert main(["score", "plate2d-plane-strain", str(sent), "--set", "spacing=0.1",
+                 "--name", "exo", "--out", str(record)]) == 0, capsys.readouterr().err
+    run = json.loads(record.read_text())["runs"][0]
+    assert run["diagnostics"]["external"]["kind"] == "exodus"
+    assert run["diagnostics"]["external"]["time"] == 1.0
+    _assert_same_metrics(native, run)
+
+
+def test_exodus_netcdf4_file_needs_netcdf4(tmp_path, capsys):
+    """A NetCDF-4 (HDF5) Exodus file is read through netCDF4; without it the message
+    names the package (netCDF4 is not installed on the machine these tests ran on)."""
+    import importlib.util
+    if importlib.util.find_spec("netCDF4") is not None:
+        pytest.skip("netCDF4 is installed: NetCDF-4 Exodus files are read")
+    f = tmp_path / "result.e"
+    f.write_bytes(b"\x89HDF\r\n\x1a\n")
+    assert main(["score", "bar1d-traction", str(f), "--name", "c"]) == 2
+    assert "netCDF4" in capsys.readouterr().err
+
+
+# ------------------------------------------------------------------------------ decks
+def _yaml(text: str) -> dict:
+    """The block mappings of a deck (what Peridigm's and PeriLab's decks use): nested
+    ``key: value`` by indentation, comments and quotes removed. Written here so that the
+    test needs no YAML library; a list, flow style or anchor is refused."""
+    root: dict = {}
+    stack = [(-1, root)]
+    for raw in text.splitlines():
+        line = raw.split(" #", 1)[0].rstrip() if '"' not in raw else raw.rstrip()
+        if not line.strip() or line.lstrip().startswith("#"):
+            continue
+        indent = len(line) - len(line.lstrip())
+        key, sep, value = line.strip().partition(":")
+        assert sep and not key.startswith(("-", "[", "{", "&", "*")), raw
+        while stack[-1][0] >= indent:
+            stack.pop()
+        value = value.strip()
+        if value.startswith('"') and value.endswith('"'):
+            value = value[1:-1]
+        if value:
+            stack[-1][1][key] = value
+        else:
+            stack[-1][1][key] = {}
+            stack.append((indent, stack[-1][1][key]))
+    return root
+
+
+#: a 1D bar (end force, one prescribed node) and a 2D plate (a traction face, prescribed
+#: components on two faces; plane strain)
+DECK_SCENES = ("bar1d-traction", "plate2d-plane-strain")
+
+
+@pytest.fixture(scope="module")
+def decks(tmp_path_factory):
+    out = {}
+    for scene_id in DECK_SCENES:
+        for fmt in ("peridigm", "perilab"):
+            folder = tmp_path_factory.mktemp(fmt)
+            assert main(["export", scene_id, "--format", fmt, "--out",
+                         str(folder / "x")]) == 0
+            out[scene_id, fmt] = folder / "x" / fmt
+    return out
+
+
+def test_peridigm_deck_matches_its_examples(decks):
+    example = _yaml((DATA / "peridigm_wave_in_bar.yaml").read_text())["Peridigm"]
+    solver_ex = _yaml((DATA / "peridigm_tensile_test_solver.yaml").read_text())["Solver"]
+    materials_ex = _yaml((DATA / "peridigm_Notched_Plate_materials.yaml").read_text())
+    body_force = {p.get("value") for p in ET.parse(DATA / "peridigm_Body_Force_QS_bcs.xml")
+                  .iter("Parameter") if p.get("name") == "Type"}
+    # an excerpt (the opening of a deck): its Discretization list names the key
+    infl = (DATA / "peridigm_InfluenceFunction_discretization.xml").read_text()
+    header = (DATA / "peridigm_Compression_QS_3x2x2_TextFile.txt").read_text().splitlines()[0]
+    for scene_id in DECK_SCENES:
+        folder = decks[scene_id, "peridigm"]
+        problem = json.loads((folder.parent / "problem.json").read_text())
+        deck = _yaml((folder / "pdverify.yaml").read_text())
+        assert list(deck) == ["Peridigm"]
+        ours = deck["Peridigm"]
+        assert set(ours) == set(example) - {"Output"} | {"Output"}
+        assert ours["Discretization"]["Type"] == example["Discretization"]["Type"] == "Text File"
+        assert set(ours["Discretization"]) - {"Influence Function"} == set(example["Discretization"])
+        assert '<Parameter name="Influence Function"' in infl
+        (material,) = ours["Materials"].values()
+        ex_material = next(iter(materials_ex["Materials"].values()))
+        assert material["Material Model"] == ex_material["Material Model"] == "Elastic"
+        extra = set(material) - set(ex_material)
+        assert extra <= {"Plane Stress", "Plane Strain"}, extra
+        src = (DATA / "peridigm_Material_excerpt.cpp").read_text()
+        assert all(f'"{k}"' in src for k in extra)
+        (block,) = ours["Blocks"].values()
+        assert set(block) == set(next(iter(example["Blocks"].values())))
+        assert float(block["Horizon"]) == problem["horizon_m"]
+        kind = problem["material"]["kind"]
+        assert material.get("Plane Strain") == ("true" if kind == "plane-strain" else None)
+        bcs = ours["Boundary Conditions"]
+        ex_bc = next(v for v in example["Boundary Conditions"].values() if isinstance(v, dict))
+        sets = {k: v for k, v in bcs.items() if not isinstance(v, dict)}
+        assert all(k.startswith("Node Set") for k in sets)
+        for name, bc in bcs.items():
+            if not isinstance(bc, dict):
+                continue
+            assert set(bc) == set(ex_bc), name
+            assert bc["Type"] in {"Prescribed Displacement"} | body_force
+            assert bc["Node Set"] in sets and bc["Coordinate"] in "xyz"
+            float(bc["Value"])
+        assert set(ours["Solver"]["QuasiStatic"]) == set(solver_ex["QuasiStatic"])
+        assert set(ours["Solver"]) - {"QuasiStatic"} <= set(solver_ex) | {"Verbose"}
+        # the Text File discretisation: the example's header, x y z block_id volume
+        lines = (folder / "nodes.txt").read_text().splitlines()
+        assert lines[0] == header == "# x y z block_id volume"
+        for ln in lines[1:]:
+            x, y, z, block, vol = ln.split()
+            assert int(block) == 1 and float(vol) > 0
+        # node set files: 1-based ids, one per line, as the example's nodeset_1.txt
+        for fname in sets.values():
+            ids = [int(v) for v in (folder / fname).read_text().split()]
+            assert min(ids) >= 1 and max(ids) <= len(lines) - 1
+        assert (DATA / "peridigm_nodeset_1.txt").read_text().split() == ["1", "2", "3", "4"]
+
+
+def test_perilab_deck_matches_its_examples(decks):
+    example = _yaml((DATA / "perilab_ENFmodel.yaml").read_text())["PeriLab"]
+    static = _yaml((DATA / "perilab_truss.yaml").read_text())["PeriLab"]["Solver"]
+    solid = _yaml((DATA / "perilab_thermal_expansion_PD_Solid_static_head.yaml").read_text())
+    ex_material = solid["PeriLab"]["Models"]["Material Models"]["Test"]
+    disc_ex = _yaml((DATA / "perilab_DCB_discretization.yaml").read_text())["Discretization"]
+    solver_src = (DATA / "perilab_Static_solver_excerpt.jl").read_text()
+    for scene_id in DECK_SCENES:
+        folder = decks[scene_id, "perilab"]
+        problem = json.loads((folder.parent / "problem.json").read_text())
+        deck = _yaml((folder / "pdverify.yaml").read_text())
+        assert list(deck) == ["PeriLab"]
+        ours = deck["PeriLab"]
+        assert set(ours) <= set(example) and {"Discretization", "Models", "Blocks",
+                                              "Boundary Conditions", "Solver",
+                                              "Outputs"} == set(ours)
+        disc = ours["Discretization"]
+        assert disc["Type"] == "Text File" == example["Discretization"]["Type"]
+        assert set(disc) <= set(example["Discretization"]) | set(disc_ex)
+        (material,) = ours["Models"]["Material Models"].values()
+        assert material["Material Model"] == ex_material["Material Model"] == "PD Solid Elastic"
+        assert set(material) <= set(ex_material)
+        assert material["Symmetry"] == {"1d": "isotropic plane stress",   # no 1D kind
+                                        "plane-strain": "isotropic plane strain"}[
+            problem["material"]["kind"]]
+        (block,) = ours["Blocks"].values()
+        ex_block = example["Blocks"]["block_3"]   # the example's block without damage
+        assert set(block) == set(ex_block)
+        ex_bc = example["Boundary Conditions"]["BC_2"]
+        variables = set()
+        for name, bc in ours["Boundary Conditions"].items():
+            assert set(bc) == set(ex_bc), name
+            assert bc["Type"] == "Dirichlet" and bc["Node Set"] in disc["Node Sets"]
+            variables.add(bc["Variable"])
+            float(bc["Value"])
+        assert variables == {"Displacements", "Forces"}
+        assert '"Forces"' in solver_src   # the Static solver applies nodal Forces
+        assert set(ours["Solver"]["Static"]) <= set(static["Static"])
+        assert set(ours["Solver"]) <= set(static)
+        assert set(ours["Outputs"]["Output1"]) <= set(example["Outputs"]["Output1"])
+        # the mesh: the example's 2D header (x y block_id volume), also for the 1D bar
+        lines = (folder / "mesh.txt").read_text().splitlines()
+        ex_mesh = [ln for ln in (DATA / "perilab_test_mesh_2D.txt").read_text().splitlines()
+                   if ln.startswith("header")]
+        assert lines[0] == ex_mesh[0] == "header: x y block_id volume"
+        assert all(len(ln.split()) == 4 for ln in lines[1:])
+        ns_header = [ln for ln in (DATA / "perilab_ns_ENFmodel_1.txt").read_text().splitlines()
+                     if ln.startswith("header")]
+        for fname in disc["Node Sets"].values():
+            text = (folder / fname).read_text().splitlines()
+            assert text[0] == ns_header[0] == "header: global_id"
+            ids = [int(v) for v in text[1:]]
+            assert min(ids) >= 1 and max(ids) <= len(lines) - 1
+
+
+def test_perilab_3d_header():
+    from pdverify.decks import perilab_files
+    from pdverify.exchange import node_set, scene_of
+    ns = node_set(scene_of("body3d-traction"), {"spacing": 0.125})
+    mesh = perilab_files(ns)["perilab/mesh.txt"].splitlines()
+    ex = [ln for ln in (DATA / "perilab_test_mesh_3D.txt").read_text().splitlines()
+          if ln.startswith("header")]
+    assert mesh[0] == ex[0] == "header: x y z block_id volume"
+
+
+# ------------------------------------------------------------------------------ report
+@pytest.mark.slow   # a --quick report of one scene in a subprocess: ~15 s
+def test_report_include_and_compare(tmp_path):
+    _, x, u = _native("bar1d-traction")
+    sent = tmp_path / "back.csv"
+    _write_csv(sent, x, u)
+    record = tmp_path / "ext.json"
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+
+    def cli(*args):
+        return subprocess.run([sys.executable, "-m", "pdverify", *args], capture_output=True,
+                              text=True, timeout=600, cwd=ROOT, env=env)
+
+    assert cli("score", "bar1d-traction", str(sent), "--name", "mycode", "--out",
+               str(record)).returncode == 0
+    out = tmp_path / "rep"
+    proc = cli("report", "--quick", "--only", "bar1d-traction", "--include", str(record),
+               "--out", str(out), "--jobs", "1")
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    doc = json.loads((out / "results.json").read_text())
+    ext = [r for r in doc["runs"] if r["method"] == "external:mycode"]
+    assert len(ext) == 1 and ext[0]["diagnostics"]["external"]["cost_measured"] is False
+    assert (out / "figures" / "overview-pareto.png").is_file()
+    html = (out / "index.html").read_text()
+    assert html.count("external:mycode") >= 2   # the overview's column and the table's row
+    assert "external:mycode" in (out / "tables" / "bar1d-traction.csv").read_text()
+    # compare sees it: against itself nothing changes; a changed metric is a regression
+    assert cli("compare", str(out / "results.json"), str(out / "results.json")).returncode == 0
+    worse = json.loads((out / "results.json").read_text())
+    run = next(r for r in worse["runs"] if r["method"] == "external:mycode")
+    run["metrics"]["max_error_pct"] *= 2
+    (tmp_path / "worse.json").write_text(json.dumps(worse))
+    proc = cli("compare", str(out / "results.json"), str(tmp_path / "worse.json"))
+    assert proc.returncode == 1 and "external:mycode" in proc.stdout
+    # only external runs are included
+    proc = cli("report", "--quick", "--only", "bar1d-traction", "--include",
+               str(out / "results.json"), "--out", str(tmp_path / "rep2"))
+    assert proc.returncode == 2 and "not an external run" in proc.stderr
+
+
+def test_a_shape_body_exports_its_cut_volumes_and_part_loads(tmp_path):
+    """A body that is not a box (pdverify.pd.shapes: the quarter plate with a hole), as
+    the family's uncorrected model assembles it: the node set holds its real nodes with
+    their cut volumes, its prescribed part's nodes, and the loads of its traction parts;
+    the CSV and PeriLab writers take it as a box's."""
+    from types import SimpleNamespace
+    from pdverify.corrections.static_state import assemble_plain
+    from pdverify.decks import csv_files, perilab_files
+    from pdverify.exchange import node_set_of
+    from pdverify.pd import StateBasedConstants, get_influence, state_based_stencil
+    from pdverify.pd.problem import FaceCondition, StaticProblem
+    from pdverify.pd.shapes import quarter_hole
+    h, t = 0.05, 0.01
+    shape = quarter_hole(1.0, 0.2)
+    inf = get_influence("hyperbolic")
+    pull = FaceCondition(traction=lambda x, n: np.c_[np.full(len(x), 1e6), np.zeros(len(x))])
+    conds = {k: (FaceCondition(prescribed=(0, 1)) if k == "x-" else
+                 pull if k == "x+" else FaceCondition()) for k in shape.part_names}
+    problem = StaticProblem(tuple(np.subtract(shape.upper, shape.lower)), (0.0, 0.0), h,
+                            state_based_stencil(2, 3.0, h, inf, "partial-volume"),
+                            StateBasedConstants("plane-stress", 1e9, 0.3), inf, conds,
+                            exact=lambda x: np.zeros_like(x), thickness=t, solver="direct",
+                            shape=shape)
+    system = assemble_plain(problem)
+    scene = SimpleNamespace(id="shape-test", title="quarter plate", reference="none",
+                            default_params=dict)
+    ns = node_set_of(scene, {}, problem, system)
+    g = system.model.grid
+    assert len(ns.x) == g.n_interior and ns.x.shape[1] == 2
+    # the cut volumes are the model's own (cut cells of the hole below a whole cell),
+    # together at most the plate's area times t (cells whose centre lies outside the
+    # shape carry no node)
+    np.testing.assert_array_equal(ns.volume, system.model.node_volume[g.interior_ids])
+    assert ns.volume.max() <= h * h * t * (1 + 1e-12) and ns.volume.min() < 0.9 * h * h * t
+    assert ns.volume.sum() <= t * (1 - np.pi * 0.04 / 4)
+    # the x+ part's traction, 1e6 Pa in x over its length 1 m times t: its Gauss weights
+    # sum to the length, so rounding only (a few eps of 1e4 N); nothing in y
+    np.testing.assert_allclose(ns.forces[:, 0].sum(), 1e6 * t, rtol=1e-12, atol=0)
+    assert np.all(ns.forces[:, 1] == 0.0)
+    assert set(ns.fixed) == {0, 1} and np.all(ns.x[ns.fixed[0][0], 0] < 2 * h)
+    files = {**csv_files(ns), **perilab_files(ns)}
+    rows = files["nodes.csv"].splitlines()
+    assert len(rows) == len(ns.x) + 1
+    np.testing.assert_array_equal([float(r.split(",")[3]) for r in rows[1:]], ns.volume)
+    assert files["perilab/mesh.txt"].splitlines()[0] == "header: x y block_id volume"
