@@ -219,7 +219,21 @@ class LPlate(ShapeScene):
     are whole cells and the lattice is a box's with a quarter removed; the re-entrant
     corner is where the neighbourhoods are cut from two sides at once. Metrics: as
     ``plate-hole``, with the nodes nearest the re-entrant edges (``notch-x_``,
-    ``notch-y_max_error_pct``)."""
+    ``notch-y_max_error_pct``).
+
+    Finding (what breaks at a re-entrant corner; measured, not tuned): Taylor's
+    fictitious nodes along the normal do worse here than the uncorrected model (h = 0.025,
+    rel L2 0.181 / 0.142 / 0.142 for orders 1 / 2 / 3 against 0.097; the error grows
+    linearly along the lower arm from the re-entrant corner, a rotation of the arm: the
+    corner is too stiff). Not the rows: on a smooth cubic field with its body force on
+    the same L-shape, x- prescribed and every other part loaded by the field's traction,
+    order 2 errs 1.7e-3 (moment-corrected stencil) against 6.0e-2 uncorrected. Part of the
+    cause: the fictitious nodes in the notch are extrapolated from one arm and bonded to
+    the other, so bonds bridge the notch the singular field opens (u ~ r^0.5445); dropping
+    those 88 bridging bonds takes order 2 from 0.142 to 0.092 (order 1: 0.181 to 0.126).
+    The rest (the clamped-free corners' singularities; the uncorrected model's ring takes
+    the FEM values, its advantage here) is not chased further. A fictitious value per
+    bond, extrapolated from the real end's side, would remove the bridging; not built."""
 
     id = "plate-l"
     title = "L-shaped plate with a re-entrant corner (2D state-based, FEM reference)"
