@@ -118,6 +118,12 @@ def test_round_trip_plate(tmp_path, capsys):
     _round_trip(tmp_path, capsys, "plate2d-clamped", {})
 
 
+def test_round_trip_shape_with_cut_cells(tmp_path, capsys):
+    """A body that is not a box (issue 35): the plate with a hole at h = 0.05 (cut cells,
+    part-keyed conditions, FEM reference), every format and both ways back."""
+    _round_trip(tmp_path, capsys, "plate-hole", {"spacing": 0.05})
+
+
 def test_round_trip_plane_strain_plate(tmp_path, capsys):
     """A 2D case in the fast tier (analytic reference, no FEM to compute): seed 001's
     plane-strain plate, a traction face and prescribed components."""
