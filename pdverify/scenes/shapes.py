@@ -200,10 +200,9 @@ class HolePlate(ShapeScene):
     L2 (0.014) with its largest error at the hole's ends (4.85 %); the volume correction
     is worse than none at the loaded edge's corners (8.23 %). Jitter up to 0.4 spacings
     raises the Taylor extension's error (rel L2 0.021 -> 0.031, order 2) and lowers the
-    uncorrected and energy-corrected ones slightly (0.031 -> 0.026, 0.025 -> 0.020):
-    a moved node set breaks the lattice's symmetric truncation pattern that the
-    uncorrected surface effect builds on, while the polynomial fits see noisier
-    neighbourhoods.
+    uncorrected and energy-corrected ones slightly (0.031 -> 0.026, 0.025 -> 0.020), the
+    means of two seeds; why the truncated models gain is not chased (the spread between
+    seeds at 0.4 is a fifth of the change).
     """
 
     id = "plate-hole"
