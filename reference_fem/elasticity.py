@@ -66,7 +66,30 @@ class Material:
         return self.thickness if self.dim == 2 else 1.0
 
 
-class TensorElasticity:
+class ElasticityBasis:
+    """What every elasticity model here shares: DOF selection and the stiffness, from a
+    vector ``basis`` with ``dof_coords``/``dof_component`` and a :class:`Material`."""
+
+    def dofs(self, where: Callable[..., np.ndarray] | None = None,
+             components: Sequence[int] | None = None) -> np.ndarray:
+        """Global DOF numbers whose location satisfies ``where(x, y[, z])`` (vectorised
+        boolean function; ``None`` = all) and whose component is in ``components``."""
+        mask = np.ones(self.basis.N, dtype=bool)
+        if where is not None:
+            mask &= np.asarray(where(*self.dof_coords), dtype=bool)
+        if components is not None:
+            mask &= np.isin(self.dof_component, np.asarray(components))
+        return np.flatnonzero(mask)
+
+    @cached_property
+    def stiffness(self) -> sp.csr_matrix:
+        """Global stiffness matrix K (times the thickness in 2D)."""
+        lam, mu = self.material.lame()
+        K = asm(linear_elasticity(lam, mu), self.basis)
+        return (self.material.scale * K).tocsr()
+
+
+class TensorElasticity(ElasticityBasis):
     """Small-strain elasticity on a tensor-product mesh of quadratic elements.
 
     2D uses the 9-node biquadratic ``ElementQuad2``, 3D the 27-node triquadratic
@@ -123,25 +146,6 @@ class TensorElasticity:
         self.dof_component = comp
         self.dof_grid_index = flat
         self.dof_coords = self.basis.doflocs
-
-    def dofs(self, where: Callable[..., np.ndarray] | None = None,
-             components: Sequence[int] | None = None) -> np.ndarray:
-        """Global DOF numbers whose location satisfies ``where(x, y[, z])`` (vectorised
-        boolean function; ``None`` = all) and whose component is in ``components``."""
-        mask = np.ones(self.basis.N, dtype=bool)
-        if where is not None:
-            mask &= np.asarray(where(*self.dof_coords), dtype=bool)
-        if components is not None:
-            mask &= np.isin(self.dof_component, np.asarray(components))
-        return np.flatnonzero(mask)
-
-    # --- assembly -----------------------------------------------------------------------
-    @cached_property
-    def stiffness(self) -> sp.csr_matrix:
-        """Global stiffness matrix K (times the thickness in 2D)."""
-        lam, mu = self.material.lame()
-        K = asm(linear_elasticity(lam, mu), self.basis)
-        return (self.material.scale * K).tocsr()
 
     def body_load(self, b: Sequence[float]) -> np.ndarray:
         """Load vector of a uniform body force density b (N/m^3)."""

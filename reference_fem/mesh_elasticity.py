@@ -17,10 +17,9 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
-from skfem import Basis, ElementQuad2, ElementVector, MeshQuad, MeshQuad2, asm, condense
-from skfem.models.elasticity import linear_elasticity
+from skfem import Basis, ElementQuad2, ElementVector, MeshQuad, MeshQuad2, condense
 
-from .elasticity import Material
+from .elasticity import ElasticityBasis, Material
 from .field import _lagrange_1d
 from .mesh_field import TENSOR_NODES, MeshField
 
@@ -79,7 +78,7 @@ def _skfem_to_tensor(element) -> np.ndarray:
     return np.array([3 * int(round(2 * a)) + int(round(2 * b)) for a, b in ref])
 
 
-class MeshElasticity:
+class MeshElasticity(ElasticityBasis):
     """Small-strain plane elasticity with vector Q2 elements on a ``MeshQuad2``.
 
     Parameters
@@ -112,23 +111,6 @@ class MeshElasticity:
         for idx in self.split:        # component c of scalar node k is DOF split[c][k]
             if not np.array_equal(self.basis.doflocs[:, idx], self.scalar.doflocs):
                 raise RuntimeError("vector and scalar Q2 DOFs do not correspond")
-
-    def dofs(self, where: Callable[..., np.ndarray] | None = None,
-             components: Sequence[int] | None = None) -> np.ndarray:
-        """Global DOF numbers whose node satisfies ``where(x, y)`` and whose component is
-        in ``components`` (None: all)."""
-        mask = np.ones(self.basis.N, dtype=bool)
-        if where is not None:
-            mask &= np.asarray(where(*self.dof_coords), dtype=bool)
-        if components is not None:
-            mask &= np.isin(self.dof_component, np.asarray(components))
-        return np.flatnonzero(mask)
-
-    @cached_property
-    def stiffness(self) -> sp.csr_matrix:
-        lam, mu = self.material.lame()
-        K = asm(linear_elasticity(lam, mu), self.basis)
-        return (self.material.scale * K).tocsr()
 
     @cached_property
     def elements(self) -> np.ndarray:

@@ -200,6 +200,20 @@ class FemStaticStateScene(StaticStateScene, FemAndPD):
             memo = self.__dict__["_reference_memo"] = (key, self.fem_reference(p))
         return memo[1]
 
+    def fem_outcome(self, p, system, info, metrics, err, x_int, u, u_ref, lengths) -> Outcome:
+        """A PD run's :class:`Outcome` against the FEM reference: the reference's last
+        field change beside ``metrics``, the fields of the error maps, the size with K's
+        non-zeros, and the constraint rows (if any) in the diagnostics."""
+        ref = self.reference_of(p)
+        metrics["reference_change_pct"] = float(ref.refinement[-1].extra["field_change_pct"])
+        fields = {"x": x_int, "u": u, "u_ref": u_ref, "error": err, "spacing": p["spacing"],
+                  "horizon": system.model.horizon, "lengths": lengths}
+        size = self.size(system)
+        size["stiffness_nnz"] = int(system.K.nnz)
+        if system.B is not None:
+            info["constraints"] = int(system.B.shape[0])
+        return Outcome(metrics=metrics, size=size, fields=fields, diagnostics=info)
+
     def solve(self, method, p, timer):
         if method == FEM.name:
             return FemReference.solve(self, method, p, timer)

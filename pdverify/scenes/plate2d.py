@@ -9,7 +9,7 @@ from ..metrics import plate_errors
 from ..params import Param, at_least, positive
 from ..pd import QUADRATURES, StateBasedConstants, get_influence, state_based_stencil
 from ..pd.problem import FACES, FaceCondition, StaticProblem
-from . import Outcome, Published, influence_param, register, whole_cells
+from . import Published, influence_param, register, whole_cells
 from .family import FemStaticStateScene
 
 #: SuperLU ordering of the plate's direct solves: minimum degree on A + A^T, 2.9x faster
@@ -176,14 +176,7 @@ class ClampedPlate(FemStaticStateScene):
         u_ref = ref.evaluate(x_int)
         horizon = system.model.horizon
         metrics, err = plate_errors(x_int, u, u_ref, lengths, horizon)
-        metrics["reference_change_pct"] = float(ref.refinement[-1].extra["field_change_pct"])
-        fields = {"x": x_int, "u": u, "u_ref": u_ref, "error": err, "spacing": p["spacing"],
-                  "horizon": horizon, "lengths": lengths}
-        size = self.size(system)
-        size["stiffness_nnz"] = int(system.K.nnz)
-        if system.B is not None:
-            info["constraints"] = int(system.B.shape[0])
-        return Outcome(metrics=metrics, size=size, fields=fields, diagnostics=info)
+        return self.fem_outcome(p, system, info, metrics, err, x_int, u, u_ref, lengths)
 
     def cases(self, quick=False):
         out = [("fem", {}), ("none", {})] + [("taylor-fictitious", {"order": n})

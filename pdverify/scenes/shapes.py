@@ -18,7 +18,7 @@ from ..params import Param, at_least, positive
 from ..pd import QUADRATURES, StateBasedConstants, get_influence, state_based_stencil
 from ..pd.problem import FaceCondition, StaticProblem
 from ..pd.shapes import l_shape, quarter_hole
-from . import Outcome, influence_param, register, whole_cells
+from . import influence_param, register, whole_cells
 from .family import FemStaticStateScene
 
 #: SuperLU ordering of the direct solves: minimum degree on A + A^T (4.5x faster than
@@ -129,15 +129,8 @@ class ShapeScene(FemStaticStateScene):
         u_ref = ref.evaluate(x_int)
         horizon = system.model.horizon
         metrics, err = shape_errors(x_int, u, u_ref, problem.shape, horizon, self.regions)
-        metrics["reference_change_pct"] = float(ref.refinement[-1].extra["field_change_pct"])
-        lengths, _ = self.box(p)
-        fields = {"x": x_int, "u": u, "u_ref": u_ref, "error": err, "spacing": p["spacing"],
-                  "horizon": horizon, "lengths": lengths}
-        size = self.size(system)
-        size["stiffness_nnz"] = int(system.K.nnz)
-        if system.B is not None:
-            info["constraints"] = int(system.B.shape[0])
-        return Outcome(metrics=metrics, size=size, fields=fields, diagnostics=info)
+        return self.fem_outcome(p, system, info, metrics, err, x_int, u, u_ref,
+                                self.box(p)[0])
 
     def cases(self, quick=False):
         runs = self.default_cases()
