@@ -88,6 +88,24 @@ class ElasticityBasis:
         K = asm(linear_elasticity(lam, mu), self.basis)
         return (self.material.scale * K).tocsr()
 
+    def solve(self, f: np.ndarray, fixed: np.ndarray, values: np.ndarray | float = 0.0,
+              K: sp.spmatrix | None = None) -> np.ndarray:
+        """Solve K u = f with u[fixed] = values, by condensation (``skfem.condense``)
+        and a sparse LU factorisation (SuperLU, symmetric ordering)."""
+        K = self.stiffness if K is None else K
+        fixed = np.asarray(fixed, dtype=np.int64)
+        x = np.zeros(self.basis.N)
+        x[fixed] = values
+        A, b, x, I = condense(K, f, x=x, D=fixed)
+        if A.shape[0] == 0:
+            return x
+        lu = spla.splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A")
+        x[I] = lu.solve(b)
+        if not np.all(np.isfinite(x)):
+            raise FloatingPointError("solve: non-finite displacement (singular system? "
+                                     "check the supports remove every rigid motion)")
+        return x
+
 
 class TensorElasticity(ElasticityBasis):
     """Small-strain elasticity on a tensor-product mesh of quadratic elements.
@@ -173,24 +191,6 @@ class TensorElasticity(ElasticityBasis):
         return self.material.scale * asm(form, fb)
 
     # --- solution -----------------------------------------------------------------------
-    def solve(self, f: np.ndarray, fixed: np.ndarray, values: np.ndarray | float = 0.0,
-              K: sp.spmatrix | None = None) -> np.ndarray:
-        """Solve K u = f with u[fixed] = values, by condensation (``skfem.condense``)
-        and a sparse LU factorisation (SuperLU, symmetric ordering)."""
-        K = self.stiffness if K is None else K
-        fixed = np.asarray(fixed, dtype=np.int64)
-        x = np.zeros(self.basis.N)
-        x[fixed] = values
-        A, b, x, I = condense(K, f, x=x, D=fixed)
-        if A.shape[0] == 0:
-            return x
-        lu = spla.splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A")
-        x[I] = lu.solve(b)
-        if not np.all(np.isfinite(x)):
-            raise FloatingPointError("solve: non-finite displacement (singular system? "
-                                     "check the supports remove every rigid motion)")
-        return x
-
     def reactions(self, u: np.ndarray, f: np.ndarray | None = None) -> np.ndarray:
         """Reaction forces K u - f (N); nonzero only on constrained DOFs up to round-off."""
         r = self.stiffness @ u

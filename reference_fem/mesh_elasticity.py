@@ -14,10 +14,9 @@ from typing import Callable, Sequence
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
-from skfem import Basis, ElementQuad2, ElementVector, MeshQuad, MeshQuad2, condense
+from skfem import Basis, ElementQuad2, ElementVector, MeshQuad, MeshQuad2
 
 from .elasticity import ElasticityBasis, Material
 from .field import _lagrange_1d
@@ -166,18 +165,6 @@ class MeshElasticity(ElasticityBasis):
             local = np.einsum("qi,eq,q->ei", N, tc * length, w)     # (e, 3)
             np.add.at(f, self.split[c][edges], local)
         return self.material.scale * f
-
-    def solve(self, f: np.ndarray, fixed: np.ndarray) -> np.ndarray:
-        """Solve K u = f with u[fixed] = 0 (condensation, SuperLU as TensorElasticity)."""
-        fixed = np.asarray(fixed, dtype=np.int64)
-        x = np.zeros(self.basis.N)
-        A, b, x, I = condense(self.stiffness, f, x=x, D=fixed)
-        lu = spla.splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A")
-        x[I] = lu.solve(b)
-        if not np.all(np.isfinite(x)):
-            raise FloatingPointError("solve: non-finite displacement (singular system? "
-                                     "check the supports remove every rigid motion)")
-        return x
 
     def field(self, u: np.ndarray) -> MeshField:
         """The displacement as a self-contained :class:`MeshField`."""
