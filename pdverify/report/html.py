@@ -51,13 +51,15 @@ KEY_METRICS = 4
 
 def key_metrics(scene, results) -> list[str]:
     """The compact table's metric columns: the headline error, the metrics the paper
-    prints for this scene, then the scene's first metrics; at most :data:`KEY_METRICS`."""
+    prints for this scene, those the scene names (``table_metrics``), then the scene's
+    first metrics; at most :data:`KEY_METRICS`."""
     present = []
     for r in results:
         for k in r.metrics:
             if k not in present:
                 present.append(k)
-    wanted = [headline(scene)] + [p.metric for p in scene.published] + present
+    wanted = ([headline(scene)] + [p.metric for p in scene.published]
+              + list(getattr(scene, "table_metrics", ())) + present)
     out = []
     for m in wanted:
         if m in present and m not in out:

@@ -89,6 +89,13 @@ class ShapeScene(FemStaticStateScene):
             out += [(name, {"order": n}) for n in (1, 2, 3)] if ordered else [(name, {})]
         return out
 
+    @property
+    def table_metrics(self):
+        """The report's compact table: the largest error, and the largest near each
+        reported part, beside the headline rel_l2_error."""
+        return ("max_error_pct",) + tuple(
+            f"{r}_max_error_pct" for r in self.regions)
+
     def shape(self, p):
         raise NotImplementedError
 

@@ -86,3 +86,21 @@ def test_the_fictitious_nodes_beat_the_baseline_on_the_hole_at_the_default_grid(
         out[method] = scene.solve(method, p, Timer()).metrics
     assert out["taylor-fictitious"]["max_error_pct"] < 0.5 * out["none"]["max_error_pct"]
     assert out["taylor-fictitious"]["rel_l2_error"] < out["none"]["rel_l2_error"]
+
+
+@pytest.mark.slow   # every run of plate-hole and its figures: ~20 s on 2 cores
+def test_the_report_shows_the_hole_scene_its_reference_and_the_jitter_study(tmp_path):
+    out = tmp_path / "rep"
+    subprocess.run([sys.executable, "-m", "pdverify", "report", "--only", "plate-hole",
+                    "--out", str(out)], check=True, capture_output=True)
+    html = (out / "index.html").read_text()
+    section = html[html.index('<h2 id="plate-hole"'):]
+    assert "Source: ours (issue 35" in section and "()" not in section.split("</p>")[0]
+    for needle in ("plate-hole-jitter.png", "plate-hole-errors.png",
+                   "plate-hole-convergence.png", "hole_max_error_pct", "max_error_pct",
+                   "Kirsch"):
+        assert needle in html, needle
+    runs = json.loads((out / "results.json").read_text())["runs"]
+    assert not [r for r in runs if r["status"] != "ok"]
+    jitter = {(r["method"], r["params"].get("jitter")) for r in runs}
+    assert {("none", 0.4), ("energy", 0.4), ("taylor-fictitious", 0.4)} <= jitter
