@@ -13,7 +13,8 @@ from pdverify.scenes import all_scenes
 
 def test_every_scene_has_its_paper_and_every_doi_was_checked():
     for scene in all_scenes():
-        assert seed_of(scene.seed) in PAPERS, scene.id
+        # a scene of pdverify's own (issue 35's shapes) says so instead of naming a paper
+        assert seed_of(scene.seed) in PAPERS or scene.seed.startswith("ours"), scene.id
     for key, p in PAPERS.items():
         assert p["authors"] and p["title"], key
         # a DOI only with the page it was checked against (never recalled)
