@@ -467,7 +467,7 @@ def _build_logged(cases, out, final, jobs, progress, client=None, quick=False,
     scenes = [scene for scene, _ in owned]
     from ..convergence import collect
     studies = collect(results, quick)
-    with phase("figures_s"):
+    with phase("figures_s"), figures.quick_figures(quick):
         drawn = _draw_all(
             [(f"figure for {scene.id}", figures.draw, (scene, mine, figdir), [])
              for scene, mine in owned]
