@@ -16,9 +16,11 @@ it), the number of runs and of failed
 runs, the ``critical path:`` line; medians. ``--cold``: each of those reports with an
 empty FEM cache (``$PDVERIFY_CACHE_DIR`` a fresh temporary folder), so the FEM
 references are computed; prints the FEM runs' times, which dominate a cold report.
+``--against SRC``: the same reports of another source tree, alternating round by round.
 
 ``--mode inprocess``: one process plans the quick report, runs its cases with ``--jobs``
-workers (as the report does), then draws every figure task of the report serially,
+workers (as the report does), then draws every figure task of the report serially (as a ``--quick`` report draws
+them: ``pdverify.report.figures.quick_figures``),
 ``--repeat`` times, timing each (a scene's figures, the error-against-cost figures, the
 convergence figures), and then the report's own parallel drawing (``--jobs`` processes)
 once; prints the median of each task, the sum, the figures per task and the seconds per
@@ -51,9 +53,10 @@ def _load() -> str:
     return " ".join(f"{v:.2f}" for v in os.getloadavg())
 
 
-def fresh_report(jobs=None, cold=False, only=None) -> dict:
-    """One ``report --quick`` in a fresh process; its phases, wall time and runs."""
-    env = {**os.environ, "PYTHONPATH": HERE + os.pathsep + os.environ.get("PYTHONPATH", "")}
+def fresh_report(jobs=None, cold=False, only=None, src=HERE) -> dict:
+    """One ``report --quick`` of the source tree ``src`` in a fresh process; its phases,
+    wall and CPU time and runs."""
+    env = {**os.environ, "PYTHONPATH": src + os.pathsep + os.environ.get("PYTHONPATH", "")}
     with tempfile.TemporaryDirectory() as tmp:
         if cold:
             env["PDVERIFY_CACHE_DIR"] = os.path.join(tmp, "fem-cache")
@@ -83,12 +86,24 @@ def fresh_report(jobs=None, cold=False, only=None) -> dict:
 
 
 def fresh(a) -> None:
+    trees = {"this tree": HERE}
+    if a.against:
+        trees[f"against {a.against}"] = os.path.abspath(a.against)
+    rounds = {name: [] for name in trees}
     print(f"load before: {_load()}")
-    rounds = [fresh_report(a.jobs, a.cold, a.only) for _ in range(a.repeat)]
+    for _ in range(a.repeat):        # alternating, so that the machine's load weighs alike
+        for name, src in trees.items():
+            rounds[name].append(fresh_report(a.jobs, a.cold, a.only, src))
     print(f"load after:  {_load()}")
+    for name, rs in rounds.items():
+        _summary(a, name, rs)
+
+
+def _summary(a, name, rounds) -> None:
     kind = "cold (empty FEM cache)" if a.cold else "warm"
     r0 = rounds[0]
-    print(f"report --quick, {kind}, fresh processes, median of {a.repeat}: {r0['runs']} runs, "
+    print(f"{name}: report --quick, {kind}, fresh processes, median of {a.repeat}: "
+          f"{r0['runs']} runs, "
           f"exit codes {[r['exit'] for r in rounds]}, {r0['figures']} figure files")
     print(f"  {r0['last']}")
     for k in PHASES + ("wall_s", "cpu_s"):
@@ -156,7 +171,8 @@ def inprocess(a) -> None:
     for s, t in sorted(per_scene.items(), key=lambda x: -x[1])[:8]:
         print(f"  {s:28s} {t:7.2f} s")
     times, cpu, counts = {}, {}, {}
-    with tempfile.TemporaryDirectory() as figdir:
+    from pdverify.report import figures
+    with tempfile.TemporaryDirectory() as figdir, figures.quick_figures(True):
         tasks = _tasks(cases, results, figdir)
         for _ in range(a.repeat):
             for what, draw, args, _empty in tasks:
@@ -198,6 +214,9 @@ def main(argv=None) -> int:
     ap.add_argument("--mode", choices=("fresh", "inprocess", "both"), default="both")
     ap.add_argument("--profile", default=None, metavar="FILE")
     ap.add_argument("--cold", action="store_true", help="fresh reports with an empty FEM cache")
+    ap.add_argument("--against", default=None, metavar="SRC",
+                    help="fresh mode: also time this source tree (e.g. `git archive` of an "
+                         "earlier commit unpacked), alternating with this one")
     ap.add_argument("--only", nargs="+", default=None)
     ap.add_argument("--runs-file", default=None, metavar="FILE",
                     help="inprocess: the runs' results pickled here on the first call and "

@@ -86,12 +86,18 @@ def _mratio(scene, kind, levels, skip=(), quick=None):
     ql = None if quick is None else tuple({"spacing": h, "m_ratio": float(m)}
                                           for h, m in quick)
     if kind == "delta":
+        if ql is not None and len({q["m_ratio"] for q in ql}) > 1:
+            raise ValueError(f"{scene}: a delta-refinement's quick levels share one m_ratio")
         return Study(scene, kind, lv, lambda p: p["spacing"] * p["m_ratio"],
                      f"m = {lv[0]['m_ratio']:g}", "horizon delta [m]", skip=skip,
-                     quick_levels=ql)
+                     quick_levels=ql,
+                     quick_fixed=f"m = {ql[0]['m_ratio']:g}" if ql else None)
+    if ql is not None and len({round(q["spacing"] * q["m_ratio"], 12) for q in ql}) > 1:
+        raise ValueError(f"{scene}: an m-refinement's quick levels share one delta")
     return Study(scene, kind, lv, lambda p: p["spacing"],
                  f"delta = {lv[0]['spacing'] * lv[0]['m_ratio']:g}", "grid spacing Delta [m]",
-                 skip=skip, quick_levels=ql)
+                 skip=skip, quick_levels=ql,
+                 quick_fixed=f"delta = {ql[0]['spacing'] * ql[0]['m_ratio']:g}" if ql else None)
 
 
 #: seed 000's fictitious nodes in 3D: 35-40 s and 2 GB a run at h = 0.05, near-singular on
@@ -119,8 +125,9 @@ def _clamped(kind, levels, quick=None):
     if kind == "delta":
         ql = None if quick is None else tuple({"side_factor": float(s), "m_ratio": float(m)}
                                               for s, m in quick)
-        if ql is not None and len({q["m_ratio"] for q in ql}) != 1:
-            raise ValueError("a delta-refinement's quick levels share one m_ratio")
+        if ql is not None and len({q["m_ratio"] for q in ql}) > 1:
+            raise ValueError("sheet2d-clamped: a delta-refinement's quick levels share one "
+                             "m_ratio")
         return Study("sheet2d-clamped", kind, lv, lambda p: 1.0 / p["side_factor"],
                      f"m = {lv[0]['m_ratio']:g}", "delta / L (side L)", quick_levels=ql,
                      quick_fixed=None if ql is None else f"m = {ql[0]['m_ratio']:g}")
@@ -156,7 +163,10 @@ STUDIES = (
     _clamped("m", [(4, m) for m in (3, 6, 12)]),
     # seed 000 §6: the scene's own sweeps (same levels, so no extra runs in a full report)
     _mratio("plate2d-clamped", "delta", [(h, 3) for h in (0.2, 0.1, 0.05)]),
-    _mratio("plate2d-clamped", "m", [(0.2 / m, m) for m in (2, 3, 4)]),
+    # --quick at delta = 0.4 (h = 0.2 at m = 2, 0.1 at m = 4: 1.5 s for the eight methods;
+    # 3.5 s at delta = 0.2, whose h = 1/15 level took 3.1 s; issue 32)
+    _mratio("plate2d-clamped", "m", [(0.2 / m, m) for m in (2, 3, 4)],
+            quick=[(0.2, 2), (0.1, 4)]),
     _mratio("plate2d-plane-strain", "delta", [(h, 3) for h in (0.1, 0.05, 0.025, 0.0125)]),
     _mratio("plate2d-plane-strain", "m", [(0.2 / m, m) for m in (2, 4, 8)]),
     # --quick (issue 32: the quick report in 30 s on 2 cores): the delta-refinement at
@@ -209,6 +219,9 @@ def collect(results, quick: bool = False) -> list[dict]:
     from .results import run_key
     from .scenes import get_scene
     present = {r.scene for r in results}
+    first = {}                  # each key's first run, as a scan of ``results`` finds it
+    for r in results:
+        first.setdefault(r.key, r)
     out = []
     for st in STUDIES:
         if st.scene not in present or not st.used_levels(quick):
@@ -222,7 +235,7 @@ def collect(results, quick: bool = False) -> list[dict]:
                 # the run at exactly the level's params (the method's other params at
                 # their defaults), not another case of the scene at the same spacing
                 want = run_key(st.scene, method, scene.resolve(method, level))
-                run = next((r for r in results if r.key == want), None)
+                run = first.get(want)
                 err = None if run is None or run.status != "ok" else run.metrics.get(st.metric)
                 levels.append({"h": st.h(level), **level,
                                "error": err, "status": "missing" if run is None else run.status,

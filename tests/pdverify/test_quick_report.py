@@ -98,3 +98,19 @@ def test_quick_figures_skip_the_tight_bbox_of_a_constrained_figure(tmp_path, mon
         assert seen["bbox_inches"] == ("tight" if tight else None), (quick, layout)
         minor = ax.xaxis.get_minor_locator()
         assert isinstance(minor, matplotlib.ticker.NullLocator) == quick
+
+
+def test_the_plates_quick_m_refinement_says_its_delta():
+    st, quick = _levels("m", "plate2d-clamped", True)
+    assert {round(lv["spacing"] * lv["m_ratio"], 12) for lv in quick} == {0.4}
+    assert st.fixed_in(True) == "delta = 0.4" and st.fixed_in(False) == "delta = 0.2"
+    assert st.used_levels(False) == st.levels
+
+
+def test_quick_levels_must_keep_what_the_study_fixes():
+    with pytest.raises(ValueError, match="share one delta"):
+        convergence._mratio("plate2d-clamped", "m", [(0.1, 2), (0.05, 4)],
+                            quick=[(0.2, 2), (0.1, 3)])
+    with pytest.raises(ValueError, match="share one m_ratio"):
+        convergence._mratio("plate2d-clamped", "delta", [(0.2, 3), (0.1, 3)],
+                            quick=[(0.2, 3), (0.1, 2)])
