@@ -31,6 +31,32 @@ one serial drawing of all tasks
 
 The machine is shared: run the alternatives back to back, quote medians and the load
 (the script prints ``os.getloadavg()`` before and after).
+
+Findings (issue 32, 2 cores; the CPU time is the steadier measure on a loaded machine):
+
+- Before (47198fc), warm, quiet (load 0.1-1.6): 319 runs, 79.8 s wall (runs 56.9 s,
+  figures 19.1 s, VTU 1.0 s, pages 0.1 s), 146 CPU-s. The runs summed 111 s, 60 s of
+  them body3d-manufactured, 50 s of that its convergence levels h = 0.0625 and 1/18
+  (surface nodes at 1/18 alone 12.2 s); sheet2d-tension 16 s (its quick cases at Table
+  1's 1 mm grid, 11 s); sheet2d-clamped 8 s (the delta-refinement's side 8 at m = 6,
+  6.7 s). Figures: 55 files, about 30 CPU-s drawn serially, three quarters of it in
+  ``savefig`` (matplotlib's layout and tick passes: a layout engine or a tight bbox
+  lays a figure out once more before the real draw), the pyvista renders 1.5-2 s with
+  the import; no figure was drawn twice, and the report process had already imported
+  every module the runs use (the forked workers import nothing).
+- After: 298 runs (every scene and every method kept), back to back with the old tree
+  at load 4-6, medians of 2: 78.4 s wall (runs 48.9, figures 26.4), 75.7 CPU-s, against
+  157.9 s (runs 119.6, figures 34.1) and 156.0 CPU-s: half the CPU time; runs 0.41,
+  figures 0.78 of before. At load 2-3: 48.8 s wall (runs 30.5, figures 14.8), 71 CPU-s.
+  The figures are now about a third: 51 files, 25 CPU-s, 0.3-1.5 s each (the 3D error
+  maps, 40 panels, 1-1.5 s; the convergence figures 3 s for 7; the error-against-cost
+  overview 2.8 s).
+- Cold (an empty FEM cache), load about 5: 110.7 s wall, 109 CPU-s (warm: 75.7): the
+  FEM references add about 34 CPU-s, two thirds of it the finite-strain indentation
+  references (Saint Venant-Kirchhoff 17.8 s, neo-Hookean 17.5 s; then the clamped
+  plate 6.2 s, the clamped sheet 5.1 s, the small-strain indentation 3.7 s), and PD
+  runs that start while their scene's reference is computed wait on its cache lock
+  (3.8 s for runs of 0.05 s).
 """
 from __future__ import annotations
 
