@@ -48,6 +48,9 @@ Findings (issue 32, 2 cores; the CPU time is the steadier measure on a loaded ma
   at load 4-6, medians of 2: 78.4 s wall (runs 48.9, figures 26.4), 75.7 CPU-s, against
   157.9 s (runs 119.6, figures 34.1) and 156.0 CPU-s: half the CPU time; runs 0.41,
   figures 0.78 of before. At load 2-3: 48.8 s wall (runs 30.5, figures 14.8), 71 CPU-s.
+  One more round each, load falling from 5.1 to 2.4: 37.8 s wall (runs 21.9, figures
+  13.4), 72 CPU-s, against 72.1 s (runs 53.9, figures 14.9), 139 CPU-s: the figures'
+  wall time barely moved (fewer, lighter files, but the same matplotlib passes).
   The figures are now about a third: 51 files, 25 CPU-s, 0.3-1.5 s each (the 3D error
   maps, 40 panels, 1-1.5 s; the convergence figures 3 s for 7; the error-against-cost
   overview 2.8 s).
