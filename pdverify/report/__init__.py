@@ -481,7 +481,7 @@ def _build_logged(cases, out, final, jobs, progress, client=None, quick=False,
     scenes = [scene for scene, _ in owned]
     from ..convergence import collect
     studies = collect([r for r in results if not is_external(r.method)], quick)
-    with phase("figures_s"):
+    with phase("figures_s"), figures.quick_figures(quick):
         drawn = _draw_all(
             [(f"figure for {scene.id}", figures.draw,
               (scene, [r for r in mine if not is_external(r.method)], figdir), [])

@@ -103,3 +103,20 @@ def test_render_deformed_draws_seed001_fig11_beside_the_paper(tmp_path):
 def test_render_deformed_needs_the_max_displacement_metric(tmp_path, run):
     scene, r = run            # body3d-traction records no max_displacement
     assert fields3d.render_deformed(scene, [r], str(tmp_path)) == []
+
+
+def test_a_quick_report_draws_no_rendering(tmp_path, monkeypatch, run):
+    """Issue 32: in a --quick report (figures.quick_figures) the 3D family draws its maps
+    and cost figure but no pyvista rendering: the renderer is not even called."""
+    from pdverify.report import figures
+    scene, r = run
+    called = []
+    monkeypatch.setattr(fields3d, "render_box_fields", lambda *a: called.append(a) or [])
+    monkeypatch.setattr(fields3d, "render_deformed", lambda *a: called.append(a) or [])
+    with figures.quick_figures(True):
+        names = [n for n, _ in surface_nodes.surface_node_figures(scene, [r], str(tmp_path))]
+    assert names == ["body3d-traction-maps.png", "body3d-traction-cost.png"]
+    assert called == []
+    assert figures.QUICK is False        # the setting ends with the block
+    surface_nodes.surface_node_figures(scene, [r], str(tmp_path))
+    assert len(called) == 2              # outside it, both renderers are called

@@ -1,6 +1,7 @@
 """Figures of the report: one module per family of scenes, each registering its draw function."""
 from __future__ import annotations
 
+import contextlib
 import importlib
 import os
 import pkgutil
@@ -12,6 +13,25 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 FAMILIES = {}
+
+#: whether the figures being drawn are a ``--quick`` report's (:func:`quick_figures`):
+#: lighter (no pyvista renderings, no minor ticks on log axes, a constrained-layout
+#: figure saved without the tight-bbox pass, which lays the figure out twice more)
+QUICK = False
+
+
+@contextlib.contextmanager
+def quick_figures(quick: bool = True):
+    """Draw the figures of a ``--quick`` report (:data:`QUICK`) inside the block; the
+    drawing processes forked inside it inherit the setting. Issue 32: the quick report's
+    figures took 30 s of CPU (55 figures; ``benchmarks/quick_report.py``), three
+    quarters of it in ``savefig``'s layout and tick passes."""
+    global QUICK
+    old, QUICK = QUICK, bool(quick)
+    try:
+        yield
+    finally:
+        QUICK = old
 
 
 def family(name, failed: bool = False):
@@ -170,10 +190,31 @@ def node_image(x, spacing, values, unit=1.0):
 
 
 def save(fig, folder, name) -> str:
+    """Write ``fig`` as ``folder/name`` (PNG, 110 dpi, cropped to its content) and close
+    it. Under :data:`QUICK`: log axes without minor ticks, and a figure with a
+    constrained layout (which already fits its content into the canvas) is saved
+    without the tight bounding box, whose extra draw and layout passes cost about a third
+    of a save (``benchmarks/quick_report.py``)."""
     _tidy_axes(fig)
+    tight = "tight"
+    if QUICK:
+        _no_minor_log_ticks(fig)
+        from matplotlib.layout_engine import ConstrainedLayoutEngine
+        if isinstance(fig.get_layout_engine(), ConstrainedLayoutEngine):
+            tight = None
     path = os.path.join(folder, name)
-    fig.savefig(path, dpi=110, bbox_inches="tight")
+    fig.savefig(path, dpi=110, bbox_inches=tight)
     plt.close(fig)
     return name
+
+
+def _no_minor_log_ticks(fig):
+    """No minor ticks on the log axes of ``fig`` (their labels are off anyway,
+    :func:`_tidy_axes`; each tick is laid out on every draw)."""
+    from matplotlib.ticker import NullLocator
+    for ax in fig.axes:
+        for axis, scale in ((ax.xaxis, ax.get_xscale()), (ax.yaxis, ax.get_yscale())):
+            if scale == "log":
+                axis.set_minor_locator(NullLocator())
 
 

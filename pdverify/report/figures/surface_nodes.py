@@ -322,7 +322,12 @@ SECTION5 = (("pals", {}, "(a) PALS"), ("mirror-nodes", {"neumann": "full-tractio
 
 def _renderings_3d(scene, results, folder):
     """pyvista renderings of |u| and the error (:mod:`.fields3d`); a renderer that fails
-    (no OpenGL, ...) costs these images only, with a warning naming the cause."""
+    (no OpenGL, ...) costs these images only, with a warning naming the cause. None in a
+    ``--quick`` report (:data:`QUICK`): pyvista's import and the renders took 2-3 s of
+    its figures' time; the maps show the same fields."""
+    from . import QUICK
+    if QUICK:
+        return []
     try:
         from .fields3d import render_box_fields, render_deformed
         return render_box_fields(scene, results, folder) + render_deformed(scene, results,

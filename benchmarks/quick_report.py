@@ -1,0 +1,263 @@
+"""Where the quick report's time goes (issue 32: ``report --quick`` warm in <= 30 s on 2
+cores, cold <= 60 s): its phases, the figure tasks one by one, and the cold FEM cache.
+
+Plain script (no test runner):
+
+    python benchmarks/quick_report.py [--repeat N] [--jobs J] [--mode fresh|inprocess|both]
+                                      [--profile FILE] [--cold] [--only SCENE ...]
+
+``--mode fresh`` (default ``both``): ``python -m pdverify report --quick`` ``--repeat``
+times (default 3), each in a fresh process into a temporary folder (the interpreter's
+start and the imports included), the phases each report records in results.json
+(``report_phases``), the wall time of the command and its CPU time (user + system, the
+report process and every worker and drawing process it waited for: on a loaded machine
+a steadier measure than the wall time; the wall time on 2 quiet cores is about half of
+it), the number of runs and of failed
+runs, the ``critical path:`` line; medians. ``--cold``: each of those reports with an
+empty FEM cache (``$PDVERIFY_CACHE_DIR`` a fresh temporary folder), so the FEM
+references are computed; prints the FEM runs' times, which dominate a cold report.
+``--against SRC``: the same reports of another source tree, alternating round by round.
+
+``--mode inprocess``: one process plans the quick report, runs its cases with ``--jobs``
+workers (as the report does), then draws every figure task of the report serially (as a ``--quick`` report draws
+them: ``pdverify.report.figures.quick_figures``),
+``--repeat`` times, timing each (a scene's figures, the error-against-cost figures, the
+convergence figures), and then the report's own parallel drawing (``--jobs`` processes)
+once; prints the median of each task, the sum, the figures per task and the seconds per
+figure, largest first. ``--runs-file FILE``: the results are pickled there and read back by the next call
+(the figures timed without running the cases again). ``--profile FILE``: cProfile of
+one serial drawing of all tasks
+(``python -m pstats FILE``), its top entries printed by cumulative time.
+
+The machine is shared: run the alternatives back to back, quote medians and the load
+(the script prints ``os.getloadavg()`` before and after).
+
+Findings (issue 32, 2 cores; the CPU time is the steadier measure on a loaded machine):
+
+- Before (47198fc), warm, quiet (load 0.1-1.6): 319 runs, 79.8 s wall (runs 56.9 s,
+  figures 19.1 s, VTU 1.0 s, pages 0.1 s), 146 CPU-s. The runs summed 111 s, 60 s of
+  them body3d-manufactured, 50 s of that its convergence levels h = 0.0625 and 1/18
+  (surface nodes at 1/18 alone 12.2 s); sheet2d-tension 16 s (its quick cases at Table
+  1's 1 mm grid, 11 s); sheet2d-clamped 8 s (the delta-refinement's side 8 at m = 6,
+  6.7 s). Figures: 55 files, about 30 CPU-s drawn serially, three quarters of it in
+  ``savefig`` (matplotlib's layout and tick passes: a layout engine or a tight bbox
+  lays a figure out once more before the real draw), the pyvista renders 1.5-2 s with
+  the import; no figure was drawn twice, and the report process had already imported
+  every module the runs use (the forked workers import nothing).
+- After: 298 runs (every scene and every method kept), back to back with the old tree
+  at load 4-6, medians of 2: 78.4 s wall (runs 48.9, figures 26.4), 75.7 CPU-s, against
+  157.9 s (runs 119.6, figures 34.1) and 156.0 CPU-s: half the CPU time; runs 0.41,
+  figures 0.78 of before. At load 2-3: 48.8 s wall (runs 30.5, figures 14.8), 71 CPU-s.
+  One more round each, load falling from 5.1 to 2.4: 37.8 s wall (runs 21.9, figures
+  13.4), 72 CPU-s, against 72.1 s (runs 53.9, figures 14.9), 139 CPU-s: the figures'
+  wall time barely moved (fewer, lighter files, but the same matplotlib passes).
+  The figures are now about a third: 51 files, 25 CPU-s, 0.3-1.5 s each (the 3D error
+  maps, 40 panels, 1-1.5 s; the convergence figures 3 s for 7; the error-against-cost
+  overview 2.8 s).
+- Cold (an empty FEM cache), load about 5: 110.7 s wall, 109 CPU-s (warm: 75.7): the
+  FEM references add about 34 CPU-s, two thirds of it the finite-strain indentation
+  references (Saint Venant-Kirchhoff 17.8 s, neo-Hookean 17.5 s; then the clamped
+  plate 6.2 s, the clamped sheet 5.1 s, the small-strain indentation 3.7 s), and PD
+  runs that start while their scene's reference is computed wait on its cache lock
+  (3.8 s for runs of 0.05 s).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import pickle
+import resource
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+PHASES = ("runs_s", "figures_s", "fields_s", "pages_s", "total_s")
+
+
+def _load() -> str:
+    return " ".join(f"{v:.2f}" for v in os.getloadavg())
+
+
+def fresh_report(jobs=None, cold=False, only=None, src=HERE) -> dict:
+    """One ``report --quick`` of the source tree ``src`` in a fresh process; its phases,
+    wall and CPU time and runs."""
+    env = {**os.environ, "PYTHONPATH": src + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    with tempfile.TemporaryDirectory() as tmp:
+        if cold:
+            env["PDVERIFY_CACHE_DIR"] = os.path.join(tmp, "fem-cache")
+        out = os.path.join(tmp, "report")
+        cmd = [sys.executable, "-m", "pdverify", "report", "--quick", "--out", out]
+        cmd += ["--jobs", str(jobs)] if jobs else []
+        cmd += ["--only", *only] if only else []
+        t0 = time.perf_counter()
+        r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        done = subprocess.run(cmd, cwd=tmp, env=env, capture_output=True, text=True)
+        wall = time.perf_counter() - t0
+        r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
+        with open(os.path.join(out, "results.json")) as fh:
+            doc = json.load(fh)
+        figures = len(os.listdir(os.path.join(out, "figures")))
+    lines = (done.stdout + done.stderr).splitlines()
+    path = [x for x in lines if x.startswith("critical path:")]
+    fem = sorted(((r["timings"].get("total_s", 0.0), f"{r['scene']} fem "
+                   + " ".join(f"{k}={v}" for k, v in r["params"].items()
+                              if k in ("kinematics", "law", "levels")))
+                  for r in doc["runs"] if r["method"] == "fem"), reverse=True)
+    return {**doc["report_phases"], "wall_s": wall, "cpu_s": cpu, "runs": len(doc["runs"]),
+            "last": next((x for x in reversed(lines) if x.startswith("report: ")), ""),
+            "exit": done.returncode, "figures": figures, "fem": fem,
+            "critical_path": path[-1] if path else ""}
+
+
+def fresh(a) -> None:
+    trees = {"this tree": HERE}
+    if a.against:
+        trees[f"against {a.against}"] = os.path.abspath(a.against)
+    rounds = {name: [] for name in trees}
+    print(f"load before: {_load()}")
+    for _ in range(a.repeat):        # alternating, so that the machine's load weighs alike
+        for name, src in trees.items():
+            rounds[name].append(fresh_report(a.jobs, a.cold, a.only, src))
+    print(f"load after:  {_load()}")
+    for name, rs in rounds.items():
+        _summary(a, name, rs)
+
+
+def _summary(a, name, rounds) -> None:
+    kind = "cold (empty FEM cache)" if a.cold else "warm"
+    r0 = rounds[0]
+    print(f"{name}: report --quick, {kind}, fresh processes, median of {a.repeat}: "
+          f"{r0['runs']} runs, "
+          f"exit codes {[r['exit'] for r in rounds]}, {r0['figures']} figure files")
+    print(f"  {r0['last']}")
+    for k in PHASES + ("wall_s", "cpu_s"):
+        vals = [r.get(k, 0.0) for r in rounds]
+        print(f"  {k[:-2]:8s} {statistics.median(vals):7.2f} s   "
+              f"(rounds: {', '.join(f'{v:.1f}' for v in vals)})")
+    for r in rounds:
+        print(f"  {r['critical_path']}")
+    if a.cold:
+        print("  FEM runs of the first round (their references computed):")
+        for t, what in r0["fem"]:
+            print(f"    {t:7.2f} s  {what}")
+
+
+def _tasks(cases, results, figdir):
+    """The figure tasks of the report, as ``pdverify.report._build_logged`` makes them."""
+    from pdverify.convergence import collect
+    from pdverify.report import figures
+    from pdverify.report.figures import convergence, overview
+    from pdverify.results import run_key
+    from pdverify.scenes import get_scene
+    order = list(dict.fromkeys(c[0] for c in cases))
+    owned = []
+    for scene_id in order:
+        scene = get_scene(scene_id)
+        own = {run_key(scene_id, m, scene.resolve(m, o)) for m, o in scene.report_cases(True)}
+        owned.append((scene, [r for r in results if r.scene == scene_id and r.key in own]))
+    scenes = [s for s, _ in owned]
+    studies = collect(results, True)
+    return ([(scene.id, figures.draw, (scene, mine, figdir), []) for scene, mine in owned]
+            + [("error-against-cost", overview.pareto, (scenes, results, figdir), []),
+               ("convergence", convergence.draw, (studies, figdir), {})])
+
+
+def _count(value) -> int:
+    if isinstance(value, dict):
+        return sum(len(v) for v in value.values())
+    return len(value)
+
+
+def inprocess(a) -> None:
+    from pdverify.report import _draw_all
+    from pdverify.runner import plan, run_cases
+    print(f"load before: {_load()}")
+    cases = plan(only=a.only, quick=True)
+    if a.runs_file and os.path.exists(a.runs_file):
+        with open(a.runs_file, "rb") as fh:
+            results = pickle.load(fh)
+        runs_s = float("nan")
+        print(f"runs: read from {a.runs_file} (not run)")
+    else:
+        t0 = time.perf_counter()
+        results = run_cases(cases, jobs=a.jobs, progress=None)
+        runs_s = time.perf_counter() - t0
+        if a.runs_file:
+            with open(a.runs_file, "wb") as fh:
+                pickle.dump(results, fh)
+    failed = sum(r.counts_as_failure for r in results)
+    total = sum(r.timings.get("total_s", 0.0) for r in results)
+    print(f"runs: {len(results)} ({failed} failed), {runs_s:.1f} s wall with --jobs "
+          f"{a.jobs or 'default'}, {total:.1f} s summed over the runs")
+    per_scene = {}
+    for r in results:
+        per_scene[r.scene] = per_scene.get(r.scene, 0.0) + r.timings.get("total_s", 0.0)
+    for s, t in sorted(per_scene.items(), key=lambda x: -x[1])[:8]:
+        print(f"  {s:28s} {t:7.2f} s")
+    times, cpu, counts = {}, {}, {}
+    from pdverify.report import figures
+    with tempfile.TemporaryDirectory() as figdir, figures.quick_figures(True):
+        tasks = _tasks(cases, results, figdir)
+        for _ in range(a.repeat):
+            for what, draw, args, _empty in tasks:
+                t, c = time.perf_counter(), time.process_time()
+                value = draw(*args)
+                times.setdefault(what, []).append(time.perf_counter() - t)
+                cpu.setdefault(what, []).append(time.process_time() - c)
+                counts[what] = _count(value)
+        if a.profile:
+            import cProfile
+            import pstats
+            prof = cProfile.Profile()
+            prof.enable()
+            for _what, draw, args, _empty in tasks:
+                draw(*args)
+            prof.disable()
+            prof.dump_stats(a.profile)
+            pstats.Stats(a.profile).sort_stats("cumulative").print_stats(25)
+        t = time.perf_counter()
+        _draw_all(tasks, a.jobs, sys.stderr)
+        parallel = time.perf_counter() - t
+    med = {w: statistics.median(v) for w, v in times.items()}
+    mcpu = {w: statistics.median(v) for w, v in cpu.items()}
+    print(f"figure tasks, serial, median of {a.repeat} (wall s, CPU s of this process, "
+          "figures, wall s per figure):")
+    for w, t in sorted(med.items(), key=lambda x: -x[1]):
+        n = counts[w]
+        print(f"  {w:28s} {t:7.2f} {mcpu[w]:7.2f} {n:4d} {t / n if n else 0.0:7.3f}")
+    print(f"  {'sum':28s} {sum(med.values()):7.2f} {sum(mcpu.values()):7.2f} "
+          f"{sum(counts.values()):4d}")
+    print(f"the report's drawing (--jobs {a.jobs or 'default'} processes): {parallel:.2f} s")
+    print(f"load after:  {_load()}")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--jobs", type=int, default=None)
+    ap.add_argument("--mode", choices=("fresh", "inprocess", "both"), default="both")
+    ap.add_argument("--profile", default=None, metavar="FILE")
+    ap.add_argument("--cold", action="store_true", help="fresh reports with an empty FEM cache")
+    ap.add_argument("--against", default=None, metavar="SRC",
+                    help="fresh mode: also time this source tree (e.g. `git archive` of an "
+                         "earlier commit unpacked), alternating with this one")
+    ap.add_argument("--only", nargs="+", default=None)
+    ap.add_argument("--runs-file", default=None, metavar="FILE",
+                    help="inprocess: the runs' results pickled here on the first call and "
+                         "read back on later ones (to time the figures alone; delete the "
+                         "file after a change to the runs)")
+    a = ap.parse_args(argv)
+    if a.mode in ("fresh", "both"):
+        fresh(a)
+    if a.mode in ("inprocess", "both"):
+        inprocess(a)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
