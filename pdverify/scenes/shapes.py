@@ -78,6 +78,8 @@ class ShapeScene(FemStaticStateScene):
     #: the jitter study (fractions of the spacing; seeds per level), on ``plate-hole``
     jitter_sweep = ()
     jitter_seeds = (0, 1)
+    #: the quick report's grid (its runs 0.1-0.2 s each, against 0.5-3 s at 0.025 m)
+    quick_spacing = 0.05
 
     def default_cases(self):
         """Every treatment offered here at the default grid (Taylor orders 1 to 3)."""
@@ -142,8 +144,8 @@ class ShapeScene(FemStaticStateScene):
     def cases(self, quick=False):
         runs = self.default_cases()
         out = [("fem", {})] + runs
-        if quick:
-            return out
+        if quick:   # every method, on the coarsest level of the refinement
+            return [("fem", {})] + [(m, {**q, "spacing": self.quick_spacing}) for m, q in runs]
         for h in self.delta_sweep:
             out += [(m, {**q, "spacing": h}) for m, q in runs]
         # the jitter study: the baseline, a bond method, the fictitious nodes (order 2)

@@ -47,6 +47,7 @@ def test_the_cases_cover_every_method_the_sweep_and_the_jitter_study(scene_id):
         assert not jittered
     quick = scene.cases(quick=True)
     assert {m for m, _ in quick} == methods
+    assert {q.get("spacing") for m, q in quick if m != "fem"} == {scene.quick_spacing}
 
 
 def test_a_jitter_out_of_range_is_bad_input():

@@ -26,10 +26,13 @@ def _default(scene, r, ignore=()):
 
 
 def _error_maps(scene, runs, folder):
-    pick = sorted((r for r in runs if _default(scene, r) and r.status == "ok"),
-                  key=lambda r: (r.method != "none", r.method, r.params.get("order", 0)))
-    if not pick:
+    level = [r for r in runs if _default(scene, r, ignore=("spacing",)) and r.status == "ok"]
+    if not level:
         return []
+    # the default grid, or the finest one present (a quick report runs a coarser one)
+    h = min((r.params.get("spacing", 0.025) for r in level), key=lambda v: abs(v - 0.025))
+    pick = sorted((r for r in level if r.params.get("spacing", 0.025) == h),
+                  key=lambda r: (r.method != "none", r.method, r.params.get("order", 0)))
     cols = min(4, len(pick))
     rows = -(-len(pick) // cols)
     fig, axes = plt.subplots(rows, cols, figsize=(3.4 * cols + 1, 3.2 * rows),
@@ -45,7 +48,7 @@ def _error_maps(scene, runs, folder):
         ax.set_axis_off()
     fig.colorbar(im, ax=axes, shrink=0.85, label="largest component error [% of max |u_FEM|]")
     return [(save(fig, folder, f"{scene.id}-errors.png"),
-             "Error maps at the default grid (0.025 m, m = 3), every method on one colour "
+             f"Error maps at h = {h:g} m (m = 3), every method on one colour "
              "scale: the largest component error at each PD node in % of max |u_FEM|. The "
              "uncorrected model and the bond methods fix the nodes nearest a prescribed part "
              "at the FEM value (zero error there by construction).")]
