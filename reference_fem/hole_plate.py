@@ -74,7 +74,7 @@ from . import params as _p
 from .cache import cached
 from .elasticity import Material
 from .mesh_elasticity import MeshElasticity, mapped_mesh
-from .results import ReferenceResult, RefinementRow, change_pct, field_change_pct
+from .results import MeshReferenceResult, RefinementRow, change_pct, field_change_pct
 
 REFERENCE = "plate-hole"
 
@@ -250,7 +250,7 @@ def _scf(fld, radius: float, traction: float) -> float:
 # --- the reference --------------------------------------------------------------------------
 
 @dataclass(frozen=True, eq=False, kw_only=True)
-class HolePlateResult(ReferenceResult):
+class HolePlateResult(MeshReferenceResult):
     """Converged plate with a hole (see :class:`ReferenceResult` for the common fields).
 
     Attributes
@@ -268,10 +268,6 @@ class HolePlateResult(ReferenceResult):
         return {"ux_load_point": float(self.ux_load_point), "scf": float(self.scf),
                 "field_change_pct": float(self.field_change_pct),
                 "refinement_change_pct": float(self.refinement_change_pct)}
-
-    def stress(self, points: np.ndarray) -> np.ndarray:
-        """Cauchy stress (Pa) at points, shape (n, 2, 2)."""
-        return self.field.stress(points)
 
 
 def compute(p: HolePlateParams) -> HolePlateResult:

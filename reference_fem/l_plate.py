@@ -60,7 +60,7 @@ from .cache import cached
 from .elasticity import Material
 from .mesh_elasticity import MeshElasticity, mapped_mesh
 from .meshing import power_graded
-from .results import ReferenceResult, RefinementRow, change_pct, field_change_pct
+from .results import MeshReferenceResult, RefinementRow, change_pct, field_change_pct
 
 REFERENCE = "plate-l"
 
@@ -161,7 +161,7 @@ def fitted_rate(quantities) -> float:
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
-class LPlateResult(ReferenceResult):
+class LPlateResult(MeshReferenceResult):
     """Converged L-shaped bracket (see :class:`ReferenceResult` for the common fields).
 
     Attributes
@@ -182,10 +182,6 @@ class LPlateResult(ReferenceResult):
                 "field_change_pct": float(self.field_change_pct),
                 "fitted_rate": float(self.fitted_rate),
                 "refinement_change_pct": float(self.refinement_change_pct)}
-
-    def stress(self, points: np.ndarray) -> np.ndarray:
-        """Cauchy stress (Pa) at points, shape (n, 2, 2)."""
-        return self.field.stress(points)
 
 
 def compute(p: LPlateParams) -> LPlateResult:

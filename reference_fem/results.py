@@ -147,6 +147,15 @@ class ReferenceResult:
 _ROW_TUPLES = ("refinement", "uniform_refinement")
 
 
+class MeshReferenceResult(ReferenceResult):
+    """A converged reference on a mapped mesh (its ``field`` a ``MeshField``), which also
+    gives the stress anywhere in the domain."""
+
+    def stress(self, points: np.ndarray) -> np.ndarray:
+        """Cauchy stress (Pa) at points, shape (n, 2, 2)."""
+        return self.field.stress(points)
+
+
 def to_npz(result: ReferenceResult, path: Path) -> None:
     """Write a result to ``path`` (an ``.npz`` without pickles)."""
     arrays, meta = {}, {"class": type(result).__name__}

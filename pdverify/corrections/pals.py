@@ -133,17 +133,13 @@ class PalsConstitutive:
         rhs_dil, rhs_dev = matching_targets(d)
         r_dil = rhs_dil[None, :] - node_sums(nodes, w * om0, E, n)
         r_dev = rhs_dev[None, :] - node_sums(nodes, w * sg0, DD, n)
-        M_dil, M_dev = node_moments(nodes, w, E, n), node_moments(nodes, w, DD, n)
+        # the nodes with bonds (a shape's void nodes have none, and no multipliers)
         has = np.bincount(nodes, minlength=n) > 0
-        if not has.all():    # a shape's void nodes have no bonds and no multipliers
-            lam, mu_ = np.zeros_like(r_dil), np.zeros_like(r_dev)
-            lam[has] = solve_per_node(M_dil[has], r_dil[has],
-                                      "pals: the dilatation Lagrange system", x[has])
-            mu_[has] = solve_per_node(M_dev[has], r_dev[has],
-                                      "pals: the deviatoric Lagrange system", x[has])
-            return lam, mu_
-        lam = solve_per_node(M_dil, r_dil, "pals: the dilatation Lagrange system", x)
-        mu_ = solve_per_node(M_dev, r_dev, "pals: the deviatoric Lagrange system", x)
+        lam, mu_ = np.zeros_like(r_dil), np.zeros_like(r_dev)
+        lam[has] = solve_per_node(node_moments(nodes, w, E, n)[has], r_dil[has],
+                                  "pals: the dilatation Lagrange system", x[has])
+        mu_[has] = solve_per_node(node_moments(nodes, w, DD, n)[has], r_dev[has],
+                                  "pals: the deviatoric Lagrange system", x[has])
         return lam, mu_
 
     def operators(self, model):

@@ -18,12 +18,15 @@ cut boundary has no such lines, and a jittered node set no lattice at all, so he
   neighbourhood at every node (as on the box);
 - the conditions at boundary points by Lagrange multipliers (seed 000 Eq. 63): one point
   per boundary node and part (the mean of the part's boundary samples that belong to the
-  node, ``static_state.boundary_nodes``, moved onto the part), where a prescribed
-  component's row sets the fitted value (Eq. 58's role) and every other component's row
-  the traction sigma(grad u_fit) n of the fit's gradient with the continuum moduli of
-  the PD constants, equal to the part's traction (zero on a free part). This replaces
-  seed 000's force-flux rows (Eq. 60; in 2D the face-crossing bonds of each boundary
-  cell face), which need cell faces on the boundary.
+  node, ``static_state.boundary_nodes``, moved onto the part). A prescribed component's
+  row sets the fitted value (Eq. 58's role). Every other component's row is, on a
+  straight part, seed 001's force flux (Eqs. 35-36): the bonds crossing the point's
+  stretch of the part (fictitious-fictitious bonds that cross it kept, half at a
+  stretch's edge or a part's end), equal to the traction's resultant over the stretch;
+  on a rectangle these are the box's rows. On an arc the flux through a short stretch
+  is a lattice quadrature whose error does not vanish, so there the row is the traction
+  sigma(grad u_fit) n of the fit's gradient with the continuum moduli of the PD
+  constants, equal to the applied traction (zero on a free part).
 
 Vectorised: the neighbours by one k-d tree query, the fits as one batched pseudo-inverse
 (points x neighbours x monomials); no loop over nodes.
@@ -83,10 +86,13 @@ def fit(x_real, centres, targets, order: int, h: float, gradient: bool = False):
     return nodes, value, np.stack(out, axis=1)
 
 
-def _rows(nodes, weights, n_rows, n_cols, row_ids=None):
+def _rows(nodes, weights, n_rows, n_cols, row_ids=None, col_offset=0):
+    """Sparse rows of ``weights`` over the columns ``nodes`` (+ ``col_offset``: the
+    component's block of the component-major unknowns)."""
     F, k = nodes.shape
     rows = np.repeat(np.arange(F) if row_ids is None else row_ids, k)
-    return sp.csr_matrix((weights.ravel(), (rows, nodes.ravel())), shape=(n_rows, n_cols))
+    return sp.csr_matrix((weights.ravel(), (rows, nodes.ravel() + col_offset)),
+                         shape=(n_rows, n_cols))
 
 
 def normal_closure(g, shape, order: int, stencil=None) -> Closure:
@@ -152,17 +158,16 @@ def condition_rows(model, problem, order: int, samples):
     """The constraint rows B u = c of the conditions (module docstring) on the real
     displacements (component-major, 2 n_real columns): a prescribed component's fitted
     value at each boundary point; every other component's force flux through the
-    boundary near the point (the bonds from a real to a fictitious node crossing the
-    boundary nearer this point's samples than any other's: sum of sign f_b n_b, seed 001
-    Eqs. 35-36 with the cell face replaced by the point's stretch of boundary) equal to
-    the traction's resultant over that stretch (zero on a free part)."""
+    point's stretch of a straight part (:func:`stretches`), equal to the traction's
+    resultant over that stretch, or on an arc the fit's traction (:func:`_traction_rows`)
+    equal to the applied traction (zero on a free part)."""
     g, shape = model.grid, problem.shape
     ni, h = g.n_interior, g.spacing
     x_real = g.x[g.interior_ids]
     pts, nrm, part, _, group = boundary_points(g, shape, samples)
     P, W = samples[0], samples[1]
     nodes, value, grad = fit(x_real, pts, pts, order, h, gradient=True)
-    curved = np.array([not hasattr(q, "a") for q in shape.parts])[part]
+    curved = ~np.array([q.straight for q in shape.parts])[part]
     lam, mu = problem.constants.moduli()
     names = shape.part_names
     exact = problem.exact(pts)
@@ -174,33 +179,32 @@ def condition_rows(model, problem, order: int, samples):
     bonds, cpart, cs, sign, alpha = crossings(model, shape)
     spart = samples[3]
     sign = sign * alpha
-    hat_c = stretches(shape, pts, part, _params(shape, P, spart), spart, group, cs, cpart, h)
-    hat_s = sp.csr_matrix((np.ones(len(P)), (np.arange(len(P)), group)),
-                          shape=(len(P), len(pts)))
+    share_c = stretches(shape, pts, part, _params(shape, P, spart), spart, group, cs, cpart, h)
+    share_s = sp.csr_matrix((np.ones(len(P)), (np.arange(len(P)), group)),
+                            shape=(len(P), len(pts)))
     used = np.unique(bonds)
     forces = model.bond_force_matrix(used)           # rows: the crossing bonds, ascending
     col = sp.csr_matrix((np.ones(bonds.size), (np.arange(bonds.size),
                                                np.searchsorted(used, bonds))),
                         shape=(bonds.size, used.size))
     F = (col @ forces).tocsr()                       # each crossing's bond force
-    resultant = hat_s.T @ (W[:, None] * problem.thickness
-                           * _traction_at(problem, P, samples[2], spart, names))
+    resultant = share_s.T @ (W[:, None] * problem.thickness
+                             * _traction_at(problem, P, samples[2], spart, names))
     traction_pts = _traction_at(problem, pts, nrm, part, names)
     rows, vals = [], []
     for k in range(2):
         pres = np.zeros(len(pts), dtype=bool)
-        load = np.zeros(len(pts))
         for name, cond in problem.conditions.items():
             if k in cond.prescribed:
                 pres |= part == names.index(name)
         load = resultant[:, k]
         if pres.any():
             sel = np.flatnonzero(pres)
-            rows.append(_rows(nodes[sel], value[sel], sel.size, ni) @ _component(k, ni))
+            rows.append(_rows(nodes[sel], value[sel], sel.size, 2 * ni, col_offset=k * ni))
             vals.append(exact[sel, k])
         free = np.flatnonzero(~pres & ~curved)
         if free.size:
-            S = (hat_c[:, free].T @ sp.diags(sign * model.bond_n[bonds, k])).tocsr()
+            S = (share_c[:, free].T @ sp.diags(sign * model.bond_n[bonds, k])).tocsr()
             rows.append((S @ F).tocsr())
             vals.append(load[free])
         bent = np.flatnonzero(~pres & curved)
@@ -242,11 +246,7 @@ def stretches(shape, pts, part, s_samples, spart, group, s_all, xpart, h) -> sp.
         s = s_all[on]
         j = np.searchsorted(edges, s)
         rows.append(on), cols.append(mine[j]), vals.append(np.ones(on.size))
-        # on an edge: half to each side
-        e = np.clip(j, 1, max(edges.size, 1)) - 1
-        if edges.size:
-            for side in (e, e + 1):
-                pass
+        if edges.size:   # on an edge: half to each side
             tie_lo = np.abs(s - edges[np.clip(j - 1, 0, edges.size - 1)]) <= 1e-9 * h
             tie_lo &= j > 0
             tie_hi = np.abs(s - edges[np.clip(j, 0, edges.size - 1)]) <= 1e-9 * h
@@ -271,7 +271,7 @@ def _traction_rows(nodes, grad, nrm, k, lam, mu, ni):
         c = c + mu * nrm[:, a][:, None] * grad[:, k]
         if a == k:
             c = c + mu * np.einsum("fl,flk->fk", nrm, grad)
-        blocks.append(_rows(nodes, c, F, ni) @ _component(a, ni))
+        blocks.append(_rows(nodes, c, F, 2 * ni, col_offset=a * ni))
     return (blocks[0] + blocks[1]).tocsr()
 
 
@@ -283,9 +283,3 @@ def _traction_at(problem, x, n, xpart, names):
         if cond.traction is not None and on.any():
             out[on] = cond.traction(x[on], n[on])
     return out
-
-
-def _component(k, ni):
-    """(ni x 2 ni) selector of component k of the component-major unknowns."""
-    return sp.csr_matrix((np.ones(ni), (np.arange(ni), k * ni + np.arange(ni))),
-                         shape=(ni, 2 * ni))

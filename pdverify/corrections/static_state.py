@@ -182,10 +182,15 @@ def _plain_on_shape(problem, g, model) -> LinearSystem:
         for k in cond.prescribed:
             fixed.append(k * nu_ + nodes)
             values.append(u_ref[nodes, k])
-    counts = {"boundary_nodes": int(np.unique(node).size)}
-    if getattr(g, "jitter", 0):
-        counts["jitter_kept"] = int(g.jitter_kept)
+    counts = _shape_counts(g, boundary_nodes=int(np.unique(node).size))
     return _eliminated(model, K, rhs, fixed, values, solver, x_int, {}, counts=counts)
+
+
+def _shape_counts(g, **counts) -> dict:
+    """A shape system's counts, with the jittered nodes that stayed put (if jittered)."""
+    if g.jitter:
+        counts["jitter_kept"] = int(g.jitter_kept)
+    return counts
 
 
 def _eliminated(model, K, rhs, fixed, values, solver, nodes, by_face, **extra):
@@ -429,10 +434,8 @@ def _taylor_on_shape(problem, order: int) -> LinearSystem:
     x_int = g.x[g.interior_ids]
     rhs = problem.body_load(x_int, model.node_volume[g.interior_ids][:, None]).T.ravel()
     B, c, points = condition_rows(model, problem, order, boundary_nodes(g, problem.shape))
-    counts = {"fictitious_nodes": int(np.sum(g.kind == 1)), "constraints": int(B.shape[0]),
-              "boundary_points": int(points)}
-    if getattr(g, "jitter", 0):
-        counts["jitter_kept"] = int(g.jitter_kept)
+    counts = _shape_counts(g, fictitious_nodes=int(np.sum(g.kind == 1)),
+                           constraints=int(B.shape[0]), boundary_points=int(points))
     none = np.zeros(0, dtype=int), np.zeros(0)
     # COLAMD: on the hole plate's bordered system at h = 0.0125 m (13,016 unknowns, 622
     # rows) SuperLU factors in 8.5-10 s with 24 M entries in L + U, against 42-52 s and

@@ -65,11 +65,8 @@ class BoxGrid:
         self.index = idx
         self.x = np.asarray(self.origin) + (idx + (0.5 if centred else 0.0)) * h
         n_axis = np.asarray(self.nodes_per_axis)
-        self.is_interior = np.all((idx >= 0) & (idx < n_axis), axis=1)
+        self._number_real(np.all((idx >= 0) & (idx < n_axis), axis=1))
         self.kind = np.where(self.is_interior, KIND_INTERIOR, KIND_FICTITIOUS)
-        self.interior_ids = np.flatnonzero(self.is_interior)
-        self.interior_number = np.full(idx.shape[0], -1)
-        self.interior_number[self.interior_ids] = np.arange(self.interior_ids.size)
         weight = np.ones(idx.shape[0])
         if not centred and self.boundary_volume == "partial":
             on_surface = self.is_interior[:, None] & ((idx == 0) | (idx == n_axis - 1))
@@ -79,6 +76,13 @@ class BoxGrid:
             self._build_surface()
 
     # ------------------------------------------------------------------ ids
+    def _number_real(self, real) -> None:
+        """``is_interior``, the real nodes' ids and each node's number among them (-1)."""
+        self.is_interior = real
+        self.interior_ids = np.flatnonzero(real)
+        self.interior_number = np.full(real.size, -1)
+        self.interior_number[self.interior_ids] = np.arange(self.interior_ids.size)
+
     @property
     def n_ext(self) -> int:
         return self.index.shape[0]
@@ -189,8 +193,9 @@ class ShapeGrid(BoxGrid):
     its cell inside the shape (:meth:`Shape.fractions`; the slivers of cut cells whose
     centre lies outside are left out, so the body's volume is short by at most half a cell
     per boundary cell). The lattice nodes outside the shape within ``layers`` spacings of
-    a real node along every axis (the stencil's reach) are the fictitious layer (every bond of a real node within that reach
-    ends on a real or fictitious node); the others are void (no bonds, ``KIND_VOID``).
+    a real node along every axis (the stencil's reach) are the fictitious layer: every
+    stencil bond of a real node ends on a real or fictitious node. The others are void
+    (no bonds, ``KIND_VOID``).
 
     ``jitter``: every real node moves by a seeded random vector, uniform in the square of
     side ``jitter * spacing`` about its lattice point (``jitter_seed``); a node the move
@@ -213,7 +218,7 @@ class ShapeGrid(BoxGrid):
         s = self.shape
         lattice = self.x.copy()
         inside = s.inside(lattice)
-        self.is_interior = inside
+        self._number_real(inside)
         fictitious = np.zeros_like(inside)
         if self.layers:
             from scipy.spatial import cKDTree
@@ -225,9 +230,6 @@ class ShapeGrid(BoxGrid):
         self.is_void = ~inside & ~fictitious
         self.kind = np.where(inside, KIND_INTERIOR,
                              np.where(fictitious, KIND_FICTITIOUS, KIND_VOID))
-        self.interior_ids = np.flatnonzero(inside)
-        self.interior_number = np.full(self.index.shape[0], -1)
-        self.interior_number[self.interior_ids] = np.arange(self.interior_ids.size)
         self.node_volume = np.full(self.index.shape[0], self.volume)
         self.node_volume[self.interior_ids] = self.volume * s.fractions(
             lattice[self.interior_ids], self.spacing)

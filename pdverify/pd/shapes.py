@@ -46,6 +46,7 @@ class Segment:
     name: str
     a: tuple
     b: tuple
+    straight = True
 
     def closest(self, x):
         a, b = np.asarray(self.a, float), np.asarray(self.b, float)
@@ -63,8 +64,8 @@ class Segment:
     def crossings(self, xa, xb):
         """Segments xa -> xb that cross this part: ``(segment, arc length of the
         crossing, sign, alpha)``: sign +1 when xa lies on the body's side of the part's
-        line, alpha 1/2 at either end of the part (exactly; seed 001's rule on a cell
-        face's edge), else 1."""
+        line, alpha 1/2 at either end of the part (within :data:`END`; seed 001's rule on
+        a cell face's edge), else 1."""
         a, b = np.asarray(self.a, float), np.asarray(self.b, float)
         e = b - a
         d = xb - xa
@@ -106,19 +107,22 @@ class Arc:
     theta0: float
     theta1: float
     hole: bool = True
+    straight = False
 
-    def closest(self, x):
-        c = np.asarray(self.centre, float)
-        r = x - c
-        th = np.arctan2(r[:, 1], r[:, 0])
+    def _angle(self, x):
+        """The angle of each point's closest point on the arc: its own angle, taken into
+        [theta0, theta0 + 2 pi), or outside [theta0, theta1] the nearer end's."""
+        r = np.asarray(x, float) - np.asarray(self.centre, float)
         lo, hi = self.theta0, self.theta1
-        # the angle into [lo, lo + 2 pi); outside [lo, hi] the nearer end
-        th = lo + np.mod(th - lo, 2 * np.pi)
+        th = lo + np.mod(np.arctan2(r[:, 1], r[:, 0]) - lo, 2 * np.pi)
         past = th > hi
         gap = 2 * np.pi - (hi - lo)
-        th = np.where(past & (th - hi < 0.5 * gap), hi, np.where(past, lo, th))
-        e = np.c_[np.cos(th), np.sin(th)]
-        p = c + self.radius * e
+        return np.where(past & (th - hi < 0.5 * gap), hi, np.where(past, lo, th))
+
+    def closest(self, x):
+        e = self._angle(x)
+        e = np.c_[np.cos(e), np.sin(e)]
+        p = np.asarray(self.centre, float) + self.radius * e
         return p, (-e if self.hole else e)
 
     @property
@@ -127,7 +131,7 @@ class Arc:
 
     def crossings(self, xa, xb):
         """As :meth:`Segment.crossings`, for the circle's arc (up to two per segment);
-        alpha 1/2 at either end angle (exactly)."""
+        alpha 1/2 at either end angle (within :data:`END`)."""
         c = np.asarray(self.centre, float)
         d = xb - xa
         f = xa - c
@@ -153,11 +157,7 @@ class Arc:
 
     def param(self, x):
         """Arc length from ``theta0`` of the closest point of each row of ``x``."""
-        r = np.asarray(x, float) - np.asarray(self.centre, float)
-        th = self.theta0 + np.mod(np.arctan2(r[:, 1], r[:, 0]) - self.theta0, 2 * np.pi)
-        th = np.where(th > self.theta1, np.where(th - self.theta1 < np.pi + 0.5 * (
-            self.theta1 - self.theta0), self.theta1, self.theta0), th)
-        return self.radius * (th - self.theta0)
+        return self.radius * (self._angle(x) - self.theta0)
 
     def point(self, s):
         th = self.theta0 + s * (self.theta1 - self.theta0)

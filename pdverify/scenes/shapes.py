@@ -73,13 +73,17 @@ class ShapeScene(FemStaticStateScene):
               "horizon, or those adjusted to an isotropic fourth moment",
               choices=QUADRATURES),
     ) + _jitter_params()
-    #: delta-refinement at fixed m = 3 (the default grid in the middle)
+    #: delta-refinement at fixed m = 3, coarser than the default grid (0.025 m)
     delta_sweep = (0.05, 1 / 30)
     #: the jitter study (fractions of the spacing; seeds per level), on ``plate-hole``
     jitter_sweep = ()
     jitter_seeds = (0, 1)
-    #: the quick report's grid (its runs 0.1-0.2 s each, against 0.5-3 s at 0.025 m)
-    quick_spacing = 0.05
+
+    @property
+    def quick_spacing(self) -> float:
+        """The quick report's grid: the refinement's coarsest (runs of 0.1-0.2 s, against
+        0.5-3 s at 0.025 m)."""
+        return max(self.delta_sweep)
 
     def default_cases(self):
         """Every treatment offered here at the default grid (Taylor orders 1 to 3)."""
@@ -128,8 +132,8 @@ class ShapeScene(FemStaticStateScene):
             state_based_stencil(2, p["m_ratio"], p["spacing"], inf, p["quadrature"]),
             StateBasedConstants("plane-stress", p["E"], p["nu"]), inf,
             self.conditions(p), exact=value, thickness=p["thickness"], solver="direct",
-            ordering=ORDERING, where=where, shape=self.shape(p), jitter=float(p.get("jitter", 0.0)),
-            jitter_seed=int(p.get("jitter_seed", 0)))
+            ordering=ORDERING, where=where, shape=self.shape(p),
+            jitter=float(p.get("jitter", 0.0)), jitter_seed=int(p.get("jitter_seed", 0)))
 
     def measure(self, p, problem, system, x, info):
         ref = self.reference_of(p)

@@ -29,9 +29,10 @@ def _error_maps(scene, runs, folder):
     level = [r for r in runs if _default(scene, r, ignore=("spacing",)) and r.status == "ok"]
     if not level:
         return []
-    # the default grid, or the finest one present (a quick report runs a coarser one)
-    h = min((r.params.get("spacing", 0.025) for r in level), key=lambda v: abs(v - 0.025))
-    pick = sorted((r for r in level if r.params.get("spacing", 0.025) == h),
+    # the default grid, or the one nearest it (a quick report runs a coarser one)
+    h0 = next(q.default for q in scene.pd_params if q.name == "spacing")
+    h = min((r.params.get("spacing", h0) for r in level), key=lambda v: abs(v - h0))
+    pick = sorted((r for r in level if r.params.get("spacing", h0) == h),
                   key=lambda r: (r.method != "none", r.method, r.params.get("order", 0)))
     cols = min(4, len(pick))
     rows = -(-len(pick) // cols)
