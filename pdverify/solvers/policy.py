@@ -64,10 +64,29 @@ def lattice_uses_cg(requested: str, iterative_ok: bool, free_unknowns: int) -> b
                                  and free_unknowns >= AUTO_ITERATIVE_UNKNOWNS)
 
 
-def lattice_note(use_cg: bool, free_unknowns: int) -> str:
+#: ... and below it, on a 2D lattice, nested dissection (the lattice's coordinates give
+#: the ordering) from :data:`ND_FROM_UNKNOWNS` free unknowns unless the dense LU applies
+#: (:func:`dense_lu`): sheet2d-clamped at m = 6 (10,366 unknowns) 1.4-2.3x faster than
+#: SuperLU's symmetric mode, at m = 12 (a dense LU) slower, perifit's tension sheet
+#: (10,150) even; over the full report's runs (benchmarks/lattice_nd.py, one run each
+#: alternating, a busy machine): sheet2d-clamped 91.9 -> 72.7 s (26 of 38 runs take it),
+#: sheet2d-tension 135.0 -> 126.8 s; the metrics equal to 6e-12 relative.
+LATTICE_ND_DIMS = (2,)
+
+
+def lattice_uses_nd(requested: str, use_cg: bool, dim: int, free_unknowns: int,
+                    nnz: int) -> bool:
+    """Whether ``auto`` solves an SPD lattice system (not by CG) under nested dissection."""
+    return (requested == "auto" and not use_cg and dim in LATTICE_ND_DIMS
+            and free_unknowns >= ND_FROM_UNKNOWNS and not dense_lu(free_unknowns, nnz))
+
+
+def lattice_note(use_cg: bool, free_unknowns: int, nd: bool = False) -> str:
     """The ``solver_choice`` a linear solve records when ``auto`` chose."""
-    return (f"auto: {'cg' if use_cg else 'direct'} ({free_unknowns} free "
-            f"unknowns; cg from {AUTO_ITERATIVE_UNKNOWNS} on SPD systems)")
+    chosen = "cg" if use_cg else ("nested-dissection" if nd else "direct")
+    return (f"auto: {chosen} ({free_unknowns} free unknowns; cg from "
+            f"{AUTO_ITERATIVE_UNKNOWNS} on SPD systems, nested dissection from "
+            f"{ND_FROM_UNKNOWNS} on 2D lattices unless the LU is dense)")
 
 
 #: The indentation's Newton steps (:class:`~pdverify.solvers.newton.DirichletLinearSolver`):
