@@ -30,6 +30,10 @@ extra ``bench``); without it those rows are skipped. Cases:
 - ``crossover3d``: whole runs (assembly and solve, ``scene.run``) of the 3D scenes with
   ``solver=direct`` against ``solver=nested-dissection`` over small to default sizes:
   where ``solver=auto`` switches in 3D (``ND3D_FROM_UNKNOWNS``).
+- ``crossover2d``: the same for plate2d-plane-strain at the report's sizes (h = 0.1 ...
+  0.02, m = 3, 4, 5, 8): where it switches in 2D (``ND_FROM_UNKNOWNS``).
+- ``pddo``: whole PDDO runs (its own square system, SuperLU), COLAMD against minimum
+  degree on A + A^T (``PDDO_ORDERING``), 2D and 3D.
 """
 from __future__ import annotations
 
@@ -282,6 +286,60 @@ def bench_crossover3d(args, out):
             "unknowns": int(n), "direct": t_d, "nested-dissection": t_n}
 
 
+def bench_crossover2d(args, out):
+    """Whole runs of plate2d-plane-strain, direct against nested dissection, at the sizes
+    and m-ratios the report runs (where ``solver=auto`` switches in 2D: ND_FROM_UNKNOWNS)."""
+    print("\n[crossover2d] whole runs (setup + solve), solver=direct vs nested-dissection, "
+          "plate2d-plane-strain")
+    cases = [(m, h, 3.0) for m in ("none", "surface-nodes") for h in (0.1, 0.05, 0.04, 0.025,
+                                                                       0.02)]
+    cases += [(m, 0.025, 8.0) for m in ("none", "surface-nodes", "taylor-fictitious")]
+    cases += [(m, 0.02, r) for m in ("surface-nodes",) for r in (4.0, 5.0)]
+    scene = get_scene("plate2d-plane-strain")
+    for method, h, m_ratio in cases:
+        over = {"spacing": h, "m_ratio": m_ratio}
+        alts = {solver: (lambda solver=solver: scene.run(method, {**over, "solver": solver}))
+                for solver in ("direct", "nested-dissection")}
+        res = alternate(alts, args.repeat)
+        n = res["direct"][1].size["dofs"]
+        t_d, t_n = res["direct"][0], res["nested-dissection"][0]
+        err = [r[1].metrics["rel_l2_error"] for r in res.values()]
+        print(f"  {method:17s} h = {h:.4f} m = {m_ratio:g} ({n:5d} unknowns): direct "
+              f"{t_d:6.2f} s ({res['direct'][1].diagnostics.get('solver', '')[:24]}), "
+              f"nested dissection {t_n:6.2f} s ({t_d / t_n:4.2f}x); "
+              f"rel_l2_error {err[0]:.6e} / {err[1]:.6e}")
+        out[f"crossover2d {method} h={h:.4f} m={m_ratio:g}"] = {
+            "unknowns": int(n), "direct": t_d, "nested-dissection": t_n}
+
+
+def bench_pddo(args, out):
+    """Whole PDDO runs (its square nonsymmetric system, SuperLU with partial pivoting),
+    COLAMD against minimum degree on A + A^T (``static_state.PDDO_ORDERING``)."""
+    import pdverify.corrections.static_state as static_state
+    print("\n[pddo] whole runs, SuperLU column ordering COLAMD vs MMD_AT_PLUS_A")
+    cases = [("plate2d-plane-strain", {"spacing": h}) for h in (0.025, 0.02, 0.0125)]
+    cases += [("plate2d-plane-strain", {"spacing": 0.025, "m_ratio": 8.0}),
+              ("body3d-traction", {}), ("body3d-manufactured", {})]
+    keep = static_state.PDDO_ORDERING
+    try:
+        for scene_id, over in cases:
+            scene = get_scene(scene_id)
+
+            def run(order, scene=scene, over=over):
+                static_state.PDDO_ORDERING = order
+                return scene.run("pddo", over)
+            alts = {o: (lambda o=o: run(o)) for o in ("COLAMD", "MMD_AT_PLUS_A")}
+            res = alternate(alts, args.repeat)
+            t_c, t_m = res["COLAMD"][0], res["MMD_AT_PLUS_A"][0]
+            err = [res[o][1].metrics["max_error_pct"] for o in res]
+            print(f"  {scene_id:20s} {over}: COLAMD {t_c:6.2f} s, MMD_AT_PLUS_A {t_m:6.2f} s "
+                  f"({t_c / t_m:4.2f}x; {res['COLAMD'][1].diagnostics.get('solver', '')[:22]}); "
+                  f"max_error_pct {err[0]:.3e} / {err[1]:.3e}")
+            out[f"pddo {scene_id} {over}"] = {"COLAMD": t_c, "MMD_AT_PLUS_A": t_m}
+    finally:
+        static_state.PDDO_ORDERING = keep
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3, help="rounds per alternative (median)")
@@ -291,7 +349,8 @@ def main(argv=None):
     ap.add_argument("--json", default=None, help="write the medians to this file")
     ap.add_argument("--with-double", action="store_true",
                     help="also time ours with the float64 LU (the path before mixed precision)")
-    ap.add_argument("--only", nargs="*", choices=("spd", "plate", "body3d", "crossover3d"),
+    ap.add_argument("--only", nargs="*", choices=("spd", "plate", "body3d", "crossover3d",
+                                                "crossover2d", "pddo"),
                     default=("spd", "plate", "body3d"))
     args = ap.parse_args(argv)
     print(f"median of {args.repeat}; PARDISO: {'pypardiso' if pypardiso else 'not installed'}")
@@ -319,6 +378,10 @@ def main(argv=None):
         bench_3d_large(out, sizes)
     if "crossover3d" in args.only:
         bench_crossover3d(args, out)
+    if "crossover2d" in args.only:
+        bench_crossover2d(args, out)
+    if "pddo" in args.only:
+        bench_pddo(args, out)
     if args.json:
         with open(args.json, "w") as fh:
             json.dump(out, fh, indent=1)

@@ -569,6 +569,15 @@ def assemble_mirror(problem, neumann: str, mirror_point: str,
                         counts={"fictitious_nodes": int(g.n_ext - g.n_interior)}, offset=U_c)
 
 
+#: SuperLU's column ordering of the PDDO system (square, nonsymmetric, partial pivoting):
+#: minimum degree on A + A^T. Whole runs, COLAMD against it (benchmarks/solvers.py
+#: --only pddo, medians of 3 alternating, a busy machine): plate2d-plane-strain 1.6x,
+#: 2.3x, 2.1x at h = 0.025, 0.02, 0.0125 (11.1 -> 5.3 s), body3d-traction 1.5x,
+#: body3d-manufactured 1.0x; the exactness metrics stay round-off (max_error_pct
+#: 4.1e-11 -> 7.3e-11 % at h = 0.0125).
+PDDO_ORDERING = "MMD_AT_PLUS_A"
+
+
 def assemble_pddo(problem, bulk_model: str = "lps") -> LinearSystem:
     """Seed 001 §5's PDDO boundary layer (``corrections.pddo``): its own square,
     nonsymmetric system on the uncorrected model, solved by a direct LU; ``bulk_model``
@@ -581,4 +590,4 @@ def assemble_pddo(problem, bulk_model: str = "lps") -> LinearSystem:
                                  _traction_of(problem), problem.constants.moduli(), body,
                                  bulk_model=bulk_model)
     return LinearSystem(model, A, rhs, np.zeros(0, dtype=int), np.zeros(0), g.n_interior,
-                        solver="direct", counts=counts)
+                        solver="direct", counts=counts, ordering=PDDO_ORDERING)

@@ -68,7 +68,9 @@ def solve_with_dirichlet(K, rhs, fixed, values, where, spd: bool = False,
     unknowns' ``lattice``, whose aggregates are ``aggregate_width`` nodes wide), ``auto``
     (:func:`~pdverify.solvers.policy.lattice_uses_cg`: ``cg`` from
     :data:`~pdverify.solvers.policy.AUTO_ITERATIVE_UNKNOWNS` free unknowns when it
-    applies, else ``direct``), or ``nested-dissection`` (sparse LU under a geometric
+    applies; else on a 2D lattice nested dissection from
+    :data:`~pdverify.solvers.policy.ND_FROM_UNKNOWNS` unless the LU is dense,
+    :func:`~pdverify.solvers.policy.lattice_uses_nd`; else ``direct``), or ``nested-dissection`` (sparse LU under a geometric
     ordering, :func:`~pdverify.solvers.nested.solve_nested`; needs the unknowns'
     ``coords``). Returns the full solution and the solver's diagnostics, which say what
     was chosen and why.
@@ -82,7 +84,11 @@ def solve_with_dirichlet(K, rhs, fixed, values, where, spd: bool = False,
         raise ValueError(f"{where}: solver=cg needs a symmetric positive definite system "
                          "on a lattice")
     use_cg = policy.lattice_uses_cg(solver, iterative_ok, free.size)
-    if solver == "nested-dissection":
+    use_nd = lattice is not None and policy.lattice_uses_nd(
+        solver, use_cg, lattice.dim, free.size, K_free.nnz)
+    if use_nd:
+        u_free, info = solve_nested(K_free, r, lattice.take(free).x, where=where)
+    elif solver == "nested-dissection":
         if coords is None:
             raise ValueError(f"{where}: solver=nested-dissection needs the unknowns' coordinates")
         u_free, info = solve_nested(K_free, r, np.asarray(coords)[free], where=where)
@@ -91,5 +97,5 @@ def solve_with_dirichlet(K, rhs, fixed, values, where, spd: bool = False,
     else:
         u_free, info = solve_square(K_free, r, where=where, spd=spd, ordering=ordering)
     if solver == "auto":
-        info["solver_choice"] = policy.lattice_note(use_cg, free.size)
+        info["solver_choice"] = policy.lattice_note(use_cg, free.size, use_nd)
     return expand(u_free), info

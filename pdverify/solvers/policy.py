@@ -64,10 +64,29 @@ def lattice_uses_cg(requested: str, iterative_ok: bool, free_unknowns: int) -> b
                                  and free_unknowns >= AUTO_ITERATIVE_UNKNOWNS)
 
 
-def lattice_note(use_cg: bool, free_unknowns: int) -> str:
+#: ... and below it, on a 2D lattice, nested dissection (the lattice's coordinates give
+#: the ordering) from :data:`ND_FROM_UNKNOWNS` free unknowns unless the dense LU applies
+#: (:func:`dense_lu`): sheet2d-clamped at m = 6 (10,366 unknowns) 1.4-2.3x faster than
+#: SuperLU's symmetric mode, at m = 12 (a dense LU) slower, perifit's tension sheet
+#: (10,150) even; over the full report's runs (benchmarks/lattice_nd.py, one run each
+#: alternating, a busy machine): sheet2d-clamped 91.9 -> 72.7 s (26 of 38 runs take it),
+#: sheet2d-tension 135.0 -> 126.8 s; the metrics equal to 6e-12 relative.
+LATTICE_ND_DIMS = (2,)
+
+
+def lattice_uses_nd(requested: str, use_cg: bool, dim: int, free_unknowns: int,
+                    nnz: int) -> bool:
+    """Whether ``auto`` solves an SPD lattice system (not by CG) under nested dissection."""
+    return (requested == "auto" and not use_cg and dim in LATTICE_ND_DIMS
+            and free_unknowns >= ND_FROM_UNKNOWNS and not dense_lu(free_unknowns, nnz))
+
+
+def lattice_note(use_cg: bool, free_unknowns: int, nd: bool = False) -> str:
     """The ``solver_choice`` a linear solve records when ``auto`` chose."""
-    return (f"auto: {'cg' if use_cg else 'direct'} ({free_unknowns} free "
-            f"unknowns; cg from {AUTO_ITERATIVE_UNKNOWNS} on SPD systems)")
+    chosen = "cg" if use_cg else ("nested-dissection" if nd else "direct")
+    return (f"auto: {chosen} ({free_unknowns} free unknowns; cg from "
+            f"{AUTO_ITERATIVE_UNKNOWNS} on SPD systems, nested dissection from "
+            f"{ND_FROM_UNKNOWNS} on 2D lattices unless the LU is dense)")
 
 
 #: The indentation's Newton steps (:class:`~pdverify.solvers.newton.DirichletLinearSolver`):
@@ -88,10 +107,16 @@ def newton_solver(requested: str, unknowns) -> str:
 # -- auto on state-based problems: nested dissection or direct ------------------------
 
 #: ``solver=auto`` solves the augmented system (dilatations as unknowns) under nested
-#: dissection from this many displacement unknowns in 2D; below it the direct solve of K
-#: takes a few seconds at most (1.7 s at the seed-001 plate's default 5,000) and the
-#: report's default-size 2D runs keep their solutions bit for bit.
-ND_FROM_UNKNOWNS = 8000
+#: dissection from this many displacement unknowns in 2D. Whole runs of
+#: plate2d-plane-strain, direct against nested dissection (benchmarks/solvers.py --only
+#: crossover2d, medians of 3 alternating, a busy machine): 0.73x at 800 unknowns (none,
+#: h = 0.05) and 1.84x at 960 (surface nodes), 1.7-2.5x at 1,250-1,450 (h = 0.04),
+#: 3.0-3.7x at 3,200-5,400 (h = 0.025, 0.02; COLAMD's SuperLU took 1.5-4.7 s), 2.2-3.2x at
+#: m = 4, 5 and 1.1-1.4x at m = 8 (where the direct solve is a dense LU); the same
+#: rel_l2_error to the printed digits. It was 8,000 until issue 32, so that the
+#: default-size runs kept their solutions bit for bit; they now change at round-off
+#: (compare --rtol 1e-9 finds nothing).
+ND_FROM_UNKNOWNS = 1000
 #: the same in 3D, where K is a dense LU: whole runs (assembly and solve) of body3d-traction,
 #: surface nodes, direct against nested dissection (benchmarks/solvers.py --only
 #: crossover3d, median of 3, quiet machine): 0.85 / 0.99 s at 2,376 unknowns, 1.79 / 2.02 s

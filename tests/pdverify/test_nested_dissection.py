@@ -173,3 +173,44 @@ def test_3d_auto_nested_dissection_agrees_with_the_dense_lu(monkeypatch, scene_i
     assert "nested-dissection" not in b.diagnostics["solver"]      # K, multiplied out
     for k, v in b.metrics.items():
         assert a.metrics[k] == pytest.approx(v, rel=1e-8, abs=1e-12), k
+
+
+def _spd_lattice(n, reach):
+    """A bond-based-like SPD stiffness on an n x n lattice (2 components per node,
+    component-major), couplings within ``reach`` (L-infinity), and its Lattice."""
+    from pdverify.solvers.iterative import Lattice
+    A, x = lattice_operator(n, reach)
+    S = (A + A.T) / 2                      # symmetric, diagonally dominant: SPD
+    K = sp.block_diag([S, S]).tocsr()
+    idx = x.astype(int)
+    return K, Lattice.component_major(idx, x, 2)
+
+
+def test_auto_on_a_2d_spd_lattice_takes_nested_dissection_unless_the_lu_is_dense():
+    """issue 32: ``solver=auto`` of an SPD lattice system (the sheets) below CG's size
+    takes nested dissection from ND_FROM_UNKNOWNS free unknowns, unless the dense LU
+    applies; the solution is the direct solve's (a diagonally dominant system, condition
+    ~10: agreement to 1e3 eps relative)."""
+    from pdverify.solvers import policy
+    from pdverify.solvers.front import solve_with_dirichlet
+    K, lat = _spd_lattice(24, 2)                         # 1,152 unknowns, 2.8 % full
+    f = np.random.default_rng(2).standard_normal(K.shape[0])
+    fixed, values = np.arange(10), np.zeros(10)
+    assert K.shape[0] - fixed.size >= ND_FROM_UNKNOWNS
+    u_auto, info = solve_with_dirichlet(K, f, fixed, values, "t", spd=True, solver="auto",
+                                        lattice=lat)
+    u_dir, info_d = solve_with_dirichlet(K, f, fixed, values, "t", spd=True,
+                                         solver="direct", lattice=lat)
+    assert "nested-dissection" in info["solver"] and "nested-dissection" in info["solver_choice"]
+    assert "symmetric mode" in info_d["solver"]
+    assert np.abs(u_auto - u_dir).max() <= 1e3 * EPS * np.abs(u_dir).max()
+    # below the threshold, or where the LU would be dense, ``auto`` stays direct
+    small, lat_s = _spd_lattice(16, 2)                    # 512 unknowns
+    _, info_s = solve_with_dirichlet(small, f[:512], fixed, values, "t", spd=True,
+                                     solver="auto", lattice=lat_s)
+    assert "nested" not in info_s["solver"]
+    assert not policy.lattice_uses_nd("auto", False, 2, 5000, int(0.2 * 5000 ** 2))
+    assert policy.lattice_uses_nd("auto", False, 2, 5000, 50 * 5000)
+    assert not policy.lattice_uses_nd("auto", True, 2, 5000, 50 * 5000)    # CG chosen
+    assert not policy.lattice_uses_nd("direct", False, 2, 5000, 50 * 5000)
+    assert not policy.lattice_uses_nd("auto", False, 3, 5000, 50 * 5000)
