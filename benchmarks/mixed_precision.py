@@ -32,13 +32,20 @@ vector) one by one: iterations and true relative residual with the corrections' 
 vector (their relative residuals), and h . M^-1 g against (M^-T h) . g (the transposed
 solve is the same factor's when they agree to its rounding).
 
+``--threshold T ...``: per threshold, in a fresh process, the float32 factor with SuperLU's
+diagonal pivot threshold T (``nested.FLOAT32_PIVOT_THRESHOLD``) and the refinement on it
+(``refine_with_probe``): factor time and entries, refinement time, plain steps, GMRES-IR
+and estimator iterations (if any), condition estimate.
+
 ``--run``: the case's whole run (``get_scene(...).run``) in a fresh process per variant,
-``estimator-60`` (the estimator's passes held to ``GMRES_MAX_ITERATIONS``, as before
-issue 32), ``now``, ``double-lu`` (``mixed=False``: the double LU alone) and
-``reference`` (the double LU refined with residuals in extended precision), median of
-``--repeat``: wall time and peak memory of the process (``ru_maxrss``), the path taken,
-the largest difference of the solution to the reference (relative to its largest entry)
-and the largest relative difference of the run's metrics to the reference's.
+``before`` (the estimator's passes held to ``GMRES_MAX_ITERATIONS``, as before issue 32),
+``now``, ``threshold-0.1`` (the float32 factor at SuperLU's pivot threshold 0.1, the
+candidate ``nested.FLOAT32_PIVOT_THRESHOLD`` describes), ``double-lu``
+(``mixed=False``: the double LU alone) and ``reference`` (the double LU refined with
+residuals in extended precision), median of ``--repeat``: wall time and peak memory of the
+process (``ru_maxrss``), the path taken, the largest difference of the solution to the
+reference (relative to its largest entry) and the largest relative difference of the
+run's metrics to the reference's.
 """
 from __future__ import annotations
 
@@ -209,6 +216,34 @@ def _estimator(folder, queue):
     queue.put(out)
 
 
+def _threshold(folder, threshold, queue):
+    """The float32 factor at SuperLU's diagonal pivot ``threshold`` and the refinement on
+    it (``refine_with_probe``): times, fill, path."""
+    import scipy.sparse as sp
+    from threadpoolctl import threadpool_limits
+
+    from pdverify.solvers import mixed, nested
+
+    A = sp.load_npz(os.path.join(folder, "A.npz")).tocsr()
+    b = np.load(os.path.join(folder, "b.npy"))
+    c = np.load(os.path.join(folder, "c.npy"))
+    nested.FLOAT32_PIVOT_THRESHOLD = threshold
+    with threadpool_limits(1):
+        A_p, b_p, _, (n1, n2), _ = nested.ordered_system(A, b, c, "threshold")
+        t = time.perf_counter()
+        lu, _ = nested.single_precision_factor(A_p, n1, n2)
+        factor_s = time.perf_counter() - t
+        t = time.perf_counter()
+        y, cond, diag = mixed.refine_with_probe(A_p, b_p, lu)
+        refine_s = time.perf_counter() - t
+    queue.put({"factor_s": factor_s, "factor_entries": lu.factor_entries,
+               "refine_s": refine_s, "condition_estimate": cond,
+               "plain_steps": diag["refinement_steps"],
+               "gmres_ir_iterations": diag.get("gmres_ir_iterations"),
+               "estimator_iterations": diag.get("gmres_ir_estimator_iterations"),
+               "path": diag.get("mixed_precision") or diag.get("refinement", "plain")})
+
+
 def _whole_run(case, variant, folder, queue):
     import resource as res
 
@@ -217,7 +252,10 @@ def _whole_run(case, variant, folder, queue):
     from pdverify.solvers import mixed
     from pdverify.solvers.nested import solve_nested
 
-    if variant == "estimator-60":
+    from pdverify.solvers import nested
+    if variant == "threshold-0.1":
+        nested.FLOAT32_PIVOT_THRESHOLD = 0.1
+    if variant == "before":
         mixed.ESTIMATOR_MAX_ITERATIONS = mixed.GMRES_MAX_ITERATIONS
     seen = {}
 
@@ -276,7 +314,7 @@ def _reference_solve(A, rhs, coords, where):
                  "solver": f"double LU + refinement in long double {residuals}"}
 
 
-RUN_VARIANTS = ("estimator-60", "now", "double-lu", "reference")
+RUN_VARIANTS = ("before", "now", "threshold-0.1", "double-lu", "reference")
 
 
 def _runs(case, repeat):
@@ -298,7 +336,7 @@ def _runs(case, repeat):
                "peak_gb": statistics.median(r["peak_gb"] for r in runs[v]),
                "solution_difference": float(np.abs(xs[v] - ref).max() / np.abs(ref).max()),
                "metrics_largest_relative_difference": metric_diff, **last}
-        print(f"  {v:12s} run {row['wall_s']:6.1f} s  peak {row['peak_gb']:5.2f} GB  "
+        print(f"  {v:14s} run {row['wall_s']:6.1f} s  peak {row['peak_gb']:5.2f} GB  "
               f"(the run's own: {row['run_total_s']:.1f} s, {row['run_peak_rss_gb']:.2f} GB)"
               f"  cond {row['condition_estimate']:.4g}  solution diff "
               f"{row['solution_difference']:.2g}  metrics diff {metric_diff:.2g}  "
@@ -334,6 +372,8 @@ def main(argv=None):
     ap.add_argument("--stages", action="store_true", help="time the GMRES-IR path's stages")
     ap.add_argument("--estimator", action="store_true",
                     help="the condition estimator's GMRES passes one by one")
+    ap.add_argument("--threshold", type=float, nargs="+",
+                    help="the float32 factor and its refinement at these pivot thresholds")
     ap.add_argument("--run", action="store_true",
                     help="the whole run, before/now/double LU, in fresh processes")
     args = ap.parse_args(argv)
@@ -355,6 +395,18 @@ def main(argv=None):
                     f"{k} {v:.3g}" if isinstance(v, float) else f"{k} {v}"
                     for k, v in st.items()))
                 out[case] = st
+                continue
+            if args.threshold:
+                print(f"{case}: float32 factor by SuperLU's diagonal pivot threshold")
+                out[case] = {}
+                for th in args.threshold:
+                    st = _in_fresh_process(_threshold, folder, th)
+                    print(f"  {th:g}: factor {st['factor_s']:.1f} s, {st['factor_entries']:,d}"
+                          f" entries; refinement {st['refine_s']:.1f} s, plain steps "
+                          f"{st['plain_steps']}, GMRES-IR {st['gmres_ir_iterations']}, "
+                          f"estimator {st['estimator_iterations']}, cond "
+                          f"{st['condition_estimate']}", flush=True)
+                    out[case][th] = st
                 continue
             if args.estimator:
                 st = _in_fresh_process(_estimator, folder)
