@@ -23,6 +23,31 @@ entry, so that the time is not bought with accuracy.
 ``--stages``: in one process, the stages of the GMRES-IR path timed one by one (the
 float32 factor, plain refinement, GMRES-IR, the condition estimator with one GMRES pass
 per solve as ``GmresIR.solve`` does, and with each solve refined to round-off instead).
+
+``--estimator``: in one process, the condition estimator's three GMRES passes (the
+transposed one from sign(A^-1 probe), then the unit vector and Higham's alternating
+vector) one by one: iterations and true relative residual with the corrections' limit
+(``GMRES_MAX_ITERATIONS``, the estimator before issue 32) and with
+``ESTIMATOR_MAX_ITERATIONS``; and the float32 factor's own solves with A and A^T of a random
+vector: their relative residuals against A and A^T, and against the factor's own M =
+Pr^T L U Pc^T and M^T (its factors in double). On manufactured-taylor2: 21 and 505 against
+A, 20 and 502 against M: M is close to A, the float32 solves' own rounding (element growth
+under the 1e-3 pivot threshold, times eps_single) is what is off, and more so transposed.
+
+``--threshold T ...``: per threshold, in a fresh process, the float32 factor with SuperLU's
+diagonal pivot threshold T (``nested.FLOAT32_PIVOT_THRESHOLD``) and the refinement on it
+(``refine_with_probe``): factor time and entries, refinement time, plain steps, GMRES-IR
+and estimator iterations (if any), condition estimate.
+
+``--run``: the case's whole run (``get_scene(...).run``) in a fresh process per variant,
+``before`` (the estimator's passes held to ``GMRES_MAX_ITERATIONS``, as before issue 32),
+``now``, ``threshold-0.1`` (the float32 factor at SuperLU's pivot threshold 0.1, the
+candidate ``nested.FLOAT32_PIVOT_THRESHOLD`` describes), ``double-lu``
+(``mixed=False``: the double LU alone) and ``reference`` (the double LU refined with
+residuals in extended precision), median of ``--repeat``: wall time and peak memory of the
+process (``ru_maxrss``), the path taken, the largest difference of the solution to the
+reference (relative to its largest entry) and the largest relative difference of the
+run's metrics to the reference's.
 """
 from __future__ import annotations
 
@@ -140,6 +165,204 @@ def _stages(folder, queue):
     queue.put(out)
 
 
+def _estimator(folder, queue):
+    import scipy.sparse as sp
+    from threadpoolctl import threadpool_limits
+
+    from pdverify.solvers import mixed
+    from pdverify.solvers.nested import ordered_system, single_precision_factor
+
+    A = sp.load_npz(os.path.join(folder, "A.npz")).tocsr()
+    b = np.load(os.path.join(folder, "b.npy"))
+    c = np.load(os.path.join(folder, "c.npy"))
+    out = {}
+    with threadpool_limits(1):
+        A_p, b_p, _, (n1, n2), _ = ordered_system(A, b, c, "estimator")
+        lu, _ = single_precision_factor(A_p, n1, n2)
+        AT = A_p.T.tocsr()
+        n = A_p.shape[0]
+        g = np.random.default_rng(1).standard_normal(n)
+        for trans, M in (("N", A_p), ("T", AT)):
+            out[f"float32_factor_residual_{trans}"] = float(
+                np.linalg.norm(M @ lu.solve(g, trans=trans) - g) / np.linalg.norm(g))
+        # the residuals against the factor's own M = Pr^T L U Pc^T (or M^T), its factors
+        # in double: as large as against A when the float32 solves' rounding dominates
+        # (whole-matrix factor only)
+        if len(lu.lus) == 1:
+            f = lu.lus[0]
+            L, U = f.L.astype(float).tocsr(), f.U.astype(float).tocsr()
+            inv_r = np.argsort(f.perm_r)
+
+            def m_times(x, trans):          # M x = Pr^T L U Pc^T x, M^T x, as products
+                if trans == "N":
+                    return (L @ (U @ x[f.perm_c]))[f.perm_r]
+                out_ = np.empty(n)
+                out_[f.perm_c] = U.T @ (L.T @ x[inv_r])
+                return out_
+
+            for trans in ("N", "T"):
+                out[f"float32_factor_residual_to_its_own_M_{trans}"] = float(
+                    np.linalg.norm(m_times(lu.solve(g, trans=trans), trans) - g)
+                    / np.linalg.norm(g))
+            del L, U
+        probe = np.random.default_rng(20211121).standard_normal(b.size)
+        stop = [mixed.REFINE_STOP, np.sqrt(b.size) * np.finfo(float).eps]
+        rhs = np.column_stack([b_p, probe])
+        Y, _, _, _ = mixed.refine(A_p, rhs, lu.solve, stop=stop)
+        gm = mixed.GmresIR(A_p, lu)
+        Y, _, hist, ok = mixed.refine(A_p, rhs, gm.correction, stop=stop,
+                                      max_steps=mixed.GMRES_OUTER_STEPS, start=Y)
+        out["gmres_ir_converged"], out["gmres_ir_iterations"] = ok, list(gm.iterations)
+        sign = np.sign(Y[:, 1])
+        one = mixed.GmresIR(A_p, lu)
+        z = one.solve(sign, trans="T")      # to find the unit vector, as the estimator does
+        unit = np.zeros(n)
+        unit[int(np.argmax(np.abs(z)))] = 1.0
+        alt = (-1.0) ** np.arange(n) * (1.0 + np.arange(n) / max(n - 1, 1))
+        for limit_name, limit in (("limit-60", mixed.GMRES_MAX_ITERATIONS),
+                                  ("limit-now", mixed.ESTIMATOR_MAX_ITERATIONS)):
+            mixed.ESTIMATOR_MAX_ITERATIONS = limit
+            for name, v, trans in (("sign-T", sign, "T"), ("unit", unit, "N"),
+                                   ("alternating", alt, "N")):
+                gm = mixed.GmresIR(A_p, lu)
+                t = time.perf_counter()
+                gm.solve(v, trans=trans)
+                out[f"{limit_name} {name}"] = (
+                    f"{gm.iterations[0]} iterations, residual {gm.worst_residual:.2g}, "
+                    f"{time.perf_counter() - t:.1f} s")
+    queue.put(out)
+
+
+def _threshold(folder, threshold, queue):
+    """The float32 factor at SuperLU's diagonal pivot ``threshold`` and the refinement on
+    it (``refine_with_probe``): times, fill, path."""
+    import scipy.sparse as sp
+    from threadpoolctl import threadpool_limits
+
+    from pdverify.solvers import mixed, nested
+
+    A = sp.load_npz(os.path.join(folder, "A.npz")).tocsr()
+    b = np.load(os.path.join(folder, "b.npy"))
+    c = np.load(os.path.join(folder, "c.npy"))
+    nested.FLOAT32_PIVOT_THRESHOLD = threshold
+    with threadpool_limits(1):
+        A_p, b_p, _, (n1, n2), _ = nested.ordered_system(A, b, c, "threshold")
+        t = time.perf_counter()
+        lu, _ = nested.single_precision_factor(A_p, n1, n2)
+        factor_s = time.perf_counter() - t
+        t = time.perf_counter()
+        y, cond, diag = mixed.refine_with_probe(A_p, b_p, lu)
+        refine_s = time.perf_counter() - t
+    queue.put({"factor_s": factor_s, "factor_entries": lu.factor_entries,
+               "refine_s": refine_s, "condition_estimate": cond,
+               "plain_steps": diag["refinement_steps"],
+               "gmres_ir_iterations": diag.get("gmres_ir_iterations"),
+               "estimator_iterations": diag.get("gmres_ir_estimator_iterations"),
+               "path": diag.get("mixed_precision") or diag.get("refinement", "plain")})
+
+
+def _whole_run(case, variant, folder, queue):
+    import resource as res
+
+    import pdverify.solvers.front as front
+    from pdverify.scenes import get_scene
+    from pdverify.solvers import mixed
+    from pdverify.solvers.nested import solve_nested
+
+    from pdverify.solvers import nested
+    if variant == "threshold-0.1":
+        nested.FLOAT32_PIVOT_THRESHOLD = 0.1
+    if variant == "before":
+        mixed.ESTIMATOR_MAX_ITERATIONS = mixed.GMRES_MAX_ITERATIONS
+    seen = {}
+
+    def keep(A, rhs, coords, where="", mixed=None):
+        if variant == "reference":
+            x, info = _reference_solve(A, rhs, coords, where)
+        else:
+            x, info = solve_nested(A, rhs, coords, where=where,
+                                   mixed=False if variant == "double-lu" else mixed)
+        seen["x"], seen["info"] = x, info
+        return x, info
+
+    front.solve_nested = keep
+    scene_id, method, params = CASES[case]
+    t0 = time.perf_counter()
+    run = get_scene(scene_id).run(method, params)
+    wall = time.perf_counter() - t0
+    np.save(os.path.join(folder, f"x-{variant}.npy"), seen["x"])
+    info = seen["info"]
+    queue.put({"wall_s": wall, "peak_gb": res.getrusage(res.RUSAGE_SELF).ru_maxrss / 1e6,
+               "run_total_s": run.timings.get("total_s"),
+               "run_peak_rss_gb": run.resources.get("peak_rss_gb"),
+               "status": run.status, "metrics": dict(run.metrics),
+               "path": info.get("mixed_precision", info.get("solver", "")),
+               "condition_estimate": info["condition_estimate"],
+               "estimator_iterations": info.get("gmres_ir_estimator_iterations")})
+
+
+def _reference_solve(A, rhs, coords, where):
+    """The double LU's solution refined with residuals in extended precision
+    (``np.longdouble``, 64-bit mantissa on x86): the forward error of the double LU alone
+    (its backward error is that of threshold pivoting at 1e-3) is what is left of the
+    difference, so the variants' solutions are measured against this one."""
+    import scipy.sparse as sp
+
+    from pdverify.solvers.checks import relative_residual
+    from pdverify.solvers.lu import factor
+    from pdverify.solvers.nested import ND_OPTIONS, ordered_system
+
+    A_p, b_p, perm, _, col_max = ordered_system(sp.csr_matrix(A), np.asarray(rhs, float),
+                                                coords, where)
+    lu = factor(A_p.tocsc(), where, **ND_OPTIONS)
+    y = lu.solve(b_p)
+    data = A_p.data.astype(np.longdouble)
+    residuals = []
+    for _ in range(4):
+        Ay = np.add.reduceat(data * y.astype(np.longdouble)[A_p.indices], A_p.indptr[:-1])
+        r = b_p.astype(np.longdouble) - Ay
+        residuals.append(float(np.abs(r).max()))
+        y = (y.astype(np.longdouble) + lu.solve(r.astype(float))).astype(float)
+    sol = np.empty_like(y)
+    sol[perm] = y
+    sol /= col_max
+    return sol, {"condition_estimate": float("nan"), "relative_residual":
+                 relative_residual(A, sol, rhs),
+                 "solver": f"double LU + refinement in long double {residuals}"}
+
+
+RUN_VARIANTS = ("before", "now", "threshold-0.1", "double-lu", "reference")
+
+
+def _runs(case, repeat):
+    with tempfile.TemporaryDirectory() as folder:
+        runs = {v: [] for v in RUN_VARIANTS}
+        for _ in range(repeat):
+            for v in RUN_VARIANTS:
+                runs[v].append(_in_fresh_process(_whole_run, case, v, folder))
+        xs = {v: np.load(os.path.join(folder, f"x-{v}.npy")) for v in RUN_VARIANTS}
+    ref, ref_m = xs["reference"], runs["reference"][-1]["metrics"]
+    out = {}
+    print(f"{case}: whole run, median of {repeat}")
+    for v in RUN_VARIANTS:
+        last = runs[v][-1]
+        m = last["metrics"]
+        metric_diff = max((abs(m[k] - ref_m[k]) / abs(ref_m[k]) if ref_m[k] else abs(m[k]))
+                          for k in ref_m)
+        row = {"wall_s": statistics.median(r["wall_s"] for r in runs[v]),
+               "peak_gb": statistics.median(r["peak_gb"] for r in runs[v]),
+               "solution_difference": float(np.abs(xs[v] - ref).max() / np.abs(ref).max()),
+               "metrics_largest_relative_difference": metric_diff, **last}
+        print(f"  {v:14s} run {row['wall_s']:6.1f} s  peak {row['peak_gb']:5.2f} GB  "
+              f"(the run's own: {row['run_total_s']:.1f} s, {row['run_peak_rss_gb']:.2f} GB)"
+              f"  cond {row['condition_estimate']:.4g}  solution diff "
+              f"{row['solution_difference']:.2g}  metrics diff {metric_diff:.2g}  "
+              f"estimator iterations "
+              f"{row['estimator_iterations']}  [{row['path']}]", flush=True)
+        out[v] = row
+    return out
+
+
 def _in_fresh_process(target, *args):
     ctx = mp.get_context("spawn")
     queue = ctx.Queue()
@@ -164,9 +387,18 @@ def main(argv=None):
     ap.add_argument("--repeat", type=int, default=1)
     ap.add_argument("--json", default=None)
     ap.add_argument("--stages", action="store_true", help="time the GMRES-IR path's stages")
+    ap.add_argument("--estimator", action="store_true",
+                    help="the condition estimator's GMRES passes one by one")
+    ap.add_argument("--threshold", type=float, nargs="+",
+                    help="the float32 factor and its refinement at these pivot thresholds")
+    ap.add_argument("--run", action="store_true",
+                    help="the whole run, before/now/double LU, in fresh processes")
     args = ap.parse_args(argv)
     out = {}
     for case in args.case or ["manufactured-snm3"]:
+        if args.run:
+            out[case] = _runs(case, args.repeat)
+            continue
         with tempfile.TemporaryDirectory() as folder:
             ctx = mp.get_context("spawn")
             q = ctx.Queue()
@@ -179,6 +411,25 @@ def main(argv=None):
                 print(f"{case}: stages " + ", ".join(
                     f"{k} {v:.3g}" if isinstance(v, float) else f"{k} {v}"
                     for k, v in st.items()))
+                out[case] = st
+                continue
+            if args.threshold:
+                print(f"{case}: float32 factor by SuperLU's diagonal pivot threshold")
+                out[case] = {}
+                for th in args.threshold:
+                    st = _in_fresh_process(_threshold, folder, th)
+                    print(f"  {th:g}: factor {st['factor_s']:.1f} s, {st['factor_entries']:,d}"
+                          f" entries; refinement {st['refine_s']:.1f} s, plain steps "
+                          f"{st['plain_steps']}, GMRES-IR {st['gmres_ir_iterations']}, "
+                          f"estimator {st['estimator_iterations']}, cond "
+                          f"{st['condition_estimate']}", flush=True)
+                    out[case][th] = st
+                continue
+            if args.estimator:
+                st = _in_fresh_process(_estimator, folder)
+                print(f"{case}: estimator")
+                for k, v in st.items():
+                    print(f"  {k}: {v}")
                 out[case] = st
                 continue
             runs = {a: [] for a in ALTERNATIVES}

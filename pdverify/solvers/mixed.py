@@ -65,7 +65,8 @@ def refine_with_probe(A, b, lu):
                                    "did not converge, nor GMRES-IR; double LU")
         return None, None, diag
     # the estimator's three solves by GMRES on the factor too (the factor's own solves are
-    # off by ~kappa eps_single, of order 1 here), each one GMRES pass (GmresIR.solve)
+    # off by ~kappa eps_single, of order 1 here), each one GMRES pass (GmresIR.solve,
+    # allowed more iterations than a correction: ESTIMATOR_MAX_ITERATIONS)
     done = len(gmres.iterations)
     cond = probe_condition_estimate(A, gmres, probe, Y[:, 1])
     diag["gmres_ir_estimator_iterations"] = gmres.iterations[done:]
@@ -88,6 +89,20 @@ GMRES_INNER_TOL = 1e-8
 GMRES_MAX_ITERATIONS = 60
 #: outer steps of GMRES-IR (each gains ~8 digits when GMRES converges)
 GMRES_OUTER_STEPS = 6
+#: The condition estimator's GMRES passes may run on beyond :data:`GMRES_MAX_ITERATIONS`, to
+#: at most this many iterations, while they have not reached a tenth of
+#: :data:`ESTIMATOR_RESIDUAL` (a margin for GMRES's recurrence residual against the true one
+#: that :meth:`GmresIR.solve` checks): near kappa ~ 1/eps_single the float32 factor leaves
+#: dozens of eigenvalues of the preconditioned matrix far from 1, and GMRES's residual stays
+#: at ~1 until it has them all. Measured on body3d-manufactured's order-2 Taylor system
+#: (12,880 unknowns, condition 1.3e7): the corrections converge in 55-60 iterations, the
+#: transposed pass from sign(x) stays above 0.99 for 70 iterations and reaches 4e-5 at 100
+#: (the factor's transposed solves are the poorer: relative residual 505 against A^T, 21
+#: against A, on a random vector; ``benchmarks/mixed_precision.py --estimator``). At the
+#: 60 the system was refactored in
+#: double though its solve had converged. Four times the corrections' limit: the bases of
+#: 10^4 unknowns x 240 are 40 MB, and only the iterations run are touched.
+ESTIMATOR_MAX_ITERATIONS = 4 * GMRES_MAX_ITERATIONS
 #: The condition estimator's solves y ~ A^-1 v (one GMRES pass each) must reach this true
 #: relative residual ||A y - v|| / ||v|| (2-norm): then y = A^-1 (v + r) with ||r|| <= tau
 #: ||v||, and a term of Hager's estimate, within a factor 3 of ||A^-1|| (Higham, Accuracy
@@ -102,9 +117,11 @@ class GmresIR:
     is one flexible GMRES solve per column preconditioned on the right by ``lu.solve``
     (FGMRES: the float32 solve is not exactly linear), to :data:`GMRES_INNER_TOL`; the
     refinement (:func:`refine`) calls it for each correction. :meth:`solve` (the
-    condition estimator's solves) is one such pass from zero, whose true residual it
-    checks (``worst_residual``, the largest relative residual of its solves; see
-    :data:`ESTIMATOR_RESIDUAL`): Hager's estimator needs A^-1 x to a few digits only
+    condition estimator's solves) is one such pass from zero, allowed to run on to
+    :data:`ESTIMATOR_MAX_ITERATIONS`, whose true residual it checks (``worst_residual``,
+    the largest relative residual of its solves; see :data:`ESTIMATOR_RESIDUAL`; once a
+    pass has failed, the later ones return zeros unsolved: the double LU decides).
+    Hager's estimator needs A^-1 x to a few digits only
     (measured on body3d-manufactured's order-2 Taylor system, condition 1e7,
     ``benchmarks/mixed_precision.py --stages``: the same estimate, 1.01e7, in 13.3 s
     against 26.6 s with each solve refined to round-off; the solve itself 16.2 s).
@@ -116,19 +133,25 @@ class GmresIR:
         self.iterations: list[int] = []
         self.worst_residual = 0.0
 
-    def correction(self, R, trans: str = "N"):
+    def correction(self, R, trans: str = "N", *, max_iterations: int | None = None,
+                   extended_tol: float = 0.0):
         R = np.asarray(R, dtype=float)
         if trans == "T" and self.AT is None:
             self.AT = self.A.T.tocsr()
         A = self.AT if trans == "T" else self.A
-        cols = [_fgmres(A, r, lambda v: self.lu.solve(v, trans=trans)) for r in
-                R.reshape(R.shape[0], -1).T]
+        cols = [_fgmres(A, r, lambda v: self.lu.solve(v, trans=trans),
+                        max_iterations=max_iterations, extended_tol=extended_tol)
+                for r in R.reshape(R.shape[0], -1).T]
         self.iterations += [k for _, k in cols]
         return np.stack([x for x, _ in cols], axis=1).reshape(R.shape)
 
     def solve(self, B, trans: str = "N"):
         B = np.asarray(B, dtype=float)
-        X = self.correction(B, trans)
+        if self.worst_residual > ESTIMATOR_RESIDUAL:
+            # an earlier pass failed: the double LU decides, whatever this one gives
+            return np.zeros_like(B)
+        X = self.correction(B, trans, max_iterations=ESTIMATOR_MAX_ITERATIONS,
+                            extended_tol=0.1 * ESTIMATOR_RESIDUAL)
         A = self.AT if trans == "T" else self.A
         B2, X2 = B.reshape(B.shape[0], -1), X.reshape(B.shape[0], -1)
         for b, x in zip(B2.T, X2.T):
@@ -140,23 +163,27 @@ class GmresIR:
         return X
 
 
-def _fgmres(A, r, precondition):
+def _fgmres(A, r, precondition, *, max_iterations: int | None = None,
+            extended_tol: float = 0.0):
     """``(z, iterations)``: z ~ A^-1 r by flexible GMRES with right preconditioning, the
     basis orthogonalised by classical Gram-Schmidt applied twice (as stable as the modified
-    one, in matrix products), to :data:`GMRES_INNER_TOL` or :data:`GMRES_MAX_ITERATIONS`."""
+    one, in matrix products), to :data:`GMRES_INNER_TOL` or :data:`GMRES_MAX_ITERATIONS`;
+    beyond those, up to ``max_iterations`` while the relative residual is above
+    ``extended_tol`` (the condition estimator's passes, :data:`ESTIMATOR_MAX_ITERATIONS`)."""
     # r scaled by a power of two near its largest entry (exact), so that its norm neither
     # overflows nor underflows (as SplitLU.solve scales its right-hand sides)
     big = float(np.abs(r).max()) if r.size else 0.0
     if big == 0.0 or not np.isfinite(big):
         return np.zeros_like(r), 0
     scale = float(np.exp2(np.round(np.log2(big))))
-    z, k = _fgmres_scaled(A, r / scale, precondition)
+    z, k = _fgmres_scaled(A, r / scale, precondition, max_iterations, extended_tol)
     return z * scale, k
 
 
-def _fgmres_scaled(A, r, precondition):
+def _fgmres_scaled(A, r, precondition, max_iterations, extended_tol):
     beta = float(np.linalg.norm(r))
-    m = GMRES_MAX_ITERATIONS
+    first = GMRES_MAX_ITERATIONS
+    m = max(first, max_iterations or first)
     V = np.zeros((m + 1, r.size))
     Z = np.zeros((m, r.size))
     H = np.zeros((m + 1, m))
@@ -177,6 +204,8 @@ def _fgmres_scaled(A, r, precondition):
         y, *_ = np.linalg.lstsq(H[:j + 2, :j + 1], e1[:j + 2], rcond=None)
         res = np.linalg.norm(H[:j + 2, :j + 1] @ y - e1[:j + 2])
         if res <= GMRES_INNER_TOL * beta or H[j + 1, j] == 0.0:
+            break
+        if j + 1 >= first and res <= extended_tol * beta:
             break
         V[j + 1] = w / H[j + 1, j]
     return y @ Z[:y.size], y.size

@@ -29,6 +29,28 @@ ND_PIVOT_THRESHOLD = 1e-3
 ND_OPTIONS = dict(permc_spec="NATURAL", diag_pivot_thresh=ND_PIVOT_THRESHOLD,
                   options=dict(SymmetricMode=True))
 
+#: ... and the single-precision factor's (:class:`SplitLU` in float32), the same. A candidate
+#: (issue 32), not taken: 0.1, which bounds the element growth that eps_single multiplies.
+#: Measured (``benchmarks/mixed_precision.py --threshold``; one process each, the machine
+#: shared) on the 3D boxes' systems whose plain refinement stalls at 1e-3: at 0.1 it
+#: converges, with 2-4% more fill, its factor's time within the noise (17-27 s both): body3d-manufactured's order-2
+#: Taylor system (12,880 unknowns, condition 1.2e7) 7 steps, 3 s, against GMRES-IR's
+#: 55-60 iterations per correction (~40 s with the estimator); body3d-traction's order-1
+#: 7 steps, 1.2 s, against 18 s; body3d-manufactured's order-3 surface-node system
+#: 4 steps, 1.7 s, against 8.9 s. But on the symmetric 576-unknown operator with 200
+#: small eigenvalues of tests/pdverify/test_split_lu.py (kappa 1e8), where GMRES-IR
+#: converges at 1e-3, neither refinement converges at 0.1; and every float32 run's
+#: numbers would change (at round-off).
+FLOAT32_PIVOT_THRESHOLD = ND_PIVOT_THRESHOLD
+
+
+def _options(dtype):
+    """SuperLU's options of a :class:`SplitLU` factor of this ``dtype``."""
+    if np.dtype(dtype) == np.float32:
+        return {**ND_OPTIONS, "diag_pivot_thresh": FLOAT32_PIVOT_THRESHOLD}
+    return ND_OPTIONS
+
+
 #: Shift of the separator blocks of the two halves' matrices (see :class:`SplitLU`; the
 #: factorisation is exact for any shift, it only sets how much float32 round-off the
 #: separator's Schur complement picks up). Measured on the plate at h = 0.01 (entries
@@ -178,7 +200,7 @@ class SplitLU:
         self.separator = n - n1 - n2 if n1 and n2 else 0
         self.crossed_pivots = 0
         if not self.separator:
-            self.lus = [spla.splu(A.tocsc().astype(dtype), **ND_OPTIONS)]
+            self.lus = [spla.splu(A.tocsc().astype(dtype), **_options(dtype))]
             self.factor_entries = int(self.lus[0].L.nnz + self.lus[0].U.nnz)
             return
         s, g = self.separator, SEPARATOR_SHIFT
@@ -207,7 +229,7 @@ class SplitLU:
         its factors in double."""
         M = C[:, idx][idx, :]
         M = (M - sp.block_diag([sp.csc_matrix((m, m)), corner], format="csc")).astype(dtype)
-        lu = spla.splu(M, **ND_OPTIONS)
+        lu = spla.splu(M, **_options(dtype))
         if np.any(lu.perm_c[:m] >= m):
             raise RuntimeError("SuperLU's column order mixed a half with the separator")
         L, U = lu.L, lu.U

@@ -197,6 +197,62 @@ def test_near_singular_system_is_refused_on_the_gmres_path():
             solve_nested(A, b, x, where="test", mixed=mixed_precision)
 
 
+def many_small_eigenvalues(k=200, kappa=1e8):
+    """The symmetric lattice operator (n = 576) with its k lowest eigenvalues replaced by k
+    spread geometrically from w_max / kappa to 1e-4 w_max: the float32 factor leaves about
+    k eigenvalues of the preconditioned matrix far from 1, and GMRES needs as many
+    iterations before its residual falls (at k = 200: the corrections stop at
+    GMRES_MAX_ITERATIONS = 60, but their outer refinement converges; the estimator's
+    passes need 73-97)."""
+    A, x = lattice_operator(24, 2)
+    w, V = np.linalg.eigh(0.5 * (A + A.T).toarray())
+    w[:k] = w[-1] * np.geomspace(1 / kappa, 1e-4, k)
+    return sp.csr_matrix((V * w) @ V.T), x
+
+
+def test_converged_gmres_ir_is_not_refactored_for_its_estimator():
+    """A solve that GMRES-IR converged stays on the float32 factor when the condition
+    estimator's GMRES passes need more iterations than a correction's limit (issue 32:
+    body3d-manufactured's order-2 Taylor system, 60 iterations where its transposed pass
+    needs ~100, was factored again in double): each pass may run on to
+    ESTIMATOR_MAX_ITERATIONS and does reach ESTIMATOR_RESIDUAL."""
+    A, x = many_small_eigenvalues()
+    b = np.random.default_rng(6).normal(size=A.shape[0])
+    u, info = solve_nested(A, b, x, where="test", mixed=True)
+    assert info["mixed_precision"] == ("float32 LU, refined in float64 by GMRES-IR (plain "
+                                       "refinement stalled)")
+    # the mechanism: a pass beyond the corrections' limit, within its own
+    assert len(info["gmres_ir_estimator_iterations"]) == 3
+    assert (mixed.GMRES_MAX_ITERATIONS < max(info["gmres_ir_estimator_iterations"])
+            < mixed.ESTIMATOR_MAX_ITERATIONS)
+    # the outer residual: REFINE_STOP = 2 eps (max-norm measure) or dsgesv's sqrt(n) eps;
+    # the solution to ~kappa n eps (kappa 1e8, n = 576)
+    assert info["gmres_ir_residuals"][-1] <= np.sqrt(A.shape[0]) * EPS
+    exact = np.linalg.solve(A.toarray(), b)
+    assert np.linalg.norm(u - exact) / np.linalg.norm(exact) < 1e8 * A.shape[0] * EPS
+    # Hager-Higham's factor 3 below (Higham, Accuracy and Stability, 15.3); above, the
+    # estimate's rounding to ESTIMATE_DIGITS = 6 digits (up to 5e-6 relative) and the
+    # solves' residual (3 ESTIMATOR_RESIDUAL)
+    kappa = np.linalg.cond(equilibrate(A, "test")[0].toarray(), 1)
+    assert kappa / 3 <= info["condition_estimate"] <= kappa * (1 + 1e-5 + 3 * mixed.ESTIMATOR_RESIDUAL)
+
+
+def test_estimator_held_to_the_corrections_limit_falls_back_to_the_double_lu(monkeypatch):
+    """The same system with the estimator's passes held to GMRES_MAX_ITERATIONS (as before
+    ESTIMATOR_MAX_ITERATIONS): its first pass ends above ESTIMATOR_RESIDUAL, the double LU
+    takes over (and the later passes are skipped)."""
+    monkeypatch.setattr(mixed, "ESTIMATOR_MAX_ITERATIONS", mixed.GMRES_MAX_ITERATIONS)
+    A, x = many_small_eigenvalues()
+    b = np.random.default_rng(6).normal(size=A.shape[0])
+    u, info = solve_nested(A, b, x, where="test", mixed=True)
+    assert info["mixed_precision"].startswith("not used: GMRES-IR converged, but the "
+                                              "condition estimator's solves did not")
+    assert info["gmres_ir_estimator_iterations"] == [mixed.GMRES_MAX_ITERATIONS]
+    assert "float32" not in info["solver"]
+    exact = np.linalg.solve(A.toarray(), b)
+    assert np.linalg.norm(u - exact) / np.linalg.norm(exact) < 1e8 * A.shape[0] * EPS
+
+
 @pytest.mark.parametrize("size", [1e-300, 1e300])
 def test_gmres_ir_takes_right_hand_sides_of_any_size(size):
     """GMRES's norms are taken of the residual scaled by a power of two (exact), so a
