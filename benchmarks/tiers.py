@@ -23,12 +23,17 @@ printed; the RSS sum counts a shared page once per process, so it is the upper b
 the PSS sum the memory the tree held. ``/usr/bin/time`` gives the largest single
 process only (printed too, as ``largest process``).
 
+CPU: the user and system time of the pytest process and every descendant it waited
+for (``RUSAGE_CHILDREN``), steadier than the wall time on a loaded machine: on 2 quiet
+cores the parallel wall time is about half of it, or the longest file if that is more.
+
 The machine is shared: the load average is printed before and after each run.
 """
 from __future__ import annotations
 
 import argparse
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -84,6 +89,14 @@ def _rss_pss(pid):
         return 0, 0
 
 
+def _cmd(pid):
+    try:
+        with open(f"/proc/{pid}/cmdline", "rb") as fh:
+            return fh.read().replace(b"\0", b" ").decode(errors="replace")[:90]
+    except OSError:
+        return "?"
+
+
 class Sampler(threading.Thread):
     """Samples the process tree under ``pid`` every ``interval`` seconds until stopped."""
 
@@ -92,12 +105,17 @@ class Sampler(threading.Thread):
         self.pid, self.interval = pid, interval
         self.peak_rss = self.peak_pss = self.peak_one = 0
         self.peak_procs = 0
+        self.at_peak = []
         self.samples = 0
         self._done = threading.Event()
 
     def run(self):
         while not self._done.is_set():
-            sizes = [_rss_pss(p) for p in _tree(self.pid)]
+            pids = _tree(self.pid)
+            sizes = [_rss_pss(p) for p in pids]
+            if sum(r for r, _ in sizes) > self.peak_rss:
+                self.at_peak = sorted(((r, _cmd(p)) for p, (r, _) in zip(pids, sizes)),
+                                      reverse=True)
             self.peak_rss = max(self.peak_rss, sum(r for r, _ in sizes))
             self.peak_pss = max(self.peak_pss, sum(p for _, p in sizes))
             self.peak_one = max([self.peak_one] + [r for r, _ in sizes])
@@ -114,6 +132,7 @@ def measure(tier, mode):
     cmd = [sys.executable, "-m", "pytest", *TIERS[tier], *MODES[mode]]
     env = dict(os.environ, PYTHONPATH=HERE)
     load0 = os.getloadavg()[0]
+    ru0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     with tempfile.TemporaryFile("w+") as out:
         t0 = time.perf_counter()
         proc = subprocess.Popen(cmd, cwd=HERE, env=env, stdout=out, stderr=subprocess.STDOUT,
@@ -123,19 +142,25 @@ def measure(tier, mode):
         code = proc.wait()
         wall = time.perf_counter() - t0
         sampler.stop()
+        ru1 = resource.getrusage(resource.RUSAGE_CHILDREN)
         out.seek(0)
         lines = [x for x in out.read().splitlines() if x.strip()]
-    return {"tier": tier, "mode": mode, "code": code, "wall_s": wall,
+    cpu = (ru1.ru_utime + ru1.ru_stime) - (ru0.ru_utime + ru0.ru_stime)
+    return {"tier": tier, "mode": mode, "code": code, "wall_s": wall, "cpu_s": cpu,
             "peak_rss_gb": sampler.peak_rss / 1e9, "peak_pss_gb": sampler.peak_pss / 1e9,
             "largest_gb": sampler.peak_one / 1e9, "procs": sampler.peak_procs,
-            "load": (load0, os.getloadavg()[0]), "summary": lines[-1] if lines else ""}
+            "load": (load0, os.getloadavg()[0]), "summary": lines[-1] if lines else "",
+            "at_peak": sampler.at_peak}
 
 
 def show(r):
     print(f"{r['tier']:4s} {r['mode']:8s} exit {r['code']}  wall {r['wall_s']:7.1f} s  "
-          f"peak total RSS {r['peak_rss_gb']:5.2f} GB  PSS {r['peak_pss_gb']:5.2f} GB  "
+          f"CPU {r['cpu_s']:7.1f} s  peak total RSS {r['peak_rss_gb']:5.2f} GB  "
+          f"PSS {r['peak_pss_gb']:5.2f} GB  "
           f"largest process {r['largest_gb']:5.2f} GB  processes <= {r['procs']:3d}  "
           f"load {r['load'][0]:.2f} -> {r['load'][1]:.2f}  | {r['summary']}", flush=True)
+    for rss, cmd in r["at_peak"][:4]:
+        print(f"    at the peak: {rss / 1e9:5.2f} GB  {cmd}")
 
 
 def main(argv=None):
@@ -158,9 +183,10 @@ def main(argv=None):
         for mode in modes:
             mine = [r for r in runs if r["tier"] == tier and r["mode"] == mode]
             med = {key: statistics.median(r[key] for r in mine)
-                   for key in ("wall_s", "peak_rss_gb", "peak_pss_gb", "largest_gb")}
+                   for key in ("wall_s", "cpu_s", "peak_rss_gb", "peak_pss_gb", "largest_gb")}
             print(f"{tier:4s} {mode:8s} n={len(mine)}  wall {med['wall_s']:7.1f} s  "
-                  f"peak total RSS {med['peak_rss_gb']:5.2f} GB  PSS {med['peak_pss_gb']:5.2f} GB  "
+                  f"CPU {med['cpu_s']:7.1f} s  peak total RSS {med['peak_rss_gb']:5.2f} GB  "
+                  f"PSS {med['peak_pss_gb']:5.2f} GB  "
                   f"largest process {med['largest_gb']:5.2f} GB")
     return 0 if all(r["code"] in (0, 5) for r in runs) else 1
 

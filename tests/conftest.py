@@ -70,14 +70,17 @@ def pytest_cmdline_main(config):
     """Both tiers run on every core the process may use (issue 32: the fast tier took
     5:35 on one core of a 2-core machine): one pytest-xdist worker a core, unless the
     command line chose (``-n N``, ``-n 0`` or ``-p no:xdist`` for a serial run, ``--pdb``),
-    the process has one core, or this is a worker itself. Each test file goes to one
-    worker as a whole (``--dist loadfile``), so the module-scoped fixtures, which share
-    their runs among a file's tests, are computed once, as in a serial run."""
+    the process has one core, or this is a worker itself. ``--bench`` runs serially: the
+    timing benchmarks measure against their budgets with no other test beside them. Each
+    test file goes to one worker as a whole (``--dist loadfile``), so the module-scoped
+    fixtures, which share their runs among a file's tests, are computed once, as in a
+    serial run."""
     if not config.pluginmanager.hasplugin("xdist") or hasattr(config, "workerinput"):
         return
     if os.environ.get("PYTEST_XDIST_WORKER") or config.option.numprocesses is not None:
         return
-    if config.getoption("usepdb") or config.getoption("collectonly"):
+    if config.getoption("usepdb") or config.getoption("collectonly") \
+            or config.getoption("--bench"):
         return
     cores = len(os.sched_getaffinity(0))
     if cores > 1:
