@@ -18,7 +18,8 @@ Memory: every 0.2 s the script reads /proc for the pytest process and all its
 descendants (xdist's workers, the reports' worker pools, the subprocesses the tests
 start) and sums their resident set (RSS) and their proportional set (PSS, from
 ``smaps_rollup``: pages shared among the processes, such as a forked pool's
-copy-on-write pages, counted once in all). The peak of each sum over the run is
+copy-on-write pages, counted once in all; read every fifth sample, every 1 s, as
+walking the pages costs the sampler CPU time). The peak of each sum over the run is
 printed; the RSS sum counts a shared page once per process, so it is the upper bound,
 the PSS sum the memory the tree held. ``/usr/bin/time`` gives the largest single
 process only (printed too, as ``largest process``).
@@ -73,12 +74,15 @@ def _tree(pid):
     return seen
 
 
-def _rss_pss(pid):
-    """(RSS, PSS) of one process in bytes; (0, 0) once it has gone."""
+def _rss_pss(pid, pss_too=True):
+    """(RSS, PSS) of one process in bytes; (0, 0) once it has gone; PSS 0 unless
+    ``pss_too`` (``smaps_rollup`` costs the kernel a walk of the process's pages)."""
     try:
         with open(f"/proc/{pid}/statm") as fh:
             rss = int(fh.read().split()[1]) * PAGE
         pss = 0
+        if not pss_too:
+            return rss, pss
         with open(f"/proc/{pid}/smaps_rollup") as fh:
             for line in fh:
                 if line.startswith("Pss:"):
@@ -112,7 +116,7 @@ class Sampler(threading.Thread):
     def run(self):
         while not self._done.is_set():
             pids = _tree(self.pid)
-            sizes = [_rss_pss(p) for p in pids]
+            sizes = [_rss_pss(p, self.samples % 5 == 0) for p in pids]
             if sum(r for r, _ in sizes) > self.peak_rss:
                 self.at_peak = sorted(((r, _cmd(p)) for p, (r, _) in zip(pids, sizes)),
                                       reverse=True)
