@@ -175,14 +175,22 @@ def _inside_import_or_exec(frame) -> bool:
     into ``ImportError: initialization failed``, and one raised inside ``exec`` (which
     dataclasses use to build their methods) makes CPython 3.11 end the process by SIGINT
     even after the CLI has caught it. Only frames above ``main`` count (``python -c``
-    itself runs from a string).
+    itself runs from a string). With ``main`` not on the stack (the handlers stay after
+    an in-process ``main()`` has returned), the strings the program itself started from
+    do not count either: the outermost frames of a ``python -c`` program, or of a
+    pytest-xdist worker's bootstrap, return only when the process ends, so a stop
+    deferred until then never landed (a forked pool worker of such a process ignored
+    SIGTERM for good).
     """
+    inside = []
     while frame is not None and frame.f_code is not main.__code__:
         name = frame.f_code.co_filename
-        if name == "<string>" or name.startswith("<frozen importlib"):
-            return True
+        inside.append(name == "<string>" or name.startswith("<frozen importlib"))
         frame = frame.f_back
-    return False
+    if frame is None:
+        while inside and inside[-1]:
+            inside.pop()
+    return any(inside)
 
 
 def _terminate(signum, frame):

@@ -1,7 +1,8 @@
-"""Shared pytest configuration: Agg backend, strict float errors, seeded rng, and the two
-test tiers: tests marked ``slow`` are skipped unless ``--runslow`` (the README's test
-command runs the fast tier; ``.ci/run`` then runs the slow one with
-``--runslow -m slow``)."""
+"""Shared pytest configuration: Agg backend, strict float errors, seeded rng, the two
+test tiers (tests marked ``slow`` are skipped unless ``--runslow``; the README's test
+command runs the fast tier, ``.ci/run`` then runs the slow one with ``--runslow -m slow``),
+and both tiers on every core the process may use (pytest-xdist, one worker a core; ``-n 0``
+or ``-p no:xdist`` runs serially)."""
 import os
 
 os.environ.setdefault("MPLBACKEND", "Agg")
@@ -18,7 +19,7 @@ def _strict_float_errors():
 
 
 @pytest.fixture(scope="session", autouse=True)
-def fem_cache_dir(tmp_path_factory):
+def fem_cache_dir(tmp_path_factory, request):
     """One cache folder of FEM references (and manufactured loads) for the whole session,
     never the user's: the tests see a cold cache on any machine, as CI does, and each
     reference the session needs is computed once and read by every later test and
@@ -26,7 +27,15 @@ def fem_cache_dir(tmp_path_factory):
     the user's cache held). Tests of the cache itself set a folder of their own."""
     from reference_fem.cache import ENV_VAR
     old = os.environ.get(ENV_VAR)
-    path = tmp_path_factory.mktemp("pdverify-cache")
+    if hasattr(request.config, "workerinput"):
+        # one folder for the run's workers (their temporary folders are the subfolders of
+        # the run's own, which is new for each run): a reference one worker computed is
+        # read by the others, and two workers needing it at once compute it once (the
+        # cache's lock per entry, reference_fem/cache.py)
+        path = tmp_path_factory.getbasetemp().parent / "pdverify-cache"
+        path.mkdir(exist_ok=True)
+    else:
+        path = tmp_path_factory.mktemp("pdverify-cache")
     os.environ[ENV_VAR] = str(path)
     yield path
     if old is None:
@@ -54,6 +63,30 @@ def _one_blas_thread(request):
 @pytest.fixture
 def rng():
     return np.random.default_rng(20211121)
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_cmdline_main(config):
+    """Both tiers run on every core the process may use (issue 32: the fast tier took
+    5:35 on one core of a 2-core machine): one pytest-xdist worker a core, unless the
+    command line chose (``-n N``, ``-n 0`` or ``-p no:xdist`` for a serial run, ``--pdb``),
+    the process has one core, or this is a worker itself. ``--bench`` runs serially: the
+    timing benchmarks measure against their budgets with no other test beside them. Each
+    test file goes to one worker as a whole (``--dist loadfile``), so the module-scoped
+    fixtures, which share their runs among a file's tests, are computed once, as in a
+    serial run."""
+    if not config.pluginmanager.hasplugin("xdist") or hasattr(config, "workerinput"):
+        return
+    if os.environ.get("PYTEST_XDIST_WORKER") or config.option.numprocesses is not None:
+        return
+    if config.getoption("usepdb") or config.getoption("collectonly") \
+            or config.getoption("--bench"):
+        return
+    cores = len(os.sched_getaffinity(0))
+    if cores > 1:
+        config.option.numprocesses = cores
+        if config.option.dist == "no":
+            config.option.dist = "loadfile"
 
 
 def pytest_addoption(parser):

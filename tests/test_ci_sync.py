@@ -73,3 +73,36 @@ def test_slow_tests_run_only_with_runslow(tmp_path):
     assert code == 0 and "2 passed" in last and "skipped" not in last, last
     code, last = outcome("--runslow", "-m", "slow")
     assert code == 0 and "1 passed, 1 deselected" in last, last
+
+
+def test_the_tests_use_every_core_unless_asked_to_run_serially(tmp_path):
+    # the README: the tests run on one pytest-xdist worker per core the process may use;
+    # -n 0 and -p no:xdist run them serially. Each run here records where its test ran.
+    import os
+    import shutil
+    import subprocess
+    import sys
+    shutil.copy(ROOT / "tests" / "conftest.py", tmp_path / "conftest.py")
+    (tmp_path / "test_where.py").write_text(
+        "import os\n\n\ndef test_where():\n"
+        "    with open('where.txt', 'a') as fh:\n"
+        "        fh.write(os.environ.get('PYTEST_XDIST_WORKER', 'serial') + '\\n')\n")
+    env = {k: v for k, v in os.environ.items() if not k.startswith("PYTEST_XDIST")}
+    env["PYTEST_DISABLE_PLUGIN_AUTOLOAD"] = "1"     # xdist alone, as in a clean install
+
+    def where(*args):
+        (tmp_path / "where.txt").unlink(missing_ok=True)
+        run = subprocess.run([sys.executable, "-m", "pytest", "-p", "no:cacheprovider", *args],
+                             cwd=tmp_path, capture_output=True, text=True, env=env)
+        assert run.returncode == 0, run.stdout + run.stderr
+        return (tmp_path / "where.txt").read_text().split(), run.stdout
+
+    cores = len(os.sched_getaffinity(0))
+    ran, out = where("-p", "xdist")
+    if cores > 1:
+        assert f"created: {cores}/{cores} workers" in out, out
+        assert ran[0].startswith("gw"), ran
+    else:
+        assert ran == ["serial"]
+    assert where("-p", "xdist", "-n", "0")[0] == ["serial"]
+    assert where("-p", "no:xdist")[0] == ["serial"]

@@ -7,9 +7,11 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import pytest
 
+ROOT = Path(__file__).resolve().parents[2]
 SCENES = ["bar1d-traction", "bar1d-uniform-load", "plate2d-clamped", "sheet2d-tension"]
 
 
@@ -182,3 +184,22 @@ def test_a_stop_inside_exec_or_import_waits_until_it_has_returned(monkeypatch):
         cli._retry(signal.SIGALRM, sys._getframe())
     STOP_REQUESTED["flag"] = False
     cli._retry(signal.SIGALRM, sys._getframe())  # no stop pending: an alarm does nothing
+
+
+def test_a_stop_after_main_has_returned_lands_in_a_program_run_from_a_string():
+    """``main()`` called in-process leaves its SIGTERM handler; in a program that runs
+    from a string (``python -c``, a pytest-xdist worker) a SIGTERM after it has returned
+    still ends the process: the program's own outermost string is no ``exec`` that will
+    return (it deferred the stop for good: a pool worker forked by a test under xdist
+    never ended)."""
+    code = ("import os, signal, time\n"
+            "from pdverify.cli import main\n"
+            "main(['list'])\n"
+            "os.kill(os.getpid(), signal.SIGTERM)\n"
+            "time.sleep(3)\n"
+            "print('survived')\n")
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                       env=env, timeout=120)
+    assert "survived" not in p.stdout
+    assert "KeyboardInterrupt" in p.stderr, p.stderr   # unwound like Ctrl-C

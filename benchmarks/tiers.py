@@ -1,0 +1,199 @@
+"""The two test tiers' wall time and peak total memory, serial against parallel (issue 32:
+the README's test command, the fast tier, in <= 5 min wall and <= 2.5 GB on a quiet
+2-core machine from a clean clone).
+
+Plain script (no test runner):
+
+    python benchmarks/tiers.py [--tier fast|slow|both] [--repeat N] [--modes serial,parallel]
+
+Each measurement is a fresh ``python -m pytest -q`` (the fast tier) or
+``python -m pytest -q --runslow -m slow`` (the slow tier) in the source tree, started
+from this script: ``serial`` adds ``-p no:xdist``, ``parallel`` is the command as the
+README gives it (tests/conftest.py starts a pytest-xdist worker per core). Every test
+session starts with an empty FEM cache of its own (tests/conftest.py), as on a clean
+clone. The modes alternate within each round (their order swapped every other round,
+so neither always runs after the other), ``--repeat`` rounds (default 1); medians.
+
+Memory: every 0.2 s the script reads /proc for the pytest process and all its
+descendants (xdist's workers, the reports' worker pools, the subprocesses the tests
+start) and sums their resident set (RSS) and their proportional set (PSS, from
+``smaps_rollup``: pages shared among the processes, such as a forked pool's
+copy-on-write pages, counted once in all; read every fifth sample, every 1 s, as
+walking the pages costs the sampler CPU time). The peak of each sum over the run is
+printed; the RSS sum counts a shared page once per process, so it is the upper bound,
+the PSS sum the memory the tree held. ``/usr/bin/time`` gives the largest single
+process only (printed too, as ``largest process``).
+
+CPU: the user and system time of the pytest process and every descendant it waited
+for (``RUSAGE_CHILDREN``), steadier than the wall time on a loaded machine: on 2 quiet
+cores the parallel wall time is about half of it, or the longest file if that is more.
+
+The machine is shared: the load average is printed before and after each run.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import resource
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+PAGE = os.sysconf("SC_PAGE_SIZE")
+TIERS = {"fast": ["-q"], "slow": ["-q", "--runslow", "-m", "slow"]}
+MODES = {"serial": ["-p", "no:xdist"], "parallel": []}
+
+
+def _children_map():
+    """{parent pid: [child pids]} over every process now visible in /proc."""
+    kids = {}
+    for name in os.listdir("/proc"):
+        if not name.isdigit():
+            continue
+        try:
+            with open(f"/proc/{name}/stat") as fh:
+                stat = fh.read()
+        except OSError:
+            continue
+        # the command name (field 2) may hold spaces: the fields after its ')' are plain
+        ppid = int(stat.rsplit(")", 1)[1].split()[1])
+        kids.setdefault(ppid, []).append(int(name))
+    return kids
+
+
+def _tree(pid):
+    kids, todo, seen = _children_map(), [pid], []
+    while todo:
+        p = todo.pop()
+        seen.append(p)
+        todo.extend(kids.get(p, ()))
+    return seen
+
+
+def _rss_pss(pid, pss_too=True):
+    """(RSS, PSS) of one process in bytes; (0, 0) once it has gone; PSS 0 unless
+    ``pss_too`` (``smaps_rollup`` costs the kernel a walk of the process's pages)."""
+    try:
+        with open(f"/proc/{pid}/statm") as fh:
+            rss = int(fh.read().split()[1]) * PAGE
+        pss = 0
+        if not pss_too:
+            return rss, pss
+        with open(f"/proc/{pid}/smaps_rollup") as fh:
+            for line in fh:
+                if line.startswith("Pss:"):
+                    pss = int(line.split()[1]) * 1024
+                    break
+        return rss, pss
+    except (OSError, ValueError, IndexError):
+        return 0, 0
+
+
+def _cmd(pid):
+    try:
+        with open(f"/proc/{pid}/cmdline", "rb") as fh:
+            return fh.read().replace(b"\0", b" ").decode(errors="replace")[:90]
+    except OSError:
+        return "?"
+
+
+class Sampler(threading.Thread):
+    """Samples the process tree under ``pid`` every ``interval`` seconds until stopped."""
+
+    def __init__(self, pid, interval=0.2):
+        super().__init__(daemon=True)
+        self.pid, self.interval = pid, interval
+        self.peak_rss = self.peak_pss = self.peak_one = 0
+        self.peak_procs = 0
+        self.at_peak = []
+        self.samples = 0
+        self._done = threading.Event()
+
+    def run(self):
+        while not self._done.is_set():
+            pids = _tree(self.pid)
+            sizes = [_rss_pss(p, self.samples % 5 == 0) for p in pids]
+            if sum(r for r, _ in sizes) > self.peak_rss:
+                self.at_peak = sorted(((r, _cmd(p)) for p, (r, _) in zip(pids, sizes)),
+                                      reverse=True)
+            self.peak_rss = max(self.peak_rss, sum(r for r, _ in sizes))
+            self.peak_pss = max(self.peak_pss, sum(p for _, p in sizes))
+            self.peak_one = max([self.peak_one] + [r for r, _ in sizes])
+            self.peak_procs = max(self.peak_procs, len(sizes))
+            self.samples += 1
+            self._done.wait(self.interval)
+
+    def stop(self):
+        self._done.set()
+        self.join()
+
+
+def measure(tier, mode):
+    cmd = [sys.executable, "-m", "pytest", *TIERS[tier], *MODES[mode]]
+    env = dict(os.environ, PYTHONPATH=HERE)
+    load0 = os.getloadavg()[0]
+    ru0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    with tempfile.TemporaryFile("w+") as out:
+        t0 = time.perf_counter()
+        proc = subprocess.Popen(cmd, cwd=HERE, env=env, stdout=out, stderr=subprocess.STDOUT,
+                                text=True)
+        sampler = Sampler(proc.pid)
+        sampler.start()
+        code = proc.wait()
+        wall = time.perf_counter() - t0
+        sampler.stop()
+        ru1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        out.seek(0)
+        lines = [x for x in out.read().splitlines() if x.strip()]
+    cpu = (ru1.ru_utime + ru1.ru_stime) - (ru0.ru_utime + ru0.ru_stime)
+    return {"tier": tier, "mode": mode, "code": code, "wall_s": wall, "cpu_s": cpu,
+            "peak_rss_gb": sampler.peak_rss / 1e9, "peak_pss_gb": sampler.peak_pss / 1e9,
+            "largest_gb": sampler.peak_one / 1e9, "procs": sampler.peak_procs,
+            "load": (load0, os.getloadavg()[0]), "summary": lines[-1] if lines else "",
+            "at_peak": sampler.at_peak}
+
+
+def show(r):
+    print(f"{r['tier']:4s} {r['mode']:8s} exit {r['code']}  wall {r['wall_s']:7.1f} s  "
+          f"CPU {r['cpu_s']:7.1f} s  peak total RSS {r['peak_rss_gb']:5.2f} GB  "
+          f"PSS {r['peak_pss_gb']:5.2f} GB  "
+          f"largest process {r['largest_gb']:5.2f} GB  processes <= {r['procs']:3d}  "
+          f"load {r['load'][0]:.2f} -> {r['load'][1]:.2f}  | {r['summary']}", flush=True)
+    for rss, cmd in r["at_peak"][:4]:
+        print(f"    at the peak: {rss / 1e9:5.2f} GB  {cmd}")
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--tier", choices=("fast", "slow", "both"), default="fast")
+    ap.add_argument("--repeat", type=int, default=1)
+    ap.add_argument("--modes", default="serial,parallel",
+                    help="comma-separated, of: serial, parallel")
+    args = ap.parse_args(argv)
+    tiers = ("fast", "slow") if args.tier == "both" else (args.tier,)
+    modes = args.modes.split(",")
+    runs = []
+    for tier in tiers:
+        for k in range(args.repeat):
+            for mode in (modes if k % 2 == 0 else modes[::-1]):
+                runs.append(measure(tier, mode))
+                show(runs[-1])
+    print("medians:")
+    for tier in tiers:
+        for mode in modes:
+            mine = [r for r in runs if r["tier"] == tier and r["mode"] == mode]
+            med = {key: statistics.median(r[key] for r in mine)
+                   for key in ("wall_s", "cpu_s", "peak_rss_gb", "peak_pss_gb", "largest_gb")}
+            print(f"{tier:4s} {mode:8s} n={len(mine)}  wall {med['wall_s']:7.1f} s  "
+                  f"CPU {med['cpu_s']:7.1f} s  peak total RSS {med['peak_rss_gb']:5.2f} GB  "
+                  f"PSS {med['peak_pss_gb']:5.2f} GB  "
+                  f"largest process {med['largest_gb']:5.2f} GB")
+    return 0 if all(r["code"] in (0, 5) for r in runs) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
