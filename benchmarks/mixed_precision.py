@@ -120,24 +120,32 @@ def _solve(folder, alternative, queue):
                "gmres_iterations": info.get("gmres_ir_iterations")})
 
 
-def _stages(folder, queue):
+def _ordered_factor(folder, where):
+    """The saved system of ``folder`` under its nested-dissection ordering and its
+    single-precision factor: ``(A_p, b_p, lu, factor seconds)``."""
     import scipy.sparse as sp
-    from threadpoolctl import threadpool_limits
 
-    from pdverify.solvers import mixed
     from pdverify.solvers.nested import ordered_system, single_precision_factor
 
     A = sp.load_npz(os.path.join(folder, "A.npz")).tocsr()
     b = np.load(os.path.join(folder, "b.npy"))
     c = np.load(os.path.join(folder, "c.npy"))
+    A_p, b_p, _, (n1, n2), _ = ordered_system(A, b, c, where)
+    t = time.perf_counter()
+    lu, _ = single_precision_factor(A_p, n1, n2)
+    return A_p, b_p, lu, time.perf_counter() - t
+
+
+def _stages(folder, queue):
+    from threadpoolctl import threadpool_limits
+
+    from pdverify.solvers import mixed
+
     out = {}
     with threadpool_limits(1):
-        A_p, b_p, _, (n1, n2), _ = ordered_system(A, b, c, "stages")
-        t = time.perf_counter()
-        lu, _ = single_precision_factor(A_p, n1, n2)
-        out["factor_s"] = time.perf_counter() - t
-        probe = np.random.default_rng(20211121).standard_normal(b.size)
-        stop = [mixed.REFINE_STOP, np.sqrt(b.size) * np.finfo(float).eps]
+        A_p, b_p, lu, out["factor_s"] = _ordered_factor(folder, "stages")
+        probe = np.random.default_rng(20211121).standard_normal(b_p.size)
+        stop = [mixed.REFINE_STOP, np.sqrt(b_p.size) * np.finfo(float).eps]
         rhs = np.column_stack([b_p, probe])
         t = time.perf_counter()
         Y, steps, _, ok = mixed.refine(A_p, rhs, lu.solve, stop=stop)
@@ -166,19 +174,13 @@ def _stages(folder, queue):
 
 
 def _estimator(folder, queue):
-    import scipy.sparse as sp
     from threadpoolctl import threadpool_limits
 
     from pdverify.solvers import mixed
-    from pdverify.solvers.nested import ordered_system, single_precision_factor
 
-    A = sp.load_npz(os.path.join(folder, "A.npz")).tocsr()
-    b = np.load(os.path.join(folder, "b.npy"))
-    c = np.load(os.path.join(folder, "c.npy"))
     out = {}
     with threadpool_limits(1):
-        A_p, b_p, _, (n1, n2), _ = ordered_system(A, b, c, "estimator")
-        lu, _ = single_precision_factor(A_p, n1, n2)
+        A_p, b_p, lu, _ = _ordered_factor(folder, "estimator")
         AT = A_p.T.tocsr()
         n = A_p.shape[0]
         g = np.random.default_rng(1).standard_normal(n)
@@ -205,8 +207,8 @@ def _estimator(folder, queue):
                     np.linalg.norm(m_times(lu.solve(g, trans=trans), trans) - g)
                     / np.linalg.norm(g))
             del L, U
-        probe = np.random.default_rng(20211121).standard_normal(b.size)
-        stop = [mixed.REFINE_STOP, np.sqrt(b.size) * np.finfo(float).eps]
+        probe = np.random.default_rng(20211121).standard_normal(b_p.size)
+        stop = [mixed.REFINE_STOP, np.sqrt(b_p.size) * np.finfo(float).eps]
         rhs = np.column_stack([b_p, probe])
         Y, _, _, _ = mixed.refine(A_p, rhs, lu.solve, stop=stop)
         gm = mixed.GmresIR(A_p, lu)

@@ -271,19 +271,25 @@ def bench_crossover3d(args, out):
     cases += [("body3d-manufactured", "surface-nodes", h) for h in (0.1, 1 / 12, 1 / 14)]
     cases += [("body3d-traction", "none", h) for h in (0.125, 0.1)]
     for scene_id, method, h in cases:
-        scene = get_scene(scene_id)
-        alts = {solver: (lambda solver=solver: scene.run(
-            method, {"spacing": h, "solver": solver})) for solver in ("direct",
-                                                                      "nested-dissection")}
-        res = alternate(alts, args.repeat)
-        n = res["direct"][1].size["dofs"]
-        t_d, t_n = res["direct"][0], res["nested-dissection"][0]
-        err = [r[1].metrics["rel_l2_error"] for r in res.values()]
-        print(f"  {scene_id:20s} {method:14s} h = {h:.4f} ({n:5d} unknowns): direct "
-              f"{t_d:6.2f} s, nested dissection {t_n:6.2f} s ({t_d / t_n:4.2f}x); "
-              f"rel_l2_error {err[0]:.6e} / {err[1]:.6e}")
-        out[f"crossover3d {scene_id} {method} h={h:.4f}"] = {
-            "unknowns": int(n), "direct": t_d, "nested-dissection": t_n}
+        row = direct_against_nd(args, get_scene(scene_id), method, {"spacing": h})
+        print(f"  {scene_id:20s} {method:14s} h = {h:.4f} {row['text']}")
+        out[f"crossover3d {scene_id} {method} h={h:.4f}"] = row["times"]
+
+
+def direct_against_nd(args, scene, method, over):
+    """Whole runs of ``scene`` with ``solver=direct`` and ``nested-dissection``,
+    alternating, medians of ``--repeat``: ``{"times": ..., "text": one printed line}``."""
+    alts = {solver: (lambda solver=solver: scene.run(method, {**over, "solver": solver}))
+            for solver in ("direct", "nested-dissection")}
+    res = alternate(alts, args.repeat)
+    n = res["direct"][1].size["dofs"]
+    t_d, t_n = res["direct"][0], res["nested-dissection"][0]
+    err = [r[1].metrics["rel_l2_error"] for r in res.values()]
+    text = (f"({n:5d} unknowns): direct {t_d:6.2f} s "
+            f"({res['direct'][1].diagnostics.get('solver', '')[:24]}), nested dissection "
+            f"{t_n:6.2f} s ({t_d / t_n:4.2f}x); rel_l2_error {err[0]:.6e} / {err[1]:.6e}")
+    return {"times": {"unknowns": int(n), "direct": t_d, "nested-dissection": t_n},
+            "text": text}
 
 
 def bench_crossover2d(args, out):
@@ -297,19 +303,9 @@ def bench_crossover2d(args, out):
     cases += [(m, 0.02, r) for m in ("surface-nodes",) for r in (4.0, 5.0)]
     scene = get_scene("plate2d-plane-strain")
     for method, h, m_ratio in cases:
-        over = {"spacing": h, "m_ratio": m_ratio}
-        alts = {solver: (lambda solver=solver: scene.run(method, {**over, "solver": solver}))
-                for solver in ("direct", "nested-dissection")}
-        res = alternate(alts, args.repeat)
-        n = res["direct"][1].size["dofs"]
-        t_d, t_n = res["direct"][0], res["nested-dissection"][0]
-        err = [r[1].metrics["rel_l2_error"] for r in res.values()]
-        print(f"  {method:17s} h = {h:.4f} m = {m_ratio:g} ({n:5d} unknowns): direct "
-              f"{t_d:6.2f} s ({res['direct'][1].diagnostics.get('solver', '')[:24]}), "
-              f"nested dissection {t_n:6.2f} s ({t_d / t_n:4.2f}x); "
-              f"rel_l2_error {err[0]:.6e} / {err[1]:.6e}")
-        out[f"crossover2d {method} h={h:.4f} m={m_ratio:g}"] = {
-            "unknowns": int(n), "direct": t_d, "nested-dissection": t_n}
+        row = direct_against_nd(args, scene, method, {"spacing": h, "m_ratio": m_ratio})
+        print(f"  {method:17s} h = {h:.4f} m = {m_ratio:g} {row['text']}")
+        out[f"crossover2d {method} h={h:.4f} m={m_ratio:g}"] = row["times"]
 
 
 def bench_pddo(args, out):
