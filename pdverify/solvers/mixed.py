@@ -98,9 +98,9 @@ GMRES_OUTER_STEPS = 6
 #: (12,880 unknowns, condition 1.3e7): the corrections converge in 55-60 iterations, the
 #: transposed pass from sign(x) stays above 0.99 for 70 iterations and reaches 4e-5 at 100
 #: (the factor's transposed solves are the poorer: relative residual 505 against A^T, 21
-#: against A, on a random vector; ``benchmarks/mixed_precision.py --estimator``). At the
-#: 60 the system was refactored in
-#: double though its solve had converged. Four times the corrections' limit: the bases of
+#: against A, on a random vector; ``benchmarks/mixed_precision.py --estimator``). Capped
+#: at 60, that system was factored again in double though its solve had converged. Four
+#: times the corrections' limit: the bases of
 #: 10^4 unknowns x 240 are 40 MB, and only the iterations run are touched.
 ESTIMATOR_MAX_ITERATIONS = 4 * GMRES_MAX_ITERATIONS
 #: The condition estimator's solves y ~ A^-1 v (one GMRES pass each) must reach this true
