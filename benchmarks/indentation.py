@@ -9,7 +9,7 @@ Each timed run is a fresh ``python`` process (so no run inherits another's cache
 grown memory) running ``get_scene('block2d-indentation').run(METHOD, OVERRIDES)``; the
 variants alternate within each repeat, and the table shows medians of ``--repeat``
 (default 3) runs: the run's total and solve phase (its own timings), the process's CPU
-time, linear solves, CG iterations, preconditioner builds, Newton iterations and the
+time, linear solves, CG iterations, preconditioner builds (+ refreshes), Newton iterations and the
 status. The FEM references come from the cache (the first variant's run fills it).
 
 Variants (paper grid: 161 x 161 nodes, m = 6, 20 depth steps):
@@ -203,7 +203,7 @@ def main():
                     print(f"  {name:18s} {method} {over}: {r['status']} "
                           f"{r['timings']['total_s']:.1f} s", file=sys.stderr, flush=True)
     print(f"{'case':44s} {'variant':18s} {'total s':>8s} {'solve s':>8s} {'cpu s':>7s} "
-          f"{'solves':>6s} {'CG it':>6s} {'builds':>6s} {'newton':>6s}  status")
+          f"{'solves':>6s} {'CG it':>6s} {'builds':>9s} {'newton':>6s}  status")
     sums = {}
     for (method, over, name), rs in results.items():
         med = {k: statistics.median(r["timings"][k] for r in rs) for k in ("total_s", "solve_s")}
@@ -212,7 +212,8 @@ def main():
         case = f"{method} {over if over != '{}' else ''}"
         print(f"{case:44s} {name:18s} {med['total_s']:8.2f} {med['solve_s']:8.2f} {cpu:7.1f} "
               f"{d.get('linear_solves', 0):6d} {d.get('cg_iterations', 0):6d} "
-              f"{d.get('preconditioner_builds', 0):6d} {m.get('newton_iterations', 0):6d}  "
+              f"{d.get('preconditioner_builds', 0):4d}+{d.get('preconditioner_refreshes', 0):<4d} "
+              f"{m.get('newton_iterations', 0):6d}  "
               f"{rs[0]['status']}"
               + (f" at {m['failure_depth_mm']:.3g} mm" if "failure_depth_mm" in m else ""))
         sums[name] = sums.get(name, 0.0) + med["total_s"]

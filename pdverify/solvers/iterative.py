@@ -127,33 +127,69 @@ class TwoLevelPreconditioner:
         # which made rho, hence CG's iterates and a Newton run's last digits, depend on
         # what ran before in the same worker
         start = np.random.default_rng(0).standard_normal(K.shape[0])
-        rho = float(spla.eigsh(scaled, k=1, which="LA", tol=1e-2, v0=start,
-                               return_eigenvectors=False)[0])
+        self.rho = rho = float(spla.eigsh(scaled, k=1, which="LA", tol=1e-2, v0=start,
+                                          return_eigenvectors=False)[0])
         P = (T - sp.diags((PROLONGATOR_WEIGHT / rho) * d_inv) @ (K @ T)).tocsr()
-        coarse = (P.T @ (K @ P)).toarray()
+        # The preconditioner works in single precision (CG itself in double): it only has
+        # to be a fixed SPD approximation, and halving its bytes took a 12-iteration solve
+        # from 0.47 s to 0.40 s (a side measurement on the indentation-size stiffness).
+        self._P32 = P.astype(np.float32).tocsr()
+        self._PT32 = self._P32.T.tocsr()
+        self._P = P
+        # fused: K (x1 + P e) = K x1 + (K P) e, one product with K per application instead
+        # of two; the same operator in exact arithmetic (float32 round-off apart), 8.1 ms
+        # against 12.5 ms an application on the half indentation's tangent (26,082 unknowns,
+        # CPU time, one BLAS thread, mean of 20, a side measurement;
+        # benchmarks/indentation.py times whole curves)
+        self.fused = fused
+        self._operator_parts(K, d_inv, (P.T @ (K @ P)).toarray())
+        self.setup_s = time.perf_counter() - t0
+
+    def _operator_parts(self, K, d_inv, coarse, KP32=None) -> None:
+        """What the preconditioner takes from K: its float32 copy, the Jacobi weights, the
+        inverse of the coarse matrix ``coarse`` = P^T K P, and K P if fused (``KP32``, or
+        the product of the float32 copies)."""
         try:
             chol = sl.cho_factor(coarse)
         except sl.LinAlgError:
             raise NumericalError("CG preconditioner: the coarse matrix is not positive "
                                  "definite (the stiffness is singular or not SPD)") from None
         coarse_inv = sl.cho_solve(chol, np.eye(coarse.shape[0]))
-        # The preconditioner works in single precision (CG itself in double): it only has
-        # to be a fixed SPD approximation, and halving its bytes took a 12-iteration solve
-        # from 0.47 s to 0.40 s (a side measurement on the indentation-size stiffness).
         f32 = np.float32
-        self._K32, self._P32 = K.astype(f32), P.astype(f32).tocsr()
-        self._PT32 = self._P32.T.tocsr()
+        self._K32 = K.astype(f32)
         self._coarse_inv32 = ((coarse_inv + coarse_inv.T) / 2).astype(f32)
-        self._w32 = ((SMOOTHER_WEIGHT / rho) * d_inv).astype(f32)
-        # fused: K (x1 + P e) = K x1 + (K P) e, one product with K per application instead
-        # of two; the same operator in exact arithmetic (float32 round-off apart), 8.1 ms
-        # against 12.5 ms an application on the half indentation's tangent (26,082 unknowns,
-        # CPU time, one BLAS thread, mean of 20, a side measurement;
-        # benchmarks/indentation.py times whole curves)
-        self._KP32 = (self._K32 @ self._P32).tocsr() if fused else None
+        self._w32 = ((SMOOTHER_WEIGHT / self.rho) * d_inv).astype(f32)
+        if self.fused:
+            self._KP32 = (self._K32 @ self._P32).tocsr() if KP32 is None else KP32
+        else:
+            self._KP32 = None
         self.K = K
         self.coarse_size = coarse.shape[0]
-        self.setup_s = time.perf_counter() - t0
+
+    def refresh(self, K) -> float:
+        """Adapt to a nearby matrix ``K`` of the same size (a later Newton tangent, perhaps
+        with more prescribed unknowns): the smoother's diagonal, the products with K and
+        the coarse matrix P^T K P are K's; the aggregates, the prolongator P (smoothed with
+        the first K) and the spectral radius estimate stay. Returns the seconds it took.
+
+        Why: on the paper grid's half indentation (26,082 unknowns) a preconditioner built
+        on an earlier tangent needed 31 CG iterations to 1e-8 where a fresh build needed
+        18; refreshed, 18 too, for about a third of a build's time (the eigenvalue
+        estimate, the tentative and smoothed prolongators are not recomputed; a side
+        measurement on a tangent saved mid-curve). ``benchmarks/indentation.py`` times
+        whole curves."""
+        t0 = time.perf_counter()
+        K = sp.csr_matrix(K)
+        diag = K.diagonal()
+        if np.any(diag <= 0) or not np.all(np.isfinite(diag)):
+            raise NumericalError("CG preconditioner: the stiffness has a non-positive diagonal "
+                                 "entry, so it is not symmetric positive definite")
+        KP = (K @ self._P).tocsr()
+        self._operator_parts(K, 1.0 / diag, (self._P.T @ KP).toarray(),
+                             KP.astype(np.float32) if self.fused else None)
+        dt = time.perf_counter() - t0
+        self.setup_s += dt
+        return dt
 
     def apply(self, r):
         r = np.asarray(r).astype(np.float32)

@@ -172,6 +172,38 @@ def test_cg_and_direct_newton_agree():
     assert np.abs(out[0] - out[1]).max() <= 1e-6 * np.abs(out[0]).max()
 
 
+def test_a_stale_cg_preconditioner_is_refreshed_not_rebuilt(monkeypatch):
+    """Issue 32: once the CG iterations lost to a preconditioner built on an earlier tangent
+    exceed REBUILD_FACTOR refreshes' cost, the next solve refreshes it on its own tangent
+    (one build in all), and the solves after it need fewer iterations; the solutions stay
+    those of the current tangent."""
+    from pdverify.solvers import newton as newton_module
+    monkeypatch.setattr(newton_module, "REFRESH_COST_ITERATIONS", 1.0)
+    model, nl, top, fixed = _pressed_block()
+    n = model.grid.n_ext
+    g = model.grid
+    lin = DirichletLinearSolver(nl.pattern, "cg", Lattice.component_major(g.index, g.x, 2),
+                                width=3)
+    lin.set_fixed(fixed)
+    data = nl.tangent_data(np.zeros(2 * n)).copy()
+    # the first tangent seen: the upper half of the block four times as stiff
+    row = nl.pattern.row_of
+    d = np.where(g.x[np.arange(2 * n) % n, 1] > 4 * model.spacing, 2.0, 1.0)
+    first = data * d[row] * d[nl.pattern.indices]
+    rhs = np.where(fixed, 0.0, 1.0)
+    lin.solve(first.copy(), rhs, 1e-8, "test")
+    counts = []
+    for _ in range(4):
+        before = lin.stats.iterations
+        du = lin.solve(data.copy(), rhs, 1e-8, "test")
+        counts.append(lin.stats.iterations - before)
+        T = lin.masked(data.copy())
+        # CG's stopping rule (relative residual 1e-8) on the current tangent
+        assert np.linalg.norm(T @ du - np.where(fixed, 0.0, rhs)) <= 1e-7 * np.linalg.norm(rhs)
+    assert lin.stats.rebuilds == 1 and lin.stats.refreshes >= 1, lin.stats
+    assert counts[-1] < counts[0], counts
+
+
 def test_newton_stall_is_reported():
     model, nl, top, fixed = _pressed_block()
     n = model.grid.n_ext
