@@ -51,8 +51,9 @@ class StateBasedModel:
     Where things are multiplied out: K_b is never formed in 2D/3D (each of its rows would
     couple ~1000 dofs in 3D); :meth:`stiffness` multiplies out the two terms
     (P K_e) B + (P K_theta A_Theta)(A_theta B) with B = A_e A_U, each a product of sparse
-    factors. :meth:`bond_force_matrix` does form K_b, for 1D bars, where it is banded and
-    both the stiffness and the section-force rows (seed 000, Eq. 60) need it.
+    factors (``map_last``: B is not formed, :meth:`unknown_rows`). :meth:`bond_force_matrix`
+    does form K_b, for 1D bars, where it is banded and both the stiffness and the
+    section-force rows (seed 000, Eq. 60) need it.
     :meth:`rows_of_state` applies the factors to a given state without multiplying
     anything out.
     """
@@ -186,19 +187,37 @@ class StateBasedModel:
             np.r_[g.interior_number[a[ia]], g.interior_number[b[ib]]],
             np.r_[bonds[ia], bonds[ib]], np.r_[-np.ones(ia.sum()), np.ones(ib.sum())])
 
-    def stiffness(self, P=None) -> sp.csr_matrix:
+    def unknown_rows(self, rows, map_last: bool = False) -> list:
+        """R A_e A_U for each R of ``rows`` (rows over the bonds: the equations times K_e,
+        A_theta): the same rows over the unknowns, multiplied out as R B with
+        B = A_e A_U formed once, or with ``map_last`` as (R A_e) A_U.
+
+        ``map_last`` is for a closure whose displacement map has wide rows: B holds, in
+        the row of each bond with a fictitious end, that node's whole extrapolation
+        stencil (the surface nodes' 3D stencil at order 3: 100 sources; B of
+        body3d-manufactured at h = 0.05 has 48 M entries, A_e 2 M), while R A_e has one
+        entry per node an equation sees: that run's setup then takes 2.4 s of CPU instead
+        of 4.4 s, and B's 0.6 GB is never held (benchmarks/setup3d.py). Mathematically
+        the same; the sums round in another order (there the entries 2e-15 of the largest
+        apart; tests/surface/test_surface_exactness.py bounds the difference)."""
+        if map_last:
+            return [(R @ self.A_e) @ self.A_U_full for R in rows]
+        B = (self.A_e @ self.A_U_full).tocsr()             # extensions from unknowns
+        return [R @ B for R in rows]
+
+    def stiffness(self, P=None, *, map_last: bool = False) -> sp.csr_matrix:
         """K = P K_b, multiplied out as (P K_e) B + (P K_theta A_Theta)(A_theta B).
 
-        ``P`` defaults to :meth:`equilibrium_rows` (K u = external nodal forces).
+        ``P`` defaults to :meth:`equilibrium_rows` (K u = external nodal forces);
+        ``map_last``: B is not formed (:meth:`unknown_rows`).
         """
         P = self.equilibrium_rows() if P is None else P
-        B = (self.A_e @ self.A_U_full).tocsr()             # extensions from unknowns
-        bond_part = (P @ self.K_e) @ B                      # 'bond-based' part, ~stencil-sparse
+        # 'bond-based' part (~stencil-sparse) and real dilatations <- unknowns
+        bond_part, theta_of_u = self.unknown_rows([P @ self.K_e, self.A_theta], map_last)
         coupling = (P @ self.K_theta) @ self.A_Theta        # nodes <- real dilatations
-        theta_of_u = (self.A_theta @ B).tocsr()             # real dilatations <- unknowns
-        return (bond_part + coupling @ theta_of_u).tocsr()
+        return (bond_part + coupling @ theta_of_u.tocsr()).tocsr()
 
-    def augmented_stiffness(self, P=None) -> sp.csr_matrix:
+    def augmented_stiffness(self, P=None, *, map_last: bool = False) -> sp.csr_matrix:
         """The system with the real-node dilatations as unknowns beside the displacements:
 
             [[P K_e B, P K_theta A_Theta], [A_theta B, -I]] [u; theta] = [f; 0]
@@ -208,12 +227,13 @@ class StateBasedModel:
         closure's extrapolation), so a sparse LU's separators are half as thick: on the
         plane-strain plate at h = 0.01 the augmented matrix has 3.0 M non-zeros against
         6.1 M for K (benchmarks/solvers.py). Unknowns: ``d * n_unknown_nodes``
-        displacements (component-major), then ``n_interior`` dilatations."""
+        displacements (component-major), then ``n_interior`` dilatations. ``map_last``:
+        B is not formed (:meth:`unknown_rows`)."""
         P = self.equilibrium_rows() if P is None else P
-        B = (self.A_e @ self.A_U_full).tocsr()
+        bond_part, theta_of_u = self.unknown_rows([P @ self.K_e, self.A_theta], map_last)
         ni = self.A_theta.shape[0]
-        return sp.bmat([[(P @ self.K_e) @ B, (P @ self.K_theta) @ self.A_Theta],
-                        [self.A_theta @ B, -sp.identity(ni, format="csr")]], format="csr")
+        return sp.bmat([[bond_part, (P @ self.K_theta) @ self.A_Theta],
+                        [theta_of_u, -sp.identity(ni, format="csr")]], format="csr")
 
     def bond_force_matrix(self, bonds=None) -> sp.csr_matrix:
         """K_b: scalar bond forces (times beta V_a V_b) from the unknowns, multiplied out;

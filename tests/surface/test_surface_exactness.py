@@ -97,3 +97,28 @@ def test_face_crossing_weights_give_the_discrete_stress(rng):
     # and interior nodes are in equilibrium (no body force for a uniform strain)
     interior = rows.reshape(3, -1).T[:g.n_interior]
     assert np.abs(interior).max() < 1e-12 * np.abs(flux).max() * g.face_area
+
+
+@pytest.mark.parametrize("order", [1, 3])
+def test_the_map_multiplied_in_last_gives_the_same_rows(order):
+    """``StateBasedModel.unknown_rows``: (R A_e) A_U (``map_last``, the 3D surface nodes'
+    assembly) and R (A_e A_U) are the same rows over the unknowns, to the round-off of
+    their sums. Bound (Higham, Accuracy and Stability of Numerical Algorithms, 2nd ed.,
+    Eq. 3.13, |fl(AB) - AB| <= gamma_n |A||B|, applied to both products of each order):
+    entrywise |difference| <= 2 gamma_n |R||A_e||A_U| with n the largest number of terms
+    along the chain, gamma_n = n u / (1 - n u), u = eps / 2."""
+    c = StateBasedConstants("3d", 200e9, 0.3)
+    box = StateBox((0.4, 0.3, 0.3), (0.0, -0.15, -0.15), 0.05, 3.0, c, order=order)
+    model = box.model
+    rows = [box.P @ model.K_e, model.A_theta]
+    ref = model.unknown_rows(rows)
+    new = model.unknown_rows(rows, map_last=True)
+    most = lambda A: int(np.diff(A.tocsr().indptr).max())  # noqa: E731
+    for R, a, b in zip(rows, ref, new):
+        n = most(R) + most(model.A_e) + most(model.A_U_full)
+        gamma = n * EPS / 2 / (1 - n * EPS / 2)
+        bound = 2 * gamma * (abs(R) @ abs(model.A_e) @ abs(model.A_U_full)).toarray()
+        diff = abs(a - b).toarray()
+        assert np.all(diff <= bound), (order, float((diff - bound).max()))
+        # the bound is a round-off bound, far below the rows' own size
+        assert bound.max() < 1e-12 * abs(a).max()

@@ -1,0 +1,252 @@
+"""The 3D boxes' setup and assembly (issue 32): before and after, side by side in one run.
+
+Plain script (no test runner):
+
+    python benchmarks/setup3d.py [--before REV] [--repeat N] [--runs] [--only TEXT ...]
+    python benchmarks/setup3d.py --profile {after,before} [--before REV] [--only TEXT ...]
+
+Cases: every run the full report makes of ``body3d-manufactured`` and ``body3d-traction``
+(``pdverify.runner.plan``) except ``perifit`` (its setup is the external package's);
+``--only``: the cases whose label contains one of the texts (e.g. ``surface-nodes``).
+
+Each timed case is a fresh ``python`` process running the tree's own code; this tree and
+``--before REV`` (a git revision, default ``main``, extracted with ``git archive`` into a
+temporary folder; or an existing folder holding another checkout) alternate within each
+repeat, and the table shows medians of ``--repeat`` (default 3). Two modes:
+
+- default: the run's setup only, as ``StaticStateScene.solve_problem`` does it (the
+  problem described, the treatment's ``assemble``, BLAS on one thread as in a run): its
+  wall and CPU time, and whether the assembled systems are the same (a digest of K with
+  each row's entries sorted by column, the right-hand side, the prescribed unknowns
+  and values, the constraint rows: equal bit for bit, or DIFFERENT);
+- ``--runs``: the whole run (``Scene.run``): its setup and total wall time (the run's
+  own timings), the process's CPU time for the run, and the metrics of both trees'
+  first runs compared (``same``: bitwise; else the largest relative difference, and
+  that metric's values).
+
+``--profile after`` (this tree) or ``before``: cProfile of that tree's setup of each case:
+the functions with the most own time, which is where the setup's time goes.
+
+Measured (issue 32; a 2-core machine shared with two other jobs, so the CPU times are the
+steadier figures). Where the setup went before: in the surface-node runs the sparse
+products of the stiffness, above all the extensions of the unknowns B = A_e A_U (48 M
+entries at order 3, h = 0.05) and (P K_e) B: at order 3, csr_matmat + its symbolic pass
+took ~2.5-4 s of the ~4.5 s of setup CPU; then the closure's Taylor fits
+(``taylor_monomials``, the SVDs; ~0.4 s at order 3), ``face_crossings`` (~0.2 s) and the
+model's operators (~0.15 s). The other methods' setups are 0.1-2 s, spread over many
+small steps. After the displacement map is multiplied in last in 3D
+(``StateBasedModel.unknown_rows``), ``--only surface-nodes``, medians of 3 (setup CPU, s):
+
+    manuf surface-nodes order=1                 1.69 -> 1.14
+    manuf surface-nodes order=2                 1.86 -> 1.25
+    manuf surface-nodes order=3                 4.44 -> 2.38
+    manuf surface-nodes order=3, moment         4.62 -> 2.82
+    manuf surface-nodes order=3, centre         4.80 -> 2.52
+    tract surface-nodes order=1                 1.36 -> 1.02
+    tract surface-nodes order=1, moment         1.30 -> 0.94
+    manuf surface-nodes h=0.1                   1.17 -> 0.72
+    manuf surface-nodes h=0.0625                2.30 -> 1.19
+    manuf surface-nodes h=1/12, m=2             0.60 -> 0.48
+    manuf surface-nodes h=1/18                  2.98 -> 1.55
+    sum                                        27.11 -> 16.00
+
+The systems of every other case are the same bit for bit; those of the surface-node runs
+differ at round-off, and their metrics by at most 7e-10 relative (round-off-level ones
+aside: moment-corrected traction 1.3e-11 -> 3.1e-11 %); ``compare --rtol 1e-9`` against
+the saved full report finds no change. Whole runs (``--runs``), medians of 3: order 3
+with ``surface_load=centre`` setup 8.7 -> 4.1 s wall, total 35.2 -> 32.0 s, CPU 23.8 ->
+21.7 s.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tarfile
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENES = ("body3d-manufactured", "body3d-traction")
+SKIP = ("perifit",)
+
+#: one case in a fresh process: setup only (``assemble``) or the whole run; prints JSON
+RUNNER = """
+import hashlib, json, sys, time
+import numpy as np
+scene_id, method, over, mode = sys.argv[1], sys.argv[2], json.loads(sys.argv[3]), sys.argv[4]
+from pdverify import blas
+from pdverify.scenes import get_scene
+from pdverify.corrections.registry import plugin_call
+sc = get_scene(scene_id)
+
+
+def canonical(A):
+    # A's CSR arrays with each row's entries sorted by column: the same matrix gives the
+    # same arrays whatever order a product left the entries in (the solvers sort them too)
+    A = A.tocsr(copy=True)
+    A.sort_indices()
+    return A.indptr, A.indices, A.data
+
+
+def digest(system):
+    h = hashlib.sha256()
+    parts = [*canonical(system.K), system.rhs, system.fixed, system.values]
+    if system.B is not None:
+        parts += [*canonical(system.B), system.c]
+    for arr in parts:
+        h.update(np.ascontiguousarray(arr).tobytes())
+    return h.hexdigest()[:16]
+
+
+if mode == "setup":
+    p = sc.resolve(method, over)
+    with blas.one_thread():
+        w0, c0 = time.perf_counter(), time.process_time()
+        problem = sc.problem(p, f"{scene_id}/{method}")
+        t = sc.treatment(method)
+        system = plugin_call(t, "assemble", t.assemble, problem, p)
+        wall, cpu = time.perf_counter() - w0, time.process_time() - c0
+    print(json.dumps({"setup_s": wall, "cpu_s": cpu, "digest": digest(system),
+                      "nnz": int(system.K.nnz)}))
+elif mode == "run":
+    c0 = time.process_time()
+    r = sc.run(method, over)
+    print(json.dumps({"status": r.status, "setup_s": r.timings.get("setup_s"),
+                      "total_s": r.timings.get("total_s"), "cpu_s": time.process_time() - c0,
+                      "metrics": r.metrics}))
+else:   # profile
+    import cProfile, pstats
+    p = sc.resolve(method, over)
+    prof = cProfile.Profile()
+    with blas.one_thread():
+        prof.enable()
+        problem = sc.problem(p, f"{scene_id}/{method}")
+        t = sc.treatment(method)
+        plugin_call(t, "assemble", t.assemble, problem, p)
+        prof.disable()
+    pstats.Stats(prof).sort_stats("tottime").print_stats(12)
+"""
+
+
+def extract(rev: str, into: Path) -> Path:
+    """The ``pdverify`` package (and what it reads at run time) of git revision ``rev``."""
+    data = subprocess.run(["git", "-C", str(ROOT), "archive", "--format=tar", rev, "pdverify",
+                           "reference_fem", "manufactured"],
+                          check=True, capture_output=True).stdout
+    tar = into / "src.tar"
+    tar.write_bytes(data)
+    with tarfile.open(tar) as t:
+        t.extractall(into, filter="data")
+    return into
+
+
+def cases(only) -> list[tuple[str, str, dict]]:
+    sys.path.insert(0, str(ROOT))
+    from pdverify.runner import plan
+    out = [c for c in plan(only=list(SCENES)) if c[1] not in SKIP]
+    if only:
+        out = [c for c in out if any(t in label(c) for t in only)]
+    return out
+
+
+def label(case) -> str:
+    scene, method, over = case
+    short = {"body3d-manufactured": "manuf", "body3d-traction": "tract"}[scene]
+    opts = ",".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}"
+                    for k, v in over.items())
+    return f"{short} {method}" + (f" {opts}" if opts else "")
+
+
+def run_once(path: Path, case, mode: str) -> dict | str:
+    scene, method, over = case
+    env = {**os.environ, "PYTHONPATH": str(path)}
+    out = subprocess.run([sys.executable, "-c", RUNNER, scene, method, json.dumps(over), mode],
+                         env=env, cwd=path, check=True, capture_output=True, text=True).stdout
+    return out if mode == "profile" else json.loads(out.strip().splitlines()[-1])
+
+
+def metric_check(a: dict, b: dict) -> str:
+    """``same`` when every metric is bitwise equal, else the largest relative difference."""
+    if a.keys() != b.keys():
+        return "different metrics"
+    worst, name = 0.0, ""
+    for k in a:
+        x, y = a[k], b[k]
+        if x == y or (x != x and y != y):
+            continue
+        if not isinstance(x, (int, float)) or not isinstance(y, (int, float)):
+            return f"{k}: {x!r} vs {y!r}"
+        rel = abs(x - y) / max(abs(x), 1e-300)
+        if rel > worst:
+            worst, name = rel, f" ({k}: {x!r} -> {y!r})"
+    return "same" if worst == 0.0 else f"rel diff {worst:.1e}{name}"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--before", default="main", metavar="REV",
+                    help="git revision (or folder) to time as 'before' (default main)")
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--runs", action="store_true", help="whole runs, not the setup only")
+    ap.add_argument("--profile", choices=("after", "before"),
+                    help="cProfile the setups of this tree (after) or of --before")
+    ap.add_argument("--only", nargs="*", default=[], metavar="TEXT")
+    args = ap.parse_args()
+    todo = cases(args.only)
+    mode = "run" if args.runs else "setup"
+    with tempfile.TemporaryDirectory() as tmp:
+        before = (Path(args.before) if Path(args.before).is_dir()
+                  else extract(args.before, Path(tmp)))
+        trees = {"before": before, "after": ROOT}
+        if args.profile:
+            for case in todo:
+                print(f"== {label(case)}")
+                print(run_once(trees[args.profile], case, "profile"), flush=True)
+            return
+        if mode == "setup":
+            head = (f"{'case':52s} {'setup before':>12s} {'after':>7s} {'cpu before':>10s} "
+                    f"{'after':>7s}  system")
+        else:
+            head = (f"{'case':52s} {'setup before':>12s} {'after':>7s} {'total before':>12s} "
+                    f"{'after':>7s} {'cpu before':>10s} {'after':>7s}  metrics")
+        print(f"{mode} of {len(todo)} cases, medians of {args.repeat} (seconds); before = "
+              f"{args.before}")
+        print(head)
+        sums = {k: [0.0, 0.0, 0.0] for k in trees}
+        for case in todo:
+            got = {k: [] for k in trees}
+            for _ in range(args.repeat):
+                for name, path in trees.items():
+                    got[name].append(run_once(path, case, mode))
+            med = {k: {q: statistics.median(r[q] for r in v)
+                       for q in ("setup_s", "cpu_s") + (("total_s",) if mode == "run" else ())}
+                   for k, v in got.items()}
+            for k in trees:
+                sums[k][0] += med[k]["setup_s"]
+                sums[k][1] += med[k]["cpu_s"]
+                sums[k][2] += med[k].get("total_s", 0.0)
+            b, a = med["before"], med["after"]
+            if mode == "setup":
+                dig = {r["digest"] for v in got.values() for r in v}
+                check = "same" if len(dig) == 1 else "DIFFERENT"
+                print(f"{label(case):52s} {b['setup_s']:12.2f} {a['setup_s']:7.2f} "
+                      f"{b['cpu_s']:10.2f} {a['cpu_s']:7.2f}  {check}", flush=True)
+            else:
+                check = metric_check(got["before"][0]["metrics"], got["after"][0]["metrics"])
+                print(f"{label(case):52s} {b['setup_s']:12.2f} {a['setup_s']:7.2f} "
+                      f"{b['total_s']:12.2f} {a['total_s']:7.2f} {b['cpu_s']:10.2f} "
+                      f"{a['cpu_s']:7.2f}  {check}", flush=True)
+        b, a = sums["before"], sums["after"]
+        if mode == "setup":
+            print(f"{'sum':52s} {b[0]:12.2f} {a[0]:7.2f} {b[1]:10.2f} {a[1]:7.2f}")
+        else:
+            print(f"{'sum':52s} {b[0]:12.2f} {a[0]:7.2f} {b[2]:12.2f} {a[2]:7.2f} "
+                  f"{b[1]:10.2f} {a[1]:7.2f}")
+
+
+if __name__ == "__main__":
+    main()
