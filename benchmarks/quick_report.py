@@ -70,7 +70,7 @@ Findings (issue 32, 2 cores; the CPU time is the steadier measure on a loaded ma
   overview first and the convergence figures one task per scene, last: the same pixels
   in all 55 files (``--mode figures``). Where the time went before (cProfile, 55
   files, 2 draws each): the draw without output that ``savefig`` makes to lay a figure
-  out was about half of ``savefig``'s draw time, the constrained layout a fifth, PNG
+  out was about half of ``savefig``'s draw time, the constrained layout over a quarter, PNG
   encoding at level 6 2.9 s. The serial drawing of the same runs (one process,
   alternating, load 1.4-3.8): 24.1 s CPU against 19.3 s (medians of 3; 0.80), the
   saves 20.8 s against 16.2 s. What is left is mostly the first measurement of every
