@@ -3,8 +3,10 @@ cores, cold <= 60 s): its phases, the figure tasks one by one, and the cold FEM 
 
 Plain script (no test runner):
 
-    python benchmarks/quick_report.py [--repeat N] [--jobs J] [--mode fresh|inprocess|both]
+    python benchmarks/quick_report.py [--repeat N] [--jobs J]
+                                      [--mode fresh|inprocess|both|figures]
                                       [--profile FILE] [--cold] [--only SCENE ...]
+                                      [--runs-file FILE] [--against SRC] [--keep DIR]
 
 ``--mode fresh`` (default ``both``): ``python -m pdverify report --quick`` ``--repeat``
 times (default 3), each in a fresh process into a temporary folder (the interpreter's
@@ -28,6 +30,16 @@ figure, largest first. ``--runs-file FILE``: the results are pickled there and r
 (the figures timed without running the cases again). ``--profile FILE``: cProfile of
 one serial drawing of all tasks
 (``python -m pstats FILE``), its top entries printed by cumulative time.
+
+``--mode figures --runs-file FILE [--against SRC] [--keep DIR]``: the figures alone,
+side by side: for this tree and for ``SRC`` (another source tree, e.g. ``git archive`` of
+an earlier commit unpacked), alternating, ``--repeat`` rounds, each in a fresh process
+with that tree on ``PYTHONPATH``: the quick report's figure tasks drawn serially (wall
+and CPU time, and the CPU time of each task) and then as the report draws them
+(``--jobs`` forked processes, default 2: wall, and CPU time including the drawing
+processes'); medians, and whether the two trees' files hold the same pixels. The runs
+come from ``FILE`` (made by ``--mode inprocess --runs-file FILE``), so both trees draw
+the same results.
 
 The machine is shared: run the alternatives back to back, quote medians and the load
 (the script prints ``os.getloadavg()`` before and after).
@@ -54,6 +66,20 @@ Findings (issue 32, 2 cores; the CPU time is the steadier measure on a loaded ma
   The figures are now about a third: 51 files, 25 CPU-s, 0.3-1.5 s each (the 3D error
   maps, 40 panels, 1-1.5 s; the convergence figures 3 s for 7; the error-against-cost
   overview 2.8 s).
+- Figures laid out once (``pdverify.report.figures.save``), PNG at zlib level 3, the
+  overview first and the convergence figures one task per scene, last: the same pixels
+  in all 55 files (``--mode figures``). Where the time went before (cProfile, 55
+  files, 2 draws each): the draw without output that ``savefig`` makes to lay a figure
+  out was about half of ``savefig``'s draw time, the constrained layout over a quarter, PNG
+  encoding at level 6 2.9 s. The serial drawing of the same runs (one process,
+  alternating, load 1.4-3.8): 24.1 s CPU against 19.3 s (medians of 3; 0.80), the
+  saves 20.8 s against 16.2 s. What is left is mostly the first measurement of every
+  text (tick labels, titles; each renderer measures its texts anew, mathtext parsed
+  again): a second pass over a measured figure is cheap, so placing the titles once
+  (the y axis measured once for each) saved nothing. One quick report each, load
+  about 3: figures_s 19.2 s against 10.1 s, 71.5 against 65.6 CPU-s for the whole
+  report. At load 5-6 ``--mode figures`` rounds of one tree varied from 22 to 39 CPU-s:
+  too noisy to show a 20 % change.
 - Cold (an empty FEM cache), load about 5: 110.7 s wall, 109 CPU-s (warm: 75.7): the
   FEM references add about 34 CPU-s, two thirds of it the finite-strain indentation
   references (Saint Venant-Kirchhoff 17.8 s, neo-Hookean 17.5 s; then the clamped
@@ -148,10 +174,11 @@ def _summary(a, name, rounds) -> None:
 
 
 def _tasks(cases, results, figdir):
-    """The figure tasks of the report, as ``pdverify.report._build_logged`` makes them."""
+    """The figure tasks of the report, as ``pdverify.report._build_logged`` makes them
+    (``pdverify.report.figure_tasks``; a source tree from before it: the same list,
+    scenes first, the overview and all convergence figures last)."""
+    from pdverify import report
     from pdverify.convergence import collect
-    from pdverify.report import figures
-    from pdverify.report.figures import convergence, overview
     from pdverify.results import run_key
     from pdverify.scenes import get_scene
     order = list(dict.fromkeys(c[0] for c in cases))
@@ -160,11 +187,26 @@ def _tasks(cases, results, figdir):
         scene = get_scene(scene_id)
         own = {run_key(scene_id, m, scene.resolve(m, o)) for m, o in scene.report_cases(True)}
         owned.append((scene, [r for r in results if r.scene == scene_id and r.key in own]))
-    scenes = [s for s, _ in owned]
     studies = collect(results, True)
+    if hasattr(report, "figure_tasks"):
+        return [(_short_name(what), draw, args, empty) for what, draw, args, empty
+                in report.figure_tasks(owned, results, studies, figdir)]
+    from pdverify.report import figures
+    from pdverify.report.figures import convergence, overview
+    scenes = [s for s, _ in owned]
     return ([(scene.id, figures.draw, (scene, mine, figdir), []) for scene, mine in owned]
             + [("error-against-cost", overview.pareto, (scenes, results, figdir), []),
                ("convergence", convergence.draw, (studies, figdir), {})])
+
+
+def _short_name(what):
+    """A task's name in the tables: the scene, ``error-against-cost``, ``convergence
+    SCENE``."""
+    if what.startswith("figure for "):
+        return what[len("figure for "):]
+    if what.startswith("convergence figures of "):
+        return "convergence " + what[len("convergence figures of "):]
+    return what.replace(" figures", "")
 
 
 def _count(value) -> int:
@@ -236,22 +278,131 @@ def inprocess(a) -> None:
     print(f"load after:  {_load()}")
 
 
+def figures_child(runs_file, out, jobs) -> None:
+    """In a process of its own (``PYTHONPATH`` the tree timed): the report's figure tasks
+    drawn once serially into ``out/serial`` (wall and CPU time of each) and once as the
+    report draws them, by ``jobs`` forked processes, into ``out/parallel`` (wall, and the
+    CPU time of this process and of the drawing processes); one JSON line on stdout."""
+    from pdverify.report import _draw_all, figures
+    from pdverify.runner import plan
+    with open(runs_file, "rb") as fh:
+        results = pickle.load(fh)
+    cases = plan(quick=True)
+    row = {"tasks": {}}
+    with figures.quick_figures(True):
+        os.makedirs(os.path.join(out, "serial"))
+        t0, c0 = time.perf_counter(), time.process_time()
+        for what, draw, args, _empty in _tasks(cases, results, os.path.join(out, "serial")):
+            t, c = time.perf_counter(), time.process_time()
+            draw(*args)
+            row["tasks"][what] = (time.perf_counter() - t, time.process_time() - c)
+        row["serial_wall_s"] = time.perf_counter() - t0
+        row["serial_cpu_s"] = time.process_time() - c0
+        os.makedirs(os.path.join(out, "parallel"))
+        tasks = _tasks(cases, results, os.path.join(out, "parallel"))
+        r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        t0, c0 = time.perf_counter(), time.process_time()
+        _draw_all(tasks, jobs, sys.stderr)
+        r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        row["parallel_wall_s"] = time.perf_counter() - t0
+        row["parallel_cpu_s"] = (time.process_time() - c0 + r1.ru_utime - r0.ru_utime
+                                 + r1.ru_stime - r0.ru_stime)
+    print(json.dumps(row))
+
+
+def figures_side_by_side(a) -> None:
+    """``--mode figures``: :func:`figures_child` of this tree and of ``--against``,
+    alternating, ``--repeat`` rounds; medians side by side, and whether the two trees
+    drew the same pixels (each figure file of the last round's serial drawing)."""
+    if not (a.runs_file and os.path.exists(a.runs_file)):
+        raise SystemExit("--mode figures draws the runs of --runs-file FILE: make it first "
+                         "with --mode inprocess --runs-file FILE")
+    trees = {"this tree": HERE}
+    if a.against:
+        trees["against"] = os.path.abspath(a.against)
+    rows = {name: [] for name in trees}
+    keep = a.keep or tempfile.mkdtemp(prefix="figures-")
+    print(f"load before: {_load()}")
+    for k in range(a.repeat):
+        for name, src in trees.items():
+            out = os.path.join(keep, f"{'this' if name == 'this tree' else 'against'}-{k}")
+            env = {**os.environ,
+                   "PYTHONPATH": src + os.pathsep + os.environ.get("PYTHONPATH", "")}
+            done = subprocess.run(
+                [sys.executable, os.path.abspath(__file__), "--figures-child", a.runs_file,
+                 out, str(a.jobs or 2)], env=env, capture_output=True, text=True, check=True)
+            rows[name].append(json.loads(done.stdout.strip().splitlines()[-1]))
+    print(f"load after:  {_load()}")
+    med = {name: {key: statistics.median(r[key] for r in rs) for key in
+                  ("serial_wall_s", "serial_cpu_s", "parallel_wall_s", "parallel_cpu_s")}
+           for name, rs in rows.items()}
+    names = list(trees)
+    print(f"figures, quick report's tasks, median of {a.repeat} rounds (alternating), "
+          f"--jobs {a.jobs or 2}: " + " | ".join(f"{n}: {trees[n]}" for n in names))
+    print(f"  {'':28s}" + "".join(f"{n:>22s}" for n in names))
+    for key in ("serial_cpu_s", "serial_wall_s", "parallel_wall_s", "parallel_cpu_s"):
+        vals = [med[n][key] for n in names]
+        extra = f"   ratio {vals[0] / vals[1]:.2f}" if len(vals) == 2 else ""
+        print(f"  {key:28s}" + "".join(f"{v:22.2f}" for v in vals) + extra)
+        for n in names:
+            print(f"    {n} rounds: {', '.join(f'{r[key]:.1f}' for r in rows[n])}")
+    print("  CPU s per task (serial, median):")
+    tasks = list(dict.fromkeys(t for n in names for t in rows[n][0]["tasks"]))
+    cpu = {n: {t: statistics.median(r["tasks"][t][1] for r in rows[n])
+               for t in rows[n][0]["tasks"]} for n in names}
+    for t in sorted(tasks, key=lambda t: -max(cpu[n].get(t, 0.0) for n in names)):
+        print(f"    {t:34s}" + "".join(f"{cpu[n][t]:10.2f}" if t in cpu[n] else f"{'-':>10s}"
+                                      for n in names))
+    if len(names) == 2:
+        _same_pixels(os.path.join(keep, f"this-{a.repeat - 1}", "serial"),
+                     os.path.join(keep, f"against-{a.repeat - 1}", "serial"))
+    print(f"  figure files kept in {keep}")
+
+
+def _same_pixels(one, two) -> None:
+    import numpy as np
+    from PIL import Image
+    files = sorted(set(os.listdir(one)) | set(os.listdir(two)))
+    differ = []
+    for f in files:
+        try:
+            a, b = (np.asarray(Image.open(os.path.join(d, f))) for d in (one, two))
+        except FileNotFoundError:
+            differ.append(f + " (in one tree only)")
+            continue
+        if a.shape != b.shape or (a != b).any():
+            differ.append(f"{f} ({a.shape[1]}x{a.shape[0]} against {b.shape[1]}x{b.shape[0]})")
+    print(f"  pixels: {len(files) - len(differ)} of {len(files)} files identical"
+          + "".join(f"\n    differs: {d}" for d in differ))
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--jobs", type=int, default=None)
-    ap.add_argument("--mode", choices=("fresh", "inprocess", "both"), default="both")
+    ap.add_argument("--mode", choices=("fresh", "inprocess", "both", "figures"),
+                    default="both")
+    ap.add_argument("--keep", default=None, metavar="DIR",
+                    help="figures mode: the figure files of every round kept in DIR")
+    ap.add_argument("--figures-child", nargs=3, default=None, help=argparse.SUPPRESS)
     ap.add_argument("--profile", default=None, metavar="FILE")
     ap.add_argument("--cold", action="store_true", help="fresh reports with an empty FEM cache")
     ap.add_argument("--against", default=None, metavar="SRC",
-                    help="fresh mode: also time this source tree (e.g. `git archive` of an "
-                         "earlier commit unpacked), alternating with this one")
+                    help="fresh and figures modes: also time this source tree (e.g. `git "
+                         "archive` of an earlier commit unpacked), alternating with this one")
     ap.add_argument("--only", nargs="+", default=None)
     ap.add_argument("--runs-file", default=None, metavar="FILE",
                     help="inprocess: the runs' results pickled here on the first call and "
                          "read back on later ones (to time the figures alone; delete the "
                          "file after a change to the runs)")
     a = ap.parse_args(argv)
+    if a.figures_child:
+        runs_file, out, jobs = a.figures_child
+        figures_child(runs_file, out, int(jobs))
+        return 0
+    if a.mode == "figures":
+        figures_side_by_side(a)
+        return 0
     if a.mode in ("fresh", "both"):
         fresh(a)
     if a.mode in ("inprocess", "both"):

@@ -412,6 +412,37 @@ def _draw_all(tasks, jobs, progress) -> list:
         _TASKS = []
 
 
+def figure_tasks(owned, results, studies, figdir) -> list:
+    """The report's figure tasks for :func:`_draw_all`, ``(what, draw, args, empty)``:
+    the error-against-cost overview, one task per scene of ``owned`` (``(scene, its
+    runs)``), then one per scene of the convergence ``studies``.
+
+    The order is the drawing processes' schedule (each takes the next task when it is
+    done): the overview, one of the longest tasks, first, and the convergence figures,
+    short pieces once split by scene, last, so that the processes end close together
+    (the overview and all convergence figures, 2-3 s each, were the last two tasks).
+    :func:`figures_drawn` sorts the results back."""
+    from . import figures
+    from .figures import convergence, overview
+    scenes = [scene for scene, _ in owned]
+    return ([("error-against-cost figures", overview.pareto, (scenes, results, figdir), [])]
+            + [(f"figure for {scene.id}", figures.draw,
+                (scene, [r for r in mine if not is_external(r.method)], figdir), [])
+               for scene, mine in owned]
+            + [(f"convergence figures of {name}", convergence.draw,
+                ([s for s in studies if s["scene"] == name], figdir), {})
+               for name in dict.fromkeys(s["scene"] for s in studies)])
+
+
+def figures_drawn(owned, drawn) -> tuple:
+    """The results of :func:`figure_tasks`' tasks as ``(figures of each scene of owned,
+    the overview's figures, {scene: convergence figures})``."""
+    conv = {}
+    for part in drawn[1 + len(owned):]:
+        conv.update(part)
+    return drawn[1:1 + len(owned)], drawn[0], conv
+
+
 def _drawing_process(parent: int) -> None:
     from ..runner import _die_with_parent, _quiet_worker
     _quiet_worker()
@@ -462,7 +493,6 @@ def _build_logged(cases, out, final, jobs, progress, client=None, quick=False,
     with phase("figures_s"):
         os.makedirs(figdir, exist_ok=True)
     from . import figures, html
-    from .figures import convergence, overview
     sections = []
     tabled = set()   # the runs in the scenes' tables (the failure list links to their rows)
     order = []
@@ -482,17 +512,11 @@ def _build_logged(cases, out, final, jobs, progress, client=None, quick=False,
     from ..convergence import collect
     studies = collect([r for r in results if not is_external(r.method)], quick)
     with phase("figures_s"), figures.quick_figures(quick):
-        drawn = _draw_all(
-            [(f"figure for {scene.id}", figures.draw,
-              (scene, [r for r in mine if not is_external(r.method)], figdir), [])
-             for scene, mine in owned]
-            + [("error-against-cost figures", overview.pareto, (scenes, results, figdir), []),
-               ("convergence figures", convergence.draw, (studies, figdir), {})],
-            jobs, progress)
-    front, conv = drawn[-2:]
+        tasks = figure_tasks(owned, results, studies, figdir)
+        figs, front, conv = figures_drawn(owned, _draw_all(tasks, jobs, progress))
     with phase("pages_s"):
-        for (scene, mine), figs in zip(owned, drawn):
-            sections.append((scene, html.scene_section(scene, mine, figs)))
+        for (scene, mine), mine_figs in zip(owned, figs):
+            sections.append((scene, html.scene_section(scene, mine, mine_figs)))
     with phase("fields_s"):
         export_fields(results, out)
         if kept is not None:

@@ -140,8 +140,30 @@ def test_a_broken_figure_keeps_the_numbers(tmp_path, monkeypatch, capsys):
     assert "bar1d-sine-load" in (out / "index.html").read_text()
     err = capsys.readouterr().err
     for what in ("figure for bar1d-sine-load", "error-against-cost figures",
-                 "convergence figures"):
+                 "convergence figures of bar1d-sine-load"):
         assert f"{what} failed: RuntimeError: no ink" in err
+
+
+def test_figure_tasks_start_with_the_overview_and_end_with_the_convergence_pieces():
+    """The drawing processes take the tasks in order: the long overview first, the
+    convergence figures last, one short task per scene; figures_drawn gives each
+    scene its own figures back, whatever the order drawn."""
+    from types import SimpleNamespace
+
+    from pdverify.report import figure_tasks, figures_drawn
+    owned = [(SimpleNamespace(id=name), []) for name in ("a", "b", "c")]
+    studies = [{"scene": "c", "study": "delta"}, {"scene": "a", "study": "delta"},
+               {"scene": "c", "study": "m"}]
+    tasks = figure_tasks(owned, [], studies, "figs")
+    assert [t[0] for t in tasks] == [
+        "error-against-cost figures", "figure for a", "figure for b", "figure for c",
+        "convergence figures of c", "convergence figures of a"]
+    assert [s["study"] for s in tasks[4][2][0]] == ["delta", "m"]   # c's two studies
+    drawn = [["front.png"], ["a.png"], ["b.png"], ["c.png"], {"c": ["c-conv.png"]},
+             {"a": ["a-conv.png"]}]
+    figs, front, conv = figures_drawn(owned, drawn)
+    assert figs == [["a.png"], ["b.png"], ["c.png"]] and front == ["front.png"]
+    assert conv == {"c": ["c-conv.png"], "a": ["a-conv.png"]}
 
 
 def test_figures_drawn_by_two_processes_equal_those_drawn_by_one(reports_by_jobs):
