@@ -5,6 +5,7 @@ the README's test command, the fast tier, in <= 5 min wall and <= 2.5 GB on a qu
 Plain script (no test runner):
 
     python benchmarks/tiers.py [--tier fast|slow|both] [--repeat N] [--modes serial,parallel]
+                               [--trace [DIR]]
 
 Each measurement is a fresh ``python -m pytest -q`` (the fast tier) or
 ``python -m pytest -q --runslow -m slow`` (the slow tier) in the source tree, started
@@ -27,6 +28,15 @@ process only (printed too, as ``largest process``).
 CPU: the user and system time of the pytest process and every descendant it waited
 for (``RUSAGE_CHILDREN``), steadier than the wall time on a loaded machine: on 2 quiet
 cores the parallel wall time is about half of it, or the longest file if that is more.
+
+``--trace``: what made the peak. Each test process then logs its tests' starts and ends
+(tests/conftest.py, ``PDVERIFY_TEST_TRACE``), and the script prints, for the sample with
+the largest PSS sum, each process's PSS and RSS, the test process it runs under (an xdist
+worker or the pytest process itself: forked pools and subprocesses are counted with the
+test that started them), the test that worker was running and the files it had run
+before (whose freed memory it may still hold). ``--trace DIR`` keeps the logs, one file
+per test process, a line ``start|end TIME RSS NODEID`` per test: the RSS at a file's last
+``end`` against its first ``start`` is what the file left resident.
 
 The machine is shared: the load average is printed before and after each run.
 """
@@ -65,12 +75,17 @@ def _children_map():
     return kids
 
 
-def _tree(pid):
+def _tree(pid, parents=None):
+    """The pids of ``pid`` and all its descendants; ``parents`` (a dict), if given,
+    receives each one's parent."""
     kids, todo, seen = _children_map(), [pid], []
     while todo:
         p = todo.pop()
         seen.append(p)
-        todo.extend(kids.get(p, ()))
+        for c in kids.get(p, ()):
+            todo.append(c)
+            if parents is not None:
+                parents[c] = p
     return seen
 
 
@@ -110,16 +125,22 @@ class Sampler(threading.Thread):
         self.peak_rss = self.peak_pss = self.peak_one = 0
         self.peak_procs = 0
         self.at_peak = []
+        self.at_pss_peak = (0.0, [])   # (monotonic time, [(pid, parent, rss, pss, cmd)])
         self.samples = 0
         self._done = threading.Event()
 
     def run(self):
         while not self._done.is_set():
-            pids = _tree(self.pid)
+            parents = {}
+            pids = _tree(self.pid, parents)
             sizes = [_rss_pss(p, self.samples % 5 == 0) for p in pids]
             if sum(r for r, _ in sizes) > self.peak_rss:
                 self.at_peak = sorted(((r, _cmd(p)) for p, (r, _) in zip(pids, sizes)),
                                       reverse=True)
+            if sum(p for _, p in sizes) > self.peak_pss:
+                self.at_pss_peak = (time.monotonic(),
+                                    [(p, parents.get(p), r, s, _cmd(p))
+                                     for p, (r, s) in zip(pids, sizes)])
             self.peak_rss = max(self.peak_rss, sum(r for r, _ in sizes))
             self.peak_pss = max(self.peak_pss, sum(p for _, p in sizes))
             self.peak_one = max([self.peak_one] + [r for r, _ in sizes])
@@ -132,9 +153,58 @@ class Sampler(threading.Thread):
         self.join()
 
 
-def measure(tier, mode):
+def _read_trace(folder):
+    """{pid: [(kind, time, rss, nodeid)]} from the test processes' logs
+    (tests/conftest.py)."""
+    logs = {}
+    for name in os.listdir(folder):
+        with open(os.path.join(folder, name)) as fh:
+            logs[int(name.split(".")[0])] = [
+                (kind, float(t), int(rss), node) for kind, t, rss, node in
+                (line.rstrip("\n").split(" ", 3) for line in fh)]
+    return logs
+
+
+def _at_peak_trace(root, when, procs, logs):
+    """Lines naming, for each process at the PSS peak, its size, the test process it runs
+    under (the pytest process or an xdist worker: the child of ``root``) and the test
+    that process was running at ``when``, with the test files it had run before."""
+    parent = {pid: ppid for pid, ppid, *_ in procs}
+
+    def test_process(pid):
+        while pid != root and parent.get(pid) not in (root, None):
+            pid = parent[pid]
+        return pid
+
+    out = [f"    at the PSS peak ({sum(p[3] for p in procs) / 1e9:.2f} GB):"]
+    for pid, ppid, rss, pss, cmd in sorted(procs, key=lambda x: -x[3]):
+        owner = test_process(pid)
+        events = [e for e in logs.get(owner, []) if e[1] <= when]
+        now = events[-1][3] if events and events[-1][0] == "start" else \
+            (f"between tests, after {events[-1][3]}" if events else "before its first test")
+        out.append(f"      pid {pid:7d} (under {owner:7d})  PSS {pss / 1e9:5.2f} GB  "
+                   f"RSS {rss / 1e9:5.2f} GB  {cmd[:60]}")
+        if pid == owner and owner != root:
+            files = []
+            for kind, _, _, node in events:
+                f = node.split("::")[0]
+                if kind == "start" and f not in files:
+                    files.append(f)
+            out.append(f"          running: {now}")
+            out.append(f"          its files so far: {', '.join(files)}")
+    return out
+
+
+def measure(tier, mode, trace=False):
     cmd = [sys.executable, "-m", "pytest", *TIERS[tier], *MODES[mode]]
     env = dict(os.environ, PYTHONPATH=HERE)
+    keep = isinstance(trace, str) and trace != ""
+    folder = None
+    if trace is not False:
+        if keep:
+            os.makedirs(trace, exist_ok=True)
+        folder = tempfile.mkdtemp(prefix=f"{tier}-{mode}-", dir=trace if keep else None)
+        env["PDVERIFY_TEST_TRACE"] = folder
     load0 = os.getloadavg()[0]
     ru0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     with tempfile.TemporaryFile("w+") as out:
@@ -150,11 +220,19 @@ def measure(tier, mode):
         out.seek(0)
         lines = [x for x in out.read().splitlines() if x.strip()]
     cpu = (ru1.ru_utime + ru1.ru_stime) - (ru0.ru_utime + ru0.ru_stime)
+    traced = []
+    if trace is not False:
+        import shutil
+        traced = _at_peak_trace(proc.pid, *sampler.at_pss_peak, _read_trace(folder))
+        if keep:
+            traced.append(f"    the tests' logs: {folder}")
+        else:
+            shutil.rmtree(folder)
     return {"tier": tier, "mode": mode, "code": code, "wall_s": wall, "cpu_s": cpu,
             "peak_rss_gb": sampler.peak_rss / 1e9, "peak_pss_gb": sampler.peak_pss / 1e9,
             "largest_gb": sampler.peak_one / 1e9, "procs": sampler.peak_procs,
             "load": (load0, os.getloadavg()[0]), "summary": lines[-1] if lines else "",
-            "at_peak": sampler.at_peak}
+            "at_peak": sampler.at_peak, "traced": traced}
 
 
 def show(r):
@@ -165,6 +243,8 @@ def show(r):
           f"load {r['load'][0]:.2f} -> {r['load'][1]:.2f}  | {r['summary']}", flush=True)
     for rss, cmd in r["at_peak"][:4]:
         print(f"    at the peak: {rss / 1e9:5.2f} GB  {cmd}")
+    for line in r["traced"]:
+        print(line)
 
 
 def main(argv=None):
@@ -173,6 +253,10 @@ def main(argv=None):
     ap.add_argument("--repeat", type=int, default=1)
     ap.add_argument("--modes", default="serial,parallel",
                     help="comma-separated, of: serial, parallel")
+    ap.add_argument("--trace", nargs="?", const="", default=False, metavar="DIR",
+                    help="name each process at the PSS peak, the test its worker was "
+                         "running and the files it had run (tests/conftest.py's "
+                         "PDVERIFY_TEST_TRACE); with DIR, keep the tests' logs there")
     args = ap.parse_args(argv)
     tiers = ("fast", "slow") if args.tier == "both" else (args.tier,)
     modes = args.modes.split(",")
@@ -180,7 +264,7 @@ def main(argv=None):
     for tier in tiers:
         for k in range(args.repeat):
             for mode in (modes if k % 2 == 0 else modes[::-1]):
-                runs.append(measure(tier, mode))
+                runs.append(measure(tier, mode, args.trace))
                 show(runs[-1])
     print("medians:")
     for tier in tiers:

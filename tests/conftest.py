@@ -60,6 +60,59 @@ def _one_blas_thread(request):
         yield
 
 
+#: glibc's ``mallopt`` parameter M_MMAP_THRESHOLD, and the size the test processes give it
+#: (``PDVERIFY_TEST_MMAP_THRESHOLD`` bytes; 0: glibc's own, for comparing)
+_M_MMAP_THRESHOLD = -3
+MMAP_THRESHOLD = int(os.environ.get("PDVERIFY_TEST_MMAP_THRESHOLD", 1 << 20))
+
+
+def pytest_configure(config):
+    """In each test process (the xdist workers, the serial run), allocations of at least
+    :data:`MMAP_THRESHOLD` bytes get pages of their own, returned to the system when freed
+    (glibc; elsewhere nothing). glibc's default raises that threshold to 32 MB as large
+    blocks are freed, after which the arrays of a solve came from the heaps, whose freed
+    pages stayed with the process (issue 32: an xdist worker grew from 0.32 GB to 1.2 GB
+    over the fast tier, and two such workers in heavy tests at the same time held 2.9 GB,
+    over the 2.5 GB budget; tests/pdverify/test_rate_gates.py and
+    tests/corrections/test_bond_methods.py in one process: peak 0.62 GB, 0.56 GB left
+    resident, against 0.49 and 0.48 GB with 1 MB, at about the same CPU time). Where memory
+    comes from changes no computed number (the report is bitwise the same in any worker
+    process, tests/pdverify/test_cli.py)."""
+    if MMAP_THRESHOLD > 0:
+        import ctypes
+        try:
+            ctypes.CDLL(None).mallopt(_M_MMAP_THRESHOLD, MMAP_THRESHOLD)
+        except (OSError, AttributeError):  # not glibc
+            pass
+
+
+def _release_freed_memory():
+    """Hand the memory that freed objects left in the C allocator's heap back to the
+    system (glibc's ``malloc_trim``; elsewhere nothing). A test file's arrays, freed at its
+    end, stayed resident in the process that ran it: an xdist worker grew by every file it
+    ran (0.32 GB after collection to 1.2 GB over the fast tier), and two such workers,
+    each in a heavy test at the same time, held 2.9 GB (issue 32's 2.5 GB budget). Only
+    pages no object uses are given back, so no computed number changes."""
+    import ctypes
+    import gc
+    gc.collect()
+    try:
+        ctypes.CDLL(None).malloc_trim(0)
+    except (OSError, AttributeError):      # not glibc
+        pass
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_teardown(item, nextitem):
+    """After a test file's last test (its module fixtures torn down), the memory it freed
+    goes back to the system (:func:`_release_freed_memory`)."""
+    try:
+        return (yield)
+    finally:
+        if nextitem is None or nextitem.path != item.path:
+            _release_freed_memory()
+
+
 @pytest.fixture
 def rng():
     return np.random.default_rng(20211121)
@@ -87,6 +140,30 @@ def pytest_cmdline_main(config):
         config.option.numprocesses = cores
         if config.option.dist == "no":
             config.option.dist = "loadfile"
+
+
+#: ``PDVERIFY_TEST_TRACE=DIR``: each test process appends to ``DIR/<pid>.log`` a line
+#: ``start|end MONOTONIC_SECONDS RSS_BYTES NODEID`` as each test starts and ends
+#: (CLOCK_MONOTONIC, the same clock in every process; the process's own resident set), so
+#: benchmarks/tiers.py --trace can name the test each xdist worker ran when the tree's
+#: memory peaked, and what each file left resident. Unset (the default): nothing.
+_TRACE = os.environ.get("PDVERIFY_TEST_TRACE")
+
+
+def _trace(what, nodeid):
+    import time
+    with open("/proc/self/statm") as fh:
+        rss = int(fh.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+    with open(os.path.join(_TRACE, f"{os.getpid()}.log"), "a") as fh:
+        fh.write(f"{what} {time.monotonic():.3f} {rss} {nodeid}\n")
+
+
+if _TRACE:
+    def pytest_runtest_logstart(nodeid, location):
+        _trace("start", nodeid)
+
+    def pytest_runtest_logfinish(nodeid, location):
+        _trace("end", nodeid)
 
 
 def pytest_addoption(parser):
