@@ -45,9 +45,10 @@ import os
 import statistics
 import subprocess
 import sys
-import tarfile
 import tempfile
 from pathlib import Path
+
+from _trees import extract
 
 ROOT = Path(__file__).resolve().parents[1]
 QUICK = {"spacing": 0.001, "horizon": 0.006}
@@ -144,18 +145,6 @@ def phases(args):
                for rs in runs.values() for r in rs)
     print(f"status {first['status']}, CG iterations {first['cg_iterations']}; metrics "
           f"{'bitwise identical' if same else 'DIFFER'} across all runs")
-
-
-def extract(rev: str, into: Path) -> Path:
-    """The ``pdverify`` package (and what it reads at run time) of git revision ``rev``."""
-    data = subprocess.run(["git", "-C", str(ROOT), "archive", "--format=tar", rev, "pdverify",
-                           "reference_fem", "manufactured"],
-                          check=True, capture_output=True).stdout
-    tar = into / "src.tar"
-    tar.write_bytes(data)
-    with tarfile.open(tar) as t:
-        t.extractall(into, filter="data")
-    return into
 
 
 def run_once(path: Path, method: str, over: dict) -> dict:

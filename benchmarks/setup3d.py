@@ -65,9 +65,10 @@ import os
 import statistics
 import subprocess
 import sys
-import tarfile
 import tempfile
 from pathlib import Path
+
+from _trees import extract
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ("body3d-manufactured", "body3d-traction")
@@ -130,18 +131,6 @@ else:   # profile
         prof.disable()
     pstats.Stats(prof).sort_stats("tottime").print_stats(12)
 """
-
-
-def extract(rev: str, into: Path) -> Path:
-    """The ``pdverify`` package (and what it reads at run time) of git revision ``rev``."""
-    data = subprocess.run(["git", "-C", str(ROOT), "archive", "--format=tar", rev, "pdverify",
-                           "reference_fem", "manufactured"],
-                          check=True, capture_output=True).stdout
-    tar = into / "src.tar"
-    tar.write_bytes(data)
-    with tarfile.open(tar) as t:
-        t.extractall(into, filter="data")
-    return into
 
 
 def cases(only) -> list[tuple[str, str, dict]]:
