@@ -93,13 +93,10 @@ def _release_freed_memory():
     ran (0.32 GB after collection to 1.2 GB over the fast tier), and two such workers,
     each in a heavy test at the same time, held 2.9 GB (issue 32's 2.5 GB budget). Only
     pages no object uses are given back, so no computed number changes."""
-    import ctypes
     import gc
+    from pdverify.budget import release_freed_memory
     gc.collect()
-    try:
-        ctypes.CDLL(None).malloc_trim(0)
-    except (OSError, AttributeError):      # not glibc
-        pass
+    release_freed_memory()
 
 
 @pytest.hookimpl(wrapper=True)

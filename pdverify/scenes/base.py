@@ -427,6 +427,7 @@ class Scene:
                            published=[p.entry() for p in
                                       self.published_for(method, params).values()])
         timer = Timer()
+        budget.release_freed_memory()        # what earlier runs left is not this run's
         measured = budget.reset_peak_rss()   # the run's own peak memory, beside its time
         broken = self._broken_plugin(method)
         if broken:
