@@ -93,6 +93,30 @@ def _tentative_prolongator(lattice: Lattice, agg, n_agg: int, rel):
     return T[:, used].tocsr()
 
 
+def _jacobi_radius(K, d_inv, formed: bool = True) -> float:
+    """rho(D^-1 K), estimated to 1 % (ARPACK on D^-1/2 K D^-1/2; ``formed=False``: that
+    matrix applied as s * (K @ (s * x)) instead of multiplied out, which saves two copies
+    of K and rounds differently)."""
+    s = np.sqrt(d_inv)
+    if formed:
+        scaled = sp.diags(s) @ K @ sp.diags(s)
+    else:
+        scaled = spla.LinearOperator(K.shape, matvec=lambda x: s * (K @ (s * x)), dtype=float)
+    # a fixed start vector: ARPACK's own random one differs between calls in a process,
+    # which made rho, hence CG's iterates and a Newton run's last digits, depend on
+    # what ran before in the same worker
+    start = np.random.default_rng(0).standard_normal(K.shape[0])
+    return float(spla.eigsh(scaled, k=1, which="LA", tol=1e-2, v0=start,
+                            return_eigenvectors=False)[0])
+
+
+#: A refresh keeps the build's spectral radius estimate while rho(D^-1 K) of the new
+#: matrix stays below this multiple of it: the Jacobi smoother (weight SMOOTHER_WEIGHT /
+#: rho) converges, and the preconditioner stays SPD, below 2 / SMOOTHER_WEIGHT = 1.54
+#: times; the margin covers the estimates' 1 % tolerance.
+REFRESH_RADIUS_GROWTH = 1.45
+
+
 class TwoLevelPreconditioner:
     """Symmetric two-level smoothed aggregation: Jacobi, coarse correction, Jacobi.
 
@@ -121,14 +145,7 @@ class TwoLevelPreconditioner:
             raise NumericalError("CG preconditioner: the stiffness has a non-positive diagonal "
                                  "entry, so it is not symmetric positive definite")
         d_inv = 1.0 / diag
-        s = np.sqrt(d_inv)
-        scaled = sp.diags(s) @ K @ sp.diags(s)
-        # a fixed start vector: ARPACK's own random one differs between calls in a process,
-        # which made rho, hence CG's iterates and a Newton run's last digits, depend on
-        # what ran before in the same worker
-        start = np.random.default_rng(0).standard_normal(K.shape[0])
-        self.rho = rho = float(spla.eigsh(scaled, k=1, which="LA", tol=1e-2, v0=start,
-                                          return_eigenvectors=False)[0])
+        self.rho = rho = _jacobi_radius(K, d_inv)
         P = (T - sp.diags((PROLONGATOR_WEIGHT / rho) * d_inv) @ (K @ T)).tocsr()
         # The preconditioner works in single precision (CG itself in double): it only has
         # to be a fixed SPD approximation, and halving its bytes took a 12-iteration solve
@@ -170,7 +187,9 @@ class TwoLevelPreconditioner:
         """Adapt to a nearby matrix ``K`` of the same size (a later Newton tangent, perhaps
         with more prescribed unknowns): the smoother's diagonal, the products with K and
         the coarse matrix P^T K P are K's; the aggregates, the prolongator P (smoothed with
-        the first K) and the spectral radius estimate stay. Returns the seconds it took.
+        the first K) and the spectral radius estimate stay. Returns False, changing nothing,
+        when rho(D^-1 K) has grown past :data:`REFRESH_RADIUS_GROWTH` times the build's
+        (the caller then builds anew), else True.
 
         Why: on the paper grid's half indentation (26,082 unknowns) a preconditioner built
         on an earlier tangent needed 31 CG iterations to 1e-8 where a fresh build needed
@@ -184,12 +203,13 @@ class TwoLevelPreconditioner:
         if np.any(diag <= 0) or not np.all(np.isfinite(diag)):
             raise NumericalError("CG preconditioner: the stiffness has a non-positive diagonal "
                                  "entry, so it is not symmetric positive definite")
+        if _jacobi_radius(K, 1.0 / diag, formed=False) > REFRESH_RADIUS_GROWTH * self.rho:
+            return False         # the smoother would diverge with the build's weight
         KP = (K @ self._P).tocsr()
         self._operator_parts(K, 1.0 / diag, (self._P.T @ KP).toarray(),
                              KP.astype(np.float32) if self.fused else None)
-        dt = time.perf_counter() - t0
-        self.setup_s += dt
-        return dt
+        self.setup_s += time.perf_counter() - t0
+        return True
 
     def apply(self, r):
         r = np.asarray(r).astype(np.float32)

@@ -156,7 +156,10 @@ class DirichletLinearSolver:
         self.stats.setup_s += self.precond.setup_s
 
     def _refresh(self, T):
-        self.stats.setup_s += self.precond.refresh(T)
+        setup = self.precond.setup_s
+        if not self.precond.refresh(T):
+            return self._build(T)
+        self.stats.setup_s += self.precond.setup_s - setup
         self._best_rate, self._lost, self._stale = np.inf, 0.0, False
         self.stats.refreshes += 1
 
