@@ -43,9 +43,10 @@ FORCING_MIN = 1e-10
 #: that a run is reproducible bit for bit.
 REBUILD_FACTOR = 3.0
 #: What a refresh costs in CG iterations: 0.45 s against ~18 ms per iteration on the paper
-#: grid's half indentation (26,082 unknowns; a build is 1.2 s). Refreshing instead of
-#: rebuilding (at 65 iterations a build) took the corrected curve from 1004 CG iterations
-#: and 3 builds to 775 and 1 build (benchmarks/indentation.py).
+#: grid's half indentation (26,082 unknowns; a build is 1.2 s); its radius check
+#: (iterative.REFRESH_RADIUS_GROWTH) added ~0.2 s later, not re-tuned. Refreshing instead
+#: of rebuilding (at 65 iterations a build) took the corrected curve from 1004 CG
+#: iterations and 3 builds to 775 and 1 build (benchmarks/indentation.py).
 REFRESH_COST_ITERATIONS = 25
 
 
