@@ -93,6 +93,15 @@ def _tentative_prolongator(lattice: Lattice, agg, n_agg: int, rel):
     return T[:, used].tocsr()
 
 
+def _inverse_diagonal(K) -> np.ndarray:
+    """1 / diag(K), or :class:`NumericalError` if a diagonal entry is not positive."""
+    diag = K.diagonal()
+    if np.any(diag <= 0) or not np.all(np.isfinite(diag)):
+        raise NumericalError("CG preconditioner: the stiffness has a non-positive diagonal "
+                             "entry, so it is not symmetric positive definite")
+    return 1.0 / diag
+
+
 def _jacobi_radius(K, d_inv, formed: bool = True) -> float:
     """rho(D^-1 K), estimated to 1 % (ARPACK on D^-1/2 K D^-1/2; ``formed=False``: that
     matrix applied as s * (K @ (s * x)) instead of multiplied out, which saves two copies
@@ -140,11 +149,7 @@ class TwoLevelPreconditioner:
         centroid = np.stack([np.bincount(agg, lattice.x[:, k], n_agg) / count
                              for k in range(dim)], axis=1)
         T = _tentative_prolongator(lattice, agg, n_agg, lattice.x - centroid[agg])
-        diag = K.diagonal()
-        if np.any(diag <= 0) or not np.all(np.isfinite(diag)):
-            raise NumericalError("CG preconditioner: the stiffness has a non-positive diagonal "
-                                 "entry, so it is not symmetric positive definite")
-        d_inv = 1.0 / diag
+        d_inv = _inverse_diagonal(K)
         self.rho = rho = _jacobi_radius(K, d_inv)
         P = (T - sp.diags((PROLONGATOR_WEIGHT / rho) * d_inv) @ (K @ T)).tocsr()
         # The preconditioner works in single precision (CG itself in double): it only has
@@ -183,30 +188,29 @@ class TwoLevelPreconditioner:
         self.K = K
         self.coarse_size = coarse.shape[0]
 
-    def refresh(self, K) -> float:
+    def refresh(self, K) -> bool:
         """Adapt to a nearby matrix ``K`` of the same size (a later Newton tangent, perhaps
         with more prescribed unknowns): the smoother's diagonal, the products with K and
         the coarse matrix P^T K P are K's; the aggregates, the prolongator P (smoothed with
         the first K) and the spectral radius estimate stay. Returns False, changing nothing,
         when rho(D^-1 K) has grown past :data:`REFRESH_RADIUS_GROWTH` times the build's
-        (the caller then builds anew), else True.
+        (the caller then builds anew), else True; either way its time is added to
+        :attr:`setup_s`.
 
         Why: on the paper grid's half indentation (26,082 unknowns) a preconditioner built
         on an earlier tangent needed 31 CG iterations to 1e-8 where a fresh build needed
-        18; refreshed, 18 too, for about a third of a build's time (the eigenvalue
-        estimate, the tentative and smoothed prolongators are not recomputed; a side
-        measurement on a tangent saved mid-curve). ``benchmarks/indentation.py`` times
+        18; refreshed, 18 too, for about half a build's time (0.71 against 1.28 s, the
+        tentative and smoothed prolongators not recomputed; a side measurement on a
+        tangent saved mid-curve, a loaded machine), plus ~0.2 s for the radius check. ``benchmarks/indentation.py`` times
         whole curves."""
         t0 = time.perf_counter()
         K = sp.csr_matrix(K)
-        diag = K.diagonal()
-        if np.any(diag <= 0) or not np.all(np.isfinite(diag)):
-            raise NumericalError("CG preconditioner: the stiffness has a non-positive diagonal "
-                                 "entry, so it is not symmetric positive definite")
-        if _jacobi_radius(K, 1.0 / diag, formed=False) > REFRESH_RADIUS_GROWTH * self.rho:
+        d_inv = _inverse_diagonal(K)
+        if _jacobi_radius(K, d_inv, formed=False) > REFRESH_RADIUS_GROWTH * self.rho:
+            self.setup_s += time.perf_counter() - t0
             return False         # the smoother would diverge with the build's weight
         KP = (K @ self._P).tocsr()
-        self._operator_parts(K, 1.0 / diag, (self._P.T @ KP).toarray(),
+        self._operator_parts(K, d_inv, (self._P.T @ KP).toarray(),
                              KP.astype(np.float32) if self.fused else None)
         self.setup_s += time.perf_counter() - t0
         return True

@@ -158,9 +158,10 @@ class DirichletLinearSolver:
 
     def _refresh(self, T):
         setup = self.precond.setup_s
-        if not self.precond.refresh(T):
+        refreshed = self.precond.refresh(T)
+        self.stats.setup_s += self.precond.setup_s - setup     # a refused one's check too
+        if not refreshed:
             return self._build(T)
-        self.stats.setup_s += self.precond.setup_s - setup
         self._best_rate, self._lost, self._stale = np.inf, 0.0, False
         self.stats.refreshes += 1
 

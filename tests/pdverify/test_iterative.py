@@ -171,14 +171,17 @@ def test_refresh_adapts_the_preconditioner_to_a_new_matrix():
     def iterations(pc):
         return cg_solve(K1, b, pc, where="test", rtol=1e-8)[1]["iterations"]
 
-    fresh, stale = iterations(TwoLevelPreconditioner(K1, lat, 4, fused=True)), None
+    fresh = iterations(TwoLevelPreconditioner(K1, lat, 4, fused=True))
     pc = TwoLevelPreconditioner(K0, lat, 4, fused=True)
     stale = iterations(pc)
     assert pc.refresh(K1) is True
     refreshed = iterations(pc)
     assert pc.K is K1 or (pc.K != K1).nnz == 0
-    # the measured counts are printed on failure; a refresh that left K0's diagonal or
-    # coarse matrix would stay at the stale count
+    # fresh + 1: a refreshed K P is rounded from the double product, not multiplied in
+    # float32, which may cost CG one iteration (the fused test above allows the same);
+    # stale - 2: the set-up's premise, a stale operator that loses iterations (measured 9
+    # fresh, 30 stale); a refresh that left K0's diagonal or coarse matrix would stay at
+    # the stale count. The counts are printed on failure
     assert refreshed <= fresh + 1 and refreshed < stale - 2, (fresh, stale, refreshed)
 
 

@@ -1,5 +1,6 @@
 """Every run records its peak memory beside its time (issue 32: the 2 GB budget is about
 the heaviest run's process, so each run's own peak has to be known)."""
+import os
 import sys
 
 import numpy as np
@@ -51,7 +52,7 @@ def test_the_report_names_the_heaviest_run():
 
 def _rss():
     with open("/proc/self/statm") as fh:
-        return int(fh.read().split()[1]) * __import__("os").sysconf("SC_PAGE_SIZE")
+        return int(fh.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
 
 
 def test_memory_that_earlier_work_freed_is_returned_before_a_run():
