@@ -110,6 +110,48 @@ def run_key(scene: str, method: str, params: dict) -> tuple:
     return scene, method, json.dumps(_plain(params), sort_keys=True)
 
 
+#: The timing of setup work a run read from pdverify's cache instead of doing it: the
+#: seconds that work took when it was computed (perifit's weights). Part of the run's cost
+#: (:func:`cost_s`), so that a warm cache does not make a method look cheaper than it is.
+CACHED_SETUP = "cached_setup_s"
+
+
+def cost_s(timings: dict) -> float:
+    """A run's cost: its setup and solve time plus the setup it read from the cache at
+    the time that took (:data:`CACHED_SETUP`); the metrics and fields computed afterwards
+    are not counted (``total_s`` includes them)."""
+    return sum(float(timings.get(k, 0.0) or 0.0) for k in ("setup_s", "solve_s", CACHED_SETUP))
+
+
+#: The collectors of the runs in progress in this process (innermost last): what code deep
+#: inside a run reports beside its metrics (:func:`note`), merged into its result by
+#: :meth:`pdverify.scenes.base.Scene.run`.
+_NOTES: list[dict] = []
+
+
+@contextmanager
+def collecting_notes():
+    """Collect :func:`note` calls of the code run inside: yields ``{"diagnostics": {},
+    "timings": {}}``."""
+    notes: dict = {"diagnostics": {}, "timings": {}}
+    _NOTES.append(notes)
+    try:
+        yield notes
+    finally:
+        _NOTES.pop()
+
+
+def note(diagnostics: dict | None = None, timings: dict | None = None) -> None:
+    """Report facts (``diagnostics``) and seconds (``timings``, summed per key) to the run
+    in progress; outside a run (:func:`collecting_notes`) nothing happens."""
+    if not _NOTES:
+        return
+    notes = _NOTES[-1]
+    notes["diagnostics"].update(diagnostics or {})
+    for k, v in (timings or {}).items():
+        notes["timings"][k] = notes["timings"].get(k, 0.0) + float(v)
+
+
 class Timer:
     """Accumulates wall time per phase (``setup``, ``solve``) of one run."""
 

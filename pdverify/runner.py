@@ -5,7 +5,7 @@ import os
 import sys
 
 from .errors import InputError
-from .results import RunResult, write_results
+from .results import CACHED_SETUP, RunResult, write_results
 from .scenes import get_scene
 
 
@@ -44,7 +44,9 @@ def run_one(scene_id: str, *, method=None, overrides=None, json_path=None, vtu_p
         print(f"  warning: {text}", file=stream)
     t = result.timings
     peak = result.resources.get("peak_rss_gb")
-    print(f"  time: setup {t['setup_s']:.4f} s, solve {t['solve_s']:.4f} s, "
+    cached = (f" (+ {t[CACHED_SETUP]:.4f} s from the cache)" if t.get(CACHED_SETUP)
+              else "")
+    print(f"  time: setup {t['setup_s']:.4f} s{cached}, solve {t['solve_s']:.4f} s, "
           f"total {t['total_s']:.4f} s" + (f"; peak memory {peak:.3g} GB" if peak else "")
           + f"; size {result.size}", file=stream)
     if vtu_path:

@@ -14,15 +14,34 @@ the dilatation too, as its README says to replace omega everywhere). perifit's o
 kernels (q = 3 bond-based, q = 2 LPS) are what it calibrates against; the scenes' influence
 functions are not passed (its API has no such input). The version that produced the
 weights is a parameter of every run (``perifit_version``), so it is in results.json.
+
+The weights are cached (issue 32): they depend only on perifit's code and on what it is
+given (node positions and volumes, horizon, families, model kind), and perifit's own
+assembly loops over nodes (``compute_weights_2d``: 15-17 s on the indentation block and
+the largest tension sheet, about a tenth of a full report's run time). An entry of the
+cache folder's ``perifit`` folder (:func:`pdverify.outputs.cache_root`) is keyed by a
+SHA-256 of all of these, perifit's version and the digest of its source; a run that
+reads it records the seconds the weights took when computed
+(:data:`pdverify.results.CACHED_SETUP`, part of its cost) and says so in its diagnostics
+(``perifit_weights``). An entry that does not read back whole is a miss.
 """
 from __future__ import annotations
 
+import hashlib
+import os
+import tempfile
+import time
+from functools import lru_cache
 from importlib.metadata import PackageNotFoundError, version
+from pathlib import Path
 
 import numpy as np
 
+from .. import blas
+from ..outputs import cache_root
 from ..pd.closure import Closure
 from ..pd.statebased import StateBasedModel
+from ..results import CACHED_SETUP, note
 
 INSTALL = 'pip install ".[peers]" (perifit from PyPI)'
 #: scenes whose model perifit supports: 3D LPS and bond-based, 2D bond-based
@@ -47,18 +66,110 @@ def families(model) -> list[list[int]]:
     return [list(map(int, f)) for f in np.split(other[order], np.cumsum(counts)[:-1])]
 
 
-def node_weights(model) -> np.ndarray:
-    """perifit's w_i at every grid node of a plain grid's model."""
-    import perifit
+def _kind(model) -> str:
     g = model.grid
     state = isinstance(model, StateBasedModel)
-    fam = families(model)
     if g.dim == 3:
-        return perifit.compute_weights(g.x, model.node_volume, model.horizon,
-                                       model="osb" if state else "bb", families=fam)
+        return "osb" if state else "bb"
     if g.dim == 2 and not state:
-        return perifit.compute_weights_2d(g.x, model.node_volume, model.horizon, families=fam)
+        return "bb-2d"
     raise ValueError("perifit: 3D bond-based and LPS models and 2D bond-based ones only")
+
+
+def _compute(model, kind: str) -> np.ndarray:
+    """perifit's weights, with one BLAS thread as in a run (pdverify.blas), so that a
+    cached entry holds what any run would compute, wherever it was computed."""
+    import perifit
+    g = model.grid
+    fam = families(model)
+    with blas.one_thread():
+        if kind == "bb-2d":
+            return perifit.compute_weights_2d(g.x, model.node_volume, model.horizon,
+                                              families=fam)
+        return perifit.compute_weights(g.x, model.node_volume, model.horizon, model=kind,
+                                       families=fam)
+
+
+@lru_cache(maxsize=1)
+def _perifit_digest() -> str:
+    """perifit's version and a digest of its Python source, so that an edited install
+    misses the cache even when its version was not bumped."""
+    import perifit
+    root = Path(perifit.__file__).parent
+    h = hashlib.sha256(str(installed_version()).encode())
+    for p in sorted(root.rglob("*.py")):
+        h.update(p.relative_to(root).as_posix().encode())
+        h.update(p.read_bytes())
+    return h.hexdigest()
+
+
+def cache_key(model, kind: str) -> str:
+    """SHA-256 over everything perifit's weights depend on: the model kind, node positions
+    and volumes, the horizon, the bonds (the families are their ends), perifit's version
+    and source."""
+    h = hashlib.sha256(f"perifit-weights/1 {kind} {model.horizon!r} "
+                       f"{model.grid.n_ext} {_perifit_digest()}".encode())
+    for a in (model.grid.x, model.node_volume, model.bond_a, model.bond_b):
+        a = np.ascontiguousarray(a)
+        h.update(f"{a.dtype.str}{a.shape}".encode())
+        h.update(a.tobytes())
+    return h.hexdigest()
+
+
+def _entry(key: str) -> Path:
+    return Path(cache_root()) / "perifit" / f"{key[:32]}.npz"
+
+
+def _load(key: str, n: int):
+    """``(weights, seconds)`` of the cache entry of ``key``, or None (a miss): missing, or
+    not read back whole with this key and ``n`` finite weights."""
+    try:
+        with np.load(_entry(key)) as z:
+            w, seconds = np.array(z["weights"], dtype=float), float(z["seconds"])
+            if str(z["key"]) == key and w.shape == (n,) and np.all(np.isfinite(w)):
+                return w, seconds
+    except Exception:  # noqa: BLE001 - any unreadable entry is a miss: computed again
+        pass
+    return None
+
+
+def _store(key: str, w: np.ndarray, seconds: float) -> None:
+    path = _entry(key)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp.npz")
+        os.close(fd)
+        try:
+            np.savez(tmp, weights=w, seconds=seconds, key=key)
+            os.chmod(tmp, 0o644)   # mkstemp makes 0600; the cache is plain shared data
+            os.replace(tmp, path)  # whole or not at all, for parallel runs
+        finally:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+    except OSError:
+        pass   # a read-only or full cache only costs time
+
+
+def node_weights(model, use_cache: bool = True) -> np.ndarray:
+    """perifit's w_i at every grid node of a plain grid's model, read from the cache when
+    an entry of the same inputs is there (module docstring); the run in progress is told
+    which (:func:`pdverify.results.note`)."""
+    kind = _kind(model)
+    key = cache_key(model, kind) if use_cache else ""
+    hit = _load(key, model.grid.n_ext) if use_cache else None
+    if hit is not None:
+        w, seconds = hit
+        note(diagnostics={"perifit_weights": f"read from the cache (computed in "
+                                             f"{seconds:.3g} s, counted in the run's cost)"},
+             timings={CACHED_SETUP: seconds})
+        return w
+    t0 = time.perf_counter()
+    w = np.asarray(_compute(model, kind), dtype=float)
+    seconds = time.perf_counter() - t0
+    if use_cache:
+        _store(key, w, seconds)
+    note(diagnostics={"perifit_weights": f"computed ({seconds:.3g} s)"})
+    return w
 
 
 def perifit_factors(model) -> np.ndarray:

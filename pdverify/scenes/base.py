@@ -12,7 +12,7 @@ from ..errors import InputError, NumericalError, did_you_mean
 from ..params import Param, resolve
 from ..pd.closure import Closure
 from ..pd.influence import INFLUENCES
-from ..results import RunResult, Timer
+from ..results import RunResult, Timer, collecting_notes
 from ..solvers.iterative import solver_error_warnings
 
 
@@ -435,8 +435,11 @@ class Scene:
             result.message = f"{self.id}/{method}: the plugin failed to load: {broken}"
             result.timings = timer.as_dict()
             return result
+        notes = {"diagnostics": {}, "timings": {}}
         try:
-            with blas.one_thread():   # the same numbers on any machine (pdverify.blas)
+            # the same numbers on any machine (pdverify.blas); what the code inside
+            # reports beside its metrics is collected (pdverify.results.note)
+            with blas.one_thread(), collecting_notes() as notes:
                 out = self.solve(method, params, timer)
             bad = [k for k, v in out.metrics.items()
                    if isinstance(v, float) and not np.isfinite(v)]
@@ -469,7 +472,9 @@ class Scene:
             result.status = "failed"
             result.message = (f"internal error: {type(exc).__name__}: {exc} "
                               f"({frame.filename.rsplit('/', 1)[-1]}:{frame.lineno})")
-        result.timings = timer.as_dict()
+        result.timings = {**timer.as_dict(), **notes["timings"]}
+        if notes["diagnostics"]:
+            result.diagnostics = {**result.diagnostics, **notes["diagnostics"]}
         peak = budget.peak_rss() if measured else None
         if peak is not None:
             result.resources = {"peak_rss_gb": peak / 1e9}
