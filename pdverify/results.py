@@ -111,7 +111,8 @@ def run_key(scene: str, method: str, params: dict) -> tuple:
 
 
 #: The timing of setup work a run read from pdverify's cache instead of doing it: the
-#: seconds that work took when it was computed (perifit's weights). Part of the run's cost
+#: seconds that work took when it was computed (perifit's weights: its CPU seconds on
+#: one thread). Part of the run's cost
 #: (:func:`cost_s`), so that a warm cache does not make a method look cheaper than it is.
 CACHED_SETUP = "cached_setup_s"
 
