@@ -145,10 +145,16 @@ def _row(scene, r, metrics) -> dict:
                    "source": paper[m].source if m in paper else ""} for m in metrics],
         "all_metrics": [(k, _num(v)) for k, v in r.metrics.items()],
         "setup": _num3(t.get('setup_s', 0)), "solve": _num3(t.get('solve_s', 0)),
-        # setup read from the cache, at the time it took when computed (results.CACHED_SETUP)
+        # setup read from the cache, at the time it took when computed (results.CACHED_SETUP):
+        # named beside the setup, and in the total, so that a warm cache does not make a
+        # method look cheap
         "cached": (f" (+ {_num3(t[CACHED_SETUP])} s from the cache)" if t.get(CACHED_SETUP)
                    else ""),
-        "total": _num3(t.get('total_s', 0)), "solver": _solver(r.diagnostics),
+        "cached_note": (f"incl. {_num3(t[CACHED_SETUP])} s cached" if t.get(CACHED_SETUP)
+                        else ""),
+        "total": _num3(t.get('total_s', 0) + t.get(CACHED_SETUP, 0) if t.get(CACHED_SETUP)
+                       else t.get('total_s', 0)),
+        "solver": _solver(r.diagnostics),
         "peak": (f", peak memory {r.resources['peak_rss_gb']:.3g} GB"
                  if r.resources.get("peak_rss_gb") else ""),
         "size": ", ".join(f"{k} {v}" for k, v in r.size.items()),

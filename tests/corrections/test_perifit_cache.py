@@ -115,6 +115,7 @@ def test_the_report_counts_the_cached_setup_in_the_cost_and_says_so():
     assert html.cost_s(run) == 16.75                    # exact in binary floating point
     row = html._row(sheet, run, ["surface_energy_error_pct"])
     assert row["setup"] + row["cached"] == "0.25 (+ 16 s from the cache)"
+    assert row["total"] == "16.8" and row["cached_note"] == "incl. 16 s cached"
     section = str(html.scene_section(sheet, [run], []))
     assert "(+ 16 s from the cache)" in section
     from pdverify.report.summary import _time_s
