@@ -305,7 +305,7 @@ def _run_local(cases, jobs, shown, run_timeout=None, known=None, slots=None):
     from multiprocessing.connection import wait
 
     from .budget import memory_limit
-    from .schedule import Slot, longest_first, memory_estimates
+    from .schedule import Slot, longest_first, memory_estimates, next_case
 
     total = len(cases)
     results: list[RunResult | None] = [None] * total
@@ -333,14 +333,17 @@ def _run_local(cases, jobs, shown, run_timeout=None, known=None, slots=None):
         return sum(memory[w[1]] for w in workers.values() if w[1] is not None)
 
     def give_all():
-        """Idle workers take the head of the queue while it fits the memory budget."""
+        """Idle workers take the next case (:func:`~pdverify.schedule.next_case`: the head
+        of the queue, unless it would wait on a reference in flight) while it fits the
+        memory budget."""
         for conn, w in workers.items():
             if w[1] is not None or not pending:
                 continue
-            running = any(x[1] is not None for x in workers.values())
-            if running and in_flight_memory() + memory[pending[0]] > limit:
-                return                   # the head waits for memory; nothing overtakes it
-            k = pending.pop(0)
+            running = [x[1] for x in workers.values() if x[1] is not None]
+            i = next_case(pending, cases, running)
+            if running and in_flight_memory() + memory[pending[i]] > limit:
+                return                   # the case waits for memory; nothing overtakes it
+            k = pending.pop(i)
             w[1], w[3] = k, time.monotonic()
             conn.send(cases[k])
             shown.started(k)

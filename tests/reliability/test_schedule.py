@@ -180,3 +180,57 @@ def test_a_heavy_run_has_its_worker_to_itself(pid_scene):
     cases = [("test-pid", m, {}) for m in ("light", "light", "heavy", "light", "light")]
     results = run_cases(cases, jobs=1)
     assert [r.metrics["runs_here"] for r in results] == [1, 2, 1, 1, 2]
+
+
+class _Referenced(Scene):
+    """Test-only scene: ``fem`` computes the reference (sleeps 0.6 s), ``pd`` reads it."""
+
+    id = "test-referenced"
+    title = "test only"
+    methods = (MethodSpec("fem"), MethodSpec("pd"))
+
+    def solve(self, method, params, timer):
+        time.sleep(0.6 if method == "fem" else 0.05)
+        return Outcome(metrics={"value": 1.0})
+
+
+class _Other(Scene):
+    id = "test-other"
+    title = "test only"
+    methods = (MethodSpec("work"),)
+
+    def solve(self, method, params, timer):
+        time.sleep(0.3)
+        return Outcome(metrics={"value": 1.0})
+
+
+@pytest.fixture
+def referenced_scenes():
+    for cls in (_Referenced, _Other):
+        if cls.id not in _REGISTRY:
+            register(cls)
+    yield
+    for cls in (_Referenced, _Other):
+        _REGISTRY.pop(cls.id, None)
+
+
+def test_reference_runs_start_first_and_no_run_waits_on_one(referenced_scenes):
+    """The FEM run starts first even when known to be short (a warm cache), and while it
+    runs the other worker takes cases of other scenes, not the runs that read its
+    reference (in a cold report they would wait on its cache lock)."""
+    cases = [("test-referenced", "pd", {}), ("test-referenced", "pd", {}),
+             ("test-other", "work", {}), ("test-referenced", "fem", {}),
+             ("test-other", "work", {}), ("test-other", "work", {})]
+    from pdverify.results import run_key
+    known = {run_key("test-referenced", "fem", {}): 0.01}
+    assert longest_first(cases, known) == [3, 0, 1, 2, 4, 5]
+    slots = []
+    results = run_cases(cases, jobs=2, schedule=slots)
+    assert [r.status for r in results] == ["ok"] * 6
+    spans = {k: (s, e) for slot in slots for k, s, e in slot.runs}
+    fem_end = spans[3][1]
+    # the other runs (0.9 s together) outlast the reference (0.6 s): the readers start
+    # only when it is done (in plan order a reader would start beside it, at once), the
+    # other worker meanwhile on the other scene's runs
+    assert all(spans[k][0] >= fem_end for k in (0, 1))
+    assert min(spans[k][0] for k in (2, 4, 5)) < spans[3][0] + 0.3
