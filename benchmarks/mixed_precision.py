@@ -48,6 +48,31 @@ residuals in extended precision), median of ``--repeat``: wall time and peak mem
 process (``ru_maxrss``), the path taken, the largest difference of the solution to the
 reference (relative to its largest entry) and the largest relative difference of the
 run's metrics to the reference's.
+
+``--knobs``: SuperLU's own tuning knobs of the float32 factor, side by side: per
+(``relax``, ``panel_size``, ``permc_spec``) of ``KNOB_GRID`` (``-`` is scipy's default,
+SuperLU's ``sp_ienv``: panel_size 20, relax 10; neither may exceed 20, see there), in a
+fresh process, alternating, median of ``--repeat``, the whole ``solve_nested`` at one
+BLAS thread with its stages timed (the ordered system: equilibration, nested dissection,
+permutation; the float32 factor, wall and CPU; plain refinement; the probe's condition
+estimate), the factor's entries, the refinement steps, and the solution's largest
+difference to the default's, relative to the largest entry of its displacement part (the
+unknowns whose equation has a diagonal entry: an augmented system's multipliers have
+none) and, apart, of its multiplier part. ``--system DIR`` takes a saved system
+(``A.npz``, ``b.npy``, ``c.npy`` as ``_capture`` writes them) instead of assembling a
+case's. Measured on traction-taylor1, manufactured-taylor2 and manufactured-snm3 (12,840,
+12,880 and 10,700 unknowns; medians of 3, the machine shared): the float32 factor is
+82-89 % of the solve (e.g. manufactured-taylor2: 17.9 s, of which ordering 0.5, factor
+15.9, refinement 1.2, estimate 0.2), all three factored whole (separator too large to
+split at). No knob gains 15 %: panel_size 15 -2 to -6 % (17.5 against 17.9 s, 13.4
+against 14.2 s; on traction-taylor1 20.7 against 26.5 s in medians, but the load fell
+during that table, its last and quietest round 17.7 against 19.0 s), relax 20 -5 % on
+manufactured-snm3 and +16 % on manufactured-taylor2, relax 5 and panel_size 10 slower;
+COLAMD in place of the nested dissection has 30 % fewer entries on the Taylor systems
+at the same factor time, and 46 % more on manufactured-snm3 (3.4x slower). Any of them
+changes the float32 factor's rounding, and traction-taylor1's refined solution moves by
+2.2e-4 of its largest displacement (its multipliers by their own size): the report's
+metrics would not stay within 1e-9. The others' move by 1e-12 to 2e-9.
 """
 from __future__ import annotations
 
@@ -59,6 +84,7 @@ import resource
 import statistics
 import tempfile
 import time
+from queue import Empty
 
 import numpy as np
 
@@ -333,6 +359,111 @@ def _reference_solve(A, rhs, coords, where):
                  "solver": f"double LU + refinement in long double {residuals}"}
 
 
+#: ``--knobs``: (relax, panel_size, permc_spec) of the float32 factor; None: as now
+#: (scipy's defaults, SuperLU's sp_ienv(2) = 10 and sp_ienv(1) = 20; the nested-dissection
+#: order, ``NATURAL``). Neither knob may exceed 20 with scipy's SuperLU: its StatInit sizes
+#: the panel histogram by sp_ienv, max(20, 10) + 1 entries, and the factorisation counts
+#: each relaxed supernode (up to ``relax`` columns) and panel (``panel_size``) at its size,
+#: past that array's end: with relax 40 or 80 or panel_size 40, 2 of ~30 solves here died
+#: of a corrupted heap (a TypeError from a mangled object; glibc's "munmap_chunk(): invalid
+#: pointer").
+#: COLAMD: SuperLU's own column order in place of the nested dissection's.
+KNOB_GRID = ((None, None, None), (5, None, None), (15, None, None), (20, None, None),
+             (None, 10, None), (None, 15, None), (None, None, "COLAMD"))
+
+
+def _knob_name(relax, panel, permc):
+    return f"relax {relax or '-'} panel {panel or '-'}" + (f" {permc}" if permc else "")
+
+
+def _knobs(folder, relax, panel, permc, queue):
+    """One ``solve_nested`` with the float32 factor's SuperLU ``relax``, ``panel_size`` and
+    ``permc_spec`` (None: as now), its stages timed by wrapping the functions it calls."""
+    import scipy.sparse as sp
+    from threadpoolctl import threadpool_limits
+
+    from pdverify.solvers import mixed, nested
+
+    extra = {k: v for k, v in (("relax", relax), ("panel_size", panel),
+                               ("permc_spec", permc)) if v is not None}
+    base = nested._options
+    nested._options = lambda dtype: ({**base(dtype), **extra}
+                                     if np.dtype(dtype) == np.float32 else base(dtype))
+    stages = {}
+
+    def timed(name, fn):
+        def wrapper(*a, **k):
+            t, cpu = time.perf_counter(), time.process_time()
+            try:
+                return fn(*a, **k)
+            finally:
+                stages[name] = stages.get(name, 0.0) + time.perf_counter() - t
+                if name == "factor_s":      # CPU time: the machine may be shared
+                    stages["factor_cpu_s"] = time.process_time() - cpu
+        return wrapper
+
+    nested.ordered_system = timed("order_s", nested.ordered_system)
+    nested.single_precision_factor = timed("factor_s", nested.single_precision_factor)
+    nested.refine_with_probe = timed("refine_and_estimate_s", nested.refine_with_probe)
+    mixed.probe_condition_estimate = timed("estimate_s", mixed.probe_condition_estimate)
+    A = sp.load_npz(os.path.join(folder, "A.npz")).tocsr()
+    b = np.load(os.path.join(folder, "b.npy"))
+    c = np.load(os.path.join(folder, "c.npy"))
+    with threadpool_limits(1):
+        t0 = time.perf_counter()
+        x, info = nested.solve_nested(A, b, c, where="knobs")
+        wall = time.perf_counter() - t0
+    np.save(os.path.join(folder, f"x-knobs-{relax}-{panel}-{permc}.npy"), x)
+    stages["plain_refinement_s"] = (stages.pop("refine_and_estimate_s")
+                                    - stages["estimate_s"])
+    queue.put({"wall_s": wall, **stages, "factor_entries": info.get("factor_entries"),
+               "refinement_steps": info.get("refinement_steps"),
+               "path": info.get("mixed_precision", info.get("solver", "")),
+               "condition_estimate": info["condition_estimate"]})
+
+
+def _knob_table(name, folder, repeat):
+    """``--knobs`` on the system saved in ``folder``: medians, printed and returned."""
+    import scipy.sparse as sp
+
+    runs = {k: [] for k in KNOB_GRID}
+    for _ in range(repeat):
+        for knobs in KNOB_GRID:
+            runs[knobs].append(_in_fresh_process(_knobs, folder, *knobs))
+    A = sp.load_npz(os.path.join(folder, "A.npz")).tocsr()
+    displacement = A.diagonal() != 0
+    xs = {k: np.load(os.path.join(folder, "x-knobs-{}-{}-{}.npy".format(*k)))
+          for k in KNOB_GRID}
+    ref = xs[KNOB_GRID[0]]
+    keys = ("wall_s", "order_s", "factor_s", "factor_cpu_s", "plain_refinement_s",
+            "estimate_s")
+    out = {}
+    print(f"{name}: float32 factor by SuperLU's relax / panel_size, median of {repeat} "
+          f"(one BLAS thread)")
+    for k in KNOB_GRID:
+        last = runs[k][-1]
+        row = {key: statistics.median(r[key] for r in runs[k]) for key in keys}
+        d = np.abs(xs[k] - ref)
+        row["solution_difference"] = float(d[displacement].max()
+                                           / np.abs(ref[displacement]).max())
+        row["multiplier_difference"] = (float(d[~displacement].max()
+                                              / np.abs(ref[~displacement]).max())
+                                        if (~displacement).any() else None)
+        row.update(factor_entries=last["factor_entries"],
+                   refinement_steps=last["refinement_steps"], path=last["path"],
+                   all_wall_s=[r["wall_s"] for r in runs[k]])
+        mult = row["multiplier_difference"]
+        print(f"  {_knob_name(*k):27s} solve {row['wall_s']:6.2f} s (order "
+              f"{row['order_s']:.2f}, factor {row['factor_s']:6.2f} / CPU "
+              f"{row['factor_cpu_s']:6.2f}, refinement "
+              f"{row['plain_refinement_s']:.2f}, estimate {row['estimate_s']:.2f})  "
+              f"{row['factor_entries']:,d} entries  {row['refinement_steps']} steps  "
+              f"solution diff {row['solution_difference']:.2g}"
+              + (f" (multipliers {mult:.2g})" if mult is not None else ""), flush=True)
+        out[_knob_name(*k)] = row
+    return out
+
+
 RUN_VARIANTS = ("before", "now", "threshold-0.1", "double-lu", "reference")
 
 
@@ -370,7 +501,14 @@ def _in_fresh_process(target, *args):
     queue = ctx.Queue()
     p = ctx.Process(target=target, args=args + (queue,))
     p.start()
-    out = queue.get()
+    while True:     # a child that dies (an exception, memory) would leave get() waiting
+        try:
+            out = queue.get(timeout=5)
+            break
+        except Empty:
+            if not p.is_alive():
+                raise RuntimeError(f"{target.__name__} failed "
+                                   f"in its process (exit code {p.exitcode})") from None
     p.join()
     return out
 
@@ -395,8 +533,20 @@ def main(argv=None):
                     help="the float32 factor and its refinement at these pivot thresholds")
     ap.add_argument("--run", action="store_true",
                     help="the whole run, before/now/double LU, in fresh processes")
+    ap.add_argument("--knobs", action="store_true",
+                    help="the float32 factor at SuperLU's relax / panel_size (KNOB_GRID)")
+    ap.add_argument("--system", action="append", metavar="DIR",
+                    help="a saved system (A.npz, b.npy, c.npy) instead of a case's")
     args = ap.parse_args(argv)
     out = {}
+    if args.knobs and args.system:
+        for folder in args.system:
+            out[os.path.basename(os.path.normpath(folder))] = _knob_table(
+                os.path.basename(os.path.normpath(folder)), folder, args.repeat)
+        if args.json:
+            with open(args.json, "w") as fh:
+                json.dump(out, fh, indent=2)
+        return
     for case in args.case or ["manufactured-snm3"]:
         if args.run:
             out[case] = _runs(case, args.repeat)
@@ -426,6 +576,9 @@ def main(argv=None):
                           f"estimator {st['estimator_iterations']}, cond "
                           f"{st['condition_estimate']}", flush=True)
                     out[case][th] = st
+                continue
+            if args.knobs:
+                out[case] = _knob_table(case, folder, args.repeat)
                 continue
             if args.estimator:
                 st = _in_fresh_process(_estimator, folder)
