@@ -22,7 +22,7 @@ from scipy.linalg import get_lapack_funcs, get_blas_funcs, solve_triangular
 #: Subtrees of at most this many unknowns are one front (:meth:`SeparatorTree.merged`):
 #: fewer, larger dense fronts, fewer Python steps. Measured with
 #: ``benchmarks/frontal.py --merge`` (see :data:`pdverify.solvers.nested.FRONTAL_FACTOR`).
-MERGE_SIZE = 256
+MERGE_SIZE = 4096
 
 
 _dlaswp, = get_lapack_funcs(("laswp",), dtype=np.float64)
@@ -44,12 +44,13 @@ class FrontalLU:
     kind = "multifrontal LU"
 
     def __init__(self, A, tree, dtype=np.float32, *, merge: int = MERGE_SIZE):
-        # canonical (sorted, no duplicates) by two transpositions, linear time
-        C = sp.csr_matrix(A).tocsc()
+        # in the factor's precision (the fronts are), canonical (sorted, no duplicates)
+        # by two transpositions, linear time: rows and columns of A at hand
+        self.dtype = np.dtype(dtype)
+        C = sp.csr_matrix(A).astype(self.dtype).tocsc()
         C.sum_duplicates()
         A = C.tocsr()
         n = A.shape[0]
-        self.dtype = np.dtype(dtype)
         self.shape = A.shape
         if merge:
             tree = tree.merged(merge)
