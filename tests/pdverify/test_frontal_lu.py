@@ -87,7 +87,7 @@ def test_float32_factor_solves_to_single_precision_and_refines():
     from pdverify.solvers.mixed import refine_with_probe
     A, tree = ordered("3d-3dofs")
     n = A.shape[0]
-    lu = FrontalLU(A, tree)
+    lu = FrontalLU(A, tree, merge=64)
     b = np.random.default_rng(4).normal(size=n)
     assert relative_residual(A, lu.solve(b)[:, None], b[:, None]) < n * np.finfo(
         np.float32).eps
