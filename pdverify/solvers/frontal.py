@@ -60,12 +60,15 @@ class FrontalLU:
     kind = "multifrontal LU"
 
     def __init__(self, A, tree, dtype=np.float32, *, merge: int = MERGE_SIZE):
-        # in the factor's precision (the fronts are), canonical (sorted, no duplicates)
-        # by two transpositions, linear time: rows and columns of A at hand
+        # the columns in the factor's precision (the fronts are), canonical (sorted, no
+        # duplicates: a transposition sorts, linear time); the rows from A itself unless it
+        # has duplicates (memory: one copy of A fewer while the fronts are factored)
         self.dtype = np.dtype(dtype)
-        C = sp.csr_matrix(A).astype(self.dtype).tocsc()
+        A = sp.csr_matrix(A)
+        C = A.astype(self.dtype).tocsc()
         C.sum_duplicates()
-        A = C.tocsr()
+        if C.nnz != A.nnz:
+            A = C.tocsr()
         n = A.shape[0]
         self.shape = A.shape
         if merge:

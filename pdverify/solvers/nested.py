@@ -71,8 +71,16 @@ MAX_CROSSED_PIVOTS = 32
 
 #: The whole-matrix float32 factor (separator too large to split at) is the multifrontal
 #: :class:`~pdverify.solvers.frontal.FrontalLU` (dense BLAS-3 fronts), with SuperLU's as
-#: the fallback when it fails. Measured (``benchmarks/frontal.py``, one BLAS thread): see
-#: the table there. MEASUREMENT_PENDING
+#: the fallback when it fails (issue 32). Measured (``benchmarks/frontal.py``: a fresh
+#: process each, one BLAS thread, alternating, medians of 3; SuperLU -> FrontalLU): the
+#: order-1 Taylor system of body3d-traction (12,840 unknowns) factor 16.8 -> 4.3 s,
+#: 72.0 -> 75.7 M entries, plain refinement 6 -> 5 steps, 1.4 -> 1.1 s, peak 678 -> 666
+#: MB; body3d-manufactured's order-2 Taylor system (12,880) 15.1 -> 3.6 s, 7 -> 10 steps,
+#: 1.5 -> 1.6 s; its order-3 surface-node system (10,700) 12.6 -> 6.2 s, 4 -> 4 steps,
+#: peak 783 -> 1008 MB. The refined displacements differ from SuperLU's path by 4e-13,
+#: 1e-13 and 3e-12 of their largest entry (condition 3e7, 1e7, 9e6: round-off; the
+#: double LU and PARDISO differ by 1e-12 on the last). The report's runs on this path:
+#: every metric the same to 1e-9 relative.
 FRONTAL_FACTOR = True
 
 
@@ -100,7 +108,8 @@ def solve_nested(A, rhs, coords, *, where: str = "static solve", mixed: bool | N
     if not np.all(np.isfinite(A.data)) or not np.all(np.isfinite(rhs)):
         raise NumericalError(f"{where}: the system has non-finite entries")
     n = A.shape[0]
-    A_p, b_p, perm, (n1, n2), col_max, tree = ordered_system(A, rhs, coords, where, tree=True)
+    A_p, b_p, perm, (n1, n2), col_max, tree = ordered_system(A, rhs, coords, where,
+                                                             tree=True)
     use_mixed = policy.mixed_precision(n) if mixed is None else mixed
     info: dict = {"unknowns": int(n)}
     y = None
@@ -141,9 +150,10 @@ def ordered_system(A, rhs, coords, where: str, *, tree: bool = False):
 def single_precision_factor(A_p, n1: int, n2: int, tree=None):
     """``(lu, note)``: the :class:`SplitLU` of ``A_p`` on its top split, or of the whole
     matrix (``note`` says why) when the separator is too large to split at
-    (:func:`~pdverify.solvers.policy.split_too_large`) or SuperLU's pivoting crosses
-    between the blocks. Raises RuntimeError when the whole matrix's float32 factor fails
-    too."""
+    (:func:`~pdverify.solvers.policy.split_too_large`; given the ordering's separator
+    ``tree``, by :class:`~pdverify.solvers.frontal.FrontalLU`, :data:`FRONTAL_FACTOR`) or
+    SuperLU's pivoting crosses between the blocks. Raises RuntimeError when the whole
+    matrix's float32 factor fails too."""
     note = ""
     separator = A_p.shape[0] - n1 - n2
     if n1 and n2 and policy.split_too_large(separator, A_p.shape[0]):

@@ -179,3 +179,22 @@ def test_whole_matrix_factor_is_frontal_and_falls_back_to_superlu(monkeypatch):
     monkeypatch.setattr(nested, "FrontalLU", fail)
     lu, note = nested.single_precision_factor(A, 10, 10, tree)
     assert isinstance(lu, nested.SplitLU) and "multifrontal factor failed" in note
+
+
+def test_duplicate_entries_are_summed():
+    """A matrix given with duplicate entries (COO-style) is the sum of them: each entry
+    split in two halves gives the same factor's solve (float64: the halves sum exactly,
+    so bit for bit)."""
+    A, tree = ordered("2d")
+    A.sort_indices()
+    # every row's entries twice, each with half the value (CSR arrays given directly: the
+    # COO constructor would sum them)
+    nnz = np.diff(A.indptr)
+    rows = np.repeat(np.arange(A.shape[0]), nnz)
+    order = np.argsort(np.r_[rows, rows], kind="stable")
+    twice = sp.csr_matrix((np.r_[A.data, A.data][order] / 2,
+                           np.r_[A.indices, A.indices][order], 2 * A.indptr), shape=A.shape)
+    assert twice.nnz == 2 * A.nnz
+    b = np.random.default_rng(5).normal(size=A.shape[0])
+    x = FrontalLU(A, tree, dtype=np.float64).solve(b)
+    assert np.array_equal(FrontalLU(twice, tree, dtype=np.float64).solve(b), x)
