@@ -46,8 +46,8 @@ _dlaswp, = get_lapack_funcs(("laswp",), dtype=np.float64)
 
 class FrontalLU:
     """Multifrontal LU of the nested-dissection-ordered square sparse ``A`` over ``tree``
-    (a :class:`~pdverify.solvers.ordering.SeparatorTree`, merged to fronts of at least
-    ``merge`` unknowns where a subtree allows it), computed in ``dtype``.
+    (a :class:`~pdverify.solvers.ordering.SeparatorTree`; each subtree of at most ``merge``
+    unknowns made one front, 0: as it is), computed in ``dtype``.
 
     ``solve(B, trans="N"|"T")``: one or several right-hand sides, float64 in and out,
     computed in ``dtype`` (each column scaled by a power of two near its largest entry, as
