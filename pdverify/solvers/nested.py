@@ -73,14 +73,17 @@ MAX_CROSSED_PIVOTS = 32
 #: :class:`~pdverify.solvers.frontal.FrontalLU` (dense BLAS-3 fronts), with SuperLU's as
 #: the fallback when it fails (issue 32). Measured (``benchmarks/frontal.py``: a fresh
 #: process each, one BLAS thread, alternating, medians of 3; SuperLU -> FrontalLU): the
-#: order-1 Taylor system of body3d-traction (12,840 unknowns) factor 16.8 -> 4.3 s,
-#: 72.0 -> 75.7 M entries, plain refinement 6 -> 5 steps, 1.4 -> 1.1 s, peak 678 -> 666
-#: MB; body3d-manufactured's order-2 Taylor system (12,880) 15.1 -> 3.6 s, 7 -> 10 steps,
-#: 1.5 -> 1.6 s; its order-3 surface-node system (10,700) 12.6 -> 6.2 s, 4 -> 4 steps,
-#: peak 783 -> 1008 MB. The refined displacements differ from SuperLU's path by 4e-13,
-#: 1e-13 and 3e-12 of their largest entry (condition 3e7, 1e7, 9e6: round-off; the
-#: double LU and PARDISO differ by 1e-12 on the last). The report's runs on this path:
-#: every metric the same to 1e-9 relative.
+#: order-1 Taylor system of body3d-traction (12,840 unknowns) factor 27.7 -> 6.3 s,
+#: 72.0 -> 75.7 M entries, plain refinement 6 -> 5 steps, 2.1 -> 1.5 s, peak 678 -> 616
+#: MB; body3d-manufactured's order-2 Taylor system (12,880) 14.3 -> 3.3 s, 7 -> 8 steps,
+#: 1.2 -> 1.2 s, 679 -> 629 MB; its order-3 surface-node system (10,700) 11.7 -> 4.7 s,
+#: 61.6 -> 77.6 M entries, 4 -> 5 steps, 784 -> 921 MB; body3d-traction's uncorrected
+#: system (7,880) 5.3 -> 3.0 s, 21.6 -> 40.7 M entries, 334 -> 486 MB. The refined
+#: displacements differ from SuperLU's path by 4e-13, 8e-14, 1.5e-12 and 5e-14 of their
+#: largest entry (condition 3e7, 1e7, 9e6, 6e4: round-off; on the third the double LU and
+#: PARDISO differ by 1.3e-12). The report's runs on this path (body3d-traction,
+#: body3d-manufactured, plate2d-plane-strain): every metric the same to 1e-9 relative;
+#: body3d-traction's ten runs 155-188 s -> 88-103 s in all (the same busy machine).
 FRONTAL_FACTOR = True
 
 
