@@ -83,7 +83,9 @@ MAX_CROSSED_PIVOTS = 32
 #: largest entry (condition 3e7, 1e7, 9e6, 6e4: round-off; on the third the double LU and
 #: PARDISO differ by 1.3e-12). The report's runs on this path (body3d-traction,
 #: body3d-manufactured, plate2d-plane-strain): every metric the same to 1e-9 relative;
-#: body3d-traction's ten runs 155-188 s -> 88-103 s in all (the same busy machine).
+#: body3d-traction's ten runs 155-188 s -> 88-103 s in all, body3d-manufactured's 21 on
+#: this path 159-165 s -> 104-148 s (two report passes each, alternating, the machine
+#: shared and busy).
 FRONTAL_FACTOR = True
 
 
