@@ -16,6 +16,7 @@ from ..errors import NumericalError
 from . import policy
 from .checks import checked_condition, equilibrate, refuse_near_singular, relative_residual
 from .lu import factor
+from .frontal import FrontalLU
 from .mixed import refine_with_probe
 from .ordering import nested_dissection
 
@@ -68,6 +69,25 @@ SEPARATOR_SHIFT = 2.0
 #: whole matrix is factored in one piece. The plate at h = 0.0125: 1 of 741.
 MAX_CROSSED_PIVOTS = 32
 
+#: The whole-matrix float32 factor (separator too large to split at) is the multifrontal
+#: :class:`~pdverify.solvers.frontal.FrontalLU` (dense BLAS-3 fronts), with SuperLU's as
+#: the fallback when it fails (issue 32). Measured (``benchmarks/frontal.py``: a fresh
+#: process each, one BLAS thread, alternating, medians of 3; SuperLU -> FrontalLU): the
+#: order-1 Taylor system of body3d-traction (12,840 unknowns) factor 27.7 -> 6.3 s,
+#: 72.0 -> 75.7 M entries, plain refinement 6 -> 5 steps, 2.1 -> 1.5 s, peak 678 -> 616
+#: MB; body3d-manufactured's order-2 Taylor system (12,880) 14.3 -> 3.3 s, 7 -> 8 steps,
+#: 1.2 -> 1.2 s, 679 -> 629 MB; its order-3 surface-node system (10,700) 11.7 -> 4.7 s,
+#: 61.6 -> 77.6 M entries, 4 -> 5 steps, 784 -> 921 MB; body3d-traction's uncorrected
+#: system (7,880) 5.3 -> 3.0 s, 21.6 -> 40.7 M entries, 334 -> 486 MB. The refined
+#: displacements differ from SuperLU's path by 4e-13, 8e-14, 1.5e-12 and 5e-14 of their
+#: largest entry (condition 3e7, 1e7, 9e6, 6e4: round-off; on the third the double LU and
+#: PARDISO differ by 1.3e-12). The report's runs on this path (body3d-traction,
+#: body3d-manufactured, plate2d-plane-strain): every metric the same to 1e-9 relative;
+#: body3d-traction's ten runs 155-188 s -> 88-103 s in all, body3d-manufactured's 21 on
+#: this path 159-165 s -> 104-148 s (two report passes each, alternating, the machine
+#: shared and busy).
+FRONTAL_FACTOR = True
+
 
 def solve_nested(A, rhs, coords, *, where: str = "static solve", mixed: bool | None = None):
     """Solve the square system A x = rhs by sparse LU under a geometric nested-dissection
@@ -93,12 +113,13 @@ def solve_nested(A, rhs, coords, *, where: str = "static solve", mixed: bool | N
     if not np.all(np.isfinite(A.data)) or not np.all(np.isfinite(rhs)):
         raise NumericalError(f"{where}: the system has non-finite entries")
     n = A.shape[0]
-    A_p, b_p, perm, (n1, n2), col_max = ordered_system(A, rhs, coords, where)
+    A_p, b_p, perm, (n1, n2), col_max, tree = ordered_system(A, rhs, coords, where,
+                                                             tree=True)
     use_mixed = policy.mixed_precision(n) if mixed is None else mixed
     info: dict = {"unknowns": int(n)}
     y = None
     if use_mixed:
-        y, cond, diag = _solve_mixed(A_p, b_p, n1, n2)
+        y, cond, diag = _solve_mixed(A_p, b_p, n1, n2, tree)
         info.update(diag)
     if y is None:
         # SuperLU takes CSC: the CSR copy goes before the factor is made (memory)
@@ -118,36 +139,43 @@ def solve_nested(A, rhs, coords, *, where: str = "static solve", mixed: bool | N
     return sol, info
 
 
-def ordered_system(A, rhs, coords, where: str):
+def ordered_system(A, rhs, coords, where: str, *, tree: bool = False):
     """``(A_p, b_p, perm, (n1, n2), col_max)``: ``A x = rhs`` equilibrated
     (:func:`~pdverify.solvers.checks.equilibrate`) and permuted to the geometric
     nested-dissection order (``perm``; the top split's halves ``n1``, ``n2``); the
-    solution is ``x[perm] = y / col_max`` for ``A_p y = b_p``."""
+    solution is ``x[perm] = y / col_max`` for ``A_p y = b_p``. ``tree=True`` appends the
+    ordering's separator tree."""
     A_s, row_max, col_max = equilibrate(A, where)
-    perm, halves = nested_dissection(A_s, coords, top_split=True)
+    perm, halves, *fronts = nested_dissection(A_s, coords, top_split=True, tree=tree)
     A_p = A_s[perm][:, perm].tocsr()
     del A_s     # memory: one copy of the system fewer while it is factored (issue 32)
-    return A_p, (rhs / row_max)[perm], perm, halves, col_max
+    return (A_p, (rhs / row_max)[perm], perm, halves, col_max, *fronts)
 
 
-def single_precision_factor(A_p, n1: int, n2: int):
+def single_precision_factor(A_p, n1: int, n2: int, tree=None):
     """``(lu, note)``: the :class:`SplitLU` of ``A_p`` on its top split, or of the whole
     matrix (``note`` says why) when the separator is too large to split at
-    (:func:`~pdverify.solvers.policy.split_too_large`) or SuperLU's pivoting crosses
-    between the blocks. Raises RuntimeError when the whole matrix's float32 factor fails
-    too."""
+    (:func:`~pdverify.solvers.policy.split_too_large`; given the ordering's separator
+    ``tree``, by :class:`~pdverify.solvers.frontal.FrontalLU`, :data:`FRONTAL_FACTOR`) or
+    SuperLU's pivoting crosses between the blocks. Raises RuntimeError when the whole
+    matrix's float32 factor fails too."""
     note = ""
     separator = A_p.shape[0] - n1 - n2
     if n1 and n2 and policy.split_too_large(separator, A_p.shape[0]):
         n1 = n2 = 0
         note = f" (whole matrix: separator of {separator} unknowns too large to split at)"
+        if FRONTAL_FACTOR and tree is not None:
+            try:
+                return FrontalLU(A_p, tree), note
+            except RuntimeError as exc:
+                note += f" (SuperLU: the multifrontal factor failed: {exc})"
     try:
         return SplitLU(A_p, n1, n2), note
     except RuntimeError as exc:
         return SplitLU(A_p, 0, 0), f" (whole matrix: {exc})"
 
 
-def _solve_mixed(A_p, b_p, n1: int, n2: int):
+def _solve_mixed(A_p, b_p, n1: int, n2: int, tree=None):
     """Single-precision LU of the equilibrated, permuted ``A_p`` (:class:`SplitLU`: the
     two halves of the top split in parallel, or, when SuperLU's pivoting crosses between
     the blocks or the separator is too large to split at
@@ -157,7 +185,7 @@ def _solve_mixed(A_p, b_p, n1: int, n2: int):
     diagnostics)``, or ``(None, None, diagnostics)`` with the reason in
     ``diagnostics['mixed_precision']`` when the double LU must take over."""
     try:
-        lu, note = single_precision_factor(A_p, n1, n2)
+        lu, note = single_precision_factor(A_p, n1, n2, tree)
     except RuntimeError as exc:  # "Factor is exactly singular" in single precision
         return None, None, {"mixed_precision": f"not used: single-precision factor "
                                                f"failed ({exc}); double LU"}
@@ -170,7 +198,8 @@ def _solve_mixed(A_p, b_p, n1: int, n2: int):
                     else ", refined in float64 (LAPACK dsgesv's test)"),
                 factor_entries=lu.factor_entries, separator_unknowns=lu.separator,
                 separator_rows_pivoted_into_halves=lu.crossed_pivots,
-                solver="sparse LU (SuperLU in float32 + " + ("GMRES-IR" if gmres else
+                solver=f"sparse LU ({getattr(lu, 'kind', 'SuperLU')} in float32 + "
+                       + ("GMRES-IR" if gmres else
                                                              "refinement")
                        + ", nested-dissection ordering)")
     return y, cond, diag
