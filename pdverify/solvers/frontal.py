@@ -27,6 +27,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.linalg import get_lapack_funcs, get_blas_funcs, solve_triangular
 
+from .mixed import scaled_solve
+
 #: Subtrees of at most this many unknowns are one front (:meth:`SeparatorTree.merged`):
 #: fewer, larger dense fronts, fewer Python steps, and more rows for each front's pivot
 #: search, which is what sets the float32 factor's accuracy here. Measured
@@ -180,20 +182,16 @@ class FrontalLU:
         return step
 
     def solve(self, b, trans: str = "N"):
-        b = np.asarray(b, dtype=float)
-        if trans not in ("N", "T"):
-            raise ValueError(f"trans={trans!r}: 'N' or 'T'")
-        # each column scaled by a power of two near its largest entry (exact), so that
-        # single precision neither overflows nor underflows (as SplitLU.solve)
-        big = np.abs(b).max(axis=0)
-        scale = np.exp2(np.round(np.log2(np.where(big > 0, big, 1.0))))
-        X = (b / scale).astype(self.dtype)
+        # each column scaled by a power of two, as SplitLU.solve (mixed.scaled_solve)
+        return scaled_solve(b, trans, self._solve)
+
+    def _solve(self, b, trans):
+        X = b.astype(self.dtype)
         one = X.ndim == 1
         if one:
             X = X[:, None]
-        X = self._solve_T(X) if trans == "T" else self._solve_N(X)
-        X = X.astype(float)
-        return (X[:, 0] if one else X) * scale
+        X = (self._solve_T(X) if trans == "T" else self._solve_N(X)).astype(float)
+        return X[:, 0] if one else X
 
     def _solve_N(self, X):
         for own, upd, lu, perm, U12, L21 in self.fronts:

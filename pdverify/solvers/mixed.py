@@ -15,6 +15,19 @@ import numpy as np
 
 from .checks import rounded_estimate
 
+
+def scaled_solve(b, trans: str, solve):
+    """``solve(b / s, trans) * s`` for a single-precision factor's solve (``trans`` "N"
+    or "T"): each column of ``b`` scaled by a power of two near its largest entry (exact),
+    so that single precision neither overflows nor underflows: refinement residuals are
+    ~1e-16 of the solution, the equilibrated right-hand side can be of any size."""
+    b = np.asarray(b, dtype=float)
+    if trans not in ("N", "T"):
+        raise ValueError(f"trans={trans!r}: 'N' or 'T'")
+    big = np.abs(b).max(axis=0)
+    scale = np.exp2(np.round(np.log2(np.where(big > 0, big, 1.0))))
+    return solve(b / scale, trans) * scale
+
 #: LAPACK's mixed-precision dsgesv: at most 30 refinement steps, converged when
 #: ||r||_inf <= ||x||_inf ||A||_inf eps sqrt(n); otherwise the double LU takes over.
 REFINE_MAX_STEPS = 30

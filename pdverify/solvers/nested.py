@@ -17,7 +17,7 @@ from . import policy
 from .checks import checked_condition, equilibrate, refuse_near_singular, relative_residual
 from .lu import factor
 from .frontal import FrontalLU
-from .mixed import refine_with_probe
+from .mixed import refine_with_probe, scaled_solve
 from .ordering import nested_dissection
 
 #: SuperLU's diagonal pivot threshold under the nested-dissection ordering: a diagonal
@@ -311,15 +311,7 @@ class SplitLU:
         return self.lus[i].solve(np.asarray(rhs, dtype=self.dtype), trans=trans).astype(float)
 
     def solve(self, b, trans: str = "N"):
-        b = np.asarray(b, dtype=float)
-        if trans not in ("N", "T"):
-            raise ValueError(f"trans={trans!r}: 'N' or 'T'")
-        # each column scaled by a power of two near its largest entry (exact), so that
-        # single precision neither overflows nor underflows: refinement residuals are
-        # ~1e-16 of the solution, the equilibrated right-hand side can be of any size
-        big = np.abs(b).max(axis=0)
-        scale = np.exp2(np.round(np.log2(np.where(big > 0, big, 1.0))))
-        return self._solve(b / scale, trans) * scale
+        return scaled_solve(b, trans, self._solve)
 
     def _solve(self, b, trans):
         if not self.separator:
