@@ -124,6 +124,14 @@ def cost_s(timings: dict) -> float:
     return sum(float(timings.get(k, 0.0) or 0.0) for k in ("setup_s", "solve_s", CACHED_SETUP))
 
 
+def time_s(timings: dict):
+    """A run's time as the report shows it: ``total_s`` and the setup it read from the
+    cache at the time that took (:data:`CACHED_SETUP`); ``total_s`` as it is (None if
+    absent, text for an external run) when nothing came from the cache."""
+    total, cached = timings.get("total_s"), timings.get(CACHED_SETUP)
+    return total + cached if cached and total is not None else total
+
+
 #: The collectors of the runs in progress in this process (innermost last): what code deep
 #: inside a run reports beside its metrics (:func:`note`), merged into its result by
 #: :meth:`pdverify.scenes.base.Scene.run`.

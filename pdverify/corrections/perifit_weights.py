@@ -152,13 +152,13 @@ def _store(key: str, w: np.ndarray, seconds: float) -> None:
         pass   # a read-only or full cache only costs time
 
 
-def node_weights(model, use_cache: bool = True) -> np.ndarray:
+def node_weights(model) -> np.ndarray:
     """perifit's w_i at every grid node of a plain grid's model, read from the cache when
     an entry of the same inputs is there (module docstring); the run in progress is told
     which (:func:`pdverify.results.note`)."""
     kind = _kind(model)
-    key = cache_key(model, kind) if use_cache else ""
-    hit = _load(key, model.grid.n_ext) if use_cache else None
+    key = cache_key(model, kind)
+    hit = _load(key, model.grid.n_ext)
     if hit is not None:
         w, seconds = hit
         # the diagnostics hold no time (a machine's cost, not the run's numbers, which
@@ -172,8 +172,7 @@ def node_weights(model, use_cache: bool = True) -> np.ndarray:
     t0 = time.process_time()
     w = np.asarray(_compute(model, kind), dtype=float)
     seconds = time.process_time() - t0
-    if use_cache:
-        _store(key, w, seconds)
+    _store(key, w, seconds)
     note(diagnostics={"perifit_weights": "computed"})
     return w
 

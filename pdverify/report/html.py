@@ -17,6 +17,7 @@ from ..papers import PAPERS, seed_of
 from ..published import FIGURE, verdict
 from ..results import CACHED_SETUP
 from ..results import cost_s as run_cost_s
+from ..results import time_s as run_time_s
 from .summary import default_run, headline, headline_value, summarise
 
 _ENV = jinja2.Environment(
@@ -152,8 +153,7 @@ def _row(scene, r, metrics) -> dict:
                    else ""),
         "cached_note": (f"incl. {_num3(t[CACHED_SETUP])} s cached" if t.get(CACHED_SETUP)
                         else ""),
-        "total": _num3(t.get('total_s', 0) + t.get(CACHED_SETUP, 0) if t.get(CACHED_SETUP)
-                       else t.get('total_s', 0)),
+        "total": _num3(run_time_s({"total_s": 0, **t})),
         "solver": _solver(r.diagnostics),
         "peak": (f", peak memory {r.resources['peak_rss_gb']:.3g} GB"
                  if r.resources.get("peak_rss_gb") else ""),

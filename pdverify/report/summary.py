@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..errors import InputError
-from ..results import CACHED_SETUP
+from ..results import time_s
 
 #: The error each scene is ranked by (a scene may set ``headline``).
 HEADLINE_DEFAULT = "rel_l2_error"
@@ -48,13 +48,6 @@ class SceneSummary:
     failed: list            # (method, message) of the failed runs
 
 
-def _time_s(timings) -> float | None:
-    """A run's time in the summary: ``total_s`` and the setup it read from the cache at
-    the time that took (:data:`pdverify.results.CACHED_SETUP`)."""
-    total = timings.get("total_s")
-    return None if total is None else total + timings.get(CACHED_SETUP, 0.0)
-
-
 def summarise(scene, runs) -> SceneSummary:
     picked = {m: default_run(scene, m, runs) for m in dict.fromkeys(r.method for r in runs)}
     values = {m: headline_value(scene, r) for m, r in picked.items() if r is not None}
@@ -65,7 +58,7 @@ def summarise(scene, runs) -> SceneSummary:
     return SceneSummary(
         scene=scene.id, metric=headline(scene), best=best,
         best_error=values.get(best), runs=len(runs),
-        best_time_s=_time_s(picked[best].timings) if best else None,
+        best_time_s=time_s(picked[best].timings) if best else None,
         failed=[(r.method, r.message) for r in runs if r.counts_as_failure])
 
 

@@ -47,7 +47,8 @@ def test_a_second_run_reads_the_same_weights_from_the_cache(cache):
     cached = second.timings[results.CACHED_SETUP]
     assert 0 < cached <= first.timings["setup_s"]
     assert results.cost_s(second.timings) == pytest.approx(
-        second.timings["setup_s"] + second.timings["solve_s"] + cached, rel=1e-15)
+        second.timings["setup_s"] + second.timings["solve_s"] + cached,
+        rel=1e-15)  # the same three terms summed: at most round-off of the order
 
 
 def test_every_input_of_the_weights_is_in_the_key(cache):
@@ -118,5 +119,4 @@ def test_the_report_counts_the_cached_setup_in_the_cost_and_says_so():
     assert row["total"] == "16.8" and row["cached_note"] == "incl. 16 s cached"
     section = str(html.scene_section(sheet, [run], []))
     assert "(+ 16 s from the cache)" in section
-    from pdverify.report.summary import _time_s
-    assert _time_s(timings) == 16.8                     # the summary's time: total + cached
+    assert results.time_s(timings) == 16.8              # the summary's time: total + cached
