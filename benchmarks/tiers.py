@@ -34,9 +34,13 @@ cores the parallel wall time is about half of it, or the longest file if that is
 the largest PSS sum, each process's PSS and RSS, the test process it runs under (an xdist
 worker or the pytest process itself: forked pools and subprocesses are counted with the
 test that started them), the test that worker was running and the files it had run
-before (whose freed memory it may still hold). ``--trace DIR`` keeps the logs, one file
-per test process, a line ``start|end TIME RSS NODEID`` per test: the RSS at a file's last
-``end`` against its first ``start`` is what the file left resident.
+before (whose freed memory it may still hold), and then the tests whose process reached
+the largest resident set while running them (each test's own peak, its setup and
+teardown included: Linux's VmHWM, reset as it starts; the processes it starts not
+counted), with the process's resident set as the test started (what earlier tests left).
+``--trace DIR`` keeps the logs, one file per test process, a line
+``start|end TIME RSS PEAK NODEID`` per test: the RSS at a file's last ``end`` against its
+first ``start`` is what the file left resident.
 
 The machine is shared: the load average is printed before and after each run.
 """
@@ -154,15 +158,34 @@ class Sampler(threading.Thread):
 
 
 def _read_trace(folder):
-    """{pid: [(kind, time, rss, nodeid)]} from the test processes' logs
+    """{pid: [(kind, time, rss, peak, nodeid)]} from the test processes' logs
     (tests/conftest.py)."""
     logs = {}
     for name in os.listdir(folder):
         with open(os.path.join(folder, name)) as fh:
             logs[int(name.split(".")[0])] = [
-                (kind, float(t), int(rss), node) for kind, t, rss, node in
-                (line.rstrip("\n").split(" ", 3) for line in fh)]
+                (kind, float(t), int(rss), int(peak), node) for kind, t, rss, peak, node in
+                (line.rstrip("\n").split(" ", 4) for line in fh)]
     return logs
+
+
+#: how many tests :func:`_largest_tests` lists
+LARGEST_TESTS = 15
+
+
+def _largest_tests(logs):
+    """Lines naming the tests whose process reached the largest resident set while it ran
+    them (setup and teardown included; the processes they start not counted), largest
+    first, each with the process's resident set at the test's start."""
+    ends = sorted(((peak, node, pid) for pid, events in logs.items()
+                   for kind, _, _, peak, node in events if kind == "end"), reverse=True)
+    starts = {(pid, node): rss for pid, events in logs.items()
+              for kind, _, rss, _, node in events if kind == "start"}
+    out = [f"    the {LARGEST_TESTS} tests with the largest peak resident set of their process:"]
+    for peak, node, pid in ends[:LARGEST_TESTS]:
+        out.append(f"      {peak / 1e9:5.2f} GB (from {starts.get((pid, node), 0) / 1e9:4.2f})"
+                   f"  {node}")
+    return out
 
 
 def _at_peak_trace(root, when, procs, logs):
@@ -180,13 +203,13 @@ def _at_peak_trace(root, when, procs, logs):
     for pid, ppid, rss, pss, cmd in sorted(procs, key=lambda x: -x[3]):
         owner = test_process(pid)
         events = [e for e in logs.get(owner, []) if e[1] <= when]
-        now = events[-1][3] if events and events[-1][0] == "start" else \
-            (f"between tests, after {events[-1][3]}" if events else "before its first test")
+        now = events[-1][4] if events and events[-1][0] == "start" else \
+            (f"between tests, after {events[-1][4]}" if events else "before its first test")
         out.append(f"      pid {pid:7d} (under {owner:7d})  PSS {pss / 1e9:5.2f} GB  "
                    f"RSS {rss / 1e9:5.2f} GB  {cmd[:60]}")
         if pid == owner and owner != root:
             files = []
-            for kind, _, _, node in events:
+            for kind, _, _, _, node in events:
                 f = node.split("::")[0]
                 if kind == "start" and f not in files:
                     files.append(f)
@@ -223,7 +246,9 @@ def measure(tier, mode, trace=False):
     traced = []
     if trace is not False:
         import shutil
-        traced = _at_peak_trace(proc.pid, *sampler.at_pss_peak, _read_trace(folder))
+        logs = _read_trace(folder)
+        traced = (_at_peak_trace(proc.pid, *sampler.at_pss_peak, logs)
+                  + _largest_tests(logs))
         if keep:
             traced.append(f"    the tests' logs: {folder}")
         else:

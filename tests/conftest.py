@@ -140,10 +140,13 @@ def pytest_cmdline_main(config):
 
 
 #: ``PDVERIFY_TEST_TRACE=DIR``: each test process appends to ``DIR/<pid>.log`` a line
-#: ``start|end MONOTONIC_SECONDS RSS_BYTES NODEID`` as each test starts and ends
-#: (CLOCK_MONOTONIC, the same clock in every process; the process's own resident set), so
-#: benchmarks/tiers.py --trace can name the test each xdist worker ran when the tree's
-#: memory peaked, and what each file left resident. Unset (the default): nothing.
+#: ``start|end MONOTONIC_SECONDS RSS_BYTES PEAK_BYTES NODEID`` as each test starts and ends
+#: (CLOCK_MONOTONIC, the same clock in every process; the process's own resident set, and
+#: at ``end`` its largest resident set since the test's start, setup and teardown
+#: included: Linux's VmHWM, reset at each start through /proc/self/clear_refs; at
+#: ``start`` the RSS again), so benchmarks/tiers.py --trace can name the test each xdist
+#: worker ran when the tree's memory peaked, what each file left resident, and each
+#: test's own peak. Unset (the default): nothing.
 _TRACE = os.environ.get("PDVERIFY_TEST_TRACE")
 
 
@@ -151,8 +154,19 @@ def _trace(what, nodeid):
     import time
     with open("/proc/self/statm") as fh:
         rss = int(fh.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+    peak = rss
+    if what == "start":
+        try:                      # "5": reset the peak resident set (Linux >= 4.0)
+            with open("/proc/self/clear_refs", "w") as fh:
+                fh.write("5")
+        except OSError:
+            pass
+    else:
+        with open("/proc/self/status") as fh:
+            peak = next((int(line.split()[1]) * 1024 for line in fh
+                         if line.startswith("VmHWM:")), rss)
     with open(os.path.join(_TRACE, f"{os.getpid()}.log"), "a") as fh:
-        fh.write(f"{what} {time.monotonic():.3f} {rss} {nodeid}\n")
+        fh.write(f"{what} {time.monotonic():.3f} {rss} {peak} {nodeid}\n")
 
 
 if _TRACE:

@@ -5,7 +5,9 @@
 (:mod:`pdverify.solvers.mixed`)."""
 from __future__ import annotations
 
+import itertools
 import os
+import weakref
 from concurrent import futures
 
 import numpy as np
@@ -241,10 +243,20 @@ class SplitLU:
         C = A.tocsc()
         # M_i = the half's and the separator's rows and columns, with D_i in the corner
         corner = (0.5 * C[n1 + n2:, n1 + n2:] - g * sp.identity(s, format="csc")).tocsc()
-        jobs = [_pool().submit(self._factor_half, C, np.r_[a:a + m, n1 + n2:n], corner, m,
-                               dtype) for a, m in ((0, n1), (n1, n2))]
+        pools = _pools()
+        keys = [(k, next(_KEYS)) for k in (0, 1)]
+        jobs = [pools[k].submit(self._factor_half, C, np.r_[a:a + m, n1 + n2:n], corner, m,
+                                dtype, key)
+                for (k, key), (a, m) in zip(keys, ((0, n1), (n1, n2)))]
         futures.wait(jobs)      # both halves done (or failed) before anything is raised
+        failed = next((job.exception() for job in jobs if job.exception() is not None), None)
+        if failed is not None:
+            _release(keys)      # a half factored beside a failed one
+            raise failed
+        # held by their threads (_HELD) until this object goes (_release)
+        weakref.finalize(self, _release, keys).atexit = False
         out = [job.result() for job in jobs]
+        del jobs
         self.lus = [o[0] for o in out]
         self.factor_entries = int(sum(lu.nnz for lu in self.lus))
         blocks = [self._separator_block(lu, L_ss, U_ss, m)
@@ -258,13 +270,14 @@ class SplitLU:
         self.S_lu = spla.splu(sp.csc_matrix(S), permc_spec="NATURAL")
 
     @staticmethod
-    def _factor_half(C, idx, corner, m: int, dtype):
-        """SuperLU of M_i (in a worker thread): ``(lu, L_ss, U_ss)``, the trailing blocks of
-        its factors in double."""
+    def _factor_half(C, idx, corner, m: int, dtype, key):
+        """SuperLU of M_i (in its half's thread, which holds it in :data:`_HELD` under
+        ``key``): ``(lu, L_ss, U_ss)``, the trailing blocks of its factors in double."""
         M = C[:, idx][idx, :]
         M = (M - sp.block_diag([sp.csc_matrix((m, m)), corner], format="csc")).astype(dtype)
-        lu = spla.splu(M, **_options(dtype))
+        lu = _HELD[key] = spla.splu(M, **_options(dtype))
         if np.any(lu.perm_c[:m] >= m):
+            del _HELD[key], lu          # freed here, not by the traceback's frame
             raise RuntimeError("SuperLU's column order mixed a half with the separator")
         L, U = lu.L, lu.U
         return lu, L[m:, m:].toarray().astype(float), U[m:, m:].toarray().astype(float)
@@ -322,12 +335,15 @@ class SplitLU:
         parts = (b[:n1], b[n1:n1 + n2])
         b_s = b[n1 + n2:]
         zero = np.zeros((s,) + b.shape[1:])
-        # the halves' solves run in two threads (SuperLU releases the GIL)
-        w = list(_pool().map(lambda i: self._half(i, np.concatenate([parts[i], zero]),
-                                                  trans)[-s:], (0, 1)))
+        # the halves' solves run in their two threads (SuperLU releases the GIL)
+        pools = _pools()
+        w = [job.result() for job in [
+            pools[i].submit(lambda i: self._half(i, np.concatenate([parts[i], zero]),
+                                                 trans)[-s:], i) for i in (0, 1)]]
         x_s = self.S_lu.solve(b_s + _matvec(T[0], w[0]) + _matvec(T[1], w[1]), trans=trans)
-        x = list(_pool().map(lambda i: self._half(i, np.concatenate(
-            [parts[i], _matvec(T[i], x_s - w[i])]), trans)[:-s], (0, 1)))
+        x = [job.result() for job in [
+            pools[i].submit(lambda i: self._half(i, np.concatenate(
+                [parts[i], _matvec(T[i], x_s - w[i])]), trans)[:-s], i) for i in (0, 1)]]
         return np.concatenate([x[0], x[1], x_s])
 
 
@@ -340,15 +356,44 @@ def _matvec(M, v):
     return np.stack([np.einsum("ij,j->i", M, c) for c in v.T], axis=1)
 
 
-_POOL: dict = {}
+_POOLS: dict = {}
+#: The halves' SuperLU factors of the live :class:`SplitLU` objects, by key, each held
+#: here so that its last reference is dropped by the thread that made it
+#: (:func:`_release`)
+_HELD: dict = {}
+_KEYS = itertools.count()
 
 
-def _pool():
-    """Two worker threads for :class:`SplitLU` (one per half), made on first use in each
-    process (a pool inherited through fork has no threads behind it)."""
+def _pools():
+    """One worker thread per half of :class:`SplitLU` (made on first use in each process:
+    a pool inherited through fork has no threads behind it). A half is factored, solved
+    with and freed in its own thread: scipy's SuperLU frees a factor's memory only in the
+    thread that made it (its allocations are tracked per thread), so a factor made in a
+    pool thread and dropped in another thread was never freed (scipy issue 15921): 0.6 GB
+    of address space and the factor's pages, ~60 MB resident, a sheet2d-tension run, each
+    run of a process adding its own (the test workers grew from 0.3 to 0.95 GB resident
+    over the fast tier)."""
     pid = os.getpid()
-    if pid not in _POOL:
-        _POOL.clear()
-        _POOL[pid] = futures.ThreadPoolExecutor(max_workers=2, thread_name_prefix="splitlu")
-    return _POOL[pid]
+    if pid not in _POOLS:
+        _POOLS.clear()
+        _HELD.clear()           # a parent's factors: its threads are not here
+        _POOLS[pid] = tuple(futures.ThreadPoolExecutor(max_workers=1,
+                                                       thread_name_prefix=f"splitlu{k}")
+                            for k in (0, 1))
+    return _POOLS[pid]
 
+
+def _release(keys) -> None:
+    """Drop the factors held under ``keys`` (``(half, key)`` pairs), each in its half's
+    thread, where SuperLU frees it (:func:`_pools`); a key not held is skipped."""
+    if _POOLS.get(os.getpid()) is None:
+        return
+    pools = _pools()
+    for k, key in keys:
+        pools[k].submit(_drop, key)
+
+
+def _drop(key) -> None:
+    """(in a half's thread) Forget the factor held under ``key``; returns nothing, so that
+    no future holds it."""
+    _HELD.pop(key, None)
