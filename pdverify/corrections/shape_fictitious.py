@@ -37,6 +37,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
+from ..pd.bonds import unique_ids
 from ..pd.closure import Closure
 
 
@@ -182,7 +183,7 @@ def condition_rows(model, problem, order: int, samples):
     share_c = stretches(shape, pts, part, _params(shape, P, spart), spart, group, cs, cpart, h)
     share_s = sp.csr_matrix((np.ones(len(P)), (np.arange(len(P)), group)),
                             shape=(len(P), len(pts)))
-    used = np.unique(bonds)
+    used = unique_ids(bonds)
     forces = model.bond_force_matrix(used)           # rows: the crossing bonds, ascending
     col = sp.csr_matrix((np.ones(bonds.size), (np.arange(bonds.size),
                                                np.searchsorted(used, bonds))),

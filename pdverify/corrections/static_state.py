@@ -28,6 +28,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..pd import StateBasedModel
+from ..pd.bonds import unique_ids
 from ..pd.build import build_model
 from ..pd.closure import Closure
 from ..pd.problem import FACES, LinearSystem
@@ -516,7 +517,7 @@ def _flux_of_unknowns(model, flux, n_surface, solver):
     """The force of each boundary cell face from the unknowns: :func:`_surface_flux`
     times :func:`_bond_forces`, the latter of the face-crossing bonds only (the other
     columns of the flux rows are zero; the same products, row by row)."""
-    used = np.unique(flux[1])
+    used = unique_ids(flux[1])
     return (_surface_flux(model, flux, n_surface)[:, used]
             @ _bond_forces(model, solver, used)).tocsr()
 

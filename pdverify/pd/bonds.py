@@ -10,6 +10,18 @@ import numpy as np
 _GAUSS_POINTS = 24
 
 
+def unique_ids(ids) -> np.ndarray:
+    """The distinct values of an integer array (node or bond numbers, keys of node pairs),
+    ascending: what ``np.unique(ids)`` returns, by a sort. numpy >= 2.3's ``np.unique``
+    without ``return_*`` hashes and then sorts, 40x slower on large id arrays: 0.72 s
+    against 17 ms for 0.7 million int64 keys (numpy 2.4.6, a side measurement), 0.6 s of
+    each paper-grid indentation run's setup (the half model's node pairs)."""
+    s = np.sort(np.asarray(ids).ravel())
+    if s.size:
+        s = s[np.concatenate(([True], s[1:] != s[:-1]))]
+    return s
+
+
 def stencil_offsets(dim: int, m_ratio: float) -> np.ndarray:
     """Non-zero integer offsets k whose cell [k - 1/2, k + 1/2]^d meets the open ball of
     radius m_ratio (units of the spacing), i.e. whose partial volume beta is > 0."""

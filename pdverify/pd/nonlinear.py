@@ -38,6 +38,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .bondbased import BondBasedModel
+from .bonds import unique_ids
 
 
 class _Pattern:
@@ -211,7 +212,7 @@ class NonlinearBondBased:
         bond from a node to itself)."""
         A, B, n = self.a.astype(np.int64), self.b.astype(np.int64), self.n
         lo, hi = np.minimum(A, B), np.maximum(A, B)
-        pairs = np.unique((lo * n + hi)[lo != hi])
+        pairs = unique_ids((lo * n + hi)[lo != hi])
         P = _Pattern(n, self.dim, pairs // n, pairs % n)
         k = np.searchsorted(pairs, lo * n + hi)
         k[lo == hi] = 0
