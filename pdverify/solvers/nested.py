@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import itertools
 import os
+import traceback
 import weakref
 from concurrent import futures
 
@@ -251,23 +252,32 @@ class SplitLU:
         futures.wait(jobs)      # both halves done (or failed) before anything is raised
         failed = next((job.exception() for job in jobs if job.exception() is not None), None)
         if failed is not None:
-            _release(keys)      # a half factored beside a failed one
+            del jobs            # their results hold a half factored beside the failed one,
+            _release(keys)      # which its thread then drops
             raise failed
-        # held by their threads (_HELD) until this object goes (_release)
-        weakref.finalize(self, _release, keys).atexit = False
         out = [job.result() for job in jobs]
         del jobs
-        self.lus = [o[0] for o in out]
-        self.factor_entries = int(sum(lu.nnz for lu in self.lus))
-        blocks = [self._separator_block(lu, L_ss, U_ss, m)
-                  for (lu, L_ss, U_ss), m in zip(out, (n1, n2))]
-        self.T = [T for T, _ in blocks]
-        self.crossed_pivots = int(sum(c for _, c in blocks))
-        # S by SuperLU (partial pivoting) in double, as LAPACK's threads stall when the
-        # machine is shared (measured, 921 unknowns, one of two cores busy: scipy's
-        # lu_factor 0.21 s, SuperLU 0.08 s, lu_factor with one BLAS thread 0.02 s)
-        S = self.T[0] + self.T[1] - 2 * g * np.eye(s)
-        self.S_lu = spla.splu(sp.csc_matrix(S), permc_spec="NATURAL")
+        try:
+            self.lus = [o[0] for o in out]
+            self.factor_entries = int(sum(lu.nnz for lu in self.lus))
+            blocks = [self._separator_block(lu, L_ss, U_ss, m)
+                      for (lu, L_ss, U_ss), m in zip(out, (n1, n2))]
+            self.T = [T for T, _ in blocks]
+            self.crossed_pivots = int(sum(c for _, c in blocks))
+            # S by SuperLU (partial pivoting) in double, as LAPACK's threads stall when
+            # the machine is shared (measured, 921 unknowns, one of two cores busy:
+            # scipy's lu_factor 0.21 s, SuperLU 0.08 s, lu_factor with one BLAS thread
+            # 0.02 s)
+            S = self.T[0] + self.T[1] - 2 * g * np.eye(s)
+            self.S_lu = spla.splu(sp.csc_matrix(S), permc_spec="NATURAL")
+        except BaseException as exc:
+            # the finished frames of the traceback (a _separator_block's) hold a factor
+            traceback.clear_frames(exc.__traceback__)
+            out = self.lus = None
+            _release(keys)
+            raise
+        # held by their threads (_HELD) until this object goes (_release)
+        weakref.finalize(self, _release, keys).atexit = False
 
     @staticmethod
     def _factor_half(C, idx, corner, m: int, dtype, key):

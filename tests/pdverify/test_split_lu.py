@@ -395,14 +395,17 @@ def _malloc_in_use():
     return info.uordblks + info.hblkhd
 
 
-def test_a_dropped_split_factor_gives_its_memory_back():
+@pytest.mark.parametrize("failing", [None, "second half", "separator"])
+def test_a_dropped_split_factor_gives_its_memory_back(failing, monkeypatch):
     """scipy's SuperLU frees a factor's memory only in the thread that made it (its
     allocations are tracked per thread; scipy issue 15921): SplitLU's halves, factored in
-    worker threads, are dropped there too (nested._release). Before, every SplitLU left
-    all of its halves' SuperLU memory behind (at least the factor's entries, 8 bytes each
-    in float32 with their row indices) when dropped: the test workers grew by 0.6 GB over
-    the fast tier. Here three of them made and dropped may leave less than one factor's
-    bytes (what the interpreter's own caches keep is far below that)."""
+    worker threads, are dropped there too (nested._release), also when the other half's
+    factor or the separator step fails (``failing``: the constructor raises). Before,
+    every SplitLU left all of its halves' SuperLU memory behind (at least the factor's
+    entries, 8 bytes each in float32 with their row indices) when dropped: the test
+    workers grew by 0.6 GB over the fast tier. Here three of them made and dropped may
+    leave less than one factor's bytes (what the interpreter's own caches keep is far
+    below that)."""
     import gc
     n = 100
     A = sp.diags([-1.0, -1.0, 4.0, -1.0, -1.0], [-n, -1, 0, 1, n], shape=(n * n, n * n))
@@ -411,19 +414,39 @@ def test_a_dropped_split_factor_gives_its_memory_back():
     A = A.tocsr()[p][:, p]
     if _malloc_in_use() is None:
         pytest.skip("needs glibc's mallinfo2")
+    half = SplitLU(A, 49 * n, 50 * n).factor_entries // 2     # entries of one half
+    factor_half, separator_block = SplitLU._factor_half, SplitLU._separator_block
+    if failing == "second half":
+        def factor(C, idx, corner, m, dtype, key):
+            if idx[0] != 0:                         # the second half's rows
+                raise RuntimeError("refused")
+            return factor_half(C, idx, corner, m, dtype, key)
+        monkeypatch.setattr(SplitLU, "_factor_half", staticmethod(factor))
+    elif failing == "separator":
+        def block(lu, L_ss, U_ss, m):
+            separator_block(lu, L_ss, U_ss, m)
+            raise RuntimeError("refused")
+        monkeypatch.setattr(SplitLU, "_separator_block", staticmethod(block))
 
     def one():
-        lu = SplitLU(A, 49 * n, 50 * n)
-        assert lu.separator == n and not lu.crossed_pivots
-        entries = lu.factor_entries
-        lu.solve(np.ones(n * n))
-        del lu
+        try:
+            lu = SplitLU(A, 49 * n, 50 * n)
+            assert lu.separator == n and not lu.crossed_pivots
+            lu.solve(np.ones(n * n))
+            del lu
+        except RuntimeError as exc:
+            assert failing and "refused" in str(exc)
+            # hold the exception until the halves' threads have dropped their factors:
+            # what its frames still hold is then freed here, in the wrong thread
+            for pool in nested._pools():
+                pool.submit(int).result()
         gc.collect()
         for pool in nested._pools():    # the halves' threads have dropped them
             pool.submit(int).result()
-        return entries
 
-    one()                               # the threads, the first allocations
+    one()                               # the first allocations
     before = _malloc_in_use()
-    entries = max(one() for _ in range(3))
-    assert _malloc_in_use() - before < 8 * entries, (_malloc_in_use() - before, entries)
+    for _ in range(3):
+        one()
+    assert not nested._HELD
+    assert _malloc_in_use() - before < 8 * half, (_malloc_in_use() - before, half)
