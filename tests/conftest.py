@@ -154,17 +154,12 @@ def _trace(what, nodeid):
     import time
     with open("/proc/self/statm") as fh:
         rss = int(fh.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+    from pdverify.budget import peak_rss, reset_peak_rss
     peak = rss
     if what == "start":
-        try:                      # "5": reset the peak resident set (Linux >= 4.0)
-            with open("/proc/self/clear_refs", "w") as fh:
-                fh.write("5")
-        except OSError:
-            pass
+        reset_peak_rss()
     else:
-        with open("/proc/self/status") as fh:
-            peak = next((int(line.split()[1]) * 1024 for line in fh
-                         if line.startswith("VmHWM:")), rss)
+        peak = int(peak_rss() or rss)
     with open(os.path.join(_TRACE, f"{os.getpid()}.log"), "a") as fh:
         fh.write(f"{what} {time.monotonic():.3f} {rss} {peak} {nodeid}\n")
 
