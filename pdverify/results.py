@@ -278,13 +278,20 @@ def atomic_write_text(path: str | os.PathLike, text: str) -> None:
     """Write ``text`` to ``path`` so that a reader sees the old file or the new, never half.
 
     The file gets the usual permissions (0666 under the umask), not mkstemp's 0600."""
+    atomic_write(path, lambda fh: fh.write(text), binary=False)
+
+
+def atomic_write(path: str | os.PathLike, write, *, binary: bool = True) -> None:
+    """Write ``path`` by ``write(fh)`` (a binary file object, or text in UTF-8 when not
+    ``binary``) so that a reader sees the old file or the new, never half; the usual
+    permissions (0666 under the umask). An error leaves no temporary file and is raised."""
     path = os.fspath(path)
     folder = os.path.dirname(os.path.abspath(path))
     os.makedirs(folder, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=".tmp-", dir=folder)
     try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
+        with (os.fdopen(fd, "wb") if binary else os.fdopen(fd, "w", encoding="utf-8")) as fh:
+            write(fh)
             fh.flush()
             os.fsync(fh.fileno())
         os.chmod(tmp, umask_mode(0o666))

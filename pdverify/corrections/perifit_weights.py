@@ -30,8 +30,6 @@ read back whole is a miss.
 from __future__ import annotations
 
 import hashlib
-import os
-import tempfile
 import time
 from functools import lru_cache
 from importlib.metadata import PackageNotFoundError, version
@@ -43,7 +41,7 @@ from .. import blas
 from ..outputs import cache_root
 from ..pd.closure import Closure
 from ..pd.statebased import StateBasedModel
-from ..results import CACHED_SETUP, note
+from ..results import CACHED_SETUP, atomic_write, note
 
 INSTALL = 'pip install ".[peers]" (perifit from PyPI)'
 #: scenes whose model perifit supports: 3D LPS and bond-based, 2D bond-based
@@ -136,18 +134,9 @@ def _load(key: str, n: int):
 
 
 def _store(key: str, w: np.ndarray, seconds: float) -> None:
-    path = _entry(key)
+    """The entry of ``key``, written whole or not at all (parallel runs read it)."""
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp.npz")
-        os.close(fd)
-        try:
-            np.savez(tmp, weights=w, seconds=seconds, key=key)
-            os.chmod(tmp, 0o644)   # mkstemp makes 0600; the cache is plain shared data
-            os.replace(tmp, path)  # whole or not at all, for parallel runs
-        finally:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
+        atomic_write(_entry(key), lambda fh: np.savez(fh, weights=w, seconds=seconds, key=key))
     except OSError:
         pass   # a read-only or full cache only costs time
 
