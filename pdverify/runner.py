@@ -134,10 +134,10 @@ def plan(only=None, quick=False, methods=None) -> list[tuple[str, str, dict]]:
 #: under a 6 GB ``ulimit -v`` one worker that had run all cases failed 21 runs of two
 #: scenes with MemoryError from its 179th run on, each of which passes alone at 0.5 GB.
 #: Most of that growth was SuperLU memory that split factors never gave back (0.6 GB of
-#: address space for one sheet2d-tension run; mended, see pdverify.solvers.nested._pools); the
-#: replacement stays for what else a process keeps. A fork of the report process costs
-#: milliseconds; the runs' results do not depend on
-#: which process ran them (tests/pdverify/test_cli.py: bitwise across jobs).
+#: address space for one sheet2d-tension run; mended, see pdverify.solvers.nested._pools);
+#: the replacement stays for what else a process keeps. A fork of the report process
+#: costs milliseconds; the runs' results do not depend on which process ran them
+#: (tests/pdverify/test_cli.py: bitwise across jobs).
 RUNS_PER_WORKER = 20
 HEAVY_FRACTION = 0.125
 

@@ -137,6 +137,7 @@ def _row(scene, r, metrics) -> dict:
     if _external(r.method):   # no cost pdverify measured
         t = {"setup_s": "n/a", "solve_s": "n/a", "total_s": "n/a"}
     paper = scene.published_for(r.method, r.params)
+    cached = _num3(t[CACHED_SETUP]) if t.get(CACHED_SETUP) else ""
     return {
         "anchor": run_anchor(r), "ok": r.status == "ok", "method": r.method, "params": _params(r, scene),
         "outcome": r.outcome, "expected": r.expected_failure,
@@ -149,10 +150,8 @@ def _row(scene, r, metrics) -> dict:
         # setup read from the cache, at the time it took when computed (results.CACHED_SETUP):
         # named beside the setup, and in the total, so that a warm cache does not make a
         # method look cheap
-        "cached": (f" (+ {_num3(t[CACHED_SETUP])} s from the cache)" if t.get(CACHED_SETUP)
-                   else ""),
-        "cached_note": (f"incl. {_num3(t[CACHED_SETUP])} s cached" if t.get(CACHED_SETUP)
-                        else ""),
+        "cached": f" (+ {cached} s from the cache)" if cached else "",
+        "cached_note": f"incl. {cached} s cached" if cached else "",
         "total": _num3(run_time_s({"total_s": 0, **t})),
         "solver": _solver(r.diagnostics),
         "peak": (f", peak memory {r.resources['peak_rss_gb']:.3g} GB"

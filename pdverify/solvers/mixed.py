@@ -28,6 +28,7 @@ def scaled_solve(b, trans: str, solve):
     scale = np.exp2(np.round(np.log2(np.where(big > 0, big, 1.0))))
     return solve(b / scale, trans) * scale
 
+
 #: LAPACK's mixed-precision dsgesv: at most 30 refinement steps, converged when
 #: ||r||_inf <= ||x||_inf ||A||_inf eps sqrt(n); otherwise the double LU takes over.
 REFINE_MAX_STEPS = 30
