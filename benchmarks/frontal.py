@@ -4,7 +4,7 @@ the tree, the path before) against the multifrontal
 
 Plain script (no test runner):
 
-    python benchmarks/frontal.py [--dir DIR] [--case NAME ...] [--repeat N] [--merge M ...]
+    python benchmarks/frontal.py --dir DIR [--case NAME ...] [--repeat N] [--merge M ...]
 
 A case is a system as ``solve_nested(A, rhs, coords)`` receives it, saved as
 ``DIR/NAME/{A.npz,b.npy,c.npy}`` (see ``benchmarks/mixed_precision.py`` for how a run's
@@ -36,7 +36,6 @@ import time
 
 import numpy as np
 
-DEFAULT_DIR = "/work/runs/s45/sys-frontal"
 #: per case, how many leading entries of x are the displacements (the Taylor systems'
 #: remaining unknowns are not unique: two exact solvers differ there by up to 2e-2)
 CASES = {"traction-taylor1": 8000, "manufactured-taylor2": 8000, "manufactured-snm3": 8000}
@@ -166,7 +165,8 @@ def main():
         worker(directory, case, alternative, out, int(merge))
         return
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--dir", default=DEFAULT_DIR)
+    p.add_argument("--dir", required=True,
+                   help="the folder of the saved systems, one subfolder NAME each")
     p.add_argument("--case", nargs="*", default=list(CASES))
     p.add_argument("--repeat", type=int, default=3)
     p.add_argument("--merge", type=int, nargs="*")
