@@ -11,6 +11,13 @@ converges to a relative residual of 1e-10 in 12 iterations, 0.41 s a solve
 (``benchmarks/solvers.py``); pyamg's smoothed aggregation with the same near-null space
 needed 12 iterations too, but its Gauss-Seidel smoother made a solve 1.5 s (a side
 measurement on the same matrix).
+
+The aggregates' width hardly matters: on a tangent of the half indentation model (26,082
+unknowns, a preconditioner built on the tangent 30 solves earlier; a side measurement,
+issue 32, one BLAS thread) widths 3, 4, 5, 6, 8 lattice nodes (coarse sizes 4,536 to
+692) took 19, 19, 20, 21, 23 iterations to 1e-6 at 34, 24, 19, 17, 16 ms an iteration:
+the Jacobi smoother, not the coarse space, sets the rate, and one horizon (m = 6) is as
+fast as any.
 """
 from __future__ import annotations
 

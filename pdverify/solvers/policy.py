@@ -92,7 +92,11 @@ def lattice_note(use_cg: bool, free_unknowns: int, nd: bool = False) -> str:
 #: The indentation's Newton steps (:class:`~pdverify.solvers.newton.DirichletLinearSolver`):
 #: ``solver=auto`` uses CG from this many unknowns: on the quick grid (41 x 41 nodes,
 #: m = 6, 3,362 unknowns) a sparse LU per Newton step made the corrected curve 13 s, CG
-#: 2.6 s.
+#: 2.6 s. On the paper grid's half model (26,082 unknowns, 5.6 M entries; a side
+#: measurement, issue 32) SuperLU's float32 factor of a tangent (MMD on A^T + A, symmetric
+#: mode) took 4.7 s with 46.8 M entries and 38 ms a solve: a factor per load step would
+#: cost more than the whole CG curve, and reused as CG's preconditioner an iteration
+#: (38 ms + the 8 ms product) would cost twice the two-level one's (~22 ms).
 NEWTON_CG_FROM_UNKNOWNS = 1000
 
 
