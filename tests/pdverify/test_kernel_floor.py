@@ -1,0 +1,75 @@
+"""benchmarks/kernel_floor.py's sorting of profiled time (issue 32): the floor it prints
+rests on each compiled call landing in its class."""
+import cProfile
+import importlib.util
+import pstats
+from pathlib import Path
+
+import numpy as np
+import scipy.linalg as sl
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _module():
+    spec = importlib.util.spec_from_file_location("kernel_floor",
+                                                  ROOT / "benchmarks" / "kernel_floor.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def _work():
+    rng = np.random.default_rng(0)
+    A = sp.random(400, 400, density=0.02, random_state=1, format="csr") + 10 * sp.identity(400)
+    A = A.tocsr()
+    x = rng.standard_normal(400)
+    for _ in range(50):
+        A @ x                                   # csr_matvec
+    (A @ A).tocsc()                             # csr_matmat, csr_tocsc
+    spla.splu(A.tocsc()).solve(x)               # SuperLU
+    sl.lu_factor(A.toarray())                   # LAPACK through scipy.linalg
+
+
+def test_each_kind_of_call_lands_in_its_class():
+    kf = _module()
+    prof = cProfile.Profile()
+    prof.enable()
+    _work()
+    prof.disable()
+    stats = pstats.Stats(prof).stats
+    seen = {}
+    for func in stats:
+        name = func[2]
+        for key in ("csr_matvec>", "csr_matmat>", "csr_tocsc>", "gstrf>", "'SuperLU' objects>"):
+            if name.endswith(key):
+                seen[key] = kf.classify(func)
+        if func[0].endswith("scipy/linalg/_decomp_lu.py") and name == "lu_factor":
+            seen["lu_factor"] = kf.classify(func)
+    assert seen == {"csr_matvec>": "sparse products with vectors",
+                    "csr_matmat>": "sparse assembly and conversions",
+                    "csr_tocsc>": "sparse assembly and conversions",
+                    "gstrf>": "SuperLU", "'SuperLU' objects>": "SuperLU",
+                    "lu_factor": "dense LAPACK"}
+    # a pdverify solver that calls LAPACK itself, a third-party package, plain Python
+    assert kf.classify(("/x/pdverify/solvers/frontal.py", 64, "__init__")) == "dense LAPACK"
+    assert kf.classify(("/x/site-packages/perifit/core/w.py", 1, "f")) == "perifit"
+    assert kf.classify(("/x/pdverify/pd/grid.py", 1, "f")) == "Python and numpy"
+    assert kf.classify(("~", 0, "<method 'take' of 'numpy.ndarray' objects>")) \
+        == "Python and numpy"
+
+
+def test_the_classes_add_up_to_the_profiled_time():
+    kf = _module()
+    prof = cProfile.Profile()
+    prof.enable()
+    _work()
+    prof.disable()
+    st = pstats.Stats(prof)
+    classes = kf.by_class(st)
+    assert set(classes) == set(kf.CLASSES)
+    # every function's own time in exactly one class: the sums agree to round-off
+    assert abs(sum(classes.values()) - st.total_tt) <= 1e-9 * max(st.total_tt, 1.0)
+    assert classes["sparse products with vectors"] > 0 and classes["SuperLU"] > 0
