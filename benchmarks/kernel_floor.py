@@ -58,7 +58,8 @@ def classify(func) -> str:
     if "perifit" in filename:
         return "perifit"
     if filename == "~":                              # a built-in (C) function
-        if "_superlu" in name or "SuperLU" in name or name == "<method 'acquire' of '_thread.lock' objects>":
+        if ("_superlu" in name or "SuperLU" in name
+                or name == "<method 'acquire' of '_thread.lock' objects>"):
             return "SuperLU"
         if "_sparsetools" in name:
             return ("sparse products with vectors" if name.split(".")[-1].rstrip(">")
