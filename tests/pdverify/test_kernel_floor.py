@@ -33,13 +33,17 @@ def _work():
     sl.lu_factor(A.toarray())                   # LAPACK through scipy.linalg
 
 
-def test_each_kind_of_call_lands_in_its_class():
-    kf = _module()
+def _profiled() -> pstats.Stats:
     prof = cProfile.Profile()
     prof.enable()
     _work()
     prof.disable()
-    stats = pstats.Stats(prof).stats
+    return pstats.Stats(prof)
+
+
+def test_each_kind_of_call_lands_in_its_class():
+    kf = _module()
+    stats = _profiled().stats
     seen = {}
     for func in stats:
         name = func[2]
@@ -63,11 +67,7 @@ def test_each_kind_of_call_lands_in_its_class():
 
 def test_the_classes_add_up_to_the_profiled_time():
     kf = _module()
-    prof = cProfile.Profile()
-    prof.enable()
-    _work()
-    prof.disable()
-    st = pstats.Stats(prof)
+    st = _profiled()
     classes = kf.by_class(st)
     assert set(classes) == set(kf.CLASSES)
     # every function's own time in exactly one class: the sums agree to round-off
