@@ -1,5 +1,5 @@
-"""How much of a report's run time is spent inside compiled numerical kernels (issue 32):
-the floor that no Python-side change can go below.
+"""How much of a report's run time is the solvers' arithmetic (issue 32): the floor that
+only other solvers or fewer runs would lower.
 
 Plain script (no test runner):
 
@@ -10,10 +10,12 @@ Runs the report's cases (``pdverify.runner.plan``, the full report unless ``--qu
 one after another in this process, each through ``Scene.run`` as a report worker runs it
 (one BLAS thread), under cProfile, and sorts the time by where it was spent:
 
-- **dense LAPACK**: the time of the functions that call LAPACK and little else (the
-  multifrontal factor and its solves, ``pdverify/solvers/frontal.py``; the dense LU,
-  ``dense.py``; scipy.linalg's and numpy.linalg's wrappers): f2py calls are not profiled
-  apart, so they count in their caller's own time, with the caller's few numpy lines;
+- **dense LAPACK**: the LAPACK and BLAS calls of the multifrontal factor
+  (``pdverify/solvers/frontal.py``: getrf, laswp, trsm, gemm) and of the dense LU
+  (``dense.py``), each wrapped here in a Python function so that cProfile times it apart
+  (f2py's calls are not profiled; unwrapped they count in their caller's own time, with
+  the caller's numpy work: the fronts' extend-add and copies), and scipy.linalg's and
+  numpy.linalg's wrappers (their own time is their LAPACK call and argument checks);
 - **SuperLU**: its factor (``gstrf``) and solves, and the main thread's waits on locks,
   which are the waits for the split factor's two halves (``pdverify.solvers.nested.
   SplitLU``: SuperLU in two threads that cProfile does not see);
@@ -32,14 +34,15 @@ default 2): with the same solvers doing the same arithmetic, no other change bri
 runs' wall time below it. The sparse assembly and conversions are compiled too, but
 partly avoidable (``pdverify.solvers.condense`` skips two conversions), so they are not
 in the floor. cProfile's overhead falls on the Python class (the compiled calls are timed
-once each), so the compiled shares are if anything understated. ``--stats FILE`` keeps the profile
-(``python -m pstats FILE``). Use the warm caches of a report (``PDVERIFY_CACHE_DIR``)
+once each), so the compiled shares are if anything understated; numpy's dense products
+(``@``) count as numpy. ``--stats FILE`` keeps the profile (``python -m pstats FILE``). Use the warm caches of a report (``PDVERIFY_CACHE_DIR``)
 to measure what a warm report computes.
 """
 from __future__ import annotations
 
 import argparse
 import collections
+import contextlib
 import cProfile
 import pstats
 import time
@@ -48,8 +51,43 @@ CLASSES = ("dense LAPACK", "SuperLU", "sparse products with vectors",
            "sparse assembly and conversions", "perifit", "Python and numpy")
 #: the solvers' arithmetic: the floor's classes
 ARITHMETIC = CLASSES[:3]
-#: functions of pdverify whose own time is LAPACK calls (f2py calls count in the caller)
-LAPACK_CALLERS = ("pdverify/solvers/frontal.py", "pdverify/solvers/dense.py")
+
+
+def _timed_lapack(f):
+    """``f`` (an f2py LAPACK or BLAS routine) behind a Python function, which cProfile
+    times apart: its own time is ``f``'s."""
+    def _lapack_call(*args, **kw):
+        return f(*args, **kw)
+    return _lapack_call
+
+
+class _TimedModule:
+    """A module whose callables are :func:`_timed_lapack`'s wrappers (``dense.lapack``)."""
+
+    def __init__(self, module):
+        self._module = module
+
+    def __getattr__(self, name):
+        return _timed_lapack(getattr(self._module, name))
+
+
+@contextlib.contextmanager
+def lapack_timed_apart():
+    """While open, the LAPACK and BLAS calls of ``pdverify.solvers.frontal`` and
+    ``pdverify.solvers.dense`` go through :func:`_timed_lapack` (the same calls, the same
+    results); restored on leaving."""
+    from pdverify.solvers import dense, frontal
+    saved = (frontal.get_lapack_funcs, frontal.get_blas_funcs, frontal._dlaswp, dense.lapack)
+    get_lapack, get_blas = saved[:2]
+    frontal.get_lapack_funcs = lambda *a, **k: tuple(map(_timed_lapack, get_lapack(*a, **k)))
+    frontal.get_blas_funcs = lambda *a, **k: tuple(map(_timed_lapack, get_blas(*a, **k)))
+    frontal._dlaswp = _timed_lapack(frontal._dlaswp)
+    dense.lapack = _TimedModule(dense.lapack)
+    try:
+        yield
+    finally:
+        (frontal.get_lapack_funcs, frontal.get_blas_funcs, frontal._dlaswp,
+         dense.lapack) = saved
 
 
 def classify(func) -> str:
@@ -65,8 +103,8 @@ def classify(func) -> str:
             return ("sparse products with vectors" if name.split(".")[-1].rstrip(">")
                     in ("csr_matvec", "csr_matvecs") else "sparse assembly and conversions")
         return "Python and numpy"
-    if filename.endswith(LAPACK_CALLERS) or "scipy/linalg/" in filename \
-            or "numpy/linalg/" in filename:
+    if (name == "_lapack_call" or "scipy/linalg/" in filename
+            or "numpy/linalg/" in filename):
         return "dense LAPACK"
     return "Python and numpy"
 
@@ -93,14 +131,15 @@ def main() -> None:
     prof = cProfile.Profile()
     per_scene = collections.Counter()
     t0 = time.perf_counter()
-    for scene, method, overrides in (c[:3] for c in cases):
-        t = time.perf_counter()
-        prof.enable()
-        try:
-            get_scene(scene).run(method, overrides)
-        finally:
-            prof.disable()
-        per_scene[scene] += time.perf_counter() - t
+    with lapack_timed_apart():
+        for scene, method, overrides in (c[:3] for c in cases):
+            t = time.perf_counter()
+            prof.enable()
+            try:
+                get_scene(scene).run(method, overrides)
+            finally:
+                prof.disable()
+            per_scene[scene] += time.perf_counter() - t
     wall = time.perf_counter() - t0
     stats = pstats.Stats(prof)
     if args.stats:
