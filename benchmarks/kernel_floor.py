@@ -35,8 +35,9 @@ runs' wall time below it. The sparse assembly and conversions are compiled too, 
 partly avoidable (``pdverify.solvers.condense`` skips two conversions), so they are not
 in the floor. cProfile's overhead falls on the Python class (the compiled calls are timed
 once each), so the compiled shares are if anything understated; numpy's dense products
-(``@``) count as numpy. ``--stats FILE`` keeps the profile (``python -m pstats FILE``). Use the warm caches of a report (``PDVERIFY_CACHE_DIR``)
-to measure what a warm report computes.
+(``@``) count as numpy. ``--stats FILE`` keeps the profile (``python -m pstats FILE``).
+Use the warm caches of a report (``PDVERIFY_CACHE_DIR``) to measure what a warm report
+computes.
 """
 from __future__ import annotations
 
