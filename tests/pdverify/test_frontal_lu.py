@@ -98,6 +98,30 @@ def test_float32_factor_solves_to_single_precision_and_refines():
     assert "refinement" not in diag        # plain refinement, no GMRES-IR
 
 
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_the_factor_does_not_depend_on_the_order_of_a_rows_entries(dtype):
+    """The nested-dissection ordering hands A over with unsorted rows: the factor is the
+    same, bit for bit, as of the sorted A (each entry is placed once; the columns' copy
+    is canonical either way)."""
+    A, tree = ordered("3d-3dofs")
+    A = A.sorted_indices()
+    shuffled = A.copy()
+    rng = np.random.default_rng(5)
+    for i in range(A.shape[0]):        # each row's entries in another order
+        lo, hi = shuffled.indptr[i], shuffled.indptr[i + 1]
+        p = lo + rng.permutation(hi - lo)
+        shuffled.indices[lo:hi], shuffled.data[lo:hi] = A.indices[p], A.data[p]
+    shuffled = sp.csr_matrix((shuffled.data, shuffled.indices, shuffled.indptr),
+                             shape=A.shape)
+    assert not shuffled.has_sorted_indices
+    b = np.random.default_rng(6).normal(size=A.shape[0])
+    x, y = (FrontalLU(M, tree, dtype=dtype, merge=64) for M in (A, shuffled))
+    for fx, fy in zip(x.fronts, y.fronts):
+        for ax, ay in zip(fx, fy):
+            assert (ax is None and ay is None) or np.array_equal(ax, ay)
+    assert np.array_equal(x.solve(b), y.solve(b))
+
+
 def test_singular_matrix_raises():
     """An exactly zero column: some front's pivot is exactly zero."""
     A, tree = ordered("2d")
