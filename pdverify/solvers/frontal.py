@@ -46,6 +46,34 @@ MERGE_SIZE = 4096
 _dlaswp, = get_lapack_funcs(("laswp",), dtype=np.float64)
 
 
+#: From this many update unknowns a child's update matrix goes into its parent front
+#: column run by column run (:func:`_extend_add`); below, by one ``np.ix_`` scatter.
+#: Measured (float32, a side measurement, minimum of 3): 4,258 update unknowns in 61 runs
+#: of consecutive places 565 -> 109 ms, in 500 runs 520 -> 207 ms, each place its own run
+#: 579 -> 209 ms; 500 unknowns in 50 runs 2.0 -> 1.0 ms, in 500 runs 2.2 -> 2.8 ms.
+EXTEND_ADD_BY_RUNS_FROM = 512
+
+
+def _extend_add(F, places, U, add: bool) -> None:
+    """``F[np.ix_(places, places)] = U`` (``add``: ``+=``), the same stores and sums: a
+    child's update unknowns land in runs of consecutive places of the parent front, and
+    from :data:`EXTEND_ADD_BY_RUNS_FROM` unknowns each run's columns are one slice
+    (``F[places, a:b]``), which numpy gathers and scatters faster than the 2D index."""
+    if places.size < EXTEND_ADD_BY_RUNS_FROM:
+        if add:
+            F[np.ix_(places, places)] += U
+        else:
+            F[np.ix_(places, places)] = U
+        return
+    starts = np.flatnonzero(np.diff(places) != 1) + 1
+    for s, e in zip(np.r_[0, starts], np.r_[starts, places.size]):
+        cols = slice(places[s], places[s] + e - s)
+        if add:
+            F[places, cols] += U[:, s:e]
+        else:
+            F[places, cols] = U[:, s:e]
+
+
 class FrontalLU:
     """Multifrontal LU of the nested-dissection-ordered square sparse ``A`` over ``tree``
     (a :class:`~pdverify.solvers.ordering.SeparatorTree`; each subtree of at most ``merge``
@@ -122,11 +150,7 @@ class FrontalLU:
             kids = sorted(kids, key=lambda c: -updates[c][0].size)
             for i, c in enumerate(kids):
                 cu, U = updates.pop(c)
-                lc = loc[cu]
-                if i == 0:
-                    F[np.ix_(lc, lc)] = U
-                else:
-                    F[np.ix_(lc, lc)] += U
+                _extend_add(F, loc[cu], U, add=i > 0)
                 del U
             # A's entries whose first eliminated index is an own one (no duplicates: +=),
             # placed by their offsets in F's Fortran-ordered buffer: one-dimensional

@@ -222,3 +222,48 @@ def test_duplicate_entries_are_summed():
     b = np.random.default_rng(5).normal(size=A.shape[0])
     x = FrontalLU(A, tree, dtype=np.float64).solve(b)
     assert np.array_equal(FrontalLU(twice, tree, dtype=np.float64).solve(b), x)
+
+
+@pytest.mark.parametrize("add", [False, True])
+@pytest.mark.parametrize("layout", ["runs", "scattered", "one run"])
+def test_extend_add_by_column_runs_is_the_2d_scatter(add, layout):
+    """frontal._extend_add stores and sums exactly what F[np.ix_(p, p)] (+)= U does, on
+    either side of EXTEND_ADD_BY_RUNS_FROM."""
+    from pdverify.solvers import frontal
+    rng = np.random.default_rng(7)
+    for nu in (frontal.EXTEND_ADD_BY_RUNS_FROM - 1, frontal.EXTEND_ADD_BY_RUNS_FROM + 37):
+        m = 3 * nu
+        if layout == "one run":
+            places = np.arange(5, 5 + nu)
+        elif layout == "scattered":
+            places = np.sort(rng.choice(m, nu, replace=False))
+        else:      # a few runs, not in ascending order (own and update places interleave)
+            places = np.concatenate([np.arange(a, a + k) for a, k in
+                                     zip((2 * nu, 10, nu + 3), (nu // 3, nu // 3,
+                                                                nu - 2 * (nu // 3)))])
+        U = np.asfortranarray(rng.standard_normal((nu, nu)).astype(np.float32))
+        F0 = np.asfortranarray(rng.standard_normal((m, m)).astype(np.float32))
+        F1 = F0.copy(order="F")
+        if add:
+            F0[np.ix_(places, places)] += U
+        else:
+            F0[np.ix_(places, places)] = U
+        frontal._extend_add(F1, places, U, add=add)
+        assert np.array_equal(F0.view(np.int32), F1.view(np.int32))
+
+
+def test_the_factor_is_the_same_whichever_way_the_updates_are_added(monkeypatch):
+    """The whole factor, bit for bit, with every extend-add by column runs and with every
+    one by np.ix_."""
+    from pdverify.solvers import frontal
+    A, tree = ordered("3d-3dofs")
+    b = np.random.default_rng(8).normal(size=A.shape[0])
+    out = []
+    for limit in (0, 10 ** 9):
+        monkeypatch.setattr(frontal, "EXTEND_ADD_BY_RUNS_FROM", limit)
+        lu = FrontalLU(A, tree, dtype=np.float32, merge=64)
+        out.append((lu.fronts, lu.solve(b)))
+    for fx, fy in zip(out[0][0], out[1][0]):
+        for ax, ay in zip(fx, fy):
+            assert (ax is None and ay is None) or np.array_equal(ax, ay)
+    assert np.array_equal(out[0][1], out[1][1])
