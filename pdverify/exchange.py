@@ -36,6 +36,11 @@ AXES = "xyz"
 #: largest displacement before the record warns: a result written with 9 significant
 #: digits or more stays below it; a code that imposed other values does not
 PRESCRIBED_RTOL = 1e-9
+#: the length units a CSV column may name in brackets (``ux [mm]``) and how many of each
+#: make a metre (a value is divided by it: an exact integer, so a value in mm becomes the
+#: double nearest its metres); no unit is metres. ``µm`` with the micro sign or Greek mu.
+LENGTH_UNITS = {"m": 1.0, "cm": 1e2, "mm": 1e3, "um": 1e6, "\u00b5m": 1e6, "nm": 1e9}
+_UNIT_ALIASES = {"\u03bcm": "\u00b5m"}
 
 
 def exportable(scene) -> bool:
@@ -144,6 +149,21 @@ def _column_name(text: str) -> str:
     return text.split("[", 1)[0].strip().lower()
 
 
+def _per_metre(path: str, header: str) -> float:
+    """How many of the unit a column ``header`` names in brackets make a metre (``"ux
+    [mm]"`` -> 1000; no brackets: metres, 1); another unit is InputError naming the
+    column and the allowed units."""
+    if "[" not in header:
+        return 1.0
+    unit = header.split("[", 1)[1].rsplit("]", 1)[0].strip()
+    unit = _UNIT_ALIASES.get(unit, unit)
+    if unit not in LENGTH_UNITS:
+        raise InputError(f"displacement file {path!r}: column {header.strip()!r} has unit "
+                         f"{unit!r}; allowed length units: {', '.join(LENGTH_UNITS)} "
+                         "(none: m)")
+    return LENGTH_UNITS[unit]
+
+
 #: names of a displacement component's column (CSV) or array (VTU, Exodus): ux, u_x, ...
 _U_NAMES = ("u{a}", "u_{a}", "displacement_{a}", "displacements_{a}", "displacement{a}",
             "displacements{a}")
@@ -151,26 +171,41 @@ _U_NAMES = ("u{a}", "u_{a}", "displacement_{a}", "displacements_{a}", "displacem
 
 def read_displacements(path: str, dim: int) -> Displacements:
     """Positions and displacements from a CSV (header row: ``x, y, z`` and ``ux, uy,
-    uz`` or ``u_x``..., units in brackets allowed, ``#`` lines skipped), a VTU (meshio:
-    points and a point array ``u``/``displacement(s)`` or its components) or an Exodus
-    file (:func:`_read_exodus`: its last time step). Any problem is InputError naming
-    the file."""
+    uz`` or ``u_x``..., a length unit in brackets scaled to metres (:data:`LENGTH_UNITS`),
+    ``#`` lines skipped, a UTF-8 byte-order mark allowed), a VTU (meshio: points and a
+    point array ``u``/``displacement(s)`` or its components) or an Exodus file
+    (:func:`_read_exodus`: its last time step). Any problem is InputError naming the
+    file, and so is a file without nodes, with fewer coordinates than ``dim`` or whose
+    displacements are all zero (an initial state: every exported problem has a load or
+    a prescribed value that is not zero)."""
     from .validate import input_file
     input_file(path, "displacement file")
     ext = os.path.splitext(path)[1].lower()
     if ext in (".csv", ".txt"):
-        return _read_csv(path, dim)
-    if ext == ".vtu":
-        return _read_mesh(path, dim, "vtu")
-    if ext in (".e", ".exo", ".ex2", ".exodus"):
-        return _read_exodus(path, dim)
-    raise InputError(f"displacement file {path!r}: unknown kind {ext or '(no extension)'!r}; "
-                     "allowed: .csv, .vtu, .e/.exo (Exodus, read through meshio)")
+        got = _read_csv(path, dim)
+    elif ext == ".vtu":
+        got = _read_mesh(path, dim, "vtu")
+    elif ext in (".e", ".exo", ".ex2", ".exodus"):
+        got = _read_exodus(path, dim)
+    else:
+        raise InputError(f"displacement file {path!r}: unknown kind "
+                         f"{ext or '(no extension)'!r}; allowed: .csv, .vtu, .e/.exo (Exodus)")
+    if not len(got.x):
+        raise InputError(f"displacement file {path!r} holds no nodes"
+                         + (" (no data rows below its header)" if got.kind == "csv" else ""))
+    if got.x.shape[1] < dim:
+        raise InputError(f"displacement file {path!r}: its nodes have {got.x.shape[1]} "
+                         f"coordinate(s), the scene {dim} ({', '.join(AXES[:dim])})")
+    if not np.any(got.u):
+        raise InputError(f"displacement file {path!r}: every displacement is zero (an "
+                         "initial state, not a solution: the exported problem has loads or "
+                         "prescribed values that are not zero)")
+    return got
 
 
 def _read_csv(path: str, dim: int) -> Displacements:
     try:
-        with open(path, encoding="utf-8", newline="") as fh:
+        with open(path, encoding="utf-8-sig", newline="") as fh:   # a BOM is skipped
             lines = [ln for ln in fh if ln.strip() and not ln.lstrip().startswith("#")]
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"displacement file {path!r} cannot be read ({exc})") from None
@@ -189,6 +224,7 @@ def _read_csv(path: str, dim: int) -> Displacements:
                          f"{', '.join(missing)}; it has {', '.join(names) or 'none'} "
                          f"(need {', '.join(want_x)} and {', '.join(f'u{a}' for a in AXES[:dim])})")
     cols = [names.index(c) for c in want_x + want_u]
+    per_metre = np.array([_per_metre(path, rows[0][c]) for c in cols])
     data = np.empty((len(rows) - 1, 2 * dim))
     for i, row in enumerate(rows[1:]):
         try:
@@ -197,6 +233,7 @@ def _read_csv(path: str, dim: int) -> Displacements:
             raise InputError(f"displacement file {path!r}: data row {i + 1} is not "
                              f"{len(cols)} numbers in the named columns: {row!r}") from None
     _check_finite(path, data)
+    data = data / per_metre   # metres (a column in m keeps its values bit for bit)
     return Displacements(path, "csv", data[:, :dim], data[:, dim:])
 
 
@@ -287,6 +324,11 @@ def _read_exodus(path: str, dim: int) -> Displacements:
     else:
         raise InputError(f"displacement file {path!r}: no node coordinates (coordx / coord)")
     names = text(found["name_nod_var"]) if "name_nod_var" in found else []
+    steps = [np.shape(v)[0] for k, v in found.items()
+             if k == "time_whole" or k.startswith("vals_nod_var")]
+    if steps and min(steps) == 0:
+        raise InputError(f"displacement file {path!r}: the Exodus file has no time steps "
+                         "(time_whole or its nodal variables are empty): no result written")
     step = -1
     data = {}
     for k, name in enumerate(names):

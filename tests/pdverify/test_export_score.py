@@ -598,3 +598,106 @@ def test_a_shape_body_exports_its_cut_volumes_and_part_loads(tmp_path):
     assert len(rows) == len(ns.x) + 1
     np.testing.assert_array_equal([float(r.split(",")[3]) for r in rows[1:]], ns.volume)
     assert files["perilab/mesh.txt"].splitlines()[0] == "header: x y block_id volume"
+
+# ------------------------------------------------------------------------------ issue 49
+@pytest.mark.parametrize("header, scale, ok", [
+    (("x [mm]", "ux [mm]"), 1e3, True),
+    (("x [m]", "ux [cm]"), (1.0, 1e2), True),
+    (("x", "u_x [\u00b5m]"), (1.0, 1e6), True),
+    (("x [nm]", "ux [um]"), (1e9, 1e6), True),
+    (("x [m]", "ux [in]"), 1.0, "column 'ux [in]' has unit 'in'"),
+    (("x [ft]", "ux [m]"), 1.0, "column 'x [ft]' has unit 'ft'"),
+])
+def test_length_units_in_csv_headers(tmp_path, capsys, header, scale, ok):
+    """Issue 49: a length unit in brackets is honoured (positions and displacements,
+    scaled to metres); any other is refused in one line naming the column and the unit
+    and listing the allowed ones."""
+    native, x, u = _native("bar1d-traction")
+    sx, su = (scale, scale) if np.isscalar(scale) else scale
+    sent = tmp_path / "back.csv"
+    sent.write_text(",".join(header) + "\n" + "".join(
+        f"{float(a) * sx!r},{float(b) * su!r}\n" for a, b in zip(x[:, 0], u[:, 0])))
+    out = tmp_path / "r.json"
+    rc = main(["score", "bar1d-traction", str(sent), "--name", "c", "--out", str(out)])
+    err = capsys.readouterr().err
+    if ok is True:
+        assert rc == 0, err
+        run = json.loads(out.read_text())["runs"][0]
+        # each displacement went through two roundings (times and divided by the unit's
+        # power of ten): 2 eps of u; the errors measured are above 1e-3 of u (the bar's
+        # max_error_pct is ~24 %), so they move by less than 1e-12 relative
+        for key in ("max_error_pct", "rel_l2_error"):
+            np.testing.assert_allclose(run["metrics"][key], native.metrics[key], rtol=1e-12,
+                                       err_msg=key)
+        # the prescribed node's value came back within those roundings of u_cl(x_1)
+        assert run["diagnostics"]["external"]["prescribed_max_deviation_m"] <= (
+            4 * np.finfo(float).eps * np.abs(u).max())
+    else:
+        assert rc == 2 and err.count("\n") == 1 and ok in err, err
+        assert "allowed length units: m, cm, mm, um, \u00b5m, nm" in err
+        assert not out.exists()
+
+
+def _exodus_at(path, x, u, *, steps=2):
+    """:func:`_write_exodus`'s layout (per-variable) with ``steps`` time steps (0: a run
+    that wrote none) and as many coordinates as ``x`` has columns."""
+    from scipy.io import netcdf_file
+    n, d = x.shape
+    with netcdf_file(path, "w", version=2) as nc:
+        nc.createDimension("time_step", steps if steps else None)   # None: unlimited, 0
+        nc.createDimension("num_nodes", n)
+        nc.createDimension("num_nod_var", u.shape[1])
+        nc.createDimension("len_name", 33)
+        nc.createVariable("time_whole", "d", ("time_step",))[:] = np.arange(float(steps))
+        for k in range(d):
+            nc.createVariable(f"coord{'xyz'[k]}", "d", ("num_nodes",))[:] = x[:, k]
+        names = [f"Displacement{a}" for a in "XYZ"[:u.shape[1]]]
+        nc.createVariable("name_nod_var", "c", ("num_nod_var", "len_name"))[:] = np.array(
+            [list(name.ljust(33, "\0")) for name in names], dtype="S1")
+        for k in range(u.shape[1]):
+            v = nc.createVariable(f"vals_nod_var{k + 1}", "d", ("time_step", "num_nodes"))
+            if steps:
+                v[:] = np.stack([np.zeros(n)] * (steps - 1) + [u[:, k]])
+
+
+@pytest.mark.parametrize("case, needle", [
+    ("zeros", "every displacement is zero"),
+    ("no-steps", "has no time steps"),
+    ("one-coordinate", "its nodes have 1 coordinate(s), the scene 2"),
+    ("no-rows", "holds no nodes (no data rows below its header)"),
+])
+def test_degenerate_files_are_refused(tmp_path, capsys, case, needle):
+    """Issue 49: files that hold no answer are refused in one line (exit 2), never a
+    traceback: all-zero displacements (a ZeroDivisionError in score's warning before),
+    an Exodus file without time steps (an IndexError), a 2D scene's file with one
+    coordinate per node (a KD-tree's dimension error), a CSV with a header only."""
+    _, x, u = _native("plate2d-plane-strain", {"spacing": 0.1})
+    sent = tmp_path / ("back.csv" if case in ("zeros", "no-rows") else "result.e")
+    if case == "zeros":
+        _write_csv(sent, x, np.zeros_like(u))
+    elif case == "no-rows":
+        _write_csv(sent, x[:0], u[:0])
+    elif case == "no-steps":
+        _exodus_at(sent, x, u, steps=0)
+    else:
+        _exodus_at(sent, x[:, :1], u)
+    out = tmp_path / "r.json"
+    assert main(["score", "plate2d-plane-strain", str(sent), "--set", "spacing=0.1",
+                 "--name", "c", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and needle in err and str(sent) in err, err
+    assert not out.exists()
+
+
+def test_csv_with_byte_order_mark_is_read(tmp_path, capsys):
+    """Issue 49: a CSV saved with a UTF-8 byte-order mark (Excel's "CSV UTF-8") is read
+    as without one: the same metrics to the last bit."""
+    native, x, u = _native("bar1d-traction")
+    plain = tmp_path / "plain.csv"
+    _write_csv(plain, x, u)
+    sent = tmp_path / "bom.csv"
+    sent.write_bytes(b"\xef\xbb\xbf" + plain.read_bytes())
+    out = tmp_path / "r.json"
+    assert main(["score", "bar1d-traction", str(sent), "--name", "c", "--out",
+                 str(out)]) == 0, capsys.readouterr().err
+    _assert_same_metrics(native, json.loads(out.read_text())["runs"][0])
