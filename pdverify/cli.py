@@ -12,8 +12,8 @@ usage:
   python -m pdverify compare --against-published RESULTS.json
   python -m pdverify export SCENE [--method none] [--set KEY=VALUE ...]
                           --format {csv,vtu,peridigm,perilab} --out DIR
-  python -m pdverify score SCENE FILE [--set KEY=VALUE ...] --name NAME [--out FILE.json]
-                          [--force]
+  python -m pdverify score SCENE FILE [--export DIR] [--set KEY=VALUE ...] --name NAME
+                          [--out FILE.json] [--force]
 
 Exit codes: 0 success; 1 a run failed numerically, a regression was found, or an output
 could not be written after the work (one line naming it; a report stays in its staging
@@ -155,8 +155,14 @@ def build_parser() -> argparse.ArgumentParser:
                                        "exported node set, as pdverify measures its runs")
     sco.add_argument("scene", help="the scene that was exported")
     sco.add_argument("file", help="displacements: CSV (x, y, z, ux, uy, uz), VTU or Exodus")
+    sco.add_argument("--export", default=None, metavar="DIR",
+                     help="the export folder FILE answers: its problem.json gives the scene's "
+                          "parameters (default: the first of FILE's folder and its parents "
+                          "holding .pdverify-export; none found: the --set given, and the "
+                          "record warns)")
     sco.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                     help="the --set of the export; repeat for several")
+                     help="the --set of the export (with an export found, each must agree "
+                          "with its value); repeat for several")
     sco.add_argument("--name", required=True,
                      help="the code's name; the run's method becomes external:NAME")
     sco.add_argument("--out", default=None, metavar="FILE.json",
@@ -296,8 +302,8 @@ def _dispatch(args) -> int:
         from .exchange import score_command
         from .params import parse_assignments
         return score_command(args.scene, args.file, name=args.name,
-                             overrides=parse_assignments(args.set), out=args.out,
-                             force=args.force)
+                             overrides=parse_assignments(args.set), export=args.export,
+                             out=args.out, force=args.force)
     if args.command == "compare" and args.against_published is not None:
         extra = [f for f, v in (("BASELINE", args.baseline), ("NEW", args.new),
                                 ("--rtol", args.rtol), ("--atol", args.atol),

@@ -388,17 +388,104 @@ def match_nodes(ns: NodeSet, given: Displacements) -> np.ndarray:
 
 
 # ------------------------------------------------------------------------------ scoring
-def score(scene_id: str, path: str, *, name: str, overrides=None):
+#: the record's warning when no export was found for the file (:func:`score`)
+NO_EXPORT_WARNING = ("the parameters could not be checked against an export: no "
+                     "--export DIR given and no .pdverify-export in the file's folder or "
+                     "its parents; scored at the given --set (defaults elsewhere)")
+
+
+def _find_export(path: str, export: str | None) -> str | None:
+    """The export folder the displacement file ``path`` answers: ``export`` (``--export
+    DIR``), else the first of the file's folder and its parents that holds the marker
+    ``.pdverify-export``; None when there is none."""
+    from .decks import MARKER
+    if export is not None:
+        if not str(export).strip() or not os.path.isdir(export):
+            raise InputError(f"--export {export!r} is not a folder; give the folder "
+                             "pdverify export wrote")
+        if not os.path.isfile(os.path.join(export, MARKER)):
+            raise InputError(f"--export {export!r} holds no pdverify export (no {MARKER})")
+        return os.path.abspath(export)
+    folder = os.path.dirname(os.path.abspath(path))
+    while True:
+        if os.path.isfile(os.path.join(folder, MARKER)):
+            return folder
+        parent = os.path.dirname(folder)
+        if parent == folder:
+            return None
+        folder = parent
+
+
+def _export_params(scene, folder: str, given: bool, overrides) -> dict:
+    """The params of the export in ``folder`` (its ``problem.json``), checked: its scene
+    is ``scene``, and each ``--set`` in ``overrides`` takes the export's value. Returns
+    ``diagnostics.external.export``."""
+    from .decks import MARKER, MARKER_SCHEMA
+    where = (f"--export {folder!r}" if given else
+             f"the export {folder!r} (the first folder above the displacement file holding "
+             f"{MARKER}; give --export DIR for another)")
+    try:
+        with open(os.path.join(folder, MARKER), encoding="utf-8") as fh:
+            marker = json.load(fh)
+        with open(os.path.join(folder, "problem.json"), encoding="utf-8") as fh:
+            doc = json.load(fh)
+    except (OSError, ValueError) as exc:
+        raise InputError(f"{where}: cannot read its {MARKER} and problem.json "
+                         f"({type(exc).__name__}: {exc})") from None
+    if (not isinstance(marker, dict) or marker.get("schema") != MARKER_SCHEMA
+            or not isinstance(doc, dict) or doc.get("schema") != "pdverify.export/1"
+            or not isinstance(doc.get("params"), dict) or not isinstance(doc.get("scene"), str)):
+        raise InputError(f"{where}: its {MARKER} or problem.json is not pdverify's "
+                         f"(schemas {MARKER_SCHEMA} and pdverify.export/1 with scene and params)")
+    if doc["scene"] != scene.id:
+        raise InputError(f"{where} is an export of scene {doc['scene']!r}, not {scene.id!r}")
+    try:
+        ours = scene.resolve(METHOD, doc["params"])
+    except InputError as exc:
+        raise InputError(f"{where}: its problem.json params do not resolve ({exc})") from None
+    with_set = scene.resolve(METHOD, {**doc["params"], **dict(overrides or {})})
+    for key, raw in (overrides or {}).items():
+        if with_set[key] != ours[key]:
+            raise InputError(f"--set {key}={raw}: {where} was made with {key}={ours[key]!r}; "
+                             "drop the --set, or score against the export made with it")
+    return {"folder": folder, "found_by": "--export" if given else MARKER,
+            "pdverify_version": marker.get("pdverify_version"), "nodes": doc.get("nodes"),
+            "params": ours}
+
+
+def score(scene_id: str, path: str, *, name: str, overrides=None, export=None):
     """The run record of the displacements in ``path`` on the exported node set of
-    ``scene_id`` (module docstring); bad input is InputError before the measure."""
-    from .results import RunResult
+    ``scene_id`` (module docstring); bad input is InputError before the measure.
+
+    Provenance: the export the file answers (``export``, else :func:`_find_export`)
+    gives the params (a ``--set`` in ``overrides`` must agree with it) and is recorded
+    in ``diagnostics.external.export``; without one, the file is scored at
+    ``overrides`` and the record warns (:data:`NO_EXPORT_WARNING`)."""
     scene = scene_of(scene_id)
     if not name or any(c.isspace() for c in name):
         raise InputError(f"--name {name!r}: give a non-empty name without spaces "
                          "(the run's method becomes external:NAME)")
+    folder = _find_export(path, export)
+    origin = None
+    if folder is not None:
+        origin = _export_params(scene, folder, export is not None, overrides)
+        overrides = origin["params"]
+    record = _score_file(scene, path, name=name, overrides=overrides, origin=origin)
+    if origin is None:
+        record.warnings.insert(0, NO_EXPORT_WARNING)
+    return record
+
+
+def _score_file(scene, path: str, *, name: str, overrides, origin):
+    """:func:`score` at ``overrides``, the params of the export ``origin`` (or None)."""
+    from .results import RunResult
     scene.resolve(METHOD, overrides)                 # bad --set before reading the file
     given = read_displacements(path, scene.dim)
     ns = node_set(scene, overrides)
+    if origin is not None and origin["nodes"] not in (None, len(ns.x)):
+        raise InputError(f"the export {origin['folder']!r} has {origin['nodes']} nodes, the "
+                         f"node set of its params {len(ns.x)} here (written by pdverify "
+                         f"{origin['pdverify_version']}); export it again")
     order = match_nodes(ns, given)
     U = given.u[order]
     d, n = ns.dim, len(ns.x)
@@ -418,7 +505,7 @@ def score(scene_id: str, path: str, *, name: str, overrides=None):
               **({"time": given.time_s} if given.time_s is not None else {}),
               "match_tolerance_m": MATCH_TOLERANCE * ns.spacing,
               "prescribed_max_deviation_m": deviation,
-              "cost_measured": False}
+              "cost_measured": False, **({"export": origin} if origin is not None else {})}
     info = {"solver": "external", "external": source}
     outcome = ns.scene.measure(ns.params, ns.problem, ns.system, x, info)
     record = RunResult(scene=scene.id, method=f"external:{name}", params=ns.params,
@@ -493,8 +580,8 @@ def dumps(doc: dict) -> str:
 
 
 # ------------------------------------------------------------------------------ commands
-def score_command(scene_id: str, path: str, *, name: str, overrides=None, out=None,
-                  force=False, stream=None) -> int:
+def score_command(scene_id: str, path: str, *, name: str, overrides=None, export=None,
+                  out=None, force=False, stream=None) -> int:
     """``pdverify score``: check, read, match, measure, print, write the record."""
     import sys
     from . import validate
@@ -507,7 +594,7 @@ def score_command(scene_id: str, path: str, *, name: str, overrides=None, out=No
                  if out is not None else None)
     from .outputs import check_cache
     check_cache()       # a FEM reference is computed once and cached
-    record = score(scene_id, path, name=name, overrides=overrides)
+    record = score(scene_id, path, name=name, overrides=overrides, export=export)
     src = record.diagnostics["external"]
     print(f"{record.scene} --method {record.method} (reference: {record.reference}): "
           f"{record.status}", file=stream)
@@ -519,6 +606,11 @@ def score_command(scene_id: str, path: str, *, name: str, overrides=None, out=No
     print(f"  displacements: {path} ({src['kind']}, {src['nodes']} nodes matched within "
           f"{src['match_tolerance_m']:.3g} m); prescribed values: largest deviation "
           f"{src['prescribed_max_deviation_m']:.3g} m; cost not measured", file=stream)
+    if "export" in src:
+        print(f"  parameters: those of the export {src['export']['folder']} (its "
+              "problem.json; scene and --set checked)", file=stream)
+    else:
+        print("  parameters: not checked against an export (see the warning)", file=stream)
     if json_path:
         write_results(json_path, [record])
     return 0

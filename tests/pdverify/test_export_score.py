@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from pdverify.cli import main
-from pdverify.exchange import MATCH_TOLERANCE
+from pdverify.exchange import MATCH_TOLERANCE, NO_EXPORT_WARNING
 from pdverify.scenes import get_scene
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -86,6 +86,9 @@ def _assert_same_metrics(native, scored):
 
 
 def _round_trip(tmp_path, capsys, scene_id, overrides):
+    """Each format out and both ways back: the CSV inside the export folder with the
+    export's --set (the export is found above the file), the VTU outside it with
+    --export and no --set (the params come from the export's problem.json)."""
     native, x, u = _native(scene_id, overrides)
     sets = [a for k, v in overrides.items() for a in ("--set", f"{k}={v}")]
     for fmt in FORMATS:
@@ -94,15 +97,23 @@ def _round_trip(tmp_path, capsys, scene_id, overrides):
         positions = _exported_positions(folder, fmt, x.shape[1])
         back = _solution_at(x, u, positions)
         for kind in ("csv", "vtu"):
-            sent = tmp_path / f"{fmt}-back.{kind}"
+            if kind == "csv":
+                (folder / "results").mkdir()
+                sent = folder / "results" / "back.csv"
+                how = sets
+            else:
+                sent = tmp_path / f"{fmt}-back.vtu"
+                how = ["--export", str(folder)]
             (_write_csv if kind == "csv" else _write_vtu)(sent, positions, back)
             record = tmp_path / f"{fmt}-{kind}.json"
-            assert main(["score", scene_id, str(sent), *sets, "--name", "selftest",
+            assert main(["score", scene_id, str(sent), *how, "--name", "selftest",
                          "--out", str(record)]) == 0, capsys.readouterr().err
             run = json.loads(record.read_text())["runs"][0]
             assert run["method"] == "external:selftest"
             assert run["params"] == json.loads(json.dumps(native.params))
             assert run["diagnostics"]["external"]["prescribed_max_deviation_m"] == 0.0
+            assert run["diagnostics"]["external"]["export"]["folder"] == str(folder)
+            assert run["diagnostics"]["external"]["export"]["params"] == run["params"]
             assert run["warnings"] == []
             assert run["timings"] == {"setup_s": 0.0, "solve_s": 0.0, "total_s": 0.0}
             _assert_same_metrics(native, run)
@@ -212,7 +223,9 @@ def test_other_prescribed_values_are_scored_and_warned(bar_back, capsys):
     # |0 - u_cl(x_1)|, u_cl(x_1) = 1e4 * 0.025 / (1e9 * 0.01): a few roundings
     assert run["diagnostics"]["external"]["prescribed_max_deviation_m"] == pytest.approx(
         2.5e-5, rel=4 * np.finfo(float).eps)
-    assert len(run["warnings"]) == 1 and "prescribed nodes" in run["warnings"][0]
+    # the file was scored without an export (issue 49: the record says so), and warned
+    assert len(run["warnings"]) == 2 and run["warnings"][0] == NO_EXPORT_WARNING
+    assert "prescribed nodes" in run["warnings"][1]
 
 
 def test_node_within_tolerance_is_accepted(bar_back, capsys):
@@ -599,6 +612,7 @@ def test_a_shape_body_exports_its_cut_volumes_and_part_loads(tmp_path):
     np.testing.assert_array_equal([float(r.split(",")[3]) for r in rows[1:]], ns.volume)
     assert files["perilab/mesh.txt"].splitlines()[0] == "header: x y block_id volume"
 
+
 # ------------------------------------------------------------------------------ issue 49
 @pytest.mark.parametrize("header, scale, ok", [
     (("x [mm]", "ux [mm]"), 1e3, True),
@@ -701,3 +715,75 @@ def test_csv_with_byte_order_mark_is_read(tmp_path, capsys):
     assert main(["score", "bar1d-traction", str(sent), "--name", "c", "--out",
                  str(out)]) == 0, capsys.readouterr().err
     _assert_same_metrics(native, json.loads(out.read_text())["runs"][0])
+
+
+@pytest.fixture
+def bar_export(tmp_path):
+    """bar1d-traction exported with E = 2e9 Pa (not the default 1e9: the same nodes,
+    twice the stiffness), and its solution."""
+    folder = tmp_path / "export"
+    assert main(["export", "bar1d-traction", "--set", "E=2e9", "--format", "csv",
+                 "--out", str(folder)]) == 0
+    native, x, u = _native("bar1d-traction", {"E": 2e9})
+    return folder, native, x, u
+
+
+def test_score_takes_the_params_of_its_export(bar_export, capsys):
+    """Issue 49: a file inside an export folder (here a subfolder) is scored at the
+    export's params without any --set (it was scored at the default E, status ok), and
+    the record names the export."""
+    folder, native, x, u = bar_export
+    (folder / "mine").mkdir()
+    sent = folder / "mine" / "back.csv"
+    _write_csv(sent, x, u)
+    out = folder.parent / "r.json"
+    assert main(["score", "bar1d-traction", str(sent), "--name", "c", "--out",
+                 str(out)]) == 0, capsys.readouterr().err
+    printed = capsys.readouterr().out
+    run = json.loads(out.read_text())["runs"][0]
+    assert run["params"]["E"] == 2e9 and run["warnings"] == []
+    _assert_same_metrics(native, run)
+    export = run["diagnostics"]["external"]["export"]
+    assert export["folder"] == str(folder) and export["params"] == run["params"]
+    assert f"the export {folder}" in printed
+
+
+@pytest.mark.parametrize("how, needle", [
+    ("set", "--set E=1e9: --export"),
+    ("scene", "is an export of scene 'bar1d-traction', not 'bar1d-uniform-load'"),
+    ("not-export", "holds no pdverify export"),
+])
+def test_score_refuses_what_disagrees_with_its_export(bar_export, capsys, how, needle):
+    """Issue 49: a --set that disagrees with the export's value, another scene than the
+    export's, or an --export folder that is no export: one line, exit 2."""
+    folder, _, x, u = bar_export
+    sent = folder.parent / "back.csv"
+    _write_csv(sent, x, u)
+    argv = {"set": ["bar1d-traction", str(sent), "--export", str(folder), "--set",
+                    "E=1e9"],
+            "scene": ["bar1d-uniform-load", str(sent), "--export", str(folder)],
+            "not-export": ["bar1d-traction", str(sent), "--export", str(folder.parent)],
+            }[how]
+    assert main(["score", *argv, "--name", "c"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and needle in err, err
+    if how == "set":   # both values named
+        assert "made with E=2000000000.0" in err
+
+
+def test_score_without_an_export_warns(tmp_path, capsys):
+    """Issue 49: no --export and no export above the file: scored at the --set given
+    (defaults elsewhere), and the record and the printed output say the params were
+    not checked."""
+    native, x, u = _native("bar1d-traction")
+    sent = tmp_path / "back.csv"
+    _write_csv(sent, x, u)
+    out = tmp_path / "r.json"
+    assert main(["score", "bar1d-traction", str(sent), "--name", "c", "--out",
+                 str(out)]) == 0
+    printed = capsys.readouterr().out
+    run = json.loads(out.read_text())["runs"][0]
+    assert run["warnings"] == [NO_EXPORT_WARNING]
+    assert "export" not in run["diagnostics"]["external"]
+    assert f"warning: {NO_EXPORT_WARNING}" in printed
+    _assert_same_metrics(native, run)
