@@ -12,7 +12,8 @@ import os
 import numpy as np
 
 from .errors import InputError, OutputError
-from .exchange import AXES, METHOD, NodeSet, describe_json, dumps
+from .exchange import (AXES, LENGTH_UNITS, METHOD, NodeSet, describe_json, dumps,
+                       export_horizon)
 
 FORMATS = ("csv", "vtu", "peridigm", "perilab")
 MARKER = ".pdverify-export"
@@ -21,11 +22,13 @@ MARKER_SCHEMA = "pdverify.export-folder/1"
 #: by a static solve); any positive value
 DENSITY = 1000.0
 #: influence functions as the other codes' expressions: Peridigm's RTC knows ``zeta``
-#: (bond length) and ``horizon``; PeriLab's ``xi`` (bond length); omega's scale cancels
-#: in the linear state-based force (it enters as omega / m)
-PERIDIGM_INFLUENCE = {"constant": "One", "hyperbolic": "horizon/zeta",
-                      "conical": "1.0 - zeta/horizon",
-                      "gaussian": "exp(-zeta*zeta/(horizon*horizon))"}
+#: (bond length); PeriLab's ``xi`` (bond length); omega's scale cancels in the linear
+#: state-based force (it enters as omega / m). ``{h}`` is the model's horizon m h, written
+#: as a number: the decks' ``Horizon`` is the written one (:func:`export_horizon`), which
+#: Peridigm's RTC variable ``horizon`` would hold
+PERIDIGM_INFLUENCE = {"constant": "One", "hyperbolic": "{h}/zeta",
+                      "conical": "1.0 - zeta/{h}",
+                      "gaussian": "exp(-zeta*zeta/({h}*{h}))"}
 
 
 def f(v) -> str:
@@ -153,7 +156,8 @@ def export_command(scene_id: str, *, method=None, overrides=None, fmt: str, out:
     ns = node_set(scene, overrides)
     files = write_export(ns, fmt, folder)
     print(f"{scene.id} --method {METHOD}: {len(ns.x)} nodes, {ns.dim}D, horizon "
-          f"{ns.horizon:.6g} m -> {out} ({len(files)} files: "
+          f"{ns.horizon:.6g} m (written {export_horizon(ns):.6g} m: see README.md) -> {out} "
+          f"({len(files)} files: "
           + ", ".join(files[:6]) + (", ..." if len(files) > 6 else "") + ")", file=stream)
     return 0
 
@@ -270,7 +274,8 @@ def peridigm_files(ns: NodeSet) -> dict:
              "  Discretization:",
              '      Type: "Text File"',
              '      Input Mesh File: "nodes.txt"',
-             f"      Influence Function: {_q(PERIDIGM_INFLUENCE[ns.problem.influence.name])}",
+             "      Influence Function: "
+             + _q(PERIDIGM_INFLUENCE[ns.problem.influence.name].format(h=f(ns.horizon))),
              "", "  Materials:", "      pdverify material:",
              '          Material Model: "Elastic"',
              f"          Density: {f(DENSITY)}",
@@ -279,7 +284,7 @@ def peridigm_files(ns: NodeSet) -> dict:
     if c.kind in ("plane-stress", "plane-strain"):
         lines.append(f"          Plane {'Stress' if c.kind == 'plane-stress' else 'Strain'}: true")
     lines += ["", "  Blocks:", "      pdverify block:", '          Block Names: "block_1"',
-              '          Material: "pdverify material"', f"          Horizon: {f(ns.horizon)}",
+              '          Material: "pdverify material"', f"          Horizon: {f(export_horizon(ns))}",
               "", "  Boundary Conditions:"]
     files = {"peridigm/nodes.txt": nodes}
     for name, fname, grp, _, _, _ in conds:
@@ -318,7 +323,7 @@ def perilab_files(ns: NodeSet) -> dict:
     symmetry = {"plane-stress": "isotropic plane stress", "plane-strain": "isotropic plane strain",
                 "3d": "isotropic", "1d": "isotropic plane stress"}[c.kind]
     inf = ns.problem.influence.name
-    h = f(ns.horizon)
+    h = f(ns.horizon)      # the model's m h, omega's delta; the block's Horizon is written
     omega = {"constant": "1", "hyperbolic": "1/xi", "conical": f"1 - xi/{h}",
              "gaussian": f"exp(-xi^2/{h}^2)"}[inf]
     conds = _conditions(ns, density=False)
@@ -337,7 +342,7 @@ def perilab_files(ns: NodeSet) -> dict:
               f"        Young's Modulus: {f(c.E)}", f"        Poisson's Ratio: {f(c.nu)}",
               "  Blocks:", "    block_1:", "      Block ID: 1",
               "      Material Model: \"pdverify material\"", f"      Density: {f(DENSITY)}",
-              f"      Horizon: {h}", "  Boundary Conditions:"]
+              f"      Horizon: {f(export_horizon(ns))}", "  Boundary Conditions:"]
     for j, (name, _, _, kind, axis, v) in enumerate(conds):
         lines += [f"    BC_{j + 1}:",
                   f"      Variable: {_q('Displacements' if kind == 'displacement' else 'Forces')}",
@@ -383,22 +388,94 @@ def _model_note(ns: NodeSet) -> str:
     return text
 
 
+def _horizon_note(ns: NodeSet) -> str:
+    """The README's line on the written horizon: what it keeps, and what a code with its
+    own partial-volume rule makes of it."""
+    doc = describe_json(ns)
+    s, q = doc["bond_offsets"], doc["quadrature"]
+    text = (f"- Horizon: pdverify's horizon is m h = {f(ns.horizon)} m (`horizon_m`; the "
+            "delta of the influence function, which the decks' influence expressions write "
+            "as that number). The "
+            f"decks' `Horizon` is {f(export_horizon(ns))} m (`horizon_written_m`), with a "
+            "margin, so that rounding cannot drop a bond: " + doc["horizon_rule"]
+            + " A code that applies its own partial-volume rule should be given horizon_m "
+            "instead (its fractions are of the cells inside its horizon sphere: given "
+            f"horizon_written_m they would be of a sphere {export_horizon(ns) / ns.horizon:.4g} "
+            "times as large) and then differs from pdverify by its rule: ")
+    if q == "full-cells":
+        text += ("pdverify weights each node with |xi| <= m h by its whole cell and has no "
+                 "other bonds, where such a rule weights the cells the sphere cuts by "
+                 "fractions (less than 1 inside, more than 0 outside).")
+        return text
+    text += ("pdverify's weight is the exact fraction of each cell inside the sphere"
+             + (" (then adjusted to an isotropic fourth moment)" if q == "moment-corrected"
+                else "") + ("; 1D: of its length, 1/2 at |xi| = m h" if ns.dim == 1 else ""))
+    if s["beyond"]:
+        text += (f"; a rule that keeps only the nodes inside the sphere drops the "
+                 f"{s['beyond']} offsets beyond m h (together {s['beta_beyond']:.6g} cells of "
+                 "pdverify's weight)")
+    return text + ("; an approximate fraction (e.g. a ramp in |xi| across the last spacing) "
+                   "weights the cut cells otherwise.")
+
+
+def _weights_note(ns: NodeSet) -> str:
+    """The README's line on the bond weights of the model's quadrature against the
+    decks' (whole volumes)."""
+    s = describe_json(ns)["bond_offsets"]
+    q = ns.params.get("quadrature", "partial-volume")
+    if q == "full-cells":
+        return ("- Bond weights: pdverify weights every neighbour whose node lies in the "
+                "closed horizon |xi| <= m h by its whole cell (`quadrature=full-cells`) "
+                "and has no other bonds; the decks' materials count neighbours with their "
+                "whole volume too (as far as their documentation shows), so with the written "
+                f"horizon they have pdverify's {s['offsets']} bond offsets and weights.")
+    how = ("the exact fraction beta of the neighbour's cell inside the horizon sphere "
+           "(`quadrature=partial-volume`" + ("; 1D: of its length, 1/2 at |xi| = m h)"
+                                             if ns.dim == 1 else ")")
+           if q == "partial-volume" else
+           "the exact fraction of the neighbour's cell inside the horizon sphere, adjusted "
+           "so that the stencil's fourth moment is isotropic "
+           "(`quadrature=moment-corrected`, pdverify's own; only cut cells change)")
+    return (f"- Bond weights: pdverify weights each bond by {how}, {s['beta_total']:.6g} "
+            f"cells over the {s['offsets']} offsets of a full neighbourhood; the decks' "
+            "materials have no such weights (as far as their documentation shows, "
+            "neighbours count with their whole volume), so with the written horizon they "
+            f"keep the same bonds but weight them as {s['offsets']} whole cells: their "
+            "lattice differs at the horizon's edge. This quadrature cannot be stated in "
+            "either deck.")
+
+
+def _influence_note(ns: NodeSet) -> str:
+    """The README's line on the influence function as the decks write it."""
+    inf = ns.problem.influence
+    text = (f"- Influence function `{inf.name}` ({inf.description}): written as an "
+            "expression of the bond length, delta as the number m h (not the decks' "
+            "`Horizon`; omega's scale cancels in the linear state-based force).")
+    beyond = describe_json(ns)["bond_offsets"]["beyond"]
+    if inf.name == "conical" and beyond:
+        text += (f" pdverify's omega is zero beyond m h, so the {beyond} offsets beyond it, "
+                 "which the written horizon keeps, carry no force in pdverify; the decks' "
+                 "expression 1 - |xi|/(m h) is negative there, a weight of the other sign "
+                 "in a code that evaluates it as written.")
+    return text
+
+
 def readme(ns: NodeSet, fmt: str, files) -> str:
     """What the files are, what to run, and what a deck can and cannot express."""
     d = ns.dim
-    p = ns.params
-    over = " ".join(f"--set {k}={v}" for k, v in sorted(p.items())
-                    if v != ns.scene.default_params().get(k, v))
     conds = _conditions(ns, density=fmt == "peridigm")
     nvals = {AXES[k]: len(np.unique(v[1])) for k, v in ns.fixed.items()}
     text = [f"# pdverify export: {ns.scene.id}, uncorrected (`{METHOD}`), format `{fmt}`", "",
             f"{ns.scene.title}. {len(ns.x)} nodes in {d}D, spacing {f(ns.spacing)} m, "
-            f"horizon {f(ns.horizon)} m (m = {ns.horizon / ns.spacing:g}). Reference: "
+            f"horizon m h = {f(ns.horizon)} m (m = {ns.horizon / ns.spacing:g}), written as "
+            f"{f(export_horizon(ns))} m (see Horizon below). Reference: "
             f"{ns.scene.reference}. Units: SI (m, N, Pa); node ids are 1-based.", "",
             "## Files", ""]
     what = {
         "problem.json": "the scene, every parameter, the material constants (E, nu, the "
-                        "state-based c_theta, k_theta, k_e), horizon, influence function",
+                        "state-based c_theta, k_theta, k_e), the model's horizon "
+                        "(`horizon_m`) and the written one (`horizon_written_m`, with its "
+                        "rule `horizon_rule`), influence function, quadrature",
         "README.md": "this file",
         "nodes.csv": "node id, position, volume (thickness or cross-section included), "
                      "block id",
@@ -436,11 +513,15 @@ def readme(ns: NodeSet, fmt: str, files) -> str:
         text.append("Solve the problem in your code on exactly these nodes, with these "
                     "conditions and loads.")
     text += ["", "Then score the displacements (pdverify measures them as its own runs):", "",
-             f"    python -m pdverify score {ns.scene.id} RESULT {over} --name MYCODE "
-             "--out mycode.json".replace("  ", " "), "",
+             f"    python -m pdverify score {ns.scene.id} RESULT --export EXPORT_DIR "
+             "--name MYCODE --out mycode.json", "",
+             "EXPORT_DIR: this folder. The parameters are taken from its `problem.json` (a "
+             "`--set` that disagrees with it is refused); a RESULT inside this folder (e.g. "
+             "the deck's `pdverify_result.e`) finds it without `--export`. "
              "RESULT: a CSV with a header row naming the columns "
              + ", ".join(AXES[:d]) + " and " + ", ".join(f"u{a}" for a in AXES[:d])
-             + " (units in brackets allowed, any order of rows and columns), a VTU with a "
+             + " (a unit in brackets: " + ", ".join(LENGTH_UNITS) + "; none: m; any order "
+               "of rows and columns), a VTU with a "
                "point array `u` or `displacement(s)` (or its components), or the Exodus "
                "file the deck writes (its last time step; a NetCDF-4 file needs the "
                "netCDF4 package). Every node must lie within "
@@ -448,15 +529,9 @@ def readme(ns: NodeSet, fmt: str, files) -> str:
                "`python -m pdverify report --include mycode.json` shows it beside ours.", "",
              "## What the decks can and cannot express", "",
              _model_note(ns),
-             f"- Bond weights: pdverify weights each bond by its partial volume "
-             f"(`quadrature={p.get('quadrature', 'partial-volume')}`: the cell's fraction "
-             "inside the horizon); the decks' materials have no such weights (as far as "
-             "their documentation shows, neighbours count with their whole volume), so "
-             "their lattice differs at the horizon's edge. pdverify's partial-volume "
-             "quadrature cannot be stated in either deck.",
-             f"- Influence function `{ns.problem.influence.name}` "
-             f"({ns.problem.influence.description}): written as an expression of the bond "
-             "length (its scale cancels in the linear state-based force).",
+             _horizon_note(ns),
+             _weights_note(ns),
+             _influence_note(ns),
              "- Loads: the scene's body force times the node volume plus, on the loaded "
              "faces, the traction's resultant over each boundary cell face on the node of "
              "that cell (PD tractions become nodal forces on the loaded nodes). Peridigm's "

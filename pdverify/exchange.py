@@ -15,6 +15,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import math
 import os
 from dataclasses import dataclass
 
@@ -100,7 +101,91 @@ class NodeSet:
 
     @property
     def horizon(self) -> float:
+        """The model's horizon m h [m] (its influence function's delta)."""
         return float(self.system.model.horizon)
+
+
+# ------------------------------------------------------------------------------ horizon
+def _lattice_k2(dim: int, reach: int) -> np.ndarray:
+    """|k|^2 of every integer offset k with |k_i| <= reach (0 included)."""
+    axes = np.arange(-reach, reach + 1, dtype=np.int64)
+    k = np.stack(np.meshgrid(*([axes] * dim), indexing="ij"), axis=-1).reshape(-1, dim)
+    return np.sum(k * k, axis=1)
+
+
+def _horizon_shells(ns: NodeSet) -> dict:
+    """The model's bond offsets (its stencil, in spacings) against the lattice's shells
+    of equal |k|^2: ``k2_max`` (the largest |k|^2 of a bond offset), ``k2_next`` (the
+    smallest sum of d integer squares above it), ``offsets`` (bond offsets of a full
+    neighbourhood, both signs), ``within`` (those with |k| <= m), ``beyond`` (|k| > m:
+    nodes outside the horizon m h whose cells the horizon sphere cuts, kept by the
+    partial-volume quadratures), ``beta_beyond`` and ``beta_total`` (their weights beta,
+    in cells), ``added`` (lattice offsets with |k|^2 <= k2_max the stencil leaves out:
+    a shell the stencil splits, e.g. partial-volume 3D at m >= 5) and ``jitter`` (the
+    shape grid's node moves, a fraction of h; 0 on the lattice)."""
+    model = ns.system.model
+    st = model.stencil
+    off = np.asarray(st.offsets, dtype=np.int64)
+    k2 = np.sum(off * off, axis=1)
+    k2_max = int(k2.max())
+    lattice = _lattice_k2(ns.dim, math.isqrt(k2_max) + 1)   # holds (r, 0, ..), r^2 > k2_max
+    beyond = np.sqrt(k2) > float(model.m_ratio) * (1.0 + 1e-12)   # build_stencil's closed test
+    return {"k2_max": k2_max, "k2_next": int(lattice[lattice > k2_max].min()),
+            "offsets": int(len(off)), "within": int(np.count_nonzero(~beyond)),
+            "beyond": int(np.count_nonzero(beyond)),
+            "beta_beyond": float(np.sum(st.beta[beyond])), "beta_total": float(np.sum(st.beta)),
+            "added": int(np.count_nonzero((lattice > 0) & (lattice <= k2_max))) - len(off),
+            "jitter": float(getattr(model.grid, "jitter", 0.0) or 0.0)}
+
+
+def export_horizon(ns: NodeSet) -> float:
+    """The horizon to write [m]: ``h sqrt((K + K_next) / 2)``, K the largest |k|^2 of
+    the model's bond offsets k (in spacings; K = m^2 for whole cells at an integer m, up
+    to 14 for partial volumes at m = 3 in 3D, whose stencil holds the nodes beyond m h
+    whose cells the horizon cuts) and K_next the next sum of d integer squares (the next
+    lattice shell). Halfway between the two shells in |xi|^2, a code that keeps a bond
+    when |xi|^2 <= delta^2, computed from the written coordinates, keeps every bond of
+    the model and adds none (the margin, at least h^2 / 2 in |xi|^2, exceeds the
+    rounding of coordinates written with 17 digits, ~4 eps L |xi| on a body of size L,
+    up to L ~ 1e13 h), where the stencil is whole shells (:func:`_horizon_shells`:
+    ``added`` lattice offsets otherwise, kept too)."""
+    s = _horizon_shells(ns)
+    return ns.spacing * math.sqrt(0.5 * (s["k2_max"] + s["k2_next"]))
+
+
+def _horizon_rule(ns: NodeSet) -> str:
+    """The written horizon's rule and what it keeps, as one paragraph (problem.json and
+    the export README)."""
+    s = _horizon_shells(ns)
+    m, d = float(ns.system.model.m_ratio), ns.dim
+    text = (f"horizon_written_m = h sqrt((K + K_next)/2) = {export_horizon(ns)!r} m with h the "
+            f"spacing, K = {s['k2_max']} the largest |k|^2 of the model's bond offsets k (in "
+            f"spacings) and K_next = {s['k2_next']} the next |k|^2 of the {d}D lattice: a "
+            "code that keeps a bond when |xi|^2 <= horizon_written_m^2, from the written "
+            f"coordinates, keeps the model's {s['offsets']} bond offsets per full "
+            f"neighbourhood ({s['within']} with |xi| <= m h = horizon_m")
+    if s["beyond"]:
+        text += (f", and {s['beyond']} with |xi| > m h: the nodes beyond horizon_m whose cells "
+                 "the horizon sphere cuts, whose weights beta sum to "
+                 f"{s['beta_beyond']:.6g} of the neighbourhood's {s['beta_total']:.6g} cells")
+    text += ")"
+    if s["added"]:
+        text += (f" and {s['added']} offset(s) more: the model's stencil (m = {m:g}) takes "
+                 "part of a shell of equal |k|^2, which no spherical horizon can; those "
+                 "are bonds the model does not have")
+    else:
+        text += ", and no other"
+    if s["jitter"]:
+        kw = 0.5 * (s["k2_max"] + s["k2_next"])
+        gap = min(math.sqrt(kw) - math.sqrt(s["k2_max"]), math.sqrt(s["k2_next"]) - math.sqrt(kw))
+        move = s["jitter"] * math.sqrt(d)
+        text += (f". The nodes are moved off the lattice (jitter = {s['jitter']:g}), which "
+                 f"changes a pair's |xi| by up to {move:.3g} h against a margin of "
+                 f"{gap:.3g} h: " + ("the distance test still keeps exactly those pairs"
+                                     if move < gap else
+                                     "pairs near the written horizon may fall on its other "
+                                     "side, so the kept set is not guaranteed"))
+    return text + "."
 
 
 def node_set(scene, overrides=None) -> NodeSet:
@@ -555,7 +640,9 @@ def load_external(paths) -> list:
 
 
 def describe_json(ns: NodeSet) -> dict:
-    """What ``problem.json`` holds: the scene, its params and the model's constants."""
+    """What ``problem.json`` holds: the scene, its params, the model's constants, its
+    horizon m h (``horizon_m``, the influence function's delta) and the horizon the decks
+    write (``horizon_written_m``, :func:`export_horizon`) with its rule as text."""
     from .results import _plain
     c = ns.problem.constants
     inf = ns.problem.influence
@@ -563,7 +650,8 @@ def describe_json(ns: NodeSet) -> dict:
         "schema": "pdverify.export/1", "scene": ns.scene.id, "method": METHOD,
         "params": ns.params, "reference": ns.scene.reference, "dim": ns.dim,
         "nodes": len(ns.x), "spacing_m": ns.spacing, "horizon_m": ns.horizon,
-        "m_ratio": ns.horizon / ns.spacing,
+        "m_ratio": ns.horizon / ns.spacing, "horizon_written_m": export_horizon(ns),
+        "horizon_rule": _horizon_rule(ns), "bond_offsets": _horizon_shells(ns),
         "thickness_m": float(ns.problem.thickness),
         "material": {"model": "linear ordinary state-based (LPS)", "kind": c.kind,
                      "E_Pa": c.E, "nu": c.nu, "c_theta": c.c_theta, "k_theta_Pa": c.k_theta,

@@ -432,7 +432,8 @@ def test_peridigm_deck_matches_its_examples(decks):
         assert all(f'"{k}"' in src for k in extra)
         (block,) = ours["Blocks"].values()
         assert set(block) == set(next(iter(example["Blocks"].values())))
-        assert float(block["Horizon"]) == problem["horizon_m"]
+        # the written horizon, with its margin (issue 49), not the model's m h
+        assert float(block["Horizon"]) == problem["horizon_written_m"] > problem["horizon_m"]
         kind = problem["material"]["kind"]
         assert material.get("Plane Strain") == ("true" if kind == "plane-strain" else None)
         bcs = ours["Boundary Conditions"]
@@ -614,6 +615,92 @@ def test_a_shape_body_exports_its_cut_volumes_and_part_loads(tmp_path):
 
 
 # ------------------------------------------------------------------------------ issue 49
+def _model_pairs(ns) -> set:
+    """The model's bonds as pairs of real nodes (0-based export order), i < j coded i n + j:
+    the uncorrected model's bond_a / bond_b, both ends real (the none treatment has no
+    fictitious nodes)."""
+    m = ns.system.model
+    g = m.grid
+    a, b = g.interior_number[m.bond_a], g.interior_number[m.bond_b]
+    assert np.all(a >= 0) and np.all(b >= 0)
+    n = len(ns.x)
+    return set((np.minimum(a, b) * n + np.maximum(a, b)).tolist())
+
+
+def _distance_pairs(x, delta) -> set:
+    """Pairs with |x_i - x_j|^2 <= delta^2, computed as a code does from the coordinates:
+    cKDTree's candidates within a slightly larger radius (1e-6: only a superset is
+    needed), then the exact test on the squared distance."""
+    from scipy.spatial import cKDTree
+    cand = cKDTree(x).query_pairs(delta * (1 + 1e-6), output_type="ndarray")
+    d2 = np.sum((x[cand[:, 0]] - x[cand[:, 1]]) ** 2, axis=1)
+    c = cand[d2 <= delta * delta]
+    return set((c.min(axis=1) * len(x) + c.max(axis=1)).tolist())
+
+
+def _deck_horizon(deck_file: Path) -> float:
+    (line,) = [ln for ln in deck_file.read_text().splitlines()
+               if ln.strip().startswith("Horizon:")]
+    return float(line.split(":", 1)[1])
+
+
+@pytest.mark.parametrize("scene_id, overrides", [
+    ("body3d-traction", {"spacing": 0.1}),                     # 3D, partial volumes
+    ("body3d-traction", {"spacing": 0.1, "quadrature": "full-cells"}),   # bonds at 3h
+    ("plate2d-plane-strain", {"spacing": 0.1}),
+    ("plate2d-plane-strain", {"spacing": 0.1, "quadrature": "moment-corrected"}),
+    ("plate-hole", {"spacing": 0.05}),                         # a shape's real nodes
+    ("bar1d-traction", {"spacing": 1 / 14}),   # 3h written as is lost 6 of 11 bonds at 3h
+])
+def test_written_horizon_keeps_exactly_the_model_bonds(tmp_path, scene_id, overrides):
+    """Issue 49: a code that keeps a bond when |xi|^2 <= delta^2, from the coordinates and
+    the horizon the decks write, has the model's bonds, no fewer (the horizon m h written
+    as is drops bonds at exactly m h by rounding, and every node beyond m h whose cell
+    the horizon cuts) and no more."""
+    from pdverify.exchange import node_set, scene_of
+    ns = node_set(scene_of(scene_id), overrides)
+    ours = _model_pairs(ns)
+    sets = [a for k, v in overrides.items() for a in ("--set", f"{k}={v}")]
+    d = ns.dim
+    for fmt in ("peridigm", "perilab"):
+        folder = tmp_path / fmt
+        assert main(["export", scene_id, *sets, "--format", fmt, "--out", str(folder)]) == 0
+        delta = _deck_horizon(folder / fmt / "pdverify.yaml")
+        x = _exported_positions(folder, fmt, d)
+        kept = _distance_pairs(x, delta)
+        assert len(kept - ours) == 0 and len(ours - kept) == 0, (fmt, len(ours - kept),
+                                                                 len(kept - ours))
+        from pdverify.exchange import export_horizon
+        problem = json.loads((folder / "problem.json").read_text())
+        assert problem["horizon_written_m"] == delta == export_horizon(ns)
+        assert problem["horizon_m"] == ns.horizon < delta
+        assert "horizon_written_m = h sqrt((K + K_next)/2)" in problem["horizon_rule"]
+        assert f"Horizon` is {delta!r} m" in (folder / "README.md").read_text()
+
+
+def test_written_horizon_of_a_split_shell_is_stated(tmp_path):
+    """A stencil that takes part of a shell of equal |k|^2 (partial volumes in 2D at
+    m = 4.5 keep (4, 3) but not (5, 0), both |k|^2 = 25): no sphere keeps exactly its
+    bonds; the written horizon keeps all of them and the added offsets are stated."""
+    from pdverify.exchange import node_set, scene_of
+    overrides = {"spacing": 0.1, "m_ratio": 4.5}
+    ns = node_set(scene_of("plate2d-plane-strain"), overrides)
+    assert main(["export", "plate2d-plane-strain", "--set", "spacing=0.1", "--set",
+                 "m_ratio=4.5", "--format", "csv", "--out", str(tmp_path / "e")]) == 0
+    problem = json.loads((tmp_path / "e" / "problem.json").read_text())
+    kept = _distance_pairs(_exported_positions(tmp_path / "e", "csv", 2),
+                           problem["horizon_written_m"])
+    ours = _model_pairs(ns)
+    assert ours < kept
+    n = len(ns.x)
+    extra = np.array(sorted(kept - ours))
+    k2 = np.sum(np.round((ns.x[extra % n] - ns.x[extra // n]) / 0.1) ** 2, axis=1)
+    assert set(k2.tolist()) == {25.0}
+    assert problem["bond_offsets"]["added"] == 4       # (+-5, 0), (0, +-5)
+    assert "4 offset(s) more" in problem["horizon_rule"]
+    assert "4 offset(s) more" in (tmp_path / "e" / "README.md").read_text()
+
+
 @pytest.mark.parametrize("header, scale, ok", [
     (("x [mm]", "ux [mm]"), 1e3, True),
     (("x [m]", "ux [cm]"), (1.0, 1e2), True),
@@ -787,3 +874,21 @@ def test_score_without_an_export_warns(tmp_path, capsys):
     assert "export" not in run["diagnostics"]["external"]
     assert f"warning: {NO_EXPORT_WARNING}" in printed
     _assert_same_metrics(native, run)
+
+
+@pytest.mark.parametrize("quadrature, says, never", [
+    ("full-cells", "by its whole cell (`quadrature=full-cells`)", "fraction beta"),
+    ("partial-volume", "the exact fraction beta of the neighbour's cell inside the horizon "
+                       "sphere (`quadrature=partial-volume`)", "whole cell ("),
+    ("moment-corrected", "(`quadrature=moment-corrected`", "whole cell ("),
+])
+def test_export_readme_states_the_quadrature(tmp_path, quadrature, says, never):
+    """Issue 49: the export README's bond weights are the quadrature's (whole cells were
+    described as partial volumes)."""
+    folder = tmp_path / "e"
+    assert main(["export", "plate2d-plane-strain", "--set", "spacing=0.1", "--set",
+                 f"quadrature={quadrature}", "--format", "peridigm", "--out",
+                 str(folder)]) == 0
+    (line,) = [ln for ln in (folder / "README.md").read_text().splitlines()
+               if ln.startswith("- Bond weights:")]
+    assert says in line and never not in line, line
