@@ -892,3 +892,13 @@ def test_export_readme_states_the_quadrature(tmp_path, quadrature, says, never):
     (line,) = [ln for ln in (folder / "README.md").read_text().splitlines()
                if ln.startswith("- Bond weights:")]
     assert says in line and never not in line, line
+
+
+def test_readme_names_every_exportable_scene():
+    """Issue 49: README.md's paragraph on export names every scene export takes."""
+    from pdverify.exchange import exportable_ids
+    text = (ROOT / "README.md").read_text()
+    start = text.index("- Your own PD code against ours:")
+    paragraph = text[start:text.index("\n- ", start + 1)]
+    missing = [s for s in exportable_ids() if f"`{s}`" not in paragraph]
+    assert missing == []
