@@ -284,8 +284,8 @@ def peridigm_files(ns: NodeSet) -> dict:
     if c.kind in ("plane-stress", "plane-strain"):
         lines.append(f"          Plane {'Stress' if c.kind == 'plane-stress' else 'Strain'}: true")
     lines += ["", "  Blocks:", "      pdverify block:", '          Block Names: "block_1"',
-              '          Material: "pdverify material"', f"          Horizon: {f(export_horizon(ns))}",
-              "", "  Boundary Conditions:"]
+              '          Material: "pdverify material"',
+              f"          Horizon: {f(export_horizon(ns))}", "", "  Boundary Conditions:"]
     files = {"peridigm/nodes.txt": nodes}
     for name, fname, grp, _, _, _ in conds:
         lines.append(f"      Node Set {name}: {_q(fname)}")
