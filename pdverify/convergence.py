@@ -183,11 +183,14 @@ STUDIES = (
 
 
 def methods(scene) -> list[str]:
-    """The methods a study runs: every method of the scene but its FEM reference and
-    bond methods that are unavailable (a missing optional extra)."""
+    """The methods a study runs: every method of the scene but its FEM reference, bond
+    methods that are unavailable (a missing optional extra) and peer codes (they run on
+    the parameters their own report runs name, :mod:`pdverify.peers`)."""
     bond = scene.bond_methods()
+    offered = scene.offered()
     return [m.name for m in scene.all_methods
-            if m.name != "fem" and not (m.name in bond and bond[m.name].unavailable)]
+            if m.name != "fem" and not (m.name in bond and bond[m.name].unavailable)
+            and not getattr(offered.get(m.name), "peer", False)]
 
 
 def cases(scene_ids, quick: bool = False) -> list[tuple[str, str, dict]]:

@@ -12,12 +12,10 @@ import os
 import numpy as np
 
 from .errors import InputError, OutputError
-from .exchange import (AXES, LENGTH_UNITS, METHOD, NodeSet, describe_json, dumps,
-                       export_horizon)
+from .exchange import (AXES, LENGTH_UNITS, MARKER, MARKER_SCHEMA, METHOD, NodeSet,  # noqa: F401
+                       describe_json, dumps, export_horizon)
 
 FORMATS = ("csv", "vtu", "peridigm", "perilab")
-MARKER = ".pdverify-export"
-MARKER_SCHEMA = "pdverify.export-folder/1"
 #: Peridigm's and PeriLab's QuasiStatic/Static runs need a density (inertia is not used
 #: by a static solve); any positive value
 DENSITY = 1000.0

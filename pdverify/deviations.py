@@ -326,3 +326,42 @@ def for_scene(scene_id: str) -> list[Deviation]:
     return [d for d in DEVIATIONS
             if any(scene_id == s or (s.endswith("*") and scene_id.startswith(s[:-1]))
                    for s in d.scenes)]
+
+
+def peer_findings(scene_id: str, results) -> list[Deviation]:
+    """The gap between a peer code as its users run it and pdverify's ``none``, attributed
+    from the scene's peer runs (``peer:NAME``, :mod:`pdverify.peers`): formatted from the
+    records, never typed. One finding per peer with both settings' numbers."""
+    runs = [r for r in results if r.scene == scene_id and r.method.startswith("peer:")
+            and r.status == "ok"]
+    out = []
+    for name in sorted({r.method for r in runs}):
+        by = {r.params.get("setting"): r for r in runs if r.method == name}
+        used, same = by.get("as-used"), by.get("same-model")
+        parts = []
+        if used is not None:
+            m = used.metrics
+            parts.append(f"as its users run it, {name} differs from our none by "
+                         f"{100 * m['peer_diff_to_none']:.3g} % (relative L2)")
+            if "peer_gap_volumes" in m:
+                parts.append(f"{100 * m['peer_gap_volumes']:.3g} % of that is its volume "
+                             f"weights near the horizon and uniform volumes (the linear "
+                             f"model with them against none), "
+                             f"{100 * m['peer_gap_nonlinear']:.2g} % its geometric "
+                             "nonlinearity and stopping tolerance (LAMMPS against that "
+                             "linear model); its horizon rule ((m + 2e-4) h) keeps the "
+                             "same bonds as whole cells")
+            else:
+                parts.append("no linear twin of its volumes here (cut or half cells), so "
+                             "the gap is not split")
+        if same is not None:
+            m = same.metrics
+            parts.append(f"driven to solve our discrete model it differs by "
+                         f"{100 * m['peer_diff_to_none']:.2g} % (nonlinearity and "
+                         "stopping tolerance only"
+                         + (f"; residual {m['equilibrium_residual']:.2g} in our linear "
+                            "model)" if "equilibrium_residual" in m else ")"))
+        if parts:
+            out.append(Deviation((scene_id,), "finding", "; ".join(parts) + ".",
+                                 "this report's peer runs (pdverify/peers)"))
+    return out

@@ -22,7 +22,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import InputError
+from .nodeset import (  # noqa: F401  (node_set_of re-exported: the export's node set)
+    NodeSet, _lattice_k2, between_shells, equilibrium, node_set_of, not_in_equilibrium,
+    solution_vector)
 
+#: the marker file of an export folder (it lists every file the export wrote) and its
+#: schema (:mod:`pdverify.decks` writes it; score finds an export by it)
+MARKER = ".pdverify-export"
+MARKER_SCHEMA = "pdverify.export-folder/1"
 #: The one method whose problem is exported: the uncorrected model (its conditions on
 #: real nodes only, which a node-set deck can state; the corrections add nodes, rows or
 #: bond factors no other code reads).
@@ -77,42 +84,7 @@ def check_method(method: str | None) -> str:
     return METHOD
 
 
-@dataclass
-class NodeSet:
-    """The ``none`` problem of a scene as arrays (module docstring). ``fixed``: per
-    component k, ``(nodes, values)`` of its prescribed nodes (0-based, ascending)."""
-
-    scene: object
-    params: dict
-    problem: object
-    system: object
-    x: np.ndarray          # (n, d) positions [m]
-    volume: np.ndarray     # (n,) node volumes [m^3] (thickness or cross-section included)
-    forces: np.ndarray     # (n, d) nodal forces [N]
-    fixed: dict            # k -> (nodes, values [m])
-
-    @property
-    def dim(self) -> int:
-        return self.x.shape[1]
-
-    @property
-    def spacing(self) -> float:
-        return float(self.problem.spacing)
-
-    @property
-    def horizon(self) -> float:
-        """The model's horizon m h [m] (its influence function's delta)."""
-        return float(self.system.model.horizon)
-
-
 # ------------------------------------------------------------------------------ horizon
-def _lattice_k2(dim: int, reach: int) -> np.ndarray:
-    """|k|^2 of every integer offset k with |k_i| <= reach (0 included)."""
-    axes = np.arange(-reach, reach + 1, dtype=np.int64)
-    k = np.stack(np.meshgrid(*([axes] * dim), indexing="ij"), axis=-1).reshape(-1, dim)
-    return np.sum(k * k, axis=1)
-
-
 def _horizon_shells(ns: NodeSet) -> dict:
     """The model's bond offsets (its stencil, in spacings) against the lattice's shells
     of equal |k|^2: ``k2_max`` (the largest |k|^2 of a bond offset), ``k2_next`` (the
@@ -149,8 +121,7 @@ def export_horizon(ns: NodeSet) -> float:
     rounding of coordinates written with 17 digits, ~4 eps L |xi| on a body of size L,
     up to L ~ 1e13 h), where the stencil is whole shells (:func:`_horizon_shells`:
     ``added`` lattice offsets otherwise, kept too)."""
-    s = _horizon_shells(ns)
-    return ns.spacing * math.sqrt(0.5 * (s["k2_max"] + s["k2_next"]))
+    return between_shells(ns.spacing, ns.system.model.stencil.offsets, ns.dim)
 
 
 def _horizon_rule(ns: NodeSet) -> str:
@@ -195,26 +166,6 @@ def node_set(scene, overrides=None) -> NodeSet:
     problem = scene.problem(p, f"{scene.id}/{METHOD}")
     treatment = scene.treatment(METHOD)
     return node_set_of(scene, p, problem, treatment.assemble(problem, p))
-
-
-def node_set_of(scene, p, problem, system) -> NodeSet:
-    """The arrays of an uncorrected ``system`` of ``problem`` (any body the family's
-    ``none`` assembles: a box, or a shape with cut volumes)."""
-    g = system.model.grid
-    ni, nu_, d = g.n_interior, system.n_unknown_nodes, g.dim
-    if nu_ != ni or system.B is not None or system.offset is not None:
-        raise InputError(f"{scene.id}: its uncorrected system has unknowns or rows beyond "
-                         "the real nodes, which a node set cannot state; it is not exported")
-    x = g.x[g.interior_ids]
-    volume = np.asarray(system.model.node_volume)[g.interior_ids]
-    forces = np.asarray(system.rhs[:d * nu_]).reshape(d, nu_).T
-    fixed = {}
-    comp, nodes = np.divmod(np.asarray(system.fixed), nu_)
-    for k in range(d):
-        on = comp == k
-        if on.any():
-            fixed[k] = (nodes[on], np.asarray(system.values)[on])
-    return NodeSet(scene, p, problem, system, x, volume, forces, fixed)
 
 
 # ------------------------------------------------------------------------------ reading
@@ -483,7 +434,6 @@ def _find_export(path: str, export: str | None) -> str | None:
     """The export folder the displacement file ``path`` answers: ``export`` (``--export
     DIR``), else the first of the file's folder and its parents that holds the marker
     ``.pdverify-export``; None when there is none."""
-    from .decks import MARKER
     if export is not None:
         if not str(export).strip() or not os.path.isdir(export):
             raise InputError(f"--export {export!r} is not a folder; give the folder "
@@ -505,7 +455,6 @@ def _export_params(scene, folder: str, given: bool, overrides) -> dict:
     """The params of the export in ``folder`` (its ``problem.json``), checked: its scene
     is ``scene``, and each ``--set`` in ``overrides`` takes the export's value. Returns
     ``diagnostics.external.export``."""
-    from .decks import MARKER, MARKER_SCHEMA
     where = (f"--export {folder!r}" if given else
              f"the export {folder!r} (the first folder above the displacement file holding "
              f"{MARKER}; give --export DIR for another)")
@@ -573,15 +522,8 @@ def _score_file(scene, path: str, *, name: str, overrides, origin):
                          f"{origin['pdverify_version']}); export it again")
     order = match_nodes(ns, given)
     U = given.u[order]
-    d, n = ns.dim, len(ns.x)
-    x = U.T.ravel()
-    K = ns.system.K
-    if K.shape[0] > d * n:
-        # the augmented system (solver=nested-dissection): its nodal scalars (dilatations)
-        # from the displacements, theta = A_theta A_e A_U u, so that K x - rhs (a
-        # reaction) is the direct system's; the displacement metrics do not read them
-        model = ns.system.model
-        x = np.r_[x, model.A_theta @ (model.A_e @ (model.A_U_full @ x))]
+    n = len(ns.x)
+    x = solution_vector(ns.system, U)
     deviation = 0.0
     for k, (nodes, values) in ns.fixed.items():
         if len(nodes):
@@ -592,11 +534,16 @@ def _score_file(scene, path: str, *, name: str, overrides, origin):
               "prescribed_max_deviation_m": deviation,
               "cost_measured": False, **({"export": origin} if origin is not None else {})}
     info = {"solver": "external", "external": source}
+    held = equilibrium(ns, U)
+    source["equilibrium"] = held
     outcome = ns.scene.measure(ns.params, ns.problem, ns.system, x, info)
+    outcome.metrics["equilibrium_residual"] = held["residual"]
     record = RunResult(scene=scene.id, method=f"external:{name}", params=ns.params,
                        reference=scene.reference, metrics=outcome.metrics,
                        size=outcome.size, diagnostics=outcome.diagnostics,
                        timings={"setup_s": 0.0, "solve_s": 0.0, "total_s": 0.0})
+    if not held["in_equilibrium"]:
+        record.status, record.message = "failed", not_in_equilibrium(held)
     scale = float(np.max(np.abs(U))) if U.size else 0.0
     if deviation > PRESCRIBED_RTOL * scale:
         record.warnings.append(

@@ -97,6 +97,7 @@ def _builtin() -> list[Treatment]:
     from .volume import volume_closure
     pv = installed_version()
     from .homogenized import check_homogenized, homogenized_closure
+    from .peer import peer_treatments
     return family_treatments() + [
         BondMethod("homogenized", "seed 004: stiffness factors on the end bonds (1, 1+k), "
                    "(N, N-k) so that a linear field satisfies every equilibrium equation "
@@ -139,7 +140,7 @@ def _builtin() -> list[Treatment]:
                                  "the perifit version that computes the weights (recorded "
                                  "with every run)", choices=(pv or "not installed",)),),
                    unavailable=None if pv else f"needs the optional extra: {INSTALL}"),
-    ]
+    ] + peer_treatments()
 
 
 _METHODS: dict[str, Treatment] | None = None

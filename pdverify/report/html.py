@@ -218,8 +218,8 @@ def scene_section(scene, results, figures, deviations=None) -> Markup:
     each run folded (one wrapped cell, so a scene with twenty metrics still fits), the
     reference's refinement studies and the figures."""
     if deviations is None:
-        from ..deviations import for_scene
-        deviations = for_scene(scene.id)
+        from ..deviations import for_scene, peer_findings
+        deviations = for_scene(scene.id) + peer_findings(scene.id, results)
     paper = PAPERS.get(seed_of(scene.seed), {})
     metrics = key_metrics(scene, results)
     return _render(

@@ -412,7 +412,11 @@ class Scene:
         listed = {m for m, _ in out}
         for name, t in self.offered().items():
             if name not in listed and not t.unavailable:
-                out.append((name, dict(self.quick_overrides) if quick else {}))
+                runs = getattr(t, "report_runs", None)   # a peer code names its own runs
+                if runs is not None:
+                    out += [(name, o) for o in runs(self, quick)]
+                else:
+                    out.append((name, dict(self.quick_overrides) if quick else {}))
         return out
 
     def run(self, method: str, overrides: Mapping[str, Any] | None = None) -> RunResult:

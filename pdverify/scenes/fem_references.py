@@ -125,7 +125,8 @@ class FemAndPD(FemReference):
         own = tuple(self.methods)
         offered = self.offered()
         return own + tuple(
-            MethodSpec(m.name, (self.pd_params if offered[m.name].role(self.family)
+            MethodSpec(m.name, (self.pd_params if (offered[m.name].role(self.family)
+                                                   or getattr(offered[m.name], "peer", False))
                                 else ()) + m.params)
             for m in Scene.all_methods.fget(self)[len(own):])
 

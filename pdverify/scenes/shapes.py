@@ -89,8 +89,8 @@ class ShapeScene(FemStaticStateScene):
         """Every treatment offered here at the default grid (Taylor orders 1 to 3)."""
         out = []
         for name, t in self.offered().items():
-            if t.kind == "hand-wired" or t.origin != "built-in":
-                continue
+            if t.kind == "hand-wired" or t.origin != "built-in" or getattr(t, "peer", False):
+                continue         # a peer code names its own runs (pdverify.corrections.peer)
             ordered = any(q.name == "order" for q in t.params_for(self))
             out += [(name, {"order": n}) for n in (1, 2, 3)] if ordered else [(name, {})]
         return out

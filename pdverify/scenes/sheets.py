@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import budget
-from ..errors import InputError
+from ..errors import InputError, NumericalError
 from ..metrics import rel_l2_error
 from ..params import Param, at_least, positive
 from ..pd import bond_micromodulus, build_stencil, get_influence
@@ -53,6 +53,9 @@ class SheetScene(FemAndPD):
             if not (p[name] > 0 and np.isfinite(p[name])):
                 raise InputError(f"{where}: {name}={p[name]!r} must be a finite number > 0")
         self.check_sheet(where, method, p)
+        t = self.offered().get(method)
+        if getattr(t, "peer", False):
+            t.check((), p, where)
 
     def check_sheet(self, where, method, p):
         raise NotImplementedError
@@ -214,10 +217,17 @@ class TensionSheet(SheetScene):
                 f[n + ends] = side * sigma * W * t * w / w.sum()
             fixed = np.r_[np.flatnonzero(np.isclose(x[:, 0], 0.0)),
                           n + np.flatnonzero(np.isclose(x[:, 1], 0.0))]
+        peer = getattr(self.offered().get(method), "peer_solve_bonds", None)
         with timer.phase("solve"):
-            u, _, info = self.solve_fixed(model, fixed, np.zeros(fixed.size),
-                                          f"{self.id}/{method}", f, solver=p["solver"])
-        U = u.reshape(2, n).T
+            if peer is not None:       # another code solves it (pdverify.peers)
+                U, info, peer_metrics, trouble = peer(
+                    model, f.reshape(2, n).T, fixed, p, f"{self.id}/{method}",
+                    lambda: self.solve_fixed(model, fixed, np.zeros(fixed.size),
+                                             f"{self.id}/{method}", f, solver=p["solver"]))
+            else:
+                u, _, info = self.solve_fixed(model, fixed, np.zeros(fixed.size),
+                                              f"{self.id}/{method}", f, solver=p["solver"])
+                U = u.reshape(2, n).T
         E_star, nu_star = lattice_moduli(model)
         metrics = {}
         refs = {"": (E_star, nu_star), "_continuum": (p["E"], bond_based_nu(2, "stress"))}
@@ -238,7 +248,12 @@ class TensionSheet(SheetScene):
                   "lengths": (W, H)}
         size = {"nodes": int(n), "dofs": int(2 * n - fixed.size), "bonds": model.n_bonds(),
                 "stiffness_nnz": int(model.K.nnz)}
-        return Outcome(metrics=metrics, size=size, fields=fields, diagnostics=info)
+        outcome = Outcome(metrics=metrics, size=size, fields=fields, diagnostics=info)
+        if peer is not None:
+            outcome.metrics.update(peer_metrics)
+            if trouble:
+                raise NumericalError(f"{self.id}/{method}: {trouble}", partial=outcome)
+        return outcome
 
 
 def lattice_moduli(model) -> tuple[float, float]:

@@ -79,7 +79,10 @@ def _solution_at(x_native, u_native, positions):
 
 
 def _assert_same_metrics(native, scored):
-    assert set(scored["metrics"]) == set(native.metrics)
+    # score adds the field's equilibrium residual in the scene's linear model: our own
+    # solution, read back exactly, balances to round-off (a direct solve: ~1e-14)
+    assert scored["metrics"]["equilibrium_residual"] < 1e-10
+    assert set(scored["metrics"]) - {"equilibrium_residual"} == set(native.metrics)
     for name, value in native.metrics.items():
         np.testing.assert_allclose(scored["metrics"][name], value, rtol=METRIC_RTOL,
                                    atol=0.0, err_msg=name)

@@ -1,0 +1,213 @@
+"""``peer:lammps`` as a treatment of the ``static-state`` family and of the bond-based
+sheets: the scene's uncorrected problem solved by LAMMPS (:mod:`pdverify.peers.lammps`)
+instead of pdverify's linear solve, and measured by the scene's own ``measure``.
+
+Beside the scene's metrics a run records, as metrics (all relative L2 norms over the
+real nodes, divided by the norm of pdverify's ``none`` field at the same params):
+- ``peer_diff_to_none``: LAMMPS's field against pdverify's ``none``;
+- ``peer_gap_volumes``: (``as-used`` only) the linear model with LAMMPS's volume ramp and
+  uniform volumes against ``none``: what LAMMPS's weights near the horizon change;
+- ``peer_gap_nonlinear``: LAMMPS's field against the linear model of its own setting
+  (``none`` for ``same-model``): its geometric nonlinearity and the stopping tolerance;
+- ``equilibrium_residual``: the relative residual of LAMMPS's field in the linear model of
+  its setting (:func:`pdverify.exchange.equilibrium`); above its limit the run fails
+  naming it, as does a run with lost bonds.
+Both linear models are assembled and solved by pdverify in the same run (their cost is in
+the run's setup time, LAMMPS's in its solve time).
+"""
+from __future__ import annotations
+
+import tempfile
+from dataclasses import dataclass
+
+import numpy as np
+
+from .treatment import Treatment
+from ..errors import InputError
+from ..params import Param
+from ..peers import lammps
+
+SETTING = Param("setting", "as-used", "how LAMMPS runs: as its examples run it (volume "
+                "ramp near the horizon, horizon (m + 2e-4) h, one volume per atom) or driven "
+                "to solve pdverify's discrete model (its volumes and bonds, no ramp)",
+                choices=lammps.SETTINGS)
+
+
+def ramp(bond_x, spacing, horizon):
+    """LAMMPS's volume factor of a bond of length ``bond_x`` (pair_peri_*.cpp: bonds
+    within half a lattice constant h of the horizon get (delta + h/2 - r0) / h)."""
+    half = 0.5 * spacing
+    return np.where(np.abs(bond_x - horizon) <= half,
+                    (-1.0 / (2 * half)) * bond_x + (1.0 + (horizon - half) / (2 * half)), 1.0)
+
+
+def _rel(a, b, scale) -> float:
+    return float(np.linalg.norm(a - b) / scale) if scale > 0 else float(np.linalg.norm(a - b))
+
+
+#: the report's peer runs: scene -> overrides (each run in both settings, with LAMMPS's
+#: influence and whole-cell volumes where the scene has those parameters); sizes kept small
+#: so that the runs add seconds to a full report (the 3D box at h = 0.1: 250 atoms, ~1 s)
+REPORT_RUNS = {"body3d-traction": {"spacing": 0.1}, "plate2d-clamped": {},
+               "plate2d-plane-strain": {}, "bar1d-traction": {}, "sheet2d-tension": {"spacing": 0.0025}}
+#: the bond-based scenes that solve through a peer (their own assembly; the static-state
+#: family's scenes are served through the family)
+BOND_SCENES = ("sheet2d-tension",)
+
+
+def lammps_overrides(scene) -> dict:
+    """LAMMPS's influence (1/|xi|) and whole-cell volumes, where the scene has them."""
+    names = {q.name for m in scene.all_methods for q in m.params} | {
+        q.name for q in scene.params}
+    return {k: v for k, v in (("influence", "hyperbolic"), ("quadrature", "full-cells"))
+            if k in names}
+
+
+@dataclass(frozen=True)
+class PeerTreatment(Treatment):
+    """A peer code as a method: assembles the uncorrected system (for its node set and the
+    checks) and solves it with the peer (``peer_solve``)."""
+
+    peer: bool = True
+
+    def report_runs(self, scene, quick) -> list[dict]:
+        over = REPORT_RUNS.get(scene.id)
+        if over is None:
+            return []
+        return [{**lammps_overrides(scene), **over, "setting": s} for s in lammps.SETTINGS]
+
+    def why_not(self, scene):
+        if scene.id in BOND_SCENES:
+            return None
+        return super().why_not(scene)
+
+    def check(self, cells, params, where):
+        micromodulus = params.get("micromodulus")
+        if micromodulus is not None and micromodulus != "constant":
+            raise InputError(f"{where}: micromodulus={micromodulus!r}; LAMMPS's peri/pmb "
+                             "has a constant micromodulus: run it with "
+                             "--set micromodulus=constant")
+        influence = params.get("influence")
+        if influence is not None and influence != "hyperbolic":
+            raise InputError(f"{where}: influence={influence!r}; LAMMPS's peri/lps fixes the "
+                             "influence at 1/|xi|: run it with --set influence=hyperbolic")
+        if params["setting"] == "same-model" and params.get("quadrature") != "full-cells":
+            raise InputError(f"{where}: setting=same-model needs quadrature=full-cells "
+                             f"(got {params.get('quadrature')!r}): LAMMPS cannot state "
+                             "per-bond volume fractions")
+        if self.unavailable:
+            raise InputError(f"{where}: {self.name} is not available: {self.unavailable}")
+
+    def assemble(self, problem, params):
+        from .static_state import assemble_plain
+        return assemble_plain(problem)
+
+    # ------------------------------------------------------------------ the run
+    def peer_solve(self, scene, p, problem, system, where):
+        """``(x, info, metrics)``: LAMMPS's field as the system's unknowns, the
+        diagnostics, and the peer's metrics (module docstring)."""
+        from .static_state import assemble_plain
+        from ..nodeset import equilibrium, node_set_of, not_in_equilibrium, solution_vector
+        from ..pd.closure import Closure
+        from ..solvers.front import solve as solve_system
+        ns = node_set_of(scene, p, problem, system)
+        model = lammps.state_based_model(ns)
+        setting = p["setting"]
+        with tempfile.TemporaryDirectory(prefix="pdverify-lammps-") as folder:
+            result = lammps.run(model, setting, folder, where=where)
+        d, n = ns.dim, len(ns.x)
+        x_none, _ = solve_system(system, where=where, ordering=problem.ordering)
+        u_none = np.asarray(x_none[:d * n]).reshape(d, n).T
+        scale = float(np.linalg.norm(u_none))
+        metrics = {"peer_diff_to_none": _rel(result.u, u_none, scale)}
+        own = ns
+        if setting == "as-used":
+            volumes = np.asarray(ns.volume)
+            if not np.allclose(volumes, model.uniform_volume, rtol=1e-12, atol=0):
+                own = None      # cut cells or half cells: no linear model of LAMMPS's here
+            else:
+                horizon = (model.m_ratio + lammps.EXAMPLES_MARGIN) * model.spacing
+                closure = Closure(weight_factor=lambda m: ramp(m.bond_x, model.spacing,
+                                                               horizon))
+                ramped = assemble_plain(problem, closure)
+                x_ramp, _ = solve_system(ramped, where=where, ordering=problem.ordering)
+                u_ramp = np.asarray(x_ramp[:d * n]).reshape(d, n).T
+                metrics["peer_gap_volumes"] = _rel(u_ramp, u_none, scale)
+                metrics["peer_gap_nonlinear"] = _rel(result.u, u_ramp, scale)
+                own = node_set_of(scene, p, problem, ramped)
+        else:
+            metrics["peer_gap_nonlinear"] = metrics["peer_diff_to_none"]
+        info = {"solver": self.name, "peer": result.info}
+        if own is not None:
+            balance = equilibrium(own, result.u)
+            info["equilibrium"] = balance
+            metrics["equilibrium_residual"] = balance["residual"]
+        return (solution_vector(system, result.u), info, metrics,
+                _trouble(result.info, info.get("equilibrium"), not_in_equilibrium))
+
+
+    def peer_solve_bonds(self, model, forces, fixed_dofs, p, where, solve_none):
+        """The bond-based sheets (their own assembly): ``(U, info, metrics, trouble)`` of
+        LAMMPS's peri/pmb on the linear bond-based ``model`` (all grid nodes real) with
+        nodal ``forces`` (n, d), the prescribed zero components ``fixed_dofs``
+        (component-major) and ``solve_none()`` pdverify's own solve ``(u, reactions,
+        info)``. ``same-model`` is checked for equilibrium in ``model``; ``as-used`` has
+        no linear twin here (the sheet's edge nodes carry half cells, LAMMPS's atoms one
+        volume each) and is judged by LAMMPS's own stopping and bond count."""
+        from ..nodeset import balance, between_shells, not_in_equilibrium
+        g = model.grid
+        n, d, h = g.n_ext, g.dim, model.spacing
+        comp, nodes = np.divmod(np.asarray(fixed_dofs, dtype=int), n)
+        fixed = {k: (nodes[comp == k], np.zeros(int(np.count_nonzero(comp == k))))
+                 for k in range(d) if np.any(comp == k)}
+        c = model.c
+        peer_model = lammps.Model(
+            np.asarray(g.x, float), np.asarray(model.node_volume, float), forces, fixed, h,
+            model.m_ratio, between_shells(h, model.offsets, d),
+            h ** d * model.thickness, "peri/pmb", (c,), c * model.horizon ** (d + 1))
+        setting = p["setting"]
+        with tempfile.TemporaryDirectory(prefix="pdverify-lammps-") as folder:
+            result = lammps.run(peer_model, setting, folder, where=where)
+        u_none = solve_none()[0].reshape(d, n).T
+        scale = float(np.linalg.norm(u_none))
+        metrics = {"peer_diff_to_none": _rel(result.u, u_none, scale)}
+        info = {"solver": self.name, "peer": result.info}
+        if setting == "same-model":
+            metrics["peer_gap_nonlinear"] = metrics["peer_diff_to_none"]
+            x = result.u.T.ravel()
+            ext = model.bond_extensions(x)
+            strain = float(np.max(np.abs(ext) / model.bond_x)) if ext.size else 0.0
+            info["equilibrium"] = balance(model.K, x, forces.T.ravel(), fixed_dofs,
+                                          np.zeros(len(fixed_dofs)), strain, d * n)
+            metrics["equilibrium_residual"] = info["equilibrium"]["residual"]
+        return result.u, info, metrics, _trouble(result.info, info.get("equilibrium"),
+                                                 not_in_equilibrium)
+
+
+def _trouble(peer: dict, balance: dict | None, not_in_equilibrium) -> str | None:
+    """Why a peer's field is not a solution (None: it is); the residual is named where
+    one was computed."""
+    residual = ("" if balance is None else
+                f"; relative residual {balance['residual']:.3g} in the linear model")
+    lost = peer.get("damage_sum", 0.0)
+    if lost:
+        return f"LAMMPS lost bonds (damage summed over the atoms {lost:.3g}){residual}"
+    if peer.get("stopping") != "force tolerance":
+        return (f"LAMMPS's minimiser stopped on {peer.get('stopping')!r}, force norm "
+                f"{peer.get('fnorm_final', float('nan')):.3g} of "
+                f"{peer.get('fnorm_initial', float('nan')):.3g}{residual}")
+    if balance is not None and not balance["in_equilibrium"]:
+        return not_in_equilibrium(balance)
+    return None
+
+
+def peer_treatments() -> list[Treatment]:
+    return [PeerTreatment(
+        lammps.NAME, "LAMMPS's PERI package (peri/lps, peri/pmb) run on the scene's "
+        "uncorrected node set and scored like pdverify's own runs: as its users run it, "
+        "or driven to solve pdverify's discrete model", "LAMMPS (Thompson et al., CPC 271 "
+        "(2022) 108171), PERI package (Parks, Lehoucq, Plimpton, Silling 2008)",
+        params=(SETTING,), theories=("state-based", "bond-based"), dims=(1, 2, 3),
+        families=("static-state",), shapes=True, unavailable=lammps.unavailable(),
+        scope="the static state-based scenes' uncorrected node sets (influence=hyperbolic) "
+              f"and the bond-based {', '.join(BOND_SCENES)} (micromodulus=constant)")]

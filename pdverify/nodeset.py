@@ -1,0 +1,165 @@
+"""A scene's uncorrected node set (:class:`NodeSet`: the real nodes of its ``none``
+system with their volumes, loads and prescribed components) and what pdverify checks of a
+displacement field given on it by another code: the unknowns it stands for
+(:func:`solution_vector`), its equilibrium in the scene's linear model
+(:func:`equilibrium`, :func:`balance`), and the horizon that keeps exactly the model's
+bonds for a code that tests |xi|^2 <= delta^2 (:func:`between_shells`). Used by
+``export``/``score`` (:mod:`pdverify.exchange`) and the peer codes
+(:mod:`pdverify.peers`); it imports no scene, so the treatments may use it. No printing.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import InputError
+
+
+@dataclass
+class NodeSet:
+    """The ``none`` problem of a scene as arrays (module docstring). ``fixed``: per
+    component k, ``(nodes, values)`` of its prescribed nodes (0-based, ascending)."""
+
+    scene: object
+    params: dict
+    problem: object
+    system: object
+    x: np.ndarray          # (n, d) positions [m]
+    volume: np.ndarray     # (n,) node volumes [m^3] (thickness or cross-section included)
+    forces: np.ndarray     # (n, d) nodal forces [N]
+    fixed: dict            # k -> (nodes, values [m])
+
+    @property
+    def dim(self) -> int:
+        return self.x.shape[1]
+
+    @property
+    def spacing(self) -> float:
+        return float(self.problem.spacing)
+
+    @property
+    def horizon(self) -> float:
+        """The model's horizon m h [m] (its influence function's delta)."""
+        return float(self.system.model.horizon)
+
+
+def node_set_of(scene, p, problem, system) -> NodeSet:
+    """The arrays of an uncorrected ``system`` of ``problem`` (any body the family's
+    ``none`` assembles: a box, or a shape with cut volumes)."""
+    g = system.model.grid
+    ni, nu_, d = g.n_interior, system.n_unknown_nodes, g.dim
+    if nu_ != ni or system.B is not None or system.offset is not None:
+        raise InputError(f"{scene.id}: its uncorrected system has unknowns or rows beyond "
+                         "the real nodes, which a node set cannot state; it is not exported")
+    x = g.x[g.interior_ids]
+    volume = np.asarray(system.model.node_volume)[g.interior_ids]
+    forces = np.asarray(system.rhs[:d * nu_]).reshape(d, nu_).T
+    fixed = {}
+    comp, nodes = np.divmod(np.asarray(system.fixed), nu_)
+    for k in range(d):
+        on = comp == k
+        if on.any():
+            fixed[k] = (nodes[on], np.asarray(system.values)[on])
+    return NodeSet(scene, p, problem, system, x, volume, forces, fixed)
+
+
+
+def _lattice_k2(dim: int, reach: int) -> np.ndarray:
+    """|k|^2 of every integer offset k with |k_i| <= reach (0 included)."""
+    axes = np.arange(-reach, reach + 1, dtype=np.int64)
+    k = np.stack(np.meshgrid(*([axes] * dim), indexing="ij"), axis=-1).reshape(-1, dim)
+    return np.sum(k * k, axis=1)
+
+
+
+def between_shells(spacing: float, offsets, dim: int) -> float:
+    """``h sqrt((K + K_next) / 2)`` of bond ``offsets`` (integer, in spacings) on the
+    ``dim``-D lattice (:func:`export_horizon`)."""
+    off = np.asarray(offsets, dtype=np.int64)
+    k2_max = int(np.max(np.sum(off * off, axis=1)))
+    lattice = _lattice_k2(dim, math.isqrt(k2_max) + 1)
+    return spacing * math.sqrt(0.5 * (k2_max + int(lattice[lattice > k2_max].min())))
+
+
+
+# ------------------------------------------------------------------------------ equilibrium
+#: a field counts as an equilibrium of the scene's linear model when the relative residual
+#: of its free equations is at most this many times the field's largest bond strain: a
+#: geometrically nonlinear code's exact equilibrium (LAMMPS's PERI bonds act along the
+#: deformed bond, with the current length) differs from the linear one by terms of order
+#: strain x stress, so its residual in the linear model is O(max strain) (measured: 0.1-0.6
+#: x the strain on the peer runs, tests/peers); a solver stopped early or bonds lost leave
+#: residuals of order 1e-2 to 1 of the load
+RESIDUAL_PER_STRAIN = 10.0
+#: ... and at least this (round-off of a linear solve in double precision, 1e4 eps, for a
+#: field without strain)
+RESIDUAL_FLOOR = 1e-12
+
+
+def solution_vector(system, U: np.ndarray) -> np.ndarray:
+    """The unknowns of an uncorrected ``system`` holding the displacements ``U`` (n, d) of
+    its real nodes: component-major; for the augmented system (solver=nested-dissection)
+    followed by its nodal scalars (dilatations) from the displacements, theta = A_theta
+    A_e A_U u, so that K x - rhs (a reaction) is the direct system's (the displacement
+    metrics do not read them)."""
+    d = np.shape(U)[1]
+    x = np.asarray(U, dtype=float).T.ravel()
+    if system.K.shape[0] > x.size:
+        model = system.model
+        x = np.r_[x, model.A_theta @ (model.A_e @ (model.A_U_full @ x))]
+    assert x.size == system.K.shape[0] or d == 0
+    return x
+
+
+def equilibrium(ns: NodeSet, U: np.ndarray) -> dict:
+    """How far the displacements ``U`` (n, d) of the exported node set are from an
+    equilibrium of its linear model (:func:`balance`)."""
+    system = ns.system
+    d, n = ns.dim, len(ns.x)
+    xa = solution_vector(system, U)
+    model = system.model
+
+    def extend(x):       # the augmented form's dilatations of a displacement vector
+        if system.K.shape[0] == x.size:
+            return x
+        return np.r_[x, model.A_theta @ (model.A_e @ (model.A_U_full @ x))]
+
+    ext = model.A_e @ (model.A_U_full @ xa[:d * n])
+    strain = float(np.max(np.abs(ext) / model.bond_x)) if ext.size else 0.0
+    return balance(system.K, xa, system.rhs, system.fixed, system.values, strain, d * n,
+                   extend)
+
+
+def balance(K, x, rhs, fixed, values, strain: float, rows: int, extend=None) -> dict:
+    """``residual`` = ||(K x - f)_free|| / scale over the first ``rows`` equations less the
+    prescribed unknowns ``fixed`` (the load scale is the larger of the free loads' norm
+    and the free reactions of the prescribed ``values``, so a displacement-driven scene
+    has a scale too), ``max_strain`` (the field's largest |bond extension| / |xi|, given),
+    ``limit`` and ``in_equilibrium`` (module constants above). ``extend`` completes a
+    displacement vector to all unknowns (the augmented forms' nodal scalars)."""
+    extend = extend or (lambda v: v)
+    free = np.ones(rows, dtype=bool)
+    fixed = np.asarray(fixed, dtype=int)
+    free[fixed[fixed < rows]] = False
+    f = np.asarray(rhs, dtype=float)[:rows]
+    r = (K @ x)[:rows] - f
+    prescribed = np.zeros(rows)
+    prescribed[fixed] = np.asarray(values, dtype=float)
+    drive = (K @ extend(prescribed))[:rows]
+    scale = max(float(np.linalg.norm(f[free])), float(np.linalg.norm(drive[free])))
+    norm = float(np.linalg.norm(r[free]))
+    residual = norm / scale if scale > 0 else norm
+    limit = max(RESIDUAL_PER_STRAIN * strain, RESIDUAL_FLOOR)
+    return {"residual": residual, "max_strain": strain, "limit": limit,
+            "in_equilibrium": bool(np.isfinite(residual) and residual <= limit)}
+
+
+def not_in_equilibrium(balance: dict) -> str:
+    """The message of a field that is not an equilibrium of the linear model."""
+    return (f"not in equilibrium: relative residual {balance['residual']:.3g} of the free "
+            f"equations in the scene's linear model, above {balance['limit']:.3g} "
+            f"({RESIDUAL_PER_STRAIN:g} x the field's largest bond strain "
+            f"{balance['max_strain']:.3g}): a solver stopped early, lost bonds or other "
+            "conditions than the export's")

