@@ -344,13 +344,14 @@ def peer_findings(scene_id: str, results) -> list[Deviation]:
             parts.append(f"as its users run it, {name} differs from our none by "
                          f"{100 * m['peer_diff_to_none']:.3g} % (relative L2)")
             if "peer_gap_volumes" in m:
-                parts.append(f"{100 * m['peer_gap_volumes']:.3g} % of that is its volume "
-                             f"weights near the horizon and uniform volumes (the linear "
-                             f"model with them against none), "
+                parts.append(f"{100 * m['peer_gap_volumes']:.3g} % is its bond weights "
+                             "and horizon rule (our linear model with LAMMPS's weights, "
+                             "the volume ramp within h/2 of the horizon (m + 2e-4) h, "
+                             "whole cells inside it and no bond beyond, against none at "
+                             f"quadrature={used.params.get('quadrature', '?')}) and "
                              f"{100 * m['peer_gap_nonlinear']:.2g} % its geometric "
                              "nonlinearity and stopping tolerance (LAMMPS against that "
-                             "linear model); its horizon rule ((m + 2e-4) h) keeps the "
-                             "same bonds as whole cells")
+                             "linear model)")
             else:
                 parts.append("no linear twin of its volumes here (cut or half cells), so "
                              "the gap is not split")

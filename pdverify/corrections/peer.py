@@ -127,8 +127,14 @@ class PeerTreatment(Treatment):
                 own = None      # cut cells or half cells: no linear model of LAMMPS's here
             else:
                 horizon = (model.m_ratio + lammps.EXAMPLES_MARGIN) * model.spacing
-                closure = Closure(weight_factor=lambda m: ramp(m.bond_x, model.spacing,
-                                                               horizon))
+
+                def lammps_weights(m):
+                    """LAMMPS's weight of each bond (its ramp, whole cells within its
+                    horizon, none beyond) in place of the scene's quadrature's beta."""
+                    keep = m.bond_x <= horizon
+                    return np.where(keep, ramp(m.bond_x, model.spacing, horizon)
+                                    / np.where(keep, m.bond_beta, 1.0), 0.0)
+                closure = Closure(weight_factor=lammps_weights)
                 ramped = assemble_plain(problem, closure)
                 x_ramp, _ = solve_system(ramped, where=where, ordering=problem.ordering)
                 u_ramp = np.asarray(x_ramp[:d * n]).reshape(d, n).T

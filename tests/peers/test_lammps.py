@@ -94,11 +94,13 @@ def test_same_model_in_1d_and_2d(scene_id):
 
 
 @needs_lammps
-def test_as_used_gap_is_attributed():
-    # as-used = the linear model with LAMMPS's volume ramp (computed by pdverify) plus
+@pytest.mark.parametrize("quadrature", ["full-cells", "partial-volume"])
+def test_as_used_gap_is_attributed(quadrature):
+    # as-used = the linear model with LAMMPS's weights (ramp, whole cells inside its
+    # horizon, no bond beyond; computed by pdverify whatever the scene's quadrature) plus
     # LAMMPS's nonlinearity: the two parts account for the whole gap (triangle
-    # inequality, and the nonlinear part is small: O(strain) = 7e-5)
-    r = _run("body3d-traction", influence="hyperbolic", quadrature="full-cells",
+    # inequality), and the nonlinear part is small: O(strain) = 7e-5
+    r = _run("body3d-traction", influence="hyperbolic", quadrature=quadrature,
              setting="as-used", spacing=0.1)
     m = r.metrics
     assert m["peer_gap_volumes"] > 1e-2            # the ramp matters (2.8 % measured)
@@ -202,3 +204,24 @@ def test_deck_holds_the_s0_workaround_and_fire():
     text = lammps.deck(lammps.state_based_model(ns), "as-used")["in.lammps"]
     assert "run 0\nrun 0\n" in text and "min_style fire" in text
     assert "lattice sc 0.05" in text
+
+
+def test_deviation_text_quotes_the_records():
+    # the Deviations box's peer finding is formatted from the runs' records: each number
+    # it quotes is the record's (an edited record changes the text)
+    from pdverify.deviations import peer_findings
+    from pdverify.results import RunResult
+    used = RunResult(scene="s", method="peer:x", reference="analytic",
+                     params={"setting": "as-used",
+                                                         "quadrature": "full-cells"},
+                     metrics={"peer_diff_to_none": 0.0279, "peer_gap_volumes": 0.0278,
+                              "peer_gap_nonlinear": 2.2e-5})
+    same = RunResult(scene="s", method="peer:x", reference="analytic",
+                     params={"setting": "same-model"},
+                     metrics={"peer_diff_to_none": 2.4e-5, "equilibrium_residual": 4.5e-5})
+    (finding,) = peer_findings("s", [used, same])
+    for quoted in ("2.79 %", "2.78 %", "0.0022 %", "0.0024 %", "residual 4.5e-05"):
+        assert quoted in finding.text, quoted
+    used.metrics["peer_gap_volumes"] = 0.0111
+    assert "1.11 %" in peer_findings("s", [used, same])[0].text
+    assert peer_findings("t", [used, same]) == []
