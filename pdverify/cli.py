@@ -11,7 +11,7 @@ usage:
                           [--force]
   python -m pdverify compare --against-published RESULTS.json
   python -m pdverify export SCENE [--method none] [--set KEY=VALUE ...]
-                          --format {csv,vtu,peridigm,perilab} --out DIR
+                          --format {csv,vtu,peridigm,perilab,lammps} --out DIR
   python -m pdverify score SCENE FILE [--export DIR] [--set KEY=VALUE ...] --name NAME
                           [--out FILE.json] [--force]
 
@@ -147,8 +147,8 @@ def build_parser() -> argparse.ArgumentParser:
     exp.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                      help="override a scene parameter; repeat for several")
     exp.add_argument("--format", required=True, dest="fmt",
-                     choices=("csv", "vtu", "peridigm", "perilab"),
-                     help="csv files, a VTU file, or a Peridigm / PeriLab.jl deck")
+                     choices=("csv", "vtu", "peridigm", "perilab", "lammps"),
+                     help="csv files, a VTU file, or a Peridigm / PeriLab.jl / LAMMPS deck")
     exp.add_argument("--out", required=True, metavar="DIR",
                      help="output folder: new, empty or a previous export")
     sco = sub.add_parser("score", help="measure displacements another code computed on an "

@@ -15,7 +15,7 @@ from .errors import InputError, OutputError
 from .exchange import (AXES, LENGTH_UNITS, MARKER, MARKER_SCHEMA, METHOD, NodeSet,  # noqa: F401
                        describe_json, dumps, export_horizon)
 
-FORMATS = ("csv", "vtu", "peridigm", "perilab")
+FORMATS = ("csv", "vtu", "peridigm", "perilab", "lammps")
 #: Peridigm's and PeriLab's QuasiStatic/Static runs need a density (inertia is not used
 #: by a static solve); any positive value
 DENSITY = 1000.0
@@ -109,6 +109,8 @@ def write_export(ns: NodeSet, fmt: str, out: str) -> list[str]:
         files.update(peridigm_files(ns))
     elif fmt == "perilab":
         files.update(perilab_files(ns))
+    elif fmt == "lammps":
+        files.update(lammps_files(ns))
     files["README.md"] = readme(ns, fmt, sorted(files) + (["nodes.vtu"] if fmt == "vtu" else []))
     path = out
     try:
@@ -458,6 +460,19 @@ def _influence_note(ns: NodeSet) -> str:
     return text
 
 
+def lammps_files(ns: NodeSet) -> dict:
+    """LAMMPS PERI decks of the node set in both settings of :mod:`pdverify.peers.lammps`
+    (``lammps/as-used/`` and ``lammps/same-model/``: ``in.lammps``, ``nodes.data``,
+    ``loads.in``, ``prescribed.in``); state-based scenes run peri/lps."""
+    from .peers import lammps
+    model = lammps.state_based_model(ns)
+    out = {}
+    for setting in lammps.SETTINGS:
+        for name, text in lammps.deck(model, setting, title=ns.scene.id).items():
+            out[f"lammps/{setting}/{name}"] = text
+    return out
+
+
 def readme(ns: NodeSet, fmt: str, files) -> str:
     """What the files are, what to run, and what a deck can and cannot express."""
     d = ns.dim
@@ -492,6 +507,17 @@ def readme(ns: NodeSet, fmt: str, files) -> str:
                                  "nodal Forces, Static solver, Exodus output",
         "perilab/mesh.txt": "PeriLab's text mesh: header `x y [z] block_id volume`",
     }
+    for setting, how in (("as-used", "as LAMMPS's examples run it: its volume ramp within "
+                          "h/2 of the horizon (m + 2e-4) h, one volume h^d per atom"),
+                         ("same-model", "pdverify's discrete model: each node's volume, "
+                          "the written horizon, no ramp or contact forces (lattice none "
+                          "1e-12); meant for quadrature=full-cells")):
+        what[f"lammps/{setting}/in.lammps"] = (
+            f"LAMMPS input ({how}): peri/lps with K = (c_theta k_theta + k_e) / 9 and "
+            "G = k_e / 15 (pdverify's constants; the bulk and shear moduli in 3D), loads "
+            "as force densities (fix addforce), prescribed components held by fix "
+            "setforce, equilibrium by min_style fire, final and reference positions in "
+            "`displaced.dump`; `loads.in`, `prescribed.in` and `nodes.data` beside it")
     for name in files:
         if name in what:
             text.append(f"- `{name}`: {what[name]}")
@@ -507,6 +533,12 @@ def readme(ns: NodeSet, fmt: str, files) -> str:
     elif fmt == "perilab":
         text.append("`cd perilab && julia -e 'using PeriLab; PeriLab.main(\"pdverify.yaml\")'` "
                     "writes `pdverify_result.e`.")
+    elif fmt == "lammps":
+        text.append("`cd lammps/as-used && lmp -in in.lammps` (likewise `same-model`) writes "
+                    "`displaced.dump`; `python -m pdverify run SCENE --method peer:lammps` "
+                    "does the same from inside pdverify. The deck runs `run 0` twice before "
+                    "loading: LAMMPS's first setup leaves the critical stretch s0 = 0, which "
+                    "breaks every stretched bond at the next step.")
     else:
         text.append("Solve the problem in your code on exactly these nodes, with these "
                     "conditions and loads.")
@@ -522,7 +554,8 @@ def readme(ns: NodeSet, fmt: str, files) -> str:
                "of rows and columns), a VTU with a "
                "point array `u` or `displacement(s)` (or its components), or the Exodus "
                "file the deck writes (its last time step; a NetCDF-4 file needs the "
-               "netCDF4 package). Every node must lie within "
+               "netCDF4 package), or a LAMMPS dump with columns id, x, y, z and the "
+               "reference positions (the deck's `displaced.dump`). Every node must lie within "
                "1e-3 spacings of one node of this set, one each. Then "
                "`python -m pdverify report --include mycode.json` shows it beside ours.", "",
              "## What the decks can and cannot express", "",

@@ -209,8 +209,9 @@ def read_displacements(path: str, dim: int) -> Displacements:
     """Positions and displacements from a CSV (header row: ``x, y, z`` and ``ux, uy,
     uz`` or ``u_x``..., a length unit in brackets scaled to metres (:data:`LENGTH_UNITS`),
     ``#`` lines skipped, a UTF-8 byte-order mark allowed), a VTU (meshio: points and a
-    point array ``u``/``displacement(s)`` or its components) or an Exodus file
-    (:func:`_read_exodus`: its last time step). Any problem is InputError naming the
+    point array ``u``/``displacement(s)`` or its components), an Exodus file
+    (:func:`_read_exodus`: its last time step) or a LAMMPS text dump
+    (:func:`_read_lammps_dump`: its last snapshot, with the reference positions). Any problem is InputError naming the
     file, and so is a file without nodes, with fewer coordinates than ``dim`` or whose
     displacements are all zero (an initial state: every exported problem has a load or
     a prescribed value that is not zero)."""
@@ -223,9 +224,12 @@ def read_displacements(path: str, dim: int) -> Displacements:
         got = _read_mesh(path, dim, "vtu")
     elif ext in (".e", ".exo", ".ex2", ".exodus"):
         got = _read_exodus(path, dim)
+    elif ext in (".dump", ".lammpstrj"):
+        got = _read_lammps_dump(path, dim)
     else:
         raise InputError(f"displacement file {path!r}: unknown kind "
-                         f"{ext or '(no extension)'!r}; allowed: .csv, .vtu, .e/.exo (Exodus)")
+                         f"{ext or '(no extension)'!r}; allowed: .csv, .vtu, .e/.exo "
+                         "(Exodus), .dump (LAMMPS text dump)")
     if not len(got.x):
         raise InputError(f"displacement file {path!r} holds no nodes"
                          + (" (no data rows below its header)" if got.kind == "csv" else ""))
@@ -381,6 +385,45 @@ def _read_exodus(path: str, dim: int) -> Displacements:
     _check_finite(path, np.c_[x[:, :dim], u])
     return Displacements(path, "exodus", x[:, :dim], u,
                          None if times is None or not len(times) else float(times[step]))
+
+
+#: the columns of a LAMMPS dump's reference positions: the deck's ``fix x0 all store/state
+#: 0 x y z`` (``f_x0[1]``...), or ``x0 y0 z0``
+_DUMP_REFERENCE = (("f_x0[1]", "f_x0[2]", "f_x0[3]"), ("x0", "y0", "z0"))
+
+
+def _read_lammps_dump(path: str, dim: int) -> Displacements:
+    """The last snapshot of a LAMMPS text dump (``ITEM: ATOMS id x y z ...``): positions
+    the reference columns (:data:`_DUMP_REFERENCE`), displacements the current positions
+    less them; rows in any order (sorted by id)."""
+    try:
+        with open(path, encoding="utf-8-sig") as fh:
+            lines = fh.read().splitlines()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"displacement file {path!r} cannot be read ({exc})") from None
+    starts = [i for i, ln in enumerate(lines) if ln.startswith("ITEM: ATOMS")]
+    if not starts:
+        raise InputError(f"displacement file {path!r}: no 'ITEM: ATOMS' line (not a LAMMPS "
+                         "text dump)")
+    head = lines[starts[-1]].split()[2:]
+    ref = next((cols for cols in _DUMP_REFERENCE if all(c in head for c in cols[:dim])), None)
+    need = ["id", *"xyz"[:dim]]
+    if ref is None or any(c not in head for c in need):
+        raise InputError(f"displacement file {path!r}: a LAMMPS dump needs the columns "
+                         f"id, {', '.join('xyz'[:dim])} and the reference positions "
+                         f"({' '.join(_DUMP_REFERENCE[0][:dim])}, as the deck writes them); "
+                         f"it has {' '.join(head) or 'none'}")
+    cols = [head.index(c) for c in need + list(ref[:dim])]
+    rows = [ln.split() for ln in lines[starts[-1] + 1:] if ln.strip()]
+    try:
+        data = np.array([[float(r[c]) for c in cols] for r in rows]).reshape(len(rows), -1)
+    except (ValueError, IndexError):
+        raise InputError(f"displacement file {path!r}: a row of its last snapshot is not "
+                         f"{len(head)} numbers") from None
+    data = data[np.argsort(data[:, 0], kind="stable")] if len(data) else np.zeros((0, 1 + 2 * dim))
+    x, x0 = data[:, 1:1 + dim], data[:, 1 + dim:]
+    _check_finite(path, np.c_[x, x0])
+    return Displacements(path, "lammps-dump", x0, x - x0)
 
 
 def _check_finite(path, data) -> None:

@@ -249,7 +249,9 @@ def deck(model: Model, setting: str, *, title: str = "pdverify") -> dict:
         "min_style fire",
         f"minimize 0.0 {f(ftol)} {MAX_ITERATIONS} {10 * MAX_ITERATIONS}",
         'print "pdverify-lost-bonds $(c_lost:%.17g)"',
-        "write_dump all custom displaced.dump id x y z modify sort id format float %.17g",
+        "# final and reference positions (pdverify score reads u = x - x0 from them)",
+        "write_dump all custom displaced.dump id x y z f_x0[1] f_x0[2] f_x0[3] "
+        "modify sort id format float %.17g",
     ]
     return {"in.lammps": "\n".join(lines) + "\n", "nodes.data": "\n".join(data) + "\n",
             "loads.in": "\n".join(loads) + "\n",

