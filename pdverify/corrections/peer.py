@@ -12,8 +12,8 @@ real nodes, divided by the norm of pdverify's ``none`` field at the same params)
 - ``equilibrium_residual``: the relative residual of LAMMPS's field in the linear model of
   its setting (:func:`pdverify.exchange.equilibrium`); above its limit the run fails
   naming it, as does a run with lost bonds.
-Both linear models are assembled and solved by pdverify in the same run (their cost is in
-the run's setup time, LAMMPS's in its solve time).
+Both linear models are assembled and solved by pdverify in the same run, in its solve
+phase beside LAMMPS (on body3d-traction at h = 0.1: 0.62 s of LAMMPS in a 0.66 s run).
 """
 from __future__ import annotations
 
