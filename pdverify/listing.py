@@ -83,6 +83,10 @@ def format_matrix() -> str:
     for name, bm in bond_methods().items():
         state = f"unavailable: {bm.unavailable}" if bm.unavailable else bm.origin
         lines.append(f"bond method {name}: {state}; {bm.source}")
+    from .corrections.registry import treatments
+    for name, t in treatments().items():
+        if t.kind != "closure" and t.unavailable:
+            lines.append(f"method {name}: unavailable: {t.unavailable}")
     for name, why in BROKEN.items():
         lines.append(f"plugin {name}: failed to load ({why})")
     return "\n".join(lines)
@@ -98,8 +102,12 @@ def format_scene(scene) -> str:
              "  params (name=default unit {allowed}: meaning):"]
     lines += [f"    {format_param(p)}: {p.doc}" for p in scene.params]
     lines.append("  methods:")
+    offered = scene.offered()
     for m in scene.all_methods:
         tag = " (default)" if m.name == scene.default_method else ""
+        why = getattr(offered.get(m.name), "unavailable", None)
+        if why and getattr(offered.get(m.name), "kind", "") != "closure":
+            tag += f" (unavailable: {why})"
         lines.append(f"    {m.name}{tag}" + (f"  - {describe(m.name)}" if describe(m.name)
                                                else ""))
         own = {p.name for p in scene.params}

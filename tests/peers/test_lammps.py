@@ -263,3 +263,20 @@ def test_dump_without_reference_positions_is_refused(tmp_path):
     path.write_text("no dump\n")
     with pytest.raises(InputError, match="ITEM: ATOMS"):
         read_displacements(str(path), 3)
+
+
+def test_without_lammps_the_method_is_unavailable_and_list_says_why(tmp_path):
+    # LAMMPS absent (here: PDVERIFY_LAMMPS names no executable): list names the reason,
+    # run refuses as bad input (exit 2) before any work
+    import os
+    import subprocess
+    import sys
+    env = dict(os.environ, PDVERIFY_LAMMPS=str(tmp_path / "no-lmp"))
+    out = subprocess.run([sys.executable, "-m", "pdverify", "list", "body3d-traction"],
+                         env=env, capture_output=True, text=True)
+    assert out.returncode == 0
+    assert "peer:lammps (unavailable: PDVERIFY_LAMMPS=" in out.stdout
+    run = subprocess.run([sys.executable, "-m", "pdverify", "run", "body3d-traction",
+                          "--method", "peer:lammps", "--set", "influence=hyperbolic"],
+                         env=env, capture_output=True, text=True)
+    assert run.returncode == 2 and "is not an executable file" in run.stderr
