@@ -104,8 +104,9 @@ class PeerTreatment(Treatment):
 
     # ------------------------------------------------------------------ the run
     def peer_solve(self, scene, p, problem, system, where):
-        """``(x, info, metrics)``: LAMMPS's field as the system's unknowns, the
-        diagnostics, and the peer's metrics (module docstring)."""
+        """``(x, info, metrics, trouble)``: LAMMPS's field as the system's unknowns, the
+        diagnostics, the peer's metrics (module docstring) and why the field is not a
+        solution (None when it is)."""
         from .static_state import assemble_plain
         from ..nodeset import equilibrium, node_set_of, not_in_equilibrium, solution_vector
         from ..pd.closure import Closure
