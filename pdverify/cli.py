@@ -139,16 +139,19 @@ def build_parser() -> argparse.ArgumentParser:
     cmp_.add_argument("--summary", default=None, metavar="FILE",
                       help="also write the changes as JSON (FILE.json) or Markdown (else)")
     cmp_.add_argument("--force", action="store_true", help=FORCE_HELP)
-    exp = sub.add_parser("export", help="write a static-state scene's uncorrected problem "
+    exp = sub.add_parser("export", help="write a static scene's uncorrected problem "
                                         "as a node set or input deck for another PD code")
-    exp.add_argument("scene", help="a static-state scene (see: python -m pdverify list)")
+    exp.add_argument("scene", help="a static-state scene or a bond-based sheet "
+                                   "(sheet2d-tension, sheet2d-clamped; see: python -m "
+                                   "pdverify list)")
     exp.add_argument("--method", default=None,
                      help="only 'none' (the uncorrected problem) is exported")
     exp.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                      help="override a scene parameter; repeat for several")
     exp.add_argument("--format", required=True, dest="fmt",
                      choices=("csv", "vtu", "peridigm", "perilab", "lammps"),
-                     help="csv files, a VTU file, or a Peridigm / PeriLab.jl / LAMMPS deck")
+                     help="csv files, a VTU file, or a Peridigm / PeriLab.jl / LAMMPS deck "
+                          "(a bond-based sheet: no Peridigm deck)")
     exp.add_argument("--out", required=True, metavar="DIR",
                      help="output folder: new, empty or a previous export")
     sco = sub.add_parser("score", help="measure displacements another code computed on an "

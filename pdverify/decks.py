@@ -34,6 +34,38 @@ def f(v) -> str:
     return repr(float(v))
 
 
+#: why a bond-based scene has no Peridigm deck (the export README says it too)
+NO_PERIDIGM_BOND = ("Peridigm's documented example inputs (tests/data/external_decks) show "
+                    "no bond-based material")
+
+
+def refused_formats(scene, p) -> dict:
+    """``{format: why}``: the formats the export of ``scene`` at the params ``p`` does
+    not write. A bond-based scene: no Peridigm deck (:data:`NO_PERIDIGM_BOND`) and,
+    with ``micromodulus=conical``, no LAMMPS deck (peri/pmb's micromodulus is
+    constant)."""
+    from .exchange import bond_based
+    if not bond_based(scene):
+        return {}
+    out = {"peridigm": f"{scene.id} is bond-based and {NO_PERIDIGM_BOND}, so no deck is "
+                       "written"}
+    if p.get("micromodulus") != "constant":
+        out["lammps"] = (f"micromodulus={p.get('micromodulus')}; LAMMPS's peri/pmb has "
+                         "only the constant micromodulus (--set micromodulus=constant)")
+    return out
+
+
+def check_format(scene, p, fmt: str) -> None:
+    """``--format fmt`` for ``scene`` at ``p``: one of :data:`FORMATS` that the scene
+    takes (:func:`refused_formats`); else InputError naming the allowed ones."""
+    if fmt not in FORMATS:
+        raise InputError(f"--format {fmt!r}; allowed: {', '.join(FORMATS)}")
+    refused = refused_formats(scene, p)
+    if fmt in refused:
+        allowed = [x for x in FORMATS if x not in refused]
+        raise InputError(f"--format {fmt}: {refused[fmt]}; allowed: {', '.join(allowed)}")
+
+
 # ------------------------------------------------------------------------------ folder
 def check_out(path: str) -> str:
     """``--out DIR``: new, empty, or a previous export (its marker lists everything in
@@ -101,7 +133,9 @@ def _clear(folder: str) -> None:
 def write_export(ns: NodeSet, fmt: str, out: str) -> list[str]:
     """Write the export of ``ns`` in ``fmt`` into ``out`` (checked by :func:`check_out`);
     returns the files written, relative to ``out``. A write that fails raises
-    :class:`OutputError` naming the file."""
+    :class:`OutputError` naming the file; a format the node set does not take
+    (:func:`check_format`) is InputError before any file."""
+    check_format(ns.scene, ns.params, fmt)
     files = {"problem.json": dumps(describe_json(ns))}
     if fmt == "csv":
         files.update(csv_files(ns))
@@ -149,7 +183,7 @@ def export_command(scene_id: str, *, method=None, overrides=None, fmt: str, out:
     check_method(method)
     if fmt not in FORMATS:
         raise InputError(f"--format {fmt!r}; allowed: {', '.join(FORMATS)}")
-    scene.resolve(METHOD, overrides)
+    check_format(scene, scene.resolve(METHOD, overrides), fmt)
     folder = check_out(out)
     from .outputs import check_cache
     check_cache()       # a FEM scene's prescribed values come from its cached reference
@@ -312,16 +346,22 @@ def perilab_files(ns: NodeSet) -> dict:
     """``perilab/pdverify.yaml`` (PeriLab.jl's deck, the layout of its examples, e.g.
     ``examples/ENFmodel/ENFmodel.yaml``), ``perilab/mesh.txt`` (``header: x y block_id
     volume`` in 1D/2D, ``x y z ...`` in 3D) and node set files (``header: global_id``,
-    1-based). Loads as nodal ``Forces``; material ``PD Solid Elastic``."""
-    c = ns.problem.constants
+    1-based). Loads as nodal ``Forces``; material ``PD Solid Elastic`` (state-based) or
+    ``Bond-based Elastic`` (bond-based, as its ``examples/Seminars/Part_01/truss.yaml``)."""
     d2 = max(ns.dim, 2)
     xs = np.zeros((len(ns.x), d2))
     xs[:, :ns.dim] = ns.x
     cols = " ".join(AXES[:d2])
     mesh = f"header: {cols} block_id volume\n" + "".join(
         " ".join(f(v) for v in p) + f" 1 {f(v)}\n" for p, v in zip(xs, ns.volume))
+    kind = ns.problem.kind if ns.theory == "bond-based" else ns.problem.constants.kind
     symmetry = {"plane-stress": "isotropic plane stress", "plane-strain": "isotropic plane strain",
-                "3d": "isotropic", "1d": "isotropic plane stress"}[c.kind]
+                "3d": "isotropic", "1d": "isotropic plane stress"}[kind]
+    if ns.theory == "bond-based":    # the material of its examples/Seminars truss.yaml
+        model, E, nu = "Bond-based Elastic", ns.problem.E, ns.problem.nu
+    else:
+        c = ns.problem.constants
+        model, E, nu = "PD Solid Elastic", c.E, c.nu
     inf = ns.problem.influence.name
     h = f(ns.horizon)      # the model's m h, omega's delta; the block's Horizon is written
     omega = {"constant": "1", "hyperbolic": "1/xi", "conical": f"1 - xi/{h}",
@@ -338,8 +378,8 @@ def perilab_files(ns: NodeSet) -> dict:
         lines.append(f"      Node Set {name}: {_q(fname)}")
         files[f"perilab/{fname}"] = "header: global_id\n" + _node_ids(grp)
     lines += ["  Models:", "    Material Models:", "      pdverify material:",
-              "        Material Model: \"PD Solid Elastic\"", f"        Symmetry: {_q(symmetry)}",
-              f"        Young's Modulus: {f(c.E)}", f"        Poisson's Ratio: {f(c.nu)}",
+              f"        Material Model: {_q(model)}", f"        Symmetry: {_q(symmetry)}",
+              f"        Young's Modulus: {f(E)}", f"        Poisson's Ratio: {f(nu)}",
               "  Blocks:", "    block_1:", "      Block ID: 1",
               "      Material Model: \"pdverify material\"", f"      Density: {f(DENSITY)}",
               f"      Horizon: {f(export_horizon(ns))}", "  Boundary Conditions:"]
@@ -360,8 +400,31 @@ def perilab_files(ns: NodeSet) -> dict:
 
 
 # ------------------------------------------------------------------------------ README
+def _bond_model_note(ns: NodeSet) -> str:
+    """:func:`_model_note` of a bond-based node set."""
+    pr, model = ns.problem, ns.system.model
+    lmp = ("LAMMPS's `peri/pmb` (force density c s V_j along the bond, s the stretch) is "
+           "given c itself, which is pdverify's constant micromodulus."
+           if "lammps" not in refused_formats(ns.scene, ns.params) else
+           "LAMMPS's `peri/pmb` has only the constant micromodulus: no LAMMPS deck is "
+           "written for this one (`--format lammps` is refused).")
+    return (f"- The model: pdverify's is the linear bond-based solid ({pr.kind}; nu = "
+            f"{pr.nu:.6g}, the one a bond-based model represents; micromodulus "
+            f"`{pr.influence.name}`, c = {f(model.c)} N/m^6: problem.json's "
+            "`material.force_density` says what c multiplies and `c_calibration` how it "
+            f"was matched to E), node volumes with the thickness ({f(pr.thickness)} m). "
+            f"Peridigm: no deck is written, as {NO_PERIDIGM_BOND} (`--format peridigm` "
+            "is refused for this scene). PeriLab's `Bond-based Elastic` with `Symmetry: "
+            f"isotropic {pr.kind.replace('-', ' ')}` (the material of its Seminars truss "
+            "example) computes its own bond constant from E, nu and the horizon: whether "
+            "that is pdverify's c, and how it takes the thickness, is not checked here. "
+            + lmp)
+
+
 def _model_note(ns: NodeSet) -> str:
     """The README's line on the material model and what each deck makes of it."""
+    if ns.theory == "bond-based":
+        return _bond_model_note(ns)
     c, d = ns.problem.constants, ns.dim
     text = ("- The model: pdverify's is the linear ordinary state-based solid "
             f"({c.kind}; c_theta = {c.c_theta:.6g}, k_theta = {c.k_theta:.6g} Pa, "
@@ -448,6 +511,15 @@ def _weights_note(ns: NodeSet) -> str:
 def _influence_note(ns: NodeSet) -> str:
     """The README's line on the influence function as the decks write it."""
     inf = ns.problem.influence
+    if ns.theory == "bond-based":
+        text = (f"- Micromodulus `{inf.name}`: c(xi) = c omega(|xi|), omega = "
+                f"{inf.description}. PeriLab's deck writes omega as its Discretization's "
+                "`Influence Function` (an expression of the bond length, delta as the "
+                "number m h); whether its `Bond-based Elastic` applies it to the bond "
+                "force is not shown by its examples here")
+        return text + (" (with omega = 1 it makes no difference)." if inf.name == "constant"
+                       else ": a code that does not has the constant micromodulus on "
+                            "pdverify's bonds, a different model.")
     text = (f"- Influence function `{inf.name}` ({inf.description}): written as an "
             "expression of the bond length, delta as the number m h (not the decks' "
             "`Horizon`; omega's scale cancels in the linear state-based force).")
@@ -463,14 +535,39 @@ def _influence_note(ns: NodeSet) -> str:
 def lammps_files(ns: NodeSet) -> dict:
     """LAMMPS PERI decks of the node set in both settings of :mod:`pdverify.peers.lammps`
     (``lammps/as-used/`` and ``lammps/same-model/``: ``in.lammps``, ``nodes.data``,
-    ``loads.in``, ``prescribed.in``); state-based scenes run peri/lps."""
+    ``loads.in``, ``prescribed.in``); state-based scenes run peri/lps, bond-based ones
+    peri/pmb (the models :mod:`pdverify.peers.lammps` runs as ``peer:lammps``)."""
     from .peers import lammps
-    model = lammps.state_based_model(ns)
+    model = (lammps.bond_based_model(ns) if ns.theory == "bond-based"
+             else lammps.state_based_model(ns))
     out = {}
     for setting in lammps.SETTINGS:
         for name, text in lammps.deck(model, setting, title=ns.scene.id).items():
             out[f"lammps/{setting}/{name}"] = text
     return out
+
+
+def _loads_note(ns: NodeSet) -> str:
+    """The README's line on the loads: the family's rule, or the bond-based scene's own."""
+    if ns.theory == "bond-based":
+        return (f"- Loads: {ns.problem.loads}." + (
+            " PeriLab's deck gives them as nodal `Forces`, LAMMPS's as force densities "
+            "f / V. Loads on prescribed components are left out of the decks."
+            if np.any(ns.forces) else ""))
+    return ("- Loads: the scene's body force times the node volume plus, on the loaded "
+            "faces, the traction's resultant over each boundary cell face on the node of "
+            "that cell (PD tractions become nodal forces on the loaded nodes). Peridigm's "
+            "deck gives them as `Body Force` (force density f / V), PeriLab's as nodal "
+            "`Forces`. Loads on prescribed components are left out of the decks.")
+
+
+def _supports_note(ns: NodeSet) -> str:
+    """The README's line on the prescribed components (without their values)."""
+    if ns.theory == "bond-based":
+        return f"- Boundary conditions: {ns.problem.supports}."
+    return ("- Boundary conditions: the uncorrected treatment prescribes a component on the "
+            "nodes nearest its face (the outermost ring of real nodes, h/2 inside the "
+            "surface), not on the surface.")
 
 
 def readme(ns: NodeSet, fmt: str, files) -> str:
@@ -507,17 +604,38 @@ def readme(ns: NodeSet, fmt: str, files) -> str:
                                  "nodal Forces, Static solver, Exodus output",
         "perilab/mesh.txt": "PeriLab's text mesh: header `x y [z] block_id volume`",
     }
-    for setting, how in (("as-used", "as LAMMPS's examples run it: its volume ramp within "
-                          "h/2 of the horizon (m + 2e-4) h, one volume h^d per atom"),
-                         ("same-model", "pdverify's discrete model: each node's volume, "
-                          "the written horizon, no ramp or contact forces (lattice none "
-                          "1e-12); meant for quadrature=full-cells")):
+    lammps_settings = {
+        "as-used": ("as LAMMPS's examples run it: its volume ramp within h/2 of the horizon "
+                    "(m + 2e-4) h, one volume h^d per atom"),
+        "same-model": ("pdverify's discrete model: each node's volume, the written horizon, "
+                       "no ramp or contact forces (lattice none 1e-12); meant for "
+                       "quadrature=full-cells")}
+    for setting, how in lammps_settings.items():
         what[f"lammps/{setting}/in.lammps"] = (
             f"LAMMPS input ({how}): peri/lps with K = (c_theta k_theta + k_e) / 9 and "
             "G = k_e / 15 (pdverify's constants; the bulk and shear moduli in 3D), loads "
             "as force densities (fix addforce), prescribed components held by fix "
             "setforce, equilibrium by min_style fire, final and reference positions in "
             "`displaced.dump`; `loads.in`, `prescribed.in` and `nodes.data` beside it")
+    if ns.theory == "bond-based":
+        what["problem.json"] = (
+            "the scene, every parameter, the bond-based material (E, nu, the micromodulus "
+            "c with what it multiplies and how it was calibrated, its shape omega), the "
+            "model's horizon (`horizon_m`) and the written one (`horizon_written_m`, with "
+            "its rule `horizon_rule`), quadrature, thickness")
+        what["perilab/pdverify.yaml"] = what["perilab/pdverify.yaml"].replace(
+            "PD Solid Elastic", "Bond-based Elastic")
+        from .peers.lammps import FTOL_REL
+        for setting in lammps_settings:
+            what[f"lammps/{setting}/in.lammps"] = (
+                f"LAMMPS input ({lammps_settings[setting]}): peri/pmb with pdverify's "
+                "micromodulus c (its force density c s V_j along the bond), loads as force "
+                "densities (fix addforce), prescribed components held by fix setforce, "
+                f"equilibrium by min_style fire (stopping at {FTOL_REL:g} of the loads' "
+                "force norm, or of the force the prescribed values exert where there are "
+                "no loads), "
+                "final and reference positions in `displaced.dump`; `loads.in`, "
+                "`prescribed.in` and `nodes.data` beside it")
     for name in files:
         if name in what:
             text.append(f"- `{name}`: {what[name]}")
@@ -535,8 +653,10 @@ def readme(ns: NodeSet, fmt: str, files) -> str:
                     "writes `pdverify_result.e`.")
     elif fmt == "lammps":
         text.append("`cd lammps/as-used && lmp -in in.lammps` (likewise `same-model`) writes "
-                    "`displaced.dump`; `python -m pdverify run SCENE --method peer:lammps` "
-                    "does the same from inside pdverify. The deck runs `run 0` twice before "
+                    "`displaced.dump`" + (
+                        f"; `python -m pdverify run {ns.scene.id} --method peer:lammps` does "
+                        "the same from inside pdverify" if "peer:lammps" in ns.scene.offered()
+                        else "") + ". The deck runs `run 0` twice before "
                     "loading: LAMMPS's first setup leaves the critical stretch s0 = 0, which "
                     "breaks every stretched bond at the next step.")
     else:
@@ -563,14 +683,8 @@ def readme(ns: NodeSet, fmt: str, files) -> str:
              _horizon_note(ns),
              _weights_note(ns),
              _influence_note(ns),
-             "- Loads: the scene's body force times the node volume plus, on the loaded "
-             "faces, the traction's resultant over each boundary cell face on the node of "
-             "that cell (PD tractions become nodal forces on the loaded nodes). Peridigm's "
-             "deck gives them as `Body Force` (force density f / V), PeriLab's as nodal "
-             "`Forces`. Loads on prescribed components are left out of the decks.",
-             "- Boundary conditions: the uncorrected treatment prescribes a component on the "
-             "nodes nearest its face (the outermost ring of real nodes, h/2 inside the "
-             "surface), not on the surface. Values: " + (", ".join(
+             _loads_note(ns),
+             _supports_note(ns) + " Values: " + (", ".join(
                  f"u{a} takes {n} distinct value(s)" for a, n in nvals.items()) or "none")
              + ". A value that varies from node to node (a reference field, e.g. the FEM "
                "displacement on the ring) is written as one node set per value.",

@@ -1,5 +1,8 @@
-"""A static-state scene's uncorrected problem as a node set for another PD code, and the
-score of the displacements that code computed on it (``pdverify export``, ``score``).
+"""A static scene's uncorrected problem as a node set for another PD code, and the
+score of the displacements that code computed on it (``pdverify export``, ``score``):
+the ``static-state`` family's scenes (state-based; the treatment ``none`` assembles
+them) and the bond-based seed-003 sheets (they build their own model:
+``bond_problem`` and ``measure`` of :class:`pdverify.scenes.sheets.SheetScene`).
 
 The node set is the ``none`` treatment's: the real nodes of the scene's grid with their
 volumes, the prescribed components of each boundary condition (the nodes nearest the
@@ -51,13 +54,23 @@ LENGTH_UNITS = {"m": 1.0, "cm": 1e2, "mm": 1e3, "um": 1e6, "\u00b5m": 1e6, "nm":
 _UNIT_ALIASES = {"\u03bcm": "\u00b5m"}
 
 
+def bond_based(scene) -> bool:
+    """A bond-based sheet that builds and measures its own problem
+    (:class:`~pdverify.scenes.sheets.SheetScene` with ``bond_problem`` and ``measure``)."""
+    from .scenes.sheets import SheetScene
+    return (isinstance(scene, SheetScene)
+            and type(scene).bond_problem is not SheetScene.bond_problem
+            and type(scene).measure is not SheetScene.measure)
+
+
 def exportable(scene) -> bool:
     """A scene of the ``static-state`` family that states its problem (the stiffness
-    scenes of the family prescribe every node and solve nothing)."""
+    scenes of the family prescribe every node and solve nothing), or a bond-based sheet
+    that builds and measures its own (:func:`bond_based`)."""
     from .scenes.family import StaticStateScene
-    return (isinstance(scene, StaticStateScene)
-            and type(scene).problem is not StaticStateScene.problem
-            and type(scene).measure is not StaticStateScene.measure)
+    return bond_based(scene) or (isinstance(scene, StaticStateScene)
+                                 and type(scene).problem is not StaticStateScene.problem
+                                 and type(scene).measure is not StaticStateScene.measure)
 
 
 def exportable_ids() -> list[str]:
@@ -71,7 +84,8 @@ def scene_of(scene_id: str):
     from .scenes import get_scene
     scene = get_scene(scene_id)
     if not exportable(scene):
-        raise InputError(f"scene {scene_id!r} is not a static-state problem and cannot be "
+        raise InputError(f"scene {scene_id!r} is not a static problem with a node set "
+                         "(the static-state family or a bond-based sheet) and cannot be "
                          f"exported or scored; these can: {', '.join(exportable_ids())}")
     return scene
 
@@ -94,10 +108,11 @@ def _horizon_shells(ns: NodeSet) -> dict:
     partial-volume quadratures), ``beta_beyond`` and ``beta_total`` (their weights beta,
     in cells), ``added`` (lattice offsets with |k|^2 <= k2_max the stencil leaves out:
     a shell the stencil splits, e.g. partial-volume 3D at m >= 5) and ``jitter`` (the
-    shape grid's node moves, a fraction of h; 0 on the lattice)."""
+    shape grid's node moves, a fraction of h; 0 on the lattice). The offsets are
+    :attr:`NodeSet.bond_offsets` (a bond-based model's: those that carry a bond)."""
     model = ns.system.model
-    st = model.stencil
-    off = np.asarray(st.offsets, dtype=np.int64)
+    off, beta = ns.bond_offsets
+    off = np.asarray(off, dtype=np.int64)
     k2 = np.sum(off * off, axis=1)
     k2_max = int(k2.max())
     lattice = _lattice_k2(ns.dim, math.isqrt(k2_max) + 1)   # holds (r, 0, ..), r^2 > k2_max
@@ -105,7 +120,7 @@ def _horizon_shells(ns: NodeSet) -> dict:
     return {"k2_max": k2_max, "k2_next": int(lattice[lattice > k2_max].min()),
             "offsets": int(len(off)), "within": int(np.count_nonzero(~beyond)),
             "beyond": int(np.count_nonzero(beyond)),
-            "beta_beyond": float(np.sum(st.beta[beyond])), "beta_total": float(np.sum(st.beta)),
+            "beta_beyond": float(np.sum(beta[beyond])), "beta_total": float(np.sum(beta)),
             "added": int(np.count_nonzero((lattice > 0) & (lattice <= k2_max))) - len(off),
             "jitter": float(getattr(model.grid, "jitter", 0.0) or 0.0)}
 
@@ -121,7 +136,7 @@ def export_horizon(ns: NodeSet) -> float:
     rounding of coordinates written with 17 digits, ~4 eps L |xi| on a body of size L,
     up to L ~ 1e13 h), where the stencil is whole shells (:func:`_horizon_shells`:
     ``added`` lattice offsets otherwise, kept too)."""
-    return between_shells(ns.spacing, ns.system.model.stencil.offsets, ns.dim)
+    return between_shells(ns.spacing, ns.bond_offsets[0], ns.dim)
 
 
 def _horizon_rule(ns: NodeSet) -> str:
@@ -161,9 +176,13 @@ def _horizon_rule(ns: NodeSet) -> str:
 
 def node_set(scene, overrides=None) -> NodeSet:
     """Assemble the ``none`` system of ``scene`` at ``overrides`` (bad input: InputError
-    from the scene's own checks, before any work)."""
+    from the scene's own checks, before any work): by the treatment ``none`` of the
+    static-state family, or by a bond-based sheet's own ``bond_problem``."""
     p = scene.resolve(METHOD, overrides)
-    problem = scene.problem(p, f"{scene.id}/{METHOD}")
+    where = f"{scene.id}/{METHOD}"
+    if bond_based(scene):
+        return node_set_of(scene, p, *scene.bond_problem(METHOD, p, where))
+    problem = scene.problem(p, where)
     treatment = scene.treatment(METHOD)
     return node_set_of(scene, p, problem, treatment.assemble(problem, p))
 
@@ -634,8 +653,17 @@ def describe_json(ns: NodeSet) -> dict:
     horizon m h (``horizon_m``, the influence function's delta) and the horizon the decks
     write (``horizon_written_m``, :func:`export_horizon`) with its rule as text."""
     from .results import _plain
-    c = ns.problem.constants
     inf = ns.problem.influence
+    if ns.theory == "bond-based":
+        material = bond_material(ns)
+        influence = {"name": inf.name, "omega": inf.description,
+                     "what": "the micromodulus's shape: c(xi) = c omega(|xi|)"}
+    else:
+        c = ns.problem.constants
+        material = {"model": "linear ordinary state-based (LPS)", "kind": c.kind,
+                    "E_Pa": c.E, "nu": c.nu, "c_theta": c.c_theta, "k_theta_Pa": c.k_theta,
+                    "k_e_Pa": c.k_e}
+        influence = {"name": inf.name, "omega": inf.description}
     return _plain({
         "schema": "pdverify.export/1", "scene": ns.scene.id, "method": METHOD,
         "params": ns.params, "reference": ns.scene.reference, "dim": ns.dim,
@@ -643,14 +671,41 @@ def describe_json(ns: NodeSet) -> dict:
         "m_ratio": ns.horizon / ns.spacing, "horizon_written_m": export_horizon(ns),
         "horizon_rule": _horizon_rule(ns), "bond_offsets": _horizon_shells(ns),
         "thickness_m": float(ns.problem.thickness),
-        "material": {"model": "linear ordinary state-based (LPS)", "kind": c.kind,
-                     "E_Pa": c.E, "nu": c.nu, "c_theta": c.c_theta, "k_theta_Pa": c.k_theta,
-                     "k_e_Pa": c.k_e},
-        "influence": {"name": inf.name, "omega": inf.description},
+        "material": material, "influence": influence,
         "quadrature": ns.params.get("quadrature", "partial-volume"),
         "prescribed": {AXES[k]: int(len(v[0])) for k, v in ns.fixed.items()},
         "loaded_nodes": int(np.count_nonzero(np.any(ns.forces != 0, axis=1))),
     })
+
+
+def bond_material(ns: NodeSet) -> dict:
+    """problem.json's ``material`` of a bond-based node set: the model, the moduli its
+    micromodulus was calibrated to, c and what it multiplies (BondBasedModel)."""
+    pr, model = ns.problem, ns.system.model
+    partial = ns.params.get("quadrature") == "partial-volume"
+    return {
+        "model": "linear bond-based (pairwise forces along the reference bond direction, "
+                 "linearised in the displacements)",
+        "kind": pr.kind, "E_Pa": float(pr.E), "nu": float(pr.nu),
+        "micromodulus": pr.influence.name, "c_N_per_m6": float(model.c),
+        "force_density": (
+            "force density on node a [N/m^3] = sum over its bonds b of c omega(|xi|) "
+            "(e / |xi|) V_b" + (" beta_b" if partial else "") + " along n, with xi the "
+            "reference bond vector, n = xi / |xi|, e = n . (u_b - u_a) the linearised "
+            "extension, omega the micromodulus's shape (influence) and V_b the "
+            "neighbour's volume as written (volume [m^3] in nodes.csv: the cell's area "
+            "times the thickness)" + (", beta_b the fraction of its cell inside the "
+                                      "horizon (quadrature=partial-volume)" if partial else "")
+            + "; so c is in N/m^6 and the nodal force is that density times V_a"),
+        "c_calibration": (
+            f"c = {float(model.c)!r} N/m^6 matches E and nu of a complete continuous "
+            f"horizon of radius horizon_m in {pr.kind.replace('-', ' ')} (9 E / (pi "
+            "delta^3) for the constant micromodulus) per unit thickness, and is not "
+            "divided by the thickness: with V_a and V_b both holding it, the model's "
+            "stiffness grows with thickness_m squared where its loads grow with "
+            "thickness_m, so the calibration holds at thickness_m = 1 m (the scenes' "
+            "default)"),
+    }
 
 
 def dumps(doc: dict) -> str:

@@ -1,7 +1,8 @@
 """A scene's uncorrected node set (:class:`NodeSet`: the real nodes of its ``none``
-system with their volumes, loads and prescribed components) and what pdverify checks of a
-displacement field given on it by another code: the unknowns it stands for
-(:func:`solution_vector`), its equilibrium in the scene's linear model
+system with their volumes, loads and prescribed components; the system of a state-based
+treatment, or a bond-based scene's own :class:`~pdverify.pd.problem.BondSystem`) and
+what pdverify checks of a displacement field given on it by another code: the unknowns
+it stands for (:func:`solution_vector`), its equilibrium in the scene's linear model
 (:func:`equilibrium`, :func:`balance`), and the horizon that keeps exactly the model's
 bonds for a code that tests |xi|^2 <= delta^2 (:func:`between_shells`). Used by
 ``export``/``score`` (:mod:`pdverify.exchange`) and the peer codes
@@ -44,10 +45,31 @@ class NodeSet:
         """The model's horizon m h [m] (its influence function's delta)."""
         return float(self.system.model.horizon)
 
+    @property
+    def theory(self) -> str:
+        """``bond-based`` (a :class:`~pdverify.pd.problem.BondProblem`) or ``state-based``."""
+        from .pd.problem import BondProblem
+        return "bond-based" if isinstance(self.problem, BondProblem) else "state-based"
+
+    @property
+    def bond_offsets(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(offsets, beta)``: the model's bond offsets of a full neighbourhood (integer,
+        in spacings, both signs) and their weights beta. State-based: its stencil's. A
+        bond-based model's bonds are its half offsets whose weight omega beta is not zero
+        (:class:`~pdverify.pd.bondbased.BondBasedModel`: the tip of a conical
+        micromodulus at integer m carries no bond), with their negatives."""
+        model = self.system.model
+        if self.theory == "bond-based":
+            off = np.asarray(model.offsets)
+            return np.r_[off, -off], np.r_[model.beta_k, model.beta_k]
+        return np.asarray(model.stencil.offsets), np.asarray(model.stencil.beta)
+
 
 def node_set_of(scene, p, problem, system) -> NodeSet:
     """The arrays of an uncorrected ``system`` of ``problem`` (any body the family's
-    ``none`` assembles: a box, or a shape with cut volumes)."""
+    ``none`` assembles: a box, or a shape with cut volumes; or a bond-based scene's
+    :class:`~pdverify.pd.problem.BondSystem`, every grid node real). Each component's
+    prescribed nodes in ascending order."""
     g = system.model.grid
     ni, nu_, d = g.n_interior, system.n_unknown_nodes, g.dim
     if nu_ != ni or system.B is not None or system.offset is not None:
@@ -59,8 +81,9 @@ def node_set_of(scene, p, problem, system) -> NodeSet:
     fixed = {}
     comp, nodes = np.divmod(np.asarray(system.fixed), nu_)
     for k in range(d):
-        on = comp == k
-        if on.any():
+        on = np.flatnonzero(comp == k)
+        if on.size:
+            on = on[np.argsort(nodes[on], kind="stable")]
             fixed[k] = (nodes[on], np.asarray(system.values)[on])
     return NodeSet(scene, p, problem, system, x, volume, forces, fixed)
 
@@ -113,9 +136,20 @@ def solution_vector(system, U: np.ndarray) -> np.ndarray:
     return x
 
 
+def bond_extensions(model, u) -> np.ndarray:
+    """Linearised bond extensions of the real nodes' displacements ``u`` (component-major)
+    in ``model``: a bond-based model's own (``bond_extensions``), a state-based model's
+    A_e A_U u."""
+    from .pd.bondbased import BondBasedModel
+    if isinstance(model, BondBasedModel):
+        return model.bond_extensions(u)
+    return model.A_e @ (model.A_U_full @ u)
+
+
 def equilibrium(ns: NodeSet, U: np.ndarray) -> dict:
     """How far the displacements ``U`` (n, d) of the exported node set are from an
-    equilibrium of its linear model (:func:`balance`)."""
+    equilibrium of its linear model (:func:`balance`), state-based or bond-based (K the
+    bond-based model's stiffness, the strain from its bond extensions)."""
     system = ns.system
     d, n = ns.dim, len(ns.x)
     xa = solution_vector(system, U)
@@ -126,7 +160,7 @@ def equilibrium(ns: NodeSet, U: np.ndarray) -> dict:
             return x
         return np.r_[x, model.A_theta @ (model.A_e @ (model.A_U_full @ x))]
 
-    ext = model.A_e @ (model.A_U_full @ xa[:d * n])
+    ext = bond_extensions(model, xa[:d * n])
     strain = float(np.max(np.abs(ext) / model.bond_x)) if ext.size else 0.0
     return balance(system.K, xa, system.rhs, system.fixed, system.values, strain, d * n,
                    extend)

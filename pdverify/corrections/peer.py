@@ -153,42 +153,33 @@ class PeerTreatment(Treatment):
                 _trouble(result.info, info.get("equilibrium"), not_in_equilibrium))
 
 
-    def peer_solve_bonds(self, model, forces, fixed_dofs, p, where, solve_none):
-        """The bond-based sheets (their own assembly): ``(U, info, metrics, trouble)`` of
-        LAMMPS's peri/pmb on the linear bond-based ``model`` (all grid nodes real) with
-        nodal ``forces`` (n, d), the prescribed zero components ``fixed_dofs``
-        (component-major) and ``solve_none()`` pdverify's own solve ``(u, reactions,
-        info)``. ``same-model`` is checked for equilibrium in ``model``; ``as-used`` has
-        no linear twin here (the sheet's edge nodes carry half cells, LAMMPS's atoms one
+    def peer_solve_bonds(self, scene, p, problem, system, where, solve_none):
+        """The bond-based sheets (their own assembly: ``scene.bond_problem``):
+        ``(x, info, metrics, trouble)`` of LAMMPS's peri/pmb on the node set of the
+        sheet's linear ``problem`` and ``system`` (:class:`~pdverify.pd.problem.BondSystem`,
+        every grid node real; the deck of :func:`pdverify.peers.lammps.bond_based_model`,
+        as ``export --format lammps`` writes it), with ``solve_none()`` pdverify's own
+        solve ``(u, reactions, info)``; ``x`` holds LAMMPS's field as the system's
+        unknowns. ``same-model`` is checked for equilibrium in the system's model
+        (:func:`pdverify.nodeset.equilibrium`, as ``score`` checks it); ``as-used`` has no
+        linear twin here (the sheet's edge nodes carry half cells, LAMMPS's atoms one
         volume each) and is judged by LAMMPS's own stopping and bond count."""
-        from ..nodeset import balance, between_shells, not_in_equilibrium
-        g = model.grid
-        n, d, h = g.n_ext, g.dim, model.spacing
-        comp, nodes = np.divmod(np.asarray(fixed_dofs, dtype=int), n)
-        fixed = {k: (nodes[comp == k], np.zeros(int(np.count_nonzero(comp == k))))
-                 for k in range(d) if np.any(comp == k)}
-        c = model.c
-        peer_model = lammps.Model(
-            np.asarray(g.x, float), np.asarray(model.node_volume, float), forces, fixed, h,
-            model.m_ratio, between_shells(h, model.offsets, d),
-            h ** d * model.thickness, "peri/pmb", (c,), c * model.horizon ** (d + 1))
+        from ..nodeset import equilibrium, node_set_of, not_in_equilibrium, solution_vector
+        ns = node_set_of(scene, p, problem, system)
+        d, n = ns.dim, len(ns.x)
         setting = p["setting"]
         with tempfile.TemporaryDirectory(prefix="pdverify-lammps-") as folder:
-            result = lammps.run(peer_model, setting, folder, where=where)
+            result = lammps.run(lammps.bond_based_model(ns), setting, folder, where=where)
         u_none = solve_none()[0].reshape(d, n).T
         scale = float(np.linalg.norm(u_none))
         metrics = {"peer_diff_to_none": _rel(result.u, u_none, scale)}
         info = {"solver": self.name, "peer": result.info}
         if setting == "same-model":
             metrics["peer_gap_nonlinear"] = metrics["peer_diff_to_none"]
-            x = result.u.T.ravel()
-            ext = model.bond_extensions(x)
-            strain = float(np.max(np.abs(ext) / model.bond_x)) if ext.size else 0.0
-            info["equilibrium"] = balance(model.K, x, forces.T.ravel(), fixed_dofs,
-                                          np.zeros(len(fixed_dofs)), strain, d * n)
+            info["equilibrium"] = equilibrium(ns, result.u)
             metrics["equilibrium_residual"] = info["equilibrium"]["residual"]
-        return result.u, info, metrics, _trouble(result.info, info.get("equilibrium"),
-                                                 not_in_equilibrium)
+        return (solution_vector(system, result.u), info, metrics,
+                _trouble(result.info, info.get("equilibrium"), not_in_equilibrium))
 
 
 def _trouble(peer: dict, balance: dict | None, not_in_equilibrium) -> str | None:

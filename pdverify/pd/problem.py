@@ -249,3 +249,58 @@ class LinearSystem:
     def displacements(self, x: np.ndarray) -> np.ndarray:
         """(n_unknown_nodes, d) displacements of the unknown nodes from a solution."""
         return np.asarray(x[:self.dofs]).reshape(self.dim, self.n_unknown_nodes).T
+
+
+@dataclass
+class BondProblem:
+    """A bond-based scene's problem as its PD run builds it (the seed-003 sheets,
+    ``pdverify.scenes.sheets``: they assemble their own model), beside its
+    :class:`BondSystem`: the node spacing and thickness [m], the micromodulus's shape
+    ``influence`` (c(xi) = c omega(|xi|)), the continuum moduli the constant c was
+    calibrated to (``E`` [Pa], ``nu``: the one the bond-based model represents) and the
+    ``kind`` of the plane (``plane-stress``). ``marks``: node index arrays the scene's
+    ``measure`` reads (the clamped rows); ``loads``, ``supports``: what the scene's loads
+    and prescribed components are, as a sentence each (the export README's)."""
+
+    spacing: float
+    thickness: float
+    influence: object
+    E: float
+    nu: float
+    kind: str
+    marks: dict = field(default_factory=dict)
+    loads: str = ""
+    supports: str = ""
+
+
+@dataclass
+class BondSystem:
+    """A bond-based scene's linear system: ``model.K u = rhs`` over every node of the
+    model's grid (component-major) with the unknowns ``fixed`` (component-major indices)
+    prescribed at ``values``. It reads as a :class:`LinearSystem` without constraint
+    rows or extra unknowns (``B``, ``offset``: None), so the node set
+    (:mod:`pdverify.nodeset`) and its checks take it as they take a treatment's system;
+    K is the model's, assembled on first use."""
+
+    model: object
+    rhs: np.ndarray
+    fixed: np.ndarray
+    values: np.ndarray
+    B = None
+    offset = None
+
+    @property
+    def K(self):
+        return self.model.K
+
+    @property
+    def n_unknown_nodes(self) -> int:
+        return int(self.model.grid.n_ext)
+
+    @property
+    def dim(self) -> int:
+        return self.model.grid.dim
+
+    @property
+    def dofs(self) -> int:
+        return self.dim * self.n_unknown_nodes

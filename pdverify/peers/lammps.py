@@ -42,7 +42,9 @@ Two settings:
 
 Equilibrium: LAMMPS's ``minimize`` with ``min_style fire`` (damped dynamics with FIRE's
 adaptive step; forces only) to a force 2-norm of :data:`FTOL_REL` times the load's
-(force densities; the prescribed components held by ``fix setforce``). ``min_style cg``
+(force densities; the prescribed components held by ``fix setforce``), or, for a
+bond-based problem driven by prescribed values alone (the clamped sheet), times the force
+those values exert on the free atoms (:func:`prescribed_force`). ``min_style cg``
 is not used: peri/lps tallies half of the deviatoric energy its forces derive from (each
 bond's energy is passed to ``ev_tally`` as 0.5 * evdwl with i = j and newton off), so a
 line search on the energy stalls ("linesearch alpha is zero" after 19-42 iterations on
@@ -148,6 +150,10 @@ class Model:
     pair: str              # peri/lps or peri/pmb
     coefficients: tuple    # (K, G) [Pa] or (c,) [N/m^6]
     stiffness: float       # a modulus for the time step's scale [Pa]
+    #: the 2-norm of the force densities the prescribed values exert on the free
+    #: components at the reference state [N/m^3]: the stopping tolerance's scale of a
+    #: problem without loads (0: the loads' own)
+    reference_force: float = 0.0
 
     @property
     def dim(self) -> int:
@@ -171,6 +177,39 @@ def state_based_model(ns) -> Model:
     return Model(ns.x, np.asarray(ns.volume, float), ns.forces, ns.fixed, h,
                  ns.horizon / h, between_shells(h, ns.system.model.stencil.offsets, d),
                  h ** d * float(ns.problem.thickness), "peri/lps", (K, G), K + 4 * G / 3)
+
+
+def bond_based_model(ns) -> Model:
+    """The :class:`Model` of an exported bond-based node set (a sheet's,
+    :class:`pdverify.exchange.NodeSet` of a :class:`~pdverify.pd.problem.BondSystem`):
+    peri/pmb with pdverify's micromodulus c (its force density c s V_j along the bond is
+    pdverify's c omega (e / |xi|) V_b for the constant micromodulus, omega = 1), each
+    node's volume, the horizon between the last kept and the first dropped lattice shell
+    and, for a problem driven by prescribed values alone, their force
+    (:func:`prescribed_force`) as the stopping tolerance's scale."""
+    from ..nodeset import between_shells
+    model = ns.system.model
+    h, d, c = model.spacing, ns.dim, model.c
+    return Model(ns.x, np.asarray(ns.volume, float), ns.forces, ns.fixed, h, model.m_ratio,
+                 between_shells(h, ns.bond_offsets[0], d), h ** d * model.thickness,
+                 "peri/pmb", (c,), c * model.horizon ** (d + 1), prescribed_force(ns))
+
+
+def prescribed_force(ns) -> float:
+    """The 2-norm of the force densities [N/m^3] that the node set's prescribed values
+    exert on its free components at the reference state, (K u_p)_free / V in its linear
+    model (0 when every prescribed value is zero)."""
+    system = ns.system
+    d, n = ns.dim, len(ns.x)
+    values = np.asarray(system.values, dtype=float)
+    if not np.any(values):
+        return 0.0
+    up = np.zeros(system.K.shape[0])
+    up[np.asarray(system.fixed, dtype=int)] = values
+    density = (system.K @ up)[:d * n].reshape(d, n) / np.asarray(ns.volume, float)
+    free = np.ones(d * n, dtype=bool)
+    free[np.asarray(system.fixed, dtype=int)] = False
+    return float(np.linalg.norm(density.ravel()[free]))
 
 
 def f(v) -> str:
@@ -216,7 +255,7 @@ def deck(model: Model, setting: str, *, title: str = "pdverify") -> dict:
     free[:, d:] = False
     for k, (nodes, _) in model.fixed.items():
         free[np.asarray(nodes, dtype=int), k] = False
-    ftol = FTOL_REL * max(float(np.linalg.norm(b[free])), 1e-300)
+    ftol = FTOL_REL * max(float(np.linalg.norm(b[free])), model.reference_force, 1e-300)
     # FIRE's first step: a fifth of 1/omega_max, omega_max^2 ~ (stiffness / rho) (m / h)^2
     # per bond shell times the neighbour count; FIRE grows it to 10x where it can
     dt = 0.2 / math.sqrt(model.stiffness / 1.0 * (2 * model.m_ratio + 1) ** d / h ** 2)

@@ -10,7 +10,7 @@ from ..params import Param, at_least, positive
 from ..pd import bond_micromodulus, build_stencil, get_influence
 from ..pd.build import Body, BondMaterial, build_model
 from ..pd.influence import bond_based_nu
-from ..pd.problem import ClampedBox
+from ..pd.problem import BondProblem, BondSystem, ClampedBox
 from ..solvers.front import solve_with_dirichlet
 from ..solvers.iterative import Lattice
 from ..solvers.policy import AUTO_ITERATIVE_UNKNOWNS, SPD_LATTICE_SOLVERS
@@ -38,7 +38,12 @@ TABLE2_GRID = {"side_factor": 4.0, "m_ratio": 6.0, "horizon": 0.005, "strain": 0
 
 class SheetScene(FemAndPD):
     """Shared machinery of the seed-003 sheets: the FEM reference (method ``fem``) and the
-    bond-based PD runs of one scene (see :class:`FemAndPD` for the params' split)."""
+    bond-based PD runs of one scene (see :class:`FemAndPD` for the params' split).
+
+    A sheet's PD run is :meth:`bond_problem` (its model and conditions), a linear solve,
+    and :meth:`measure` (its metrics and fields from a displacement field); ``pdverify
+    score`` measures another code's field on the ``none`` problem the same way
+    (:mod:`pdverify.exchange`)."""
 
     figure = "sheets"
     closure_theory = "bond-based"
@@ -58,6 +63,18 @@ class SheetScene(FemAndPD):
             t.check((), p, where)
 
     def check_sheet(self, where, method, p):
+        raise NotImplementedError
+
+    def bond_problem(self, method, p, where) -> tuple[BondProblem, BondSystem]:
+        """The PD run's problem at ``p``: its description (spacing, thickness, the
+        micromodulus's shape, E and nu, the nodes ``measure`` reads) and its linear system
+        (the model with the treatment ``method``'s closure or grid, nodal forces,
+        prescribed components and values)."""
+        raise NotImplementedError
+
+    def measure(self, p, problem, system, x, info) -> Outcome:
+        """Metrics, fields and size of the displacements ``x`` (the system's unknowns,
+        component-major over the model's grid) with the solver's ``info``."""
         raise NotImplementedError
 
     # ----------------------------------------------------------------- PD helpers
@@ -199,40 +216,70 @@ class TensionSheet(SheetScene):
                 out += [(m, {"spacing": h}) for m in ("none", "energy-directional")]
         return out
 
-    def solve_pd(self, method, p, timer):
+    def bond_problem(self, method, p, where):
         W, H, h, delta = p["width"], p["length"], p["spacing"], p["horizon"]
         sigma, t = p["traction"], p["thickness"]
+        body = Body((W, H), (-W / 2, -H / 2), h, placement="on-surface", thickness=t)
+        material = BondMaterial(self.micromodulus(p, delta), get_influence(p["micromodulus"]))
+        model = build_model(body, self.stencil(p, delta / h), material,
+                            self.bond_closure(method, p))
+        grid = model.grid
+        n, x = grid.n_ext, grid.x
+        f = np.zeros(2 * n)
+        for side in (-1, 1):
+            ends = np.flatnonzero(np.isclose(x[:, 1], side * H / 2))
+            w = (np.where(np.isclose(np.abs(x[ends, 0]), W / 2), 0.5, 1.0)
+                 if p["load_sharing"] == "tributary" else np.ones(ends.size))
+            f[n + ends] = side * sigma * W * t * w / w.sum()
+        fixed = np.r_[np.flatnonzero(np.isclose(x[:, 0], 0.0)),
+                      n + np.flatnonzero(np.isclose(x[:, 1], 0.0))]
+        share = ("by the length each represents (corners half)"
+                 if p["load_sharing"] == "tributary" else "equally")
+        problem = BondProblem(
+            model.spacing, model.thickness, material.influence, p["E"],
+            bond_based_nu(2, "stress"), "plane-stress",
+            loads=(f"the end force traction x width x thickness = {sigma * W * t:.6g} N on "
+                   f"each end y = +-length/2, shared among that end's nodes {share} "
+                   "(nodal forces in y, outward)"),
+            supports=("u_x = 0 on the nodes of x = 0 and u_y = 0 on those of y = 0 (the "
+                      "closed form's symmetry lines, inside the sheet; nodes lie on its "
+                      "surface)"))
+        return problem, BondSystem(model, f, fixed, np.zeros(fixed.size))
+
+    def solve_pd(self, method, p, timer):
+        where = f"{self.id}/{method}"
         with timer.phase("setup"):
-            body = Body((W, H), (-W / 2, -H / 2), h, placement="on-surface", thickness=t)
-            material = BondMaterial(self.micromodulus(p, delta), get_influence(p["micromodulus"]))
-            model = build_model(body, self.stencil(p, delta / h), material,
-                                self.bond_closure(method, p))
-            grid = model.grid
-            n, x = grid.n_ext, grid.x
-            f = np.zeros(2 * n)
-            for side in (-1, 1):
-                ends = np.flatnonzero(np.isclose(x[:, 1], side * H / 2))
-                w = (np.where(np.isclose(np.abs(x[ends, 0]), W / 2), 0.5, 1.0)
-                     if p["load_sharing"] == "tributary" else np.ones(ends.size))
-                f[n + ends] = side * sigma * W * t * w / w.sum()
-            fixed = np.r_[np.flatnonzero(np.isclose(x[:, 0], 0.0)),
-                          n + np.flatnonzero(np.isclose(x[:, 1], 0.0))]
+            problem, system = self.bond_problem(method, p, where)
+        model = system.model
+
+        def solve_none():
+            return self.solve_fixed(model, system.fixed, system.values, where, system.rhs,
+                                    solver=p["solver"])
         peer = getattr(self.offered().get(method), "peer_solve_bonds", None)
         with timer.phase("solve"):
             if peer is not None:       # another code solves it (pdverify.peers)
-                U, info, peer_metrics, trouble = peer(
-                    model, f.reshape(2, n).T, fixed, p, f"{self.id}/{method}",
-                    lambda: self.solve_fixed(model, fixed, np.zeros(fixed.size),
-                                             f"{self.id}/{method}", f, solver=p["solver"]))
+                u, info, peer_metrics, trouble = peer(self, p, problem, system, where,
+                                                      solve_none)
             else:
-                u, _, info = self.solve_fixed(model, fixed, np.zeros(fixed.size),
-                                              f"{self.id}/{method}", f, solver=p["solver"])
-                U = u.reshape(2, n).T
+                u, _, info = solve_none()
+        outcome = self.measure(p, problem, system, u, info)
+        if peer is not None:
+            outcome.metrics.update(peer_metrics)
+            if trouble:
+                raise NumericalError(f"{where}: {trouble}", partial=outcome)
+        return outcome
+
+    def measure(self, p, problem, system, x, info):
+        W, H, h, delta, sigma = (p["width"], p["length"], p["spacing"], p["horizon"],
+                                 p["traction"])
+        model = system.model
+        n, xg = model.grid.n_ext, model.grid.x
+        U = np.asarray(x).reshape(2, n).T
         E_star, nu_star = lattice_moduli(model)
         metrics = {}
         refs = {"": (E_star, nu_star), "_continuum": (p["E"], bond_based_nu(2, "stress"))}
         for suffix, (E, nu) in refs.items():
-            ref = np.stack([-nu * sigma * x[:, 0] / E, sigma * x[:, 1] / E], axis=1)
+            ref = np.stack([-nu * sigma * xg[:, 0] / E, sigma * xg[:, 1] / E], axis=1)
             rel = _relative_errors(U, ref)
             for k, comp in enumerate(("ux", "uy")):
                 metrics[f"max_error_{comp}{suffix}_pct"] = float(np.nanmax(rel[:, k]))
@@ -244,16 +291,11 @@ class TensionSheet(SheetScene):
                 metrics["rel_l2_error"] = rel_l2_error(U, ref)
         metrics["lattice_E_ratio"] = E_star / p["E"]
         metrics["lattice_nu"] = nu_star
-        fields = {"x": x, "u": U, "u_ref": u_ref, "error": err, "spacing": h, "horizon": delta,
-                  "lengths": (W, H)}
-        size = {"nodes": int(n), "dofs": int(2 * n - fixed.size), "bonds": model.n_bonds(),
-                "stiffness_nnz": int(model.K.nnz)}
-        outcome = Outcome(metrics=metrics, size=size, fields=fields, diagnostics=info)
-        if peer is not None:
-            outcome.metrics.update(peer_metrics)
-            if trouble:
-                raise NumericalError(f"{self.id}/{method}: {trouble}", partial=outcome)
-        return outcome
+        fields = {"x": xg, "u": U, "u_ref": u_ref, "error": err, "spacing": h,
+                  "horizon": delta, "lengths": (W, H)}
+        size = {"nodes": int(n), "dofs": int(2 * n - system.fixed.size),
+                "bonds": model.n_bonds(), "stiffness_nnz": int(model.K.nnz)}
+        return Outcome(metrics=metrics, size=size, fields=fields, diagnostics=info)
 
 
 def lattice_moduli(model) -> tuple[float, float]:
@@ -363,45 +405,72 @@ class ClampedSheet(SheetScene):
                       ("energy-directional", {"node_volumes": "full"}),
                       ("energy-directional", {"micromodulus": "conical"})]
 
-    def solve_pd(self, method, p, timer):
+    def bond_problem(self, method, p, where):
         delta, t = p["horizon"], p["thickness"]
         L = p["side_factor"] * delta
         h = delta / p["m_ratio"]
         lo, hi = (-L / 2, -L / 2), (L / 2, L / 2)
         uy = p["strain"] * L / 2
+        inf = get_influence(p["micromodulus"])
+        treatment = self.treatment(method)
+        if treatment.role(self.family) is not None:      # its own grid and clamp nodes
+            grid, closure, bottom, top = treatment.build_for(
+                self.family, ClampedBox(lo, hi, h, delta, inf, axis=1), p)
+            body = Body((L, L), lo, h, thickness=t)
+        else:
+            body = Body((L, L), lo, h, placement="on-surface",
+                        boundary_volume=p["node_volumes"], thickness=t)
+            grid = body.grid()
+            y = grid.x[:, 1]
+            top = np.flatnonzero(np.isclose(y, L / 2))
+            bottom = np.flatnonzero(np.isclose(y, -L / 2))
+            closure = self.bond_closure(method, p)
+        # the grid: the body's, or the treatment's own (virtual nodes: buffer layers)
+        model = build_model(body, self.stencil(p, p["m_ratio"]),
+                            BondMaterial(self.micromodulus(p, delta), inf), closure,
+                            grid=grid)
+        n = grid.n_ext
+        fixed = np.r_[top, bottom, n + top, n + bottom]
+        values = np.r_[np.zeros(top.size + bottom.size), np.full(top.size, uy),
+                       np.full(bottom.size, -uy)]
+        problem = BondProblem(
+            model.spacing, model.thickness, inf, p["E"], bond_based_nu(2, "stress"),
+            "plane-stress", marks={"top": top},
+            loads="none: the sheet is driven by its clamped rows alone",
+            supports=(f"the outermost rows y = +-L/2 clamped: u_x = 0 and u_y = +-strain "
+                      f"L / 2 = +-{uy:.6g} m (nodes lie on the sheet's surface); the "
+                      "sides are free"))
+        return problem, BondSystem(model, np.zeros(2 * n), fixed, values)
+
+    def solve_pd(self, method, p, timer):
+        where = f"{self.id}/{method}"
         with timer.phase("setup"):
-            inf = get_influence(p["micromodulus"])
-            treatment = self.treatment(method)
-            if treatment.role(self.family) is not None:      # its own grid and clamp nodes
-                grid, closure, bottom, top = treatment.build_for(
-                    self.family, ClampedBox(lo, hi, h, delta, inf, axis=1), p)
-                body = Body((L, L), lo, h, thickness=t)
-            else:
-                body = Body((L, L), lo, h, placement="on-surface",
-                            boundary_volume=p["node_volumes"], thickness=t)
-                grid = body.grid()
-                y = grid.x[:, 1]
-                top = np.flatnonzero(np.isclose(y, L / 2))
-                bottom = np.flatnonzero(np.isclose(y, -L / 2))
-                closure = self.bond_closure(method, p)
-            # the grid: the body's, or the treatment's own (virtual nodes: buffer layers)
-            model = build_model(body, self.stencil(p, p["m_ratio"]),
-                                BondMaterial(self.micromodulus(p, delta), inf), closure,
-                                grid=grid)
-            n = grid.n_ext
-            fixed = np.r_[top, bottom, n + top, n + bottom]
-            values = np.r_[np.zeros(top.size + bottom.size), np.full(top.size, uy),
-                           np.full(bottom.size, -uy)]
+            problem, system = self.bond_problem(method, p, where)
         with timer.phase("solve"):
-            u, reaction, info = self.solve_fixed(model, fixed, values, f"{self.id}/{method}",
-                                                  solver=p["solver"])
+            u, _, info = self.solve_fixed(system.model, system.fixed, system.values, where,
+                                          system.rhs, solver=p["solver"])
         with timer.phase("reference"):
             ref = self.fem_reference(p)
+        return self._measure(p, problem, system, u, info, ref)
+
+    def measure(self, p, problem, system, x, info):
+        return self._measure(p, problem, system, x, info, self.fem_reference(p))
+
+    def _measure(self, p, problem, system, x, info, ref):
+        """:meth:`measure` against the FEM reference ``ref`` (the run times its load)."""
+        delta, t = p["horizon"], p["thickness"]
+        L = p["side_factor"] * delta
+        h = delta / p["m_ratio"]
+        model, top = system.model, problem.marks["top"]
+        grid = model.grid
+        n = grid.n_ext
+        u = np.asarray(x)
+        reaction = system.K @ u - system.rhs
         stress = float(reaction[n + top].sum()) / (L * t) / 1e6
         sample = np.flatnonzero(np.abs(grid.x[:, 1]) <= L / 2 + 1e-12 * L)
         U = u.reshape(2, n).T
-        x = grid.x[sample]
-        u_ref = ref.evaluate(x)
+        xs = grid.x[sample]
+        u_ref = ref.evaluate(xs)
         scale = np.max(np.abs(u_ref), axis=0)
         err = np.abs(U[sample] - u_ref) / scale * 100.0
         metrics = {
@@ -412,9 +481,10 @@ class ClampedSheet(SheetScene):
             "max_error_uy_pct": float(err[:, 1].max()),
             "rel_l2_error": rel_l2_error(U[sample], u_ref),
         }
-        fields = {"x": x, "u": U[sample], "u_ref": u_ref, "error": err, "spacing": h,
+        fields = {"x": xs, "u": U[sample], "u_ref": u_ref, "error": err, "spacing": h,
                   "horizon": delta, "lengths": (L, L),
                   "energy": model.strain_energy_density(u)[sample],
-                  "energy_ref": ref.strain_energy_density(x)}
-        size = {"nodes": int(n), "dofs": int(2 * n - fixed.size), "bonds": model.n_bonds()}
+                  "energy_ref": ref.strain_energy_density(xs)}
+        size = {"nodes": int(n), "dofs": int(2 * n - system.fixed.size),
+                "bonds": model.n_bonds()}
         return Outcome(metrics=metrics, size=size, fields=fields, diagnostics=info)
