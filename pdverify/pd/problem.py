@@ -199,8 +199,20 @@ class StaticProblem:
         return t * face_area * self.thickness
 
 
+class _Unknowns:
+    """The dimension and unknown count of a system whose ``model`` has a grid."""
+
+    @property
+    def dim(self) -> int:
+        return self.model.grid.dim
+
+    @property
+    def dofs(self) -> int:
+        return self.dim * self.n_unknown_nodes
+
+
 @dataclass
-class LinearSystem:
+class LinearSystem(_Unknowns):
     """What a treatment makes of a :class:`StaticProblem`.
 
     ``K x = rhs`` with ``x[fixed] = values`` eliminated and, if ``B`` is set, the
@@ -238,13 +250,6 @@ class LinearSystem:
     #: scene's ``StaticProblem.ordering`` (None: the scene's)
     ordering: str | None = None
 
-    @property
-    def dim(self) -> int:
-        return self.model.grid.dim
-
-    @property
-    def dofs(self) -> int:
-        return self.dim * self.n_unknown_nodes
 
     def displacements(self, x: np.ndarray) -> np.ndarray:
         """(n_unknown_nodes, d) displacements of the unknown nodes from a solution."""
@@ -274,7 +279,7 @@ class BondProblem:
 
 
 @dataclass
-class BondSystem:
+class BondSystem(_Unknowns):
     """A bond-based scene's linear system: ``model.K u = rhs`` over every node of the
     model's grid (component-major) with the unknowns ``fixed`` (component-major indices)
     prescribed at ``values``. It reads as a :class:`LinearSystem` without constraint
@@ -297,10 +302,3 @@ class BondSystem:
     def n_unknown_nodes(self) -> int:
         return int(self.model.grid.n_ext)
 
-    @property
-    def dim(self) -> int:
-        return self.model.grid.dim
-
-    @property
-    def dofs(self) -> int:
-        return self.dim * self.n_unknown_nodes
