@@ -600,6 +600,7 @@ def _score_file(scene, path: str, *, name: str, overrides, origin):
     source["equilibrium"] = held
     outcome = ns.scene.measure(ns.params, ns.problem, ns.system, x, info)
     outcome.metrics["equilibrium_residual"] = held["residual"]
+    outcome.metrics["equilibrium_distance"] = held["distance"]
     record = RunResult(scene=scene.id, method=f"external:{name}", params=ns.params,
                        reference=scene.reference, metrics=outcome.metrics,
                        size=outcome.size, diagnostics=outcome.diagnostics,

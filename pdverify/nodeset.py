@@ -108,17 +108,22 @@ def between_shells(spacing: float, offsets, dim: int) -> float:
 
 
 # ------------------------------------------------------------------------------ equilibrium
-#: a field counts as an equilibrium of the scene's linear model when the relative residual
-#: of its free equations is at most this many times the field's largest bond strain: a
-#: geometrically nonlinear code's exact equilibrium (LAMMPS's PERI bonds act along the
-#: deformed bond, with the current length) differs from the linear one by terms of order
-#: strain x stress, so its residual in the linear model is O(max strain) (measured: 0.1-0.6
-#: x the strain on the peer runs, tests/peers); a solver stopped early or bonds lost leave
-#: residuals of order 1e-2 to 1 of the load
-RESIDUAL_PER_STRAIN = 10.0
-#: ... and at least this (round-off of a linear solve in double precision, 1e4 eps, for a
-#: field without strain)
-RESIDUAL_FLOOR = 1e-12
+#: A field counts as an equilibrium of the scene's linear model when its distance to that
+#: model's solution (relative L2 over the real nodes: the displacement its residual would
+#: still move, K^-1 r) is at most this many times the field's largest relative bond
+#: displacement |u_b - u_a| / |xi| (its strains and rotations). A geometrically nonlinear
+#: code's exact equilibrium (LAMMPS's PERI bonds act along the deformed bond, with the
+#: current length) differs from the linear one by O(displacement gradient): measured on the
+#: peer runs, a third of it (body3d-traction: 2.4e-5 at a gradient of 7.4e-5; plate-l's
+#: re-entrant corner: 5.0e-3 at 1.8e-2). A solver stopped early or bonds lost
+#: leave distances of 1e-2 to 1. The relative residual ||(K u - f)_free|| / ||f_free|| is
+#: recorded beside it but does not decide: normalised by the applied loads it grows where
+#: the bond forces are large against them (0.2 at plate-l's corner for that 0.5 % field).
+DISTANCE_PER_GRADIENT = 10.0
+#: ... and at least this: the forward error of the scenes' own solvers against a direct
+#: solve (their single-precision factors refined in double reach 1.3e-7 on
+#: plate2d-plane-strain; tests/pdverify/test_export_score.py)
+DISTANCE_FLOOR = 1e-6
 
 
 def solution_vector(system, U: np.ndarray) -> np.ndarray:
@@ -146,10 +151,11 @@ def bond_extensions(model, u) -> np.ndarray:
     return model.A_e @ (model.A_U_full @ u)
 
 
-def equilibrium(ns: NodeSet, U: np.ndarray) -> dict:
-    """How far the displacements ``U`` (n, d) of the exported node set are from an
-    equilibrium of its linear model (:func:`balance`), state-based or bond-based (K the
-    bond-based model's stiffness, the strain from its bond extensions)."""
+def equilibrium(ns: NodeSet, U: np.ndarray, u_linear: np.ndarray | None = None) -> dict:
+    """How far the displacements ``U`` (n, d) of the node set are from an equilibrium of
+    its linear model (state-based or bond-based): ``distance`` to the linear solution
+    ``u_linear`` (n, d; solved here when not given), ``residual`` (:func:`balance`),
+    ``max_gradient``, ``limit`` and ``in_equilibrium`` (module constants above)."""
     system = ns.system
     d, n = ns.dim, len(ns.x)
     xa = solution_vector(system, U)
@@ -160,19 +166,50 @@ def equilibrium(ns: NodeSet, U: np.ndarray) -> dict:
             return x
         return np.r_[x, model.A_theta @ (model.A_e @ (model.A_U_full @ x))]
 
-    ext = bond_extensions(model, xa[:d * n])
-    strain = float(np.max(np.abs(ext) / model.bond_x)) if ext.size else 0.0
-    return balance(system.K, xa, system.rhs, system.fixed, system.values, strain, d * n,
-                   extend)
+    motion = bond_gradients(model, xa[:d * n])
+    gradient = float(np.max(motion)) if motion.size else 0.0
+    if u_linear is None:
+        u_linear = linear_solution(system, n, d)
+    ref = float(np.linalg.norm(u_linear))
+    gap = float(np.linalg.norm(np.asarray(U, dtype=float) - u_linear))
+    distance = gap / ref if ref > 0 else gap
+    limit = max(DISTANCE_PER_GRADIENT * gradient, DISTANCE_FLOOR)
+    return {"distance": distance,
+            "residual": balance(system.K, xa, system.rhs, system.fixed, system.values,
+                                d * n, extend),
+            "max_gradient": gradient, "limit": limit,
+            "in_equilibrium": bool(np.isfinite(distance) and distance <= limit)}
 
 
-def balance(K, x, rhs, fixed, values, strain: float, rows: int, extend=None) -> dict:
-    """``residual`` = ||(K x - f)_free|| / scale over the first ``rows`` equations less the
-    prescribed unknowns ``fixed`` (the load scale is the larger of the free loads' norm
-    and the free reactions of the prescribed ``values``, so a displacement-driven scene
-    has a scale too), ``max_strain`` (the field's largest |bond extension| / |xi|, given),
-    ``limit`` and ``in_equilibrium`` (module constants above). ``extend`` completes a
-    displacement vector to all unknowns (the augmented forms' nodal scalars)."""
+def linear_solution(system, n: int, d: int) -> np.ndarray:
+    """(n, d) displacements of the real nodes solving ``system`` (K, rhs, its prescribed
+    ``fixed`` unknowns at ``values``): condensed and factored by SuperLU."""
+    import scipy.sparse.linalg as spla
+    from .solvers.condense import condense
+    K_ff, f_f, expand = condense(system.K, np.asarray(system.rhs, dtype=float),
+                                 np.asarray(system.fixed, dtype=int),
+                                 np.asarray(system.values, dtype=float))
+    x = expand(spla.spsolve(K_ff.tocsc(), f_f))
+    return np.asarray(x[:d * n]).reshape(d, n).T
+
+
+def bond_gradients(model, u) -> np.ndarray:
+    """|u_b - u_a| / |xi| of every bond of ``model`` for the real nodes' displacements
+    ``u`` (component-major): the displacement gradient along the bond, stretch and
+    rotation both."""
+    from .pd.bondbased import BondBasedModel
+    full = (model.displacement_map() if isinstance(model, BondBasedModel)
+            else model.A_U_full) @ np.asarray(u, dtype=float)
+    U = full.reshape(model.grid.dim, -1)
+    return np.linalg.norm(U[:, model.bond_b] - U[:, model.bond_a], axis=0) / model.bond_x
+
+
+def balance(K, x, rhs, fixed, values, rows: int, extend=None) -> float:
+    """The relative residual ||(K x - f)_free|| / scale over the first ``rows`` equations
+    less the prescribed unknowns ``fixed`` (the scale is the larger of the free loads'
+    norm and the free reactions of the prescribed ``values``, so a displacement-driven
+    scene has a scale too). ``extend`` completes a displacement vector to all unknowns
+    (the augmented forms' nodal scalars)."""
     extend = extend or (lambda v: v)
     free = np.ones(rows, dtype=bool)
     fixed = np.asarray(fixed, dtype=int)
@@ -184,16 +221,14 @@ def balance(K, x, rhs, fixed, values, strain: float, rows: int, extend=None) -> 
     drive = (K @ extend(prescribed))[:rows]
     scale = max(float(np.linalg.norm(f[free])), float(np.linalg.norm(drive[free])))
     norm = float(np.linalg.norm(r[free]))
-    residual = norm / scale if scale > 0 else norm
-    limit = max(RESIDUAL_PER_STRAIN * strain, RESIDUAL_FLOOR)
-    return {"residual": residual, "max_strain": strain, "limit": limit,
-            "in_equilibrium": bool(np.isfinite(residual) and residual <= limit)}
+    return norm / scale if scale > 0 else norm
 
 
 def not_in_equilibrium(balance: dict) -> str:
     """The message of a field that is not an equilibrium of the linear model."""
-    return (f"not in equilibrium: relative residual {balance['residual']:.3g} of the free "
-            f"equations in the scene's linear model, above {balance['limit']:.3g} "
-            f"({RESIDUAL_PER_STRAIN:g} x the field's largest bond strain "
-            f"{balance['max_strain']:.3g}): a solver stopped early, lost bonds or other "
-            "conditions than the export's")
+    return (f"not in equilibrium: {balance['distance']:.3g} (relative L2) from the scene's "
+            f"linear solution, above {balance['limit']:.3g} ({DISTANCE_PER_GRADIENT:g} x the "
+            f"field's largest relative bond displacement {balance['max_gradient']:.3g}); "
+            f"relative residual {balance['residual']:.3g} of the free equations: a solver "
+            "stopped early, lost bonds, or another model or other conditions than the "
+            "export's")

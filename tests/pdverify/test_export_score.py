@@ -86,7 +86,13 @@ def _assert_same_metrics(native, scored):
     # score adds the field's equilibrium residual in the scene's linear model: our own
     # solution, read back exactly, balances to round-off (a direct solve: ~1e-14)
     assert scored["metrics"]["equilibrium_residual"] < 1e-10
-    assert set(scored["metrics"]) - {"equilibrium_residual"} == set(native.metrics)
+    # the distance to a direct solve: 0 for a direct solve read back, 1.3e-7 for a
+    # single-precision factor refined in double (plate2d-plane-strain's nested
+    # dissection): below nodeset.DISTANCE_FLOOR, the solvers' forward error
+    from pdverify.nodeset import DISTANCE_FLOOR
+    assert scored["metrics"]["equilibrium_distance"] < DISTANCE_FLOOR
+    assert set(scored["metrics"]) - {"equilibrium_residual", "equilibrium_distance"} == set(
+        native.metrics)
     for name, value in native.metrics.items():
         np.testing.assert_allclose(scored["metrics"][name], value, rtol=METRIC_RTOL,
                                    atol=0.0, err_msg=name)
@@ -1057,7 +1063,7 @@ def test_bond_based_score_of_a_scaled_field_fails_naming_its_residual(tmp_path):
     # K (0.9 u) - f = 0.9 (K u - f) - 0.1 f: a tenth of the load's norm, up to the direct
     # solve's round-off (~1e-14 of it); the limit, 10 x the largest bond strain, is ~1e-2
     assert r.metrics["equilibrium_residual"] == pytest.approx(0.1, rel=1e-9)
-    assert "not in equilibrium: relative residual 0.1" in r.message
+    assert "not in equilibrium: 0.1 (relative L2) from the scene's linear solution" in r.message
 
 
 def test_bond_based_score_of_a_scaled_clamped_field_is_warned(tmp_path):
