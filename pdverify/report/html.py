@@ -196,12 +196,38 @@ def published_rows(scene, results) -> list[dict]:
     return rows
 
 
-def missing_published(scene, results) -> list[str]:
-    """The published values that stand beside no run of this report (e.g. at the paper's
-    grid, which the quick report does not run): one phrase each, the runs they need."""
+def full_report_runs(scene) -> list[tuple[str, dict]]:
+    """(method, params) of every run the full report makes of ``scene``."""
     out = []
+    for method, overrides in scene.report_cases(quick=False):
+        try:
+            out.append((method, scene.resolve(method, overrides)))
+        except InputError:
+            continue
+    return out
+
+
+def unmatched_published(scene) -> list[str]:
+    """The published values that no run of the full report matches (a ``where`` the
+    method's params cannot satisfy): one phrase each, so that the page never says the
+    full report runs them."""
+    runs = full_report_runs(scene)
+    return list(dict.fromkeys(
+        f"{p.metric} = {_num(p.value)} ({p.source}; {p.method or 'any method'})"
+        for p in scene.published if not any(p.applies(m, q) for m, q in runs)))
+
+
+def missing_published(scene, results) -> list[str]:
+    """The published values that stand beside no run of this report but beside a run of
+    the full report (e.g. at the paper's grid, which the quick report does not run): one
+    phrase each, the runs they need. Those no full-report run matches are
+    :func:`unmatched_published`'s."""
+    out = []
+    runs = full_report_runs(scene)
     for p in scene.published:
         if any(p.applies(r.method, r.params) for r in results):
+            continue
+        if not any(p.applies(m, q) for m, q in runs):
             continue
         mine = [r for r in results if p.method in (None, r.method)]
         where = ", ".join(f"{k}={_num(v)}" for k, v in (p.where or {}).items()
@@ -230,7 +256,8 @@ def scene_section(scene, results, figures, deviations=None) -> Markup:
         refinements=[_refinement(r) for r in results if r.fields.get("refinement")],
         sources=sorted({p.source for p in scene.published}), figures=figures,
         published=published_rows(scene, results),
-        missing=missing_published(scene, results) if results else [])
+        missing=missing_published(scene, results) if results else [],
+        unmatched=unmatched_published(scene))
 
 
 def convergence_section(studies, figures) -> Markup:

@@ -244,11 +244,12 @@ def _table12_published(key, cell: Table12Cell) -> Published:
     exact = float(Fraction(cell.exact)) if cell.exact else None
     where = {"horizon_ratio": ratio, "end_weight": weight, "nodes": cell.nodes,
              "micromodulus": "triangular", "calibration": "discrete"}
-    if key == (4.0, "full"):   # printed cut after the 4th decimal, not rounded (deviations)
+    if key == (4.0, "full"):
+        # ours 1.2178540 rounds to 1.2179; the same table rounds its other cells (1.2304,
+        # 1.3189: ours 1.23035, 1.318875), so the print is not read as cut: a known
+        # difference, half a unit in the last printed digit shown (deviations)
         return Published("strain_factor", cell.text, source, method="none", where=where,
-                         deviation="004-table12-f9-digits", expected=1.21785, tolerance=5e-5,
-                         tolerance_source="the print read as cut after the fourth decimal: "
-                                          "1.2178 <= f < 1.2179")
+                         deviation="004-table12-f9-digits")
     return Published("strain_factor", cell.text, source, method="none", where=where,
                      exact="/" in cell.text or exact is not None,
                      deviation="004-table12-f7" if cell.erratum else "", expected=exact)
@@ -482,12 +483,16 @@ class Constraints(BondBarScene):
         # "non-zero": above the round-off of an exact value (u ~ 1 here: sigma/E = 1)
         Published("half_vs_full_max_diff", "non-zero", "seed 004 §6.2 and Fig. 3", method="none",
                   bound=1e-12, check="above", tolerance_source=NONZERO),
+        # u_c != u_a both non-homogenised and homogenised (§6.2's two paragraphs): seed 004
+        # treats those two bars only, so the statement is theirs, not the peers' corrections'
         Published("horizon_constraint_vs_full_max_diff", "non-zero", "seed 004 §6.2 and Fig. 3",
-                  bound=1e-12, check="above", tolerance_source=NONZERO),
+                  method="none", bound=1e-12, check="above", tolerance_source=NONZERO),
         # "Comparison of Fig. 3b and c shows that delta-constraint (Fig. 3c) results in
         # displacements closer to the analytical solution than Delta-constraint (Fig. 3b)"
         Published("c_closer_than_b", 1, "seed 004 §6.2, Fig. 3 (b), (c)", method="none",
                   exact=True, kind="read off a figure"),
+        Published("horizon_constraint_vs_full_max_diff", "non-zero", "seed 004 §6.2 and Fig. 3",
+                  method="homogenized", bound=1e-12, check="above", tolerance_source=NONZERO),
     )
 
     def min_nodes(self, m):

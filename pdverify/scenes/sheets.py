@@ -34,6 +34,9 @@ PAPER = {"micromodulus": "constant", "quadrature": "full-cells"}
 #: not beside the convergence studies' other levels)
 TABLE1_GRID = {"spacing": 0.001, "horizon": 0.005, "traction": 1e6, "E": 1e9}
 TABLE2_GRID = {"side_factor": 4.0, "m_ratio": 6.0, "horizon": 0.005, "strain": 0.01, "E": 1e9}
+#: Table 2's sheet and load without the PD grid: the FEM row's (the ``fem`` method has no
+#: ``m_ratio``, so an entry that names it stands beside no FEM run)
+TABLE2_LOAD = {k: v for k, v in TABLE2_GRID.items() if k != "m_ratio"}
 
 
 class SheetScene(FemAndPD):
@@ -363,7 +366,7 @@ class ClampedSheet(SheetScene):
     family = "clamped-sheet"
     published = (
         Published("tensile_stress_mpa", 10.32, "seed 003 Table 2, row 1 (FEM)", method="fem",
-                  where=TABLE2_GRID),
+                  where=TABLE2_LOAD),
         Published("tensile_stress_mpa", 4.17, "seed 003 Table 2, row 2", method="none",
                   where={**PAPER, **TABLE2_GRID, "node_volumes": "partial"},
                   deviation="003-table2-quadrature"),

@@ -71,6 +71,19 @@ def bulk_anisotropy_pct(model) -> float:
     return float((w.max() - w.min()) / w.min() * 100.0)
 
 
+def cauchy_anisotropy_pct(model) -> float:
+    """The other reading of seed 003 §4.1.2's "deviations from exact isotropy": the 2D
+    bond-based bulk's |C11 / (3 C12) - 1| in %. Bond-based PD has C12 = C66 (Cauchy), so
+    the square lattice is isotropic exactly when C11 - C12 = 2 C66, i.e. C11 = 3 C12;
+    C11 = 2 W(e_x e_x), C12 = W(I) - C11 from the bulk energy density. Measures the same
+    departure as :func:`bulk_anisotropy_pct` on another scale (1.69 % there is 3.26 % here
+    at m = 6, whole cells, constant micromodulus)."""
+    W = model.bulk_work_density
+    c11 = 2.0 * W(np.diag([1.0, 0.0]))
+    c12 = W(np.eye(2)) - c11
+    return float(abs(c11 / (3.0 * c12) - 1.0) * 100.0)
+
+
 def energy_ratios(model) -> dict[str, np.ndarray]:
     """W_i / W_bulk at the real nodes, per strain state."""
     ids = model.grid.interior_ids
@@ -192,8 +205,21 @@ class SheetStiffness(StiffnessScene):
     #: seed 003 §4.1.2 chooses m = 1/6 (delta = 6 Delta), "deviations from exact isotropy
     #: are less than 2 %", with its quadrature (whole cells) and micromodulus (constant)
     PAPER_M = {"m_ratio": 6.0, "quadrature": "full-cells", "micromodulus": "constant"}
+    #: the paper does not say how it measures the deviation: both readings are shown,
+    #: the uniaxial-stiffness spread (ours, holds) and C11 against 3 C12 (a known
+    #: difference, deviations: 003-anisotropy-measure)
     published = (Published("bulk_anisotropy_pct", "< 2", "seed 003 §4.1.2", method="none",
-                           where=PAPER_M),)
+                           where=PAPER_M),
+                 Published("bulk_anisotropy_c11_3c12_pct", "< 2", "seed 003 §4.1.2, read as "
+                           "|C11 / (3 C12) - 1|", method="none", where=PAPER_M,
+                           deviation="003-anisotropy-measure"))
+
+    def measure_ratios(self, p, model, ratios, counts=None) -> Outcome:
+        """:meth:`StiffnessScene.measure_ratios` and the Cauchy reading of the bulk's
+        anisotropy (:func:`cauchy_anisotropy_pct`, bond-based in 2D only)."""
+        out = super().measure_ratios(p, model, ratios, counts)
+        out.metrics["bulk_anisotropy_c11_3c12_pct"] = cauchy_anisotropy_pct(model)
+        return out
 
     def lengths(self, p):
         return (p["width"], p["length"])

@@ -146,15 +146,15 @@ def test_table12_exact_fractions():
 
 @pytest.mark.parametrize("key", [k for k in sorted(TABLE12) if "." in TABLE12[k].text])
 def test_table12_printed_decimals(key):
-    # the printed digits, rounded or truncated (f(9) = 1.21785... is printed 1.2178),
-    # except the one erratum (f(7) = 5/3 printed as 1.043)
+    # the printed digits, rounded, except the one erratum (f(7) = 5/3 printed as 1.043)
+    # and the known difference f(9) = 1.21785... printed 1.2178 (issue 53: the table
+    # rounds its other cells, so it is not read as cut; deviations 004-table12-f9-digits)
     ratio, weight = key
     cell = TABLE12[key]
     f = strain_factor(cell.nodes, ratio, weight)
     decimals = len(cell.text.split(".")[1])
-    scale = 10 ** decimals
-    agrees = cell.printed in (round(f, decimals), np.trunc(f * scale) / scale)
-    assert agrees != bool(cell.erratum), (key, f, cell.text)
+    agrees = cell.printed == round(f, decimals)
+    assert agrees != (bool(cell.erratum) or key == (4.0, "full")), (key, f, cell.text)
 
 
 @pytest.mark.parametrize("key", [k for k in sorted(TABLE12) if TABLE12[k].formula])

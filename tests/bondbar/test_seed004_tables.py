@@ -26,6 +26,20 @@ except ModuleNotFoundError:  # Python 3.10 (pyproject.toml's tomli)
 HERE = Path(__file__).parent
 ROOT = HERE.parents[1]
 BEFORE = json.loads((HERE / "seed004_published_10df47c.json").read_text())
+#: the changes issue 53 made on purpose since the snapshot, applied to it before the exact
+#: comparison: (part, scene, index in the snapshot's list) -> the fields that changed
+#: - Table 12's f(9) = 1.2178 is a known difference (the table rounds its other cells),
+#:   no longer a check of the print read as cut: half a unit in the printed digit
+#: - §6.2's u_c != u_a attaches to the bars seed 004 treats (none; the homogenised
+#:   bar's entry is appended), not to every correction
+ISSUE53 = {
+    ("published", "bar1d-homogenization", 4): {
+        "target": 1.2178, "tolerance": 5e-05,
+        "tolerance_source": "half a unit in the last printed digit", "known_difference": True},
+    ("applies", "bar1d-constraints", 2): {"method": "none"},
+}
+for (_part, _scene, _i), _fields in ISSUE53.items():
+    BEFORE[_part][_scene][_i].update(_fields)
 SCENES = ("bar1d-homogenization", "bar1d-constraints", "bar1d-vibration")
 
 #: Table 12's formulas as the lambdas of commit 10df47c, written from the printed text
