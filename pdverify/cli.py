@@ -17,7 +17,7 @@ usage:
 
 Exit codes: 0 success; 1 a run failed numerically, a regression was found, or an output
 could not be written after the work (one line naming it; a report stays in its staging
-folder); 2 bad input (one line naming the input and what is allowed), a run above the
+folder), or report --scheduler lost its Dask scheduler (one line); 2 bad input (one line naming the input and what is allowed), a run above the
 memory budget (its estimate and the limit), an output pdverify may not replace and a
 cache or disk that cannot take the output included, all before any work; 130 interrupted.
 """
@@ -28,7 +28,7 @@ import signal
 import sys
 
 from . import __version__, budget
-from .errors import STOP_REQUESTED, InputError, OutputError
+from .errors import STOP_REQUESTED, ClusterError, InputError, OutputError
 
 
 RUN_TIMEOUT_HELP = ("kill a run that takes longer than SECONDS and record it as failed "
@@ -236,7 +236,7 @@ def main(argv=None) -> int:
     except InputError as exc:
         print(f"pdverify: error: {exc}", file=sys.stderr)
         return 2
-    except OutputError as exc:
+    except (OutputError, ClusterError) as exc:
         print(f"pdverify: error: {exc}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:

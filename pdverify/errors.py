@@ -39,6 +39,13 @@ class OutputError(RuntimeError):
     """
 
 
+class ClusterError(RuntimeError):
+    """The Dask cluster of ``report --scheduler`` went away after the work started (the
+    client lost its scheduler). The message is one line naming the scheduler and how
+    far the report got; the CLI prints it and exits with code 1. Nothing is published.
+    """
+
+
 def did_you_mean(name, allowed) -> str:
     """``" (did you mean a or b?)"`` naming the close matches of a mistyped ``name`` among
     ``allowed`` (difflib's similarity ratio >= 0.75, case ignored, at most three, best
