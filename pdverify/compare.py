@@ -270,8 +270,8 @@ def _pub_params(params: dict) -> str:
 
 def format_published(rows: list[dict]) -> str:
     """The checked entries as a fixed-width table, one line per entry."""
-    table = [("verdict", "scene", "method", "metric", "ours", "paper", "check", "tolerance",
-              "source", "params")]
+    table = [("verdict", "role", "scene", "method", "metric", "ours", "paper", "check",
+              "tolerance", "source", "params")]
     for r in rows:
         e = r["entry"]
         check = {"equal": "=", "below": "<", "above": ">", "none": "-"}[e["check"]]
@@ -280,7 +280,8 @@ def format_published(rows: list[dict]) -> str:
             check += f" {_pub_fmt(e['target'])} ({e['deviation']})"
         elif e.get("known_difference"):
             check += f" (known: {e['deviation']})"
-        table.append((r["verdict"], r["scene"], r["method"], e["metric"], _pub_fmt(r["ours"]),
+        table.append((r["verdict"], published.role_of(e), r["scene"], r["method"], e["metric"],
+                      _pub_fmt(r["ours"]),
                       _pub_fmt(e["value"])
                       + (" [figure]" if e["kind"] == published.FIGURE else ""),
                       check, _pub_fmt(e.get("tolerance")), e["source"][:50],
@@ -332,5 +333,5 @@ def compare_published(path: str, *, stream=None) -> int:
               f"{e['tolerance_source']})", file=stream)
     print(f"compare --against-published: {len(rows)} entries, {counts['holds']} hold, "
           f"{counts['known difference']} known differences, {counts['not numeric']} not "
-          f"numeric, {counts['fails']} fail", file=stream)
+          f"numeric, {counts['fails']} fail; {published.count_text(rows)}", file=stream)
     return 1 if failed else 0

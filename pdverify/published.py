@@ -18,6 +18,12 @@ from fractions import Fraction
 PRINTED = "printed"
 FIGURE = "read off a figure"
 KINDS = (PRINTED, FIGURE)
+#: what a published entry is: a number the paper computes (``value``: reproduced or not),
+#: a number it states about its setup that the scene sets itself (``setup``: checked, but
+#: it holds by construction and is never counted as a reproduced number), or a statement
+#: in words or a bound (``claim``); counted apart by ``compare --against-published`` and
+#: the report's pages
+ROLES = ("value", "setup", "claim")
 #: the check of a statement without a number (shown, not checked)
 NO_CHECK = "none"
 CHECKS = ("equal", "below", "above", NO_CHECK)
@@ -110,7 +116,7 @@ ENTRY_FIELDS = {"metric": (str,), "value": (str, int, float), "source": (str,), 
                 "check": (str,)}
 OPTIONAL_ENTRY_FIELDS = {"target": (int, float, type(None)), "tolerance": (int, float, type(None)),
                          "tolerance_source": (str,), "deviation": (str,),
-                         "known_difference": (bool,), "note": (str,)}
+                         "known_difference": (bool,), "note": (str,), "role": (str,)}
 
 
 def check_entry(entry, where: str) -> None:
@@ -130,6 +136,9 @@ def check_entry(entry, where: str) -> None:
     if entry["check"] not in CHECKS:
         raise ValueError(f"{where}.check must be one of {', '.join(CHECKS)}, "
                          f"got {entry['check']!r}")
+    if entry.get("role", "value") not in ROLES:
+        raise ValueError(f"{where}.role must be one of {', '.join(ROLES)}, "
+                         f"got {entry['role']!r}")
     if entry["check"] != "none" and not isinstance(entry.get("target"), (int, float)):
         raise ValueError(f"{where}: check {entry['check']!r} needs a numeric 'target'")
 
@@ -143,3 +152,40 @@ def check_run(run: dict) -> list[dict]:
                      "entry": entry, "ours": ours, "verdict": verdict(entry, ours)})
     return rows
 
+
+
+def role_of(entry: dict) -> str:
+    """An entry's role (:data:`ROLES`); a results file written before roles: ``claim``
+    for a bound or a statement, else ``value``."""
+    role = entry.get("role")
+    if role in ROLES:
+        return role
+    return "value" if entry.get("check") == "equal" else "claim"
+
+
+def counts(rows: list[dict]) -> dict:
+    """``{role: {verdict: n}}`` of checked rows (:func:`check_run`'s)."""
+    out = {role: {} for role in ROLES}
+    for r in rows:
+        by = out[role_of(r["entry"])]
+        by[r["verdict"]] = by.get(r["verdict"], 0) + 1
+    return out
+
+
+def count_text(rows: list[dict]) -> str:
+    """The rows counted apart by role, one phrase each: values the papers compute
+    (reproduced, known differences, failed), setups they state (checked, not counted as
+    reproduced), claims in words (held, known differences, shown)."""
+    c = counts(rows)
+
+    def n(role, verdict):
+        return c[role].get(verdict, 0)
+    values = sum(c["value"].values())
+    setups = sum(c["setup"].values())
+    claims = sum(c["claim"].values())
+    return (f"values the papers compute: {values} ({n('value', 'holds')} reproduced, "
+            f"{n('value', 'known difference')} known differences, {n('value', 'fails')} "
+            f"fail); setups they state: {setups} ({n('setup', 'holds')} checked, not counted "
+            f"as reproduced, {n('setup', 'fails')} fail); claims in words: {claims} "
+            f"({n('claim', 'holds')} hold, {n('claim', 'known difference')} known "
+            f"differences, {n('claim', 'not numeric')} shown, {n('claim', 'fails')} fail)")

@@ -192,8 +192,16 @@ def published_rows(scene, results) -> list[dict]:
                          "paper": _num(p.value), "figure": p.kind == FIGURE,
                          "check": Markup(check), "tolerance_source": entry["tolerance_source"],
                          "verdict": verdict(entry, ours), "source": p.source,
-                         "deviation": p.deviation, "note": p.note})
+                         "deviation": p.deviation, "note": p.note, "role": entry["role"],
+                         "entry": entry})
     return rows
+
+
+def published_counts(rows) -> str:
+    """The scene's published rows counted apart by role (:func:`pdverify.published.count_text`):
+    values the paper computes, setups it states, claims in words."""
+    from ..published import count_text
+    return count_text(rows)
 
 
 def full_report_runs(scene) -> list[tuple[str, dict]]:
@@ -255,7 +263,8 @@ def scene_section(scene, results, figures, deviations=None) -> Markup:
         rows=[_row(scene, r, metrics) for r in results],
         refinements=[_refinement(r) for r in results if r.fields.get("refinement")],
         sources=sorted({p.source for p in scene.published}), figures=figures,
-        published=published_rows(scene, results),
+        published=(pub := published_rows(scene, results)),
+        published_counts=published_counts(pub) if pub else "",
         missing=missing_published(scene, results) if results else [],
         unmatched=unmatched_published(scene))
 

@@ -490,7 +490,7 @@ class Constraints(BondBarScene):
         # "Comparison of Fig. 3b and c shows that delta-constraint (Fig. 3c) results in
         # displacements closer to the analytical solution than Delta-constraint (Fig. 3b)"
         Published("c_closer_than_b", 1, "seed 004 §6.2, Fig. 3 (b), (c)", method="none",
-                  exact=True, kind="read off a figure"),
+                  exact=True, kind="read off a figure", role="claim"),
         Published("horizon_constraint_vs_full_max_diff", "non-zero", "seed 004 §6.2 and Fig. 3",
                   method="homogenized", bound=1e-12, check="above", tolerance_source=NONZERO),
     )
@@ -644,7 +644,7 @@ class Vibration(BondBarScene):
         Published("frequency_error_pct", "matches Rao (Fig. 5b)", "seed 004 §6.3, Fig. 5b",
                   method="homogenized", kind="read off a figure", where={"constraint": "end"}),
         # Table 13: the plotted element of Fig. 4 and the free end of Fig. 5, per column
-        *(Published(metric, value, source, exact=True,
+        *(Published(metric, value, source, exact=True, role="setup",
                     where={"constraint": c, "nodes": n, "length": length})
           for c, n, length, nxt, free in (("mid", 201, 2.0, 102, 201),
                                           ("end", 100, 1.0, 2, 100),

@@ -79,7 +79,7 @@ class ForceFlux(Scene):
         # Fig. 8: "the overall behavior near the boundaries is the same: ... a hardening
         # and then a softening" for every reasonable influence function
         Published("hardening_softening", 1, FIG8, method="none", exact=True,
-                  kind="read off a figure"),
+                  kind="read off a figure", role="claim"),
     )
     headline = "flux_table_error"  # the report overview's error for this scene
     closed_to_treatments = ("its reference is the uncorrected model's own flux table "

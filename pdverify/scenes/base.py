@@ -183,9 +183,26 @@ class Published:
     deviation: str = ""
     expected: float | None = None
     note: str = ""
+    #: what the entry is (:data:`pdverify.published.ROLES`): ``value`` (a number the paper
+    #: computes: reproduced or not), ``setup`` (a number the paper states about its setup,
+    #: which the scene sets itself: checked, never counted as a reproduced number) or
+    #: ``claim`` (a statement in words or a bound); empty: ``claim`` for words and bounds,
+    #: else ``value``
+    role: str = ""
 
     def applies(self, method: str, params: Mapping[str, Any]) -> bool:
         return _applies(self.method, self.where, method, params)
+
+    @property
+    def entry_role(self) -> str:
+        from .. import published as pub
+        if self.role:
+            if self.role not in pub.ROLES:
+                raise ValueError(f"{self.source}: role={self.role!r}; allowed: "
+                                 f"{', '.join(pub.ROLES)}")
+            return self.role
+        check, _, _ = pub.parse(self.value)
+        return "claim" if (self.bound is not None or check != "equal") else "value"
 
     def entry(self) -> dict:
         """The run record's ``published`` entry (:mod:`pdverify.published`)."""
@@ -214,6 +231,7 @@ class Published:
             out["known_difference"] = self.expected is None
         if self.note:
             out["note"] = self.note
+        out["role"] = self.entry_role
         return out
 
 
