@@ -26,8 +26,8 @@ import numpy as np
 
 from .errors import InputError
 from .nodeset import (  # noqa: F401  (node_set_of re-exported: the export's node set)
-    NodeSet, _lattice_k2, between_shells, equilibrium, node_set_of, not_in_equilibrium,
-    solution_vector)
+    NodeSet, _lattice_k2, equilibrium, node_set_of, not_in_equilibrium, solution_vector,
+    written_horizon)
 
 #: the marker file of an export folder (it lists every file the export wrote) and its
 #: schema (:mod:`pdverify.decks` writes it; score finds an export by it)
@@ -136,7 +136,7 @@ def export_horizon(ns: NodeSet) -> float:
     rounding of coordinates written with 17 digits, ~4 eps L |xi| on a body of size L,
     up to L ~ 1e13 h), where the stencil is whole shells (:func:`_horizon_shells`:
     ``added`` lattice offsets otherwise, kept too)."""
-    return between_shells(ns.spacing, ns.bond_offsets[0], ns.dim)
+    return written_horizon(ns)
 
 
 def _horizon_rule(ns: NodeSet) -> str:

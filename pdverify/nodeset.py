@@ -88,13 +88,18 @@ def node_set_of(scene, p, problem, system) -> NodeSet:
     return NodeSet(scene, p, problem, system, x, volume, forces, fixed)
 
 
-
 def _lattice_k2(dim: int, reach: int) -> np.ndarray:
     """|k|^2 of every integer offset k with |k_i| <= reach (0 included)."""
     axes = np.arange(-reach, reach + 1, dtype=np.int64)
     k = np.stack(np.meshgrid(*([axes] * dim), indexing="ij"), axis=-1).reshape(-1, dim)
     return np.sum(k * k, axis=1)
 
+
+def written_horizon(ns: NodeSet) -> float:
+    """The horizon another code is given for ``ns`` [m]: :func:`between_shells` of the
+    model's bond offsets, so that its |xi|^2 <= delta^2 keeps exactly the model's bonds
+    (the export's decks and the peer codes' alike)."""
+    return between_shells(ns.spacing, ns.bond_offsets[0], ns.dim)
 
 
 def between_shells(spacing: float, offsets, dim: int) -> float:
@@ -104,7 +109,6 @@ def between_shells(spacing: float, offsets, dim: int) -> float:
     k2_max = int(np.max(np.sum(off * off, axis=1)))
     lattice = _lattice_k2(dim, math.isqrt(k2_max) + 1)
     return spacing * math.sqrt(0.5 * (k2_max + int(lattice[lattice > k2_max].min())))
-
 
 
 # ------------------------------------------------------------------------------ equilibrium
@@ -139,16 +143,6 @@ def solution_vector(system, U: np.ndarray) -> np.ndarray:
         x = np.r_[x, model.A_theta @ (model.A_e @ (model.A_U_full @ x))]
     assert x.size == system.K.shape[0] or d == 0
     return x
-
-
-def bond_extensions(model, u) -> np.ndarray:
-    """Linearised bond extensions of the real nodes' displacements ``u`` (component-major)
-    in ``model``: a bond-based model's own (``bond_extensions``), a state-based model's
-    A_e A_U u."""
-    from .pd.bondbased import BondBasedModel
-    if isinstance(model, BondBasedModel):
-        return model.bond_extensions(u)
-    return model.A_e @ (model.A_U_full @ u)
 
 
 def equilibrium(ns: NodeSet, U: np.ndarray, u_linear: np.ndarray | None = None) -> dict:

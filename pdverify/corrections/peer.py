@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .treatment import Treatment
-from ..errors import InputError
+from ..errors import InputError, NumericalError
 from ..params import Param
 from ..peers import lammps
 
@@ -95,14 +95,22 @@ class PeerTreatment(Treatment):
             raise InputError(f"{where}: setting=same-model needs quadrature=full-cells "
                              f"(got {params.get('quadrature')!r}): LAMMPS cannot state "
                              "per-bond volume fractions")
-        if self.unavailable:
-            raise InputError(f"{where}: {self.name} is not available: {self.unavailable}")
 
     def assemble(self, problem, params):
         from .static_state import assemble_plain
         return assemble_plain(problem)
 
     # ------------------------------------------------------------------ the run
+    @staticmethod
+    def finish(outcome, metrics, trouble, where):
+        """The run's outcome: the scene's measure of the peer's field (``outcome``) with
+        the peer's ``metrics``; a field that is no solution (``trouble``) is a failed run
+        that keeps them (NumericalError with the outcome)."""
+        outcome.metrics.update(metrics)
+        if trouble:
+            raise NumericalError(f"{where}: {trouble}", partial=outcome)
+        return outcome
+
     def peer_solve(self, scene, p, problem, system, where):
         """``(x, info, metrics, trouble)``: LAMMPS's field as the system's unknowns, the
         diagnostics, the peer's metrics (module docstring) and why the field is not a
@@ -116,15 +124,14 @@ class PeerTreatment(Treatment):
         setting = p["setting"]
         with tempfile.TemporaryDirectory(prefix="pdverify-lammps-") as folder:
             result = lammps.run(model, setting, folder, where=where)
-        d, n = ns.dim, len(ns.x)
         x_none, _ = solve_system(system, where=where, ordering=problem.ordering)
-        u_none = np.asarray(x_none[:d * n]).reshape(d, n).T
+        u_none = system.displacements(x_none)
         scale = float(np.linalg.norm(u_none))
         metrics = {"peer_diff_to_none": _rel(result.u, u_none, scale)}
-        own = ns
+        # the linear model of LAMMPS's setting (its node set and solution), if there is one
+        own, u_own = ns, u_none
         if setting == "as-used":
-            volumes = np.asarray(ns.volume)
-            if not np.allclose(volumes, model.uniform_volume, rtol=1e-12, atol=0):
+            if not np.allclose(ns.volume, model.uniform_volume, rtol=1e-12, atol=0):
                 own = None      # cut cells or half cells: no linear model of LAMMPS's here
             else:
                 horizon = (model.m_ratio + lammps.EXAMPLES_MARGIN) * model.spacing
@@ -135,23 +142,17 @@ class PeerTreatment(Treatment):
                     keep = m.bond_x <= horizon
                     return np.where(keep, ramp(m.bond_x, model.spacing, horizon)
                                     / np.where(keep, m.bond_beta, 1.0), 0.0)
-                closure = Closure(weight_factor=lammps_weights)
-                ramped = assemble_plain(problem, closure)
+                ramped = assemble_plain(problem, Closure(weight_factor=lammps_weights))
                 x_ramp, _ = solve_system(ramped, where=where, ordering=problem.ordering)
-                u_ramp = np.asarray(x_ramp[:d * n]).reshape(d, n).T
-                metrics["peer_gap_volumes"] = _rel(u_ramp, u_none, scale)
-                metrics["peer_gap_nonlinear"] = _rel(result.u, u_ramp, scale)
-                own = node_set_of(scene, p, problem, ramped)
-        else:
-            metrics["peer_gap_nonlinear"] = metrics["peer_diff_to_none"]
+                own, u_own = node_set_of(scene, p, problem, ramped), ramped.displacements(x_ramp)
+                metrics["peer_gap_volumes"] = _rel(u_own, u_none, scale)
         info = {"solver": self.name, "peer": result.info}
         if own is not None:
-            held = equilibrium(own, result.u, u_ramp if own is not ns else u_none)
-            info["equilibrium"] = held
-            metrics["equilibrium_residual"] = held["residual"]
+            metrics["peer_gap_nonlinear"] = _rel(result.u, u_own, scale)
+            info["equilibrium"] = equilibrium(own, result.u, u_own)
+            metrics["equilibrium_residual"] = info["equilibrium"]["residual"]
         return (solution_vector(system, result.u), info, metrics,
                 _trouble(result.info, info.get("equilibrium"), not_in_equilibrium))
-
 
     def peer_solve_bonds(self, scene, p, problem, system, where, solve_none):
         """The bond-based sheets (their own assembly: ``scene.bond_problem``):

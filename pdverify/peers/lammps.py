@@ -25,8 +25,9 @@ the stretch, which is pdverify's constant micromodulus c (``micromodulus=constan
 Two settings:
 - ``same-model``: LAMMPS driven to solve pdverify's discrete model: every node's own
   volume (``vfrac``), pdverify's bonds (the horizon of
-  :func:`pdverify.nodeset.between_shells`, as the export writes it, between the last kept and the first dropped
-  lattice shell, so that LAMMPS's |xi|^2 <= delta^2 keeps exactly the model's bonds), and
+  :func:`pdverify.nodeset.written_horizon`, as the export writes it, between the last
+  kept and the first dropped lattice shell, so that LAMMPS's |xi|^2 <= delta^2 keeps
+  exactly the model's bonds), and
   no volume ramp or contact force (``lattice none 1e-12``: LAMMPS scales the volume of a
   bond within half a lattice constant of the horizon and adds contact forces within
   1.35 lattice constants; a lattice constant of 1e-12 m switches both off). Needs
@@ -171,11 +172,11 @@ def lps_moduli(constants) -> tuple[float, float]:
 def state_based_model(ns) -> Model:
     """The :class:`Model` of an exported state-based node set
     (:class:`pdverify.exchange.NodeSet`)."""
-    from ..nodeset import between_shells
+    from ..nodeset import written_horizon
     K, G = lps_moduli(ns.problem.constants)
     h, d = ns.spacing, ns.dim
     return Model(ns.x, np.asarray(ns.volume, float), ns.forces, ns.fixed, h,
-                 ns.horizon / h, between_shells(h, ns.system.model.stencil.offsets, d),
+                 ns.horizon / h, written_horizon(ns),
                  h ** d * float(ns.problem.thickness), "peri/lps", (K, G), K + 4 * G / 3)
 
 
@@ -187,11 +188,11 @@ def bond_based_model(ns) -> Model:
     node's volume, the horizon between the last kept and the first dropped lattice shell
     and, for a problem driven by prescribed values alone, their force
     (:func:`prescribed_force`) as the stopping tolerance's scale."""
-    from ..nodeset import between_shells
+    from ..nodeset import written_horizon
     model = ns.system.model
     h, d, c = model.spacing, ns.dim, model.c
     return Model(ns.x, np.asarray(ns.volume, float), ns.forces, ns.fixed, h, model.m_ratio,
-                 between_shells(h, ns.bond_offsets[0], d), h ** d * model.thickness,
+                 written_horizon(ns), h ** d * model.thickness,
                  "peri/pmb", (c,), c * model.horizon ** (d + 1), prescribed_force(ns))
 
 

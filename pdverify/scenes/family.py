@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 
 from .. import budget
-from ..errors import InputError, NumericalError
+from ..errors import InputError
 from ..solvers.front import solve as solve_system
 from ..solvers.policy import auto_note
 from .base import MethodSpec, Outcome, Scene, whole_cells
@@ -115,11 +115,7 @@ class StaticStateScene(Scene):
         if peer is not None:     # another code solves it (pdverify.peers): scored as ours
             with timer.phase("solve"):
                 x, info, metrics, trouble = peer(self, p, problem, system, where)
-            outcome = self.measure(p, problem, system, x, info)
-            outcome.metrics.update(metrics)
-            if trouble:
-                raise NumericalError(f"{where}: {trouble}", partial=outcome)
-            return outcome
+            return t.finish(self.measure(p, problem, system, x, info), metrics, trouble, where)
         with timer.phase("solve"):
             x, info = solve_system(system, where=where, ordering=problem.ordering)
             if p.get("solver") == "auto":

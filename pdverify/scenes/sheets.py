@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import budget
-from ..errors import InputError, NumericalError
+from ..errors import InputError
 from ..metrics import rel_l2_error
 from ..params import Param, at_least, positive
 from ..pd import bond_micromodulus, build_stencil, get_influence
@@ -258,7 +258,8 @@ class TensionSheet(SheetScene):
         def solve_none():
             return self.solve_fixed(model, system.fixed, system.values, where, system.rhs,
                                     solver=p["solver"])
-        peer = getattr(self.offered().get(method), "peer_solve_bonds", None)
+        t = self.offered().get(method)
+        peer = getattr(t, "peer_solve_bonds", None)
         with timer.phase("solve"):
             if peer is not None:       # another code solves it (pdverify.peers)
                 u, info, peer_metrics, trouble = peer(self, p, problem, system, where,
@@ -266,11 +267,7 @@ class TensionSheet(SheetScene):
             else:
                 u, _, info = solve_none()
         outcome = self.measure(p, problem, system, u, info)
-        if peer is not None:
-            outcome.metrics.update(peer_metrics)
-            if trouble:
-                raise NumericalError(f"{where}: {trouble}", partial=outcome)
-        return outcome
+        return outcome if peer is None else t.finish(outcome, peer_metrics, trouble, where)
 
     def measure(self, p, problem, system, x, info):
         W, H, h, delta, sigma = (p["width"], p["length"], p["spacing"], p["horizon"],
