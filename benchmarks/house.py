@@ -1,7 +1,8 @@
 """The house drawn as text: for each package folder of the middle of the stack
 (``pdverify/corrections``, ``pdverify/scenes``, ``pdverify/solvers``) every module's line
 count and the pdverify modules it imports (``module -> imports``; a lazy import, inside a
-function, is marked ``~``), then the lines per folder.
+function, is marked ``~``; one for the type checker only, under ``if TYPE_CHECKING:``,
+``:``), then the lines per folder.
 
     python benchmarks/house.py [FOLDER ...]
 
@@ -42,17 +43,22 @@ def _resolve(node: ast.ImportFrom, here: str, is_package: bool) -> list[str]:
     return out
 
 
-def imports_of(path: Path) -> dict[str, bool]:
-    """pdverify modules imported by ``path``: name -> True when only lazily (in a
-    function body)."""
+def imports_of(path: Path) -> dict[str, str]:
+    """pdverify modules imported by ``path``: name -> ``""`` (at import), ``"~"`` (only
+    lazily, in a function body) or ``":"`` (only for the type checker)."""
     tree = ast.parse(path.read_text())
     here = _module_name(path)
     is_package = path.name == "__init__.py"
-    found: dict[str, bool] = {}
+    found: dict[str, str] = {}
+    rank = {"": 0, "~": 1, ":": 2}
 
-    def visit(node, lazy: bool):
+    def visit(node, mark: str):
         for child in ast.iter_child_nodes(node):
-            inner = lazy or isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef))
+            inner = mark
+            if isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                inner = mark or "~"
+            elif isinstance(child, ast.If) and "TYPE_CHECKING" in ast.unparse(child.test):
+                inner = ":"
             if isinstance(child, ast.Import):
                 names = [a.name for a in child.names]
             elif isinstance(child, ast.ImportFrom):
@@ -62,8 +68,9 @@ def imports_of(path: Path) -> dict[str, bool]:
                 continue
             for name in names:
                 if name.startswith("pdverify"):
-                    found[name] = found.get(name, True) and lazy
-    visit(tree, False)
+                    old = found.get(name, ":")
+                    found[name] = mark if rank[mark] < rank[old] else old
+    visit(tree, "")
     # a module and its parent package both listed: keep the most specific
     return {m: lazy for m, lazy in found.items()
             if not any(o.startswith(m + ".") for o in found)}
@@ -85,7 +92,7 @@ def draw(folder: str) -> tuple[list[str], int]:
                 label = label if m != pkg else "(package)"
             else:
                 label = "../" + label
-            deps.append(("~" if lazy else "") + label)
+            deps.append(lazy + label)
         lines.append(f"  {short:<24} {n:>5}  -> {', '.join(deps) if deps else '-'}")
     return lines, total
 
@@ -96,7 +103,8 @@ def main(argv: list[str]) -> int:
     for folder in folders:
         lines, total = draw(folder)
         totals[folder] = total
-        print(f"{folder}/  ({total} lines; '../x' outside the folder, '~' lazy import)")
+        print(f"{folder}/  ({total} lines; '../x' outside the folder, '~' lazy import, "
+              "':' type checker only)")
         print("\n".join(lines))
         print()
     print("lines per folder:")
