@@ -7,20 +7,19 @@ extrapolation from its nearest real node j (j = f's cell index clipped into the 
 through the surface nodes of j's own boundary faces: with ``r_a`` the number of cells f
 lies outside along axis a and ``s_a`` the surface node on j's face across axis a,
 
-    u_f = u_j + sum_a 2 |r_a| (u_{s_a} - u_j)        (``order=1``: linear)
-    u_f = u_j + sum_a (u_{s_a} - u_j)                (``order=0``: constant beyond
-                                                      the surface)
+    u_f = u_j + sum_a 2 |r_a| (u_{s_a} - u_j)        (``linear``)
+    u_f = u_j + sum_a (u_{s_a} - u_j)                (``constant`` beyond the surface)
 
 (s_a sits h/2 from j, f sits |r_a| h beyond j, so ``2 |r_a| (u_{s_a} - u_j)`` is the
 linear step; summed over the axes it is exact for every affine field, corners
-included; ``order=0`` carries each surface value outwards unchanged). Dilatations copy the nearest real node's (exact for affine fields, whose
+included; ``constant`` carries each surface value outwards unchanged). Dilatations copy the nearest real node's (exact for affine fields, whose
 dilatation is constant). The surface nodes carry the boundary conditions and the
 force-flux rows (seed 001 Eq. 36) through pdverify's public
 ``impose_on_surface_nodes``.
 
-What the theory says: with ``order=1`` and complete neighbourhoods, an affine field is
+What the theory says: ``linear`` with complete neighbourhoods, an affine field is
 reproduced to round-off wherever the discrete material has the continuum moduli
-(moment-corrected weights); ``order=0`` is not exact for any field with a gradient
+(moment-corrected weights); ``constant`` is not exact for any field with a gradient
 normal to a face.
 """
 from __future__ import annotations
@@ -37,13 +36,17 @@ from pdverify.params import Param
 from pdverify.pd.closure import Closure, real_identity, with_rows
 from pdverify.pd.problem import LinearSystem, StaticProblem
 
-ORDERS = (0, 1)
+#: the extrapolations (the parameter is not called ``order``: a scene's treatment defaults
+#: may set a parameter of that name, e.g. surface nodes' order 3 on body3d-manufactured)
+EXTRAPOLATIONS = ("constant", "linear")
 
 
-def layer_rows(grid, order: int):
+def layer_rows(grid, extrapolation: str):
     """``(fict, U, T)``: the fictitious nodes, the rows of their displacements over
     [real nodes, surface nodes] and of their dilatations over the real nodes (module
     docstring)."""
+    if extrapolation not in EXTRAPOLATIONS:
+        raise ValueError(f"extrapolation {extrapolation!r} not in {EXTRAPOLATIONS}")
     ni = grid.n_interior
     fict = np.flatnonzero(~grid.is_interior)
     cells = np.asarray(grid.cells)
@@ -63,7 +66,8 @@ def layer_rows(grid, order: int):
         for f in (2 * axis, 2 * axis + 1):
             on = face == f
             s[on] = grid.surface_id(f, near[out[on]])
-        step = 2.0 * np.abs(rel[out, axis]) if order == 1 else np.ones(out.size)
+        step = (2.0 * np.abs(rel[out, axis]) if extrapolation == "linear"
+                else np.ones(out.size))
         rows += [out, out]
         cols += [ni + s, j[out]]
         vals += [step, -step]
@@ -76,7 +80,7 @@ def assemble(problem: StaticProblem, params: Mapping[str, Any]) -> LinearSystem:
     """The ``static-state`` system under the linear layer (module docstring)."""
     g = problem.body.grid(problem.stencil.reach)
     keep, flux = crossing_bonds(g, problem.stencil)
-    fict, U, T = layer_rows(g, params["order"])
+    fict, U, T = layer_rows(g, params["extrapolation"])
     n_unknown = g.n_interior + g.n_surface
     closure = Closure(keep=keep, weighted_volume="complete",
                       displacement_map=with_rows(real_identity(g, n_unknown), fict, U),
@@ -105,7 +109,8 @@ METHOD = LinearLayer(
     "linear-layer", "fictitious layer by per-axis linear (or constant) extrapolation from "
     "the nearest real node through its boundary faces' surface nodes; the conditions and "
     "force-flux rows on the surface nodes", "pdverify's tests (tests/plugins)",
-    params=(Param("order", 1, "extrapolation order: 0 constant, 1 linear", choices=ORDERS),),
+    params=(Param("extrapolation", "linear", "the fictitious layer's extrapolation from the "
+                  "surface nodes", choices=EXTRAPOLATIONS),),
     theories=("state-based",), families=("static-state",), footprint="surface",
     box_only="its surface nodes sit at the centres of boundary cell faces and its steps run "
              "along lattice axes normal to a face; a curved or cut boundary has neither")
