@@ -18,7 +18,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from _splu_timing import time_splu
-from pdverify.corrections.static_state import assemble_taylor
+from pdverify.corrections.taylor_fictitious import assemble_taylor
 from pdverify.scenes import get_scene
 from pdverify.solvers.checks import equilibrate
 
@@ -26,7 +26,7 @@ ORDERINGS = ("COLAMD", "MMD_AT_PLUS_A", "MMD_ATA")
 
 
 def lagrange_system(spacing, order=2):
-    """The scene's own Taylor system (``static_state.assemble_taylor`` of its problem)."""
+    """The scene's own Taylor system (``taylor_fictitious.assemble_taylor`` of its problem)."""
     scene = get_scene("plate2d-clamped")
     problem = scene.problem({**scene.default_params(), "spacing": spacing}, "benchmark")
     system = assemble_taylor(problem, order)

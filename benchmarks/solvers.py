@@ -310,19 +310,19 @@ def bench_crossover2d(args, out):
 
 def bench_pddo(args, out):
     """Whole PDDO runs (its square nonsymmetric system, SuperLU with partial pivoting),
-    COLAMD against minimum degree on A + A^T (``static_state.PDDO_ORDERING``)."""
-    import pdverify.corrections.static_state as static_state
+    COLAMD against minimum degree on A + A^T (``pddo.PDDO_ORDERING``)."""
+    import pdverify.corrections.pddo as pddo_module
     print("\n[pddo] whole runs, SuperLU column ordering COLAMD vs MMD_AT_PLUS_A")
     cases = [("plate2d-plane-strain", {"spacing": h}) for h in (0.025, 0.02, 0.0125)]
     cases += [("plate2d-plane-strain", {"spacing": 0.025, "m_ratio": 8.0}),
               ("body3d-traction", {}), ("body3d-manufactured", {})]
-    keep = static_state.PDDO_ORDERING
+    keep = pddo_module.PDDO_ORDERING
     try:
         for scene_id, over in cases:
             scene = get_scene(scene_id)
 
             def run(order, scene=scene, over=over):
-                static_state.PDDO_ORDERING = order
+                pddo_module.PDDO_ORDERING = order
                 return scene.run("pddo", over)
             alts = {o: (lambda o=o: run(o)) for o in ("COLAMD", "MMD_AT_PLUS_A")}
             res = alternate(alts, args.repeat)
@@ -333,7 +333,7 @@ def bench_pddo(args, out):
                   f"max_error_pct {err[0]:.3e} / {err[1]:.3e}")
             out[f"pddo {scene_id} {over}"] = {"COLAMD": t_c, "MMD_AT_PLUS_A": t_m}
     finally:
-        static_state.PDDO_ORDERING = keep
+        pddo_module.PDDO_ORDERING = keep
 
 
 def main(argv=None):

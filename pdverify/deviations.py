@@ -119,7 +119,7 @@ DEVIATIONS = (
               "mirror nodes and PDDO use the 1D modulus E = lambda + 2 mu. All three are exact "
               "for the traction bar's linear field, surface nodes of order 2 and PDDO for the "
               "uniform load's quadratic one.",
-              "corrections/static_state.py; tests/treatments/test_static_family.py"),
+              "corrections/surface_nodes.py, mirror_nodes.py, pddo.py; tests/treatments/test_static_family.py"),
     Deviation(("plate2d-plane-strain",), "choice",
               "Ours: seed 000's Taylor fictitious nodes with tractions, which seed 000 does not "
               "treat in 2D (its plate is clamped): the force flux of every boundary cell face "
@@ -127,7 +127,7 @@ DEVIATIONS = (
               "solution is reproduced to round-off with moment-corrected weights and carries "
               "the discrete material's moduli error (1.20 / 0.51 %, as surface nodes) with "
               "exact partial areas.",
-              "corrections/static_state.py; tests/treatments/test_static_family.py"),
+              "corrections/taylor_fictitious.py; tests/treatments/test_static_family.py"),
     Deviation(("body3d-manufactured",), "finding",
               "Seed 001 §5's mirror nodes and PDDO, run here by us (the paper shows them on "
               "the 2D plate only), stay far from surface nodes on the cubic manufactured "

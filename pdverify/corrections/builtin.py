@@ -1,18 +1,24 @@
 """The built-in treatments: those that assemble problem families (``static-state``) and
-the descriptions of those that their scenes still wire by hand."""
+the descriptions of those that their scenes still wire by hand.
+
+Each treatment's assembly is in its own module (``plain``, ``taylor_fictitious``,
+``surface_nodes``, ``mirror_nodes``, ``pddo``); here it is only declared: its parameters,
+checks and the function of each family it serves, typed by the family's protocol
+(:mod:`.protocols`)."""
 from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
-from typing import Any, Callable, Mapping
 
 from ..errors import InputError
 from ..params import Param, at_least
-from ..pd.problem import LOAD_POINTS
-from .mirror_nodes import GRADIENT_AT, MIRROR_POINTS, NEUMANN_READINGS
-from .pddo import BULK_MODELS
-from .surface_nodes import MAX_ORDER, check_wave_order, wave_extension
-from .taylor_fictitious import CORNER_RULES, fictitious_closure
+from ..pd.problem import LOAD_POINTS, LinearSystem, StaticProblem
+from .mirror_nodes import GRADIENT_AT, MIRROR_POINTS, NEUMANN_READINGS, assemble_mirror
+from .pddo import BULK_MODELS, assemble_pddo
+from .plain import assemble_plain
+from .protocols import GridClosure, ParamCheck, Params, StaticAssembly
+from .surface_nodes import MAX_ORDER, assemble_surface_nodes, check_wave_order, wave_extension
+from .taylor_fictitious import CORNER_RULES, assemble_taylor, fictitious_closure
 from .treatment import Role, Treatment
 from .virtual_nodes import check_layers, clamp
 
@@ -26,10 +32,10 @@ class FamilyTreatment(Treatment):
     """A treatment whose ``assemble`` is a function ``build(problem, params)`` and whose
     parameter checks are ``checker(cells, params, where)``."""
 
-    build: Callable[[Any, Mapping[str, Any]], Any] | None = None
-    checker: Callable[[tuple, Mapping[str, Any], str], None] | None = None
+    build: StaticAssembly | None = None
+    checker: ParamCheck | None = None
 
-    def assemble(self, problem, params):
+    def assemble(self, problem: StaticProblem, params: Params) -> LinearSystem:
         return self.build(problem, params)
 
     def check(self, cells, params, where):
@@ -42,7 +48,7 @@ def _order_check(value):
             else f"must be 1, 2 or 3 (Taylor orders above {MAX_ORDER} are not supported)")
 
 
-def _check_taylor(cells, p, where):
+def _check_taylor(cells, p, where) -> None:
     """Seed 000 App. D: the extrapolation of order n needs more than 2 n nodes along
     every axis."""
     n = min(cells)
@@ -60,7 +66,7 @@ def _whole_layer(p, where, method):
                          "of cells)")
 
 
-def _check_surface(cells, p, where):
+def _check_surface(cells, p, where) -> None:
     _whole_layer(p, where, "surface-nodes")
     N = p["order"]
     need = max(N + 1, 2 * ((N + 1) // 2) + 1)
@@ -70,33 +76,28 @@ def _check_surface(cells, p, where):
                              f"{need} for the Taylor stencils")
 
 
-def _check_mirror(cells, p, where):
+def _check_mirror(cells, p, where) -> None:
     _whole_layer(p, where, "mirror-nodes")
 
 
-def _none(problem, p):
-    from .static_state import assemble_plain
+def _none(problem: StaticProblem, p: Params) -> LinearSystem:
     return assemble_plain(problem)
 
 
-def _taylor(problem, p):
-    from .static_state import assemble_taylor
+def _taylor(problem: StaticProblem, p: Params) -> LinearSystem:
     return assemble_taylor(problem, p["order"], p.get("corners", CORNERS.default))
 
 
-def _surface(problem, p):
-    from .static_state import assemble_surface_nodes
+def _surface(problem: StaticProblem, p: Params) -> LinearSystem:
     return assemble_surface_nodes(problem, p["order"])
 
 
-def _mirror(problem, p):
-    from .static_state import assemble_mirror
+def _mirror(problem: StaticProblem, p: Params) -> LinearSystem:
     return assemble_mirror(problem, p["neumann"], p["mirror_point"],
                            p.get("gradient_at", "mirror"))
 
 
-def _pddo(problem, p):
-    from .static_state import assemble_pddo
+def _pddo(problem: StaticProblem, p: Params) -> LinearSystem:
     return assemble_pddo(problem, p.get("bulk_model", "lps"))
 
 
@@ -135,19 +136,19 @@ WAVE_ORDER = Param("order", 1, "Taylor order of the fictitious-node extrapolatio
                    at_least(1))
 
 
-def _truncated(_problem, _params):
+def _truncated(_problem: None, _params: Params) -> None:
     """The baseline's role in the ``wave-bar`` and ``flux-bar`` families: no extension
     (truncated neighbourhoods)."""
     return None
 
 
-def _flux_order(_problem, params):
+def _flux_order(_problem: None, params: Params) -> GridClosure:
     """Taylor's role in the ``flux-bar`` family: its closure of the bar's grid (one
     horizon of fictitious layers, extrapolated to ``order``)."""
     return functools.partial(fictitious_closure, order=params["order"])
 
 
-def _check_flux_order(nodes, params, where):
+def _check_flux_order(nodes, params, where) -> None:
     _check_taylor((nodes,), params, where)
 
 
@@ -168,7 +169,7 @@ def family_treatments() -> list[Treatment]:
                   "boxes' h = 0.05: 35-40 s and 2.1-2.2 GB (bordered system under nested "
                   "dissection, 6.1-6.5 M non-zeros); one flux row of each edge cell's "
                   "complementary shear pair is dropped (else near-singular: "
-                  "static_state.assemble_taylor). body3d-manufactured's quick grid "
+                  "taylor_fictitious.assemble_taylor). body3d-manufactured's quick grid "
                   "(10 x 5 x 5 cells) keeps 2 dependent constraint rows and fails as "
                   "near-singular. On a shape (not a box) the series runs along the local "
                   "normal with derivatives from a least-squares fit, the conditions at "

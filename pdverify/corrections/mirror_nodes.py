@@ -68,6 +68,9 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..pd.closure import Closure, real_identity
+from ..pd.problem import LinearSystem
+from ..solvers.policy import static_solver
+from .assembly import model_of, padded, system_matrix, traction_of, unknown_coords
 
 
 def peridynamic_gradient(grid, stencil) -> np.ndarray:
@@ -285,3 +288,34 @@ class MirrorNodes:
         return Closure(weighted_volume="complete",
                        displacement_map_full=self.displacement_map(),
                        dilatation_map=self.dilatation_map())
+
+
+# ------------------------------------------------------------------------------ static assembly
+def assemble_mirror(problem, neumann: str, mirror_point: str,
+                    gradient_at: str = "mirror") -> LinearSystem:
+    """Seed 001 §5's mirror node method (:class:`MirrorNodes`) on a ``static-state``
+    problem: the loads and constraints enter through the mirror relations only."""
+    g = problem.body.grid(problem.stencil.reach)
+    mirror = MirrorNodes(g, problem.stencil, dirichlet=problem.prescribed(),
+                         exact=problem.exact, traction=traction_of(problem),
+                         moduli=problem.constants.moduli(), neumann=neumann,
+                         mirror_point=mirror_point, gradient_at=gradient_at)
+    model = model_of(problem, g, mirror.closure())
+    d, ni, nu_ = g.dim, g.n_interior, model.n_unknown_nodes
+    solver = static_solver(problem.solver, d, d * nu_)
+    P = model.equilibrium_rows()
+    K = system_matrix(model, P, solver)
+    x_int = g.x[g.interior_ids]
+    rhs = np.zeros((nu_, d))
+    rhs[:ni] = problem.body_load(x_int, model.node_volume[g.interior_ids][:, None])
+    U_c = mirror.constant_displacements()
+    e_c = model.A_e @ U_c.T.ravel()
+    rhs[:ni] -= model.rows_of_state(U_c, model.A_Theta @ (model.A_theta @ e_c),
+                                    P).reshape(d, nu_).T
+    rhs = rhs.T.ravel()
+    if solver != "direct":
+        rhs = padded(rhs, K)
+    return LinearSystem(model, K, rhs, np.zeros(0, dtype=int), np.zeros(0), nu_,
+                        solver=solver,
+                        coords=None if solver == "direct" else unknown_coords(model, x_int),
+                        counts={"fictitious_nodes": int(g.n_ext - g.n_interior)}, offset=U_c)

@@ -47,6 +47,8 @@ import itertools
 import numpy as np
 import scipy.sparse as sp
 
+from ..pd.problem import LinearSystem
+from .assembly import model_of, traction_of
 from .factors import node_moments, solve_per_node
 from .mirror_nodes import prescribed_at, prescribed_parts
 
@@ -203,3 +205,28 @@ def pddo_system(model, face_dirichlet, exact, traction, moduli, body_load=None,
                       shape=(d * n, d * n))
     return A, rhs, {"outer_nodes": int(outer.sum()), "layer_nodes": int(layer.sum()),
                     "bulk_nodes": int(bulk.sum())}
+
+
+# ------------------------------------------------------------------------------ static assembly
+#: SuperLU's column ordering of the PDDO system (square, nonsymmetric, partial pivoting):
+#: minimum degree on A + A^T. Whole runs, COLAMD against it (benchmarks/solvers.py
+#: --only pddo, medians of 3 alternating, a busy machine): plate2d-plane-strain 1.6x,
+#: 2.3x, 2.1x at h = 0.025, 0.02, 0.0125 (11.1 -> 5.3 s), body3d-traction 1.5x,
+#: body3d-manufactured 1.0x; the exactness metrics stay round-off (max_error_pct
+#: 4.1e-11 -> 7.3e-11 % at h = 0.0125).
+PDDO_ORDERING = "MMD_AT_PLUS_A"
+
+
+def assemble_pddo(problem, bulk_model: str = "lps") -> LinearSystem:
+    """Seed 001 §5's PDDO boundary layer (:func:`pddo_system`) on a ``static-state``
+    problem: its own square, nonsymmetric system on the uncorrected model, solved by a
+    direct LU; ``bulk_model`` (:data:`BULK_MODELS`) governs the nodes beyond 2 delta."""
+    g = problem.body.grid(0)
+    model = model_of(problem, g, None)
+    x_int = g.x[g.interior_ids]
+    body = problem.body_load(x_int, model.node_volume[g.interior_ids][:, None])
+    A, rhs, counts = pddo_system(model, problem.prescribed(), problem.exact,
+                                 traction_of(problem), problem.constants.moduli(), body,
+                                 bulk_model=bulk_model)
+    return LinearSystem(model, A, rhs, np.zeros(0, dtype=int), np.zeros(0), g.n_interior,
+                        solver="direct", counts=counts, ordering=PDDO_ORDERING)

@@ -97,7 +97,7 @@ class PeerTreatment(Treatment):
                              "per-bond volume fractions")
 
     def assemble(self, problem, params):
-        from .static_state import assemble_plain
+        from .plain import assemble_plain
         return assemble_plain(problem)
 
     # ------------------------------------------------------------------ the run
@@ -115,7 +115,7 @@ class PeerTreatment(Treatment):
         """``(x, info, metrics, trouble)``: LAMMPS's field as the system's unknowns, the
         diagnostics, the peer's metrics (module docstring) and why the field is not a
         solution (None when it is)."""
-        from .static_state import assemble_plain
+        from .plain import assemble_plain
         from ..nodeset import equilibrium, node_set_of, not_in_equilibrium, solution_vector
         from ..pd.closure import Closure
         from ..solvers.front import solve as solve_system

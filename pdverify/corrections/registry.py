@@ -42,6 +42,7 @@ from typing import Any, Callable, Mapping
 from ..errors import InputError, NumericalError
 from ..params import Param
 from ..pd.closure import Closure
+from .protocols import BondClosure, ParamCheck
 from .treatment import ENTRY_POINT_GROUP, THEORIES, Treatment  # noqa: F401  (re-exported)
 
 
@@ -53,12 +54,12 @@ class BondMethod(Treatment):
     boundary conditions are imposed as the uncorrected model imposes them (``none``).
     """
 
-    closure: Callable[[Mapping], Closure] | None = None
+    closure: BondClosure | None = None
     families: tuple[str, ...] = ("static-state",)
     #: a closure changes bonds only; the uncorrected model's conditions serve any shape
     shapes: bool = True
     #: ``checker(cells, params, where)``: refuses parameters before any work
-    checker: Callable[[tuple, Mapping, str], None] | None = None
+    checker: ParamCheck | None = None
 
     def check(self, cells, params, where):
         if self.checker is not None:
@@ -80,7 +81,7 @@ class BondMethod(Treatment):
         return _plugin_closure(self, params)
 
     def assemble(self, problem, params: Mapping[str, Any]):
-        from .static_state import assemble_plain
+        from .plain import assemble_plain
         return assemble_plain(problem, self.make_closure(params))
 
 

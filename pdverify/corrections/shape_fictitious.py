@@ -18,7 +18,7 @@ cut boundary has no such lines, and a jittered node set no lattice at all, so he
   neighbourhood at every node (as on the box);
 - the conditions at boundary points by Lagrange multipliers (seed 000 Eq. 63): one point
   per boundary node and part (the mean of the part's boundary samples that belong to the
-  node, ``static_state.boundary_nodes``, moved onto the part). A prescribed component's
+  node, ``assembly.boundary_nodes``, moved onto the part). A prescribed component's
   row sets the fitted value (Eq. 58's role). Every other component's row is, on a
   straight part, seed 001's force flux (Eqs. 35-36): the bonds crossing the point's
   stretch of the part (fictitious-fictitious bonds that cross it kept, half at a
@@ -115,7 +115,7 @@ def normal_closure(g, shape, order: int, stencil=None) -> Closure:
 def boundary_points(g, shape, samples):
     """One point per (boundary node, part) pair: the mean of that pair's samples moved onto
     the part, its outward normal, part and node, and each sample's point (``samples``:
-    what ``static_state.boundary_nodes`` returns)."""
+    what ``assembly.boundary_nodes`` returns)."""
     P, W, _, part, node = samples
     key = node * len(shape.parts) + part
     keys, inv = np.unique(key, return_inverse=True)

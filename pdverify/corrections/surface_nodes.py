@@ -10,6 +10,10 @@ import scipy.sparse as sp
 from ..errors import InputError
 from ..pd.bonds import bond_pairs
 from ..pd.closure import Closure, real_identity, with_rows
+from ..pd.problem import LinearSystem
+from ..solvers.policy import static_solver
+from .assembly import eliminated, model_of, system_matrix
+from .protocols import GridMap, Params
 from .taylor import extrapolation_rows, taylor_weights, window_start
 
 MAX_ORDER = 3
@@ -242,7 +246,7 @@ def flux_rows(model, flux) -> sp.csr_matrix:
     return model.bond_force_rows(model.grid.n_interior + s, bond, alpha * sign)
 
 
-def wave_extension(_problem, params):
+def wave_extension(_problem: None, params: Params) -> GridMap:
     """The ``wave-bar`` role: the fictitious layer's displacements from the real nodes and
     the two surface nodes, extrapolated about the nearest surface node at Taylor order
     ``params["order"]`` (seed 002 Eqs. 8-9 at order 1), as a function of the bar's grid."""
@@ -250,9 +254,57 @@ def wave_extension(_problem, params):
     return lambda grid: surface_node_displacement_map(grid, order)
 
 
-def check_wave_order(real_nodes, params, where) -> None:
+def check_wave_order(real_nodes, params: Params, where: str) -> None:
     """Each end's extrapolation stencil needs order + 1 real nodes of its own half."""
     order = params["order"]
     if 2 * (order + 1) > real_nodes:
         raise InputError(f"{where}: order={order} needs 2 (order + 1) <= "
                          f"{real_nodes} real nodes (order <= {real_nodes // 2 - 1})")
+
+
+# ------------------------------------------------------------------------------ static assembly
+def assemble_surface_nodes(problem, order: int) -> LinearSystem:
+    """Seed 001's surface node method on a ``static-state`` problem: surface-node unknowns
+    carry the conditions, the other surface-node equations are the force flux of Eq. (36)
+    (:func:`impose_on_surface_nodes`)."""
+    g = problem.body.grid(problem.stencil.reach)
+    closure, flux = surface_node_closure(g, problem.stencil, order)
+    return impose_on_surface_nodes(problem, g, closure, flux)
+
+
+def impose_on_surface_nodes(problem, g, closure, flux) -> LinearSystem:
+    """The system of a closure whose unknowns are the real nodes, then one surface node
+    per boundary cell face (``closure.n_unknown_nodes``): a prescribed component is set
+    on the surface nodes of its face (elimination), every other surface-node equation is
+    its force flux (``flux``, seed 001 Eq. 36) equal to the face's load (zero on a free
+    face). Shared by ``surface-nodes`` and any treatment that carries the conditions on
+    surface nodes (a plugin's, e.g.)."""
+    model = model_of(problem, g, closure)
+    d, ni, nu_ = g.dim, g.n_interior, model.n_unknown_nodes
+    solver = static_solver(problem.solver, d, d * nu_)
+    P = (model.equilibrium_rows() + flux_rows(model, flux)).tocsr()
+    # in 3D the extrapolation rows are wide (order N: (N + 1)(2 ceil(N/2) + 1)^2 sources),
+    # so the displacement map is multiplied in last; in 1D and 2D the products keep the
+    # order the runs' numbers were made with (the gain there is small)
+    K = system_matrix(model, P, solver, map_last=d == 3)
+    x_int = g.x[g.interior_ids]
+    rhs = np.zeros((nu_, d))
+    rhs[:ni] = problem.body_load(x_int, model.node_volume[g.interior_ids][:, None])
+    xs, nrm = g.surface_x, g.surface_normal
+    for face, _ in problem.loaded():
+        sel = g.surface_face == face
+        rhs[ni:][sel] = problem.face_forces(face, xs[sel], nrm[sel], g.face_area)
+    us_ref = problem.exact(xs)
+    fixed, values, by_face = [], [], {}
+    for face, k, where in problem.prescribed():
+        mask = g.surface_face == face
+        if where is not None:
+            mask &= where(g.surface_cell)
+        nodes = np.flatnonzero(mask)
+        fixed.append(k * nu_ + ni + nodes)
+        values.append(us_ref[nodes, k])
+    for face in range(2 * d):
+        by_face[face] = (face // 2) * nu_ + ni + np.flatnonzero(g.surface_face == face)
+    return eliminated(model, K, rhs, fixed, values, solver, np.r_[x_int, xs], by_face,
+                       extra_x=xs, counts={"surface_nodes": int(g.n_surface),
+                                           "fictitious_nodes": int(g.n_ext - g.n_interior)})

@@ -25,7 +25,13 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from ..pd.bonds import unique_ids
 from ..pd.closure import Closure, real_identity, with_rows
+from ..pd.problem import FACES, LinearSystem
+from ..solvers.policy import static_solver
+from .assembly import boundary_nodes, model_of, shape_counts, side_sign, unknown_coords
+from .shape_fictitious import condition_rows, normal_closure
+from .surface_nodes import crossing_bonds
 from .taylor import extrapolation_rows, monomial_exponents, taylor_extrapolation_weights, taylor_weights
 
 
@@ -163,3 +169,277 @@ def clamped_rows(grid, order: int, faces, corners: str = "normal-only"):
             points.append(x[keep])
             comps.append(np.full(keep.size, k))
     return sp.vstack(blocks).tocsr(), np.concatenate(points), np.concatenate(comps)
+
+
+# ------------------------------------------------------------------------------ static assembly
+def assemble_taylor(problem, order: int, corners: str = "normal-only") -> LinearSystem:
+    """Seed 000's Taylor-extrapolated fictitious nodes with the conditions as constraint
+    rows by Lagrange multipliers (Eq. 63) on a ``static-state`` problem. A prescribed component takes the
+    rows of Eq. (58) on the lines of its face (``where``: on part of them); every other
+    component of a face with a traction, or of a free face, takes the force flux rows:
+    in 1D the bonds crossing the end plane (Eq. 60), in 2D/3D the face-crossing bonds of
+    each boundary cell face weighted by alpha (seed 001 Eq. 35, the same rule as the
+    surface nodes' flux). Where two faces that both prescribe a component k on their
+    whole face meet, the line through the corner node perpendicular to each face would
+    constrain k twice at the same corner; ``corners`` (Remark 4, ``CORNER_RULES``):
+    ``normal-only`` keeps on such a line only the row of the component normal to its
+    face (the tangential one is imposed by the other face's line), ``both`` keeps every
+    row (the system is then singular: the over-constraint Remark 4 avoids). On faces
+    prescribing different components (seed 001's plate) the rule changes nothing.
+
+    3D (our extension; seed 000 is 1D/2D). Two findings of issue 30, each fixed at its
+    cause. (1) The near-singular Lagrange system of the 3D boxes came from the flux
+    rows, not from the corner rule: at an edge cell whose two faces both take flux rows,
+    face a's row of component b and face b's row of component a are the shear force of
+    one cell on its two faces (sigma_ab = sigma_ba), near-dependent rows, one direction
+    per body edge; on the 8 x 6 x 6-cell box one combination was exactly dependent, on
+    the quick 10 x 5 x 5 grid B was square and 20 rows short of full rank. One row of
+    each pair is dropped (:func:`_shear_pair_lines`). (2) The corner rule handled pairs
+    of faces only: on a box clamped all round, the component along an edge (tangential
+    to both faces) was imposed on neither line; it now goes to the face of the lower axis
+    (:func:`yields_component`). Both are pinned
+    in tests/treatments/test_taylor_3d.py. What remains: B's smallest singular values
+    (rows scaled to unit 1-norm) are still ~1e-4 at h = 0.1 (condition estimates 1e7 to
+    1e10); on body3d-manufactured's cubic field order 1 gives 30 / 18 / 13 % at
+    h = 1/12, 1/16, 1/20 (surface nodes N = 1: 1.9 % at 1/20), order 2 0.54 / 0.22 /
+    0.105 % (surface nodes N = 2: 0.32 %); why order 1 is that far off is not yet
+    investigated. body3d-manufactured's quick grid
+    (10 x 5 x 5) keeps 2 dependent rows and fails as near-singular.
+
+    A body that is not a box (``problem.shape``): :func:`_taylor_on_shape`."""
+    if problem.shape is not None:
+        return _taylor_on_shape(problem, order)
+    g = problem.body.grid(problem.stencil.reach)
+    d = g.dim
+    # a face that prescribes every component on its whole face needs no flux rows; a box
+    # clamped all round (seed 000's plate) then needs neither them nor the face-crossing
+    # fictitious bonds, which enter no real node's equation
+    clamped = all(c.where is None and len(c.prescribed) == d
+                  for c in (problem.conditions.get(f) for f in FACES[:2 * d]) if c is not None)
+    clamped &= len(problem.conditions) == 2 * d
+    if d == 1 or clamped:
+        closure = fictitious_closure(g, order)
+        flux = None
+    else:
+        keep, flux = crossing_bonds(g, problem.stencil)
+        base = fictitious_closure(g, order)
+        closure = Closure(keep=keep, weighted_volume="complete",
+                          displacement_map=base.displacement_map,
+                          dilatation_map=base.dilatation_map)
+    model = model_of(problem, g, closure)
+    ni = g.n_interior
+    P = model.equilibrium_rows()
+    solver = static_solver(problem.solver, d, d * ni)
+    x_int = g.x[g.interior_ids]
+    rhs = problem.body_load(x_int, model.node_volume[g.interior_ids][:, None]).T.ravel()
+    K_b = model.bond_force_matrix() if d == 1 else None
+    # the constraint rows act on the solver's unknowns: the real displacements (direct),
+    # or those and the real dilatations (the augmented system of nested dissection)
+    width = d * ni if solver == "direct" else (d + 1) * ni
+    rows, vals = [], []
+    if flux is not None:   # force of each boundary cell face from the unknowns
+        Fs = _flux_of_unknowns(model, flux, g.n_surface, solver)
+    for face in range(2 * d):
+        axis, side = divmod(face, 2)
+        cond = problem.conditions.get(FACES[face])
+        R, anchors = boundary_value_rows(g, order, face)
+        xb = g.x[g.ext_id(anchors)]
+        xb[:, axis] = g.face_coordinate(face)
+        exact = problem.exact(xb)
+        cells_face = anchors
+        if d > 1:
+            sel = np.flatnonzero(g.surface_face == face)
+            cells_s = g.surface_cell[sel]
+            nrm = g.surface_normal[sel]
+            load = (problem.face_forces(face, g.surface_x[sel], nrm, g.face_area)
+                    if cond is not None and cond.traction is not None
+                    else np.zeros((sel.size, d)))
+            # surface cells and anchors enumerate the same boundary cells: match them
+            order_s = _match(cells_s, cells_face, axis, g)
+        for k in range(d):
+            pres = np.zeros(anchors.shape[0], dtype=bool)
+            if cond is not None and k in cond.prescribed:
+                pres[:] = True if cond.where is None else cond.where(cells_face)
+            imposed = pres.copy()
+            if corners == "normal-only" and k != axis:
+                imposed &= ~_corner_lines(problem, g, anchors, axis, k)
+            if np.any(imposed):
+                Rk = sp.coo_matrix(R[np.flatnonzero(imposed)])
+                rows.append(sp.csr_matrix((Rk.data, (Rk.row, Rk.col + k * ni)),
+                                          shape=(int(imposed.sum()), width)))
+                vals.append(exact[imposed, k])
+            free = np.flatnonzero(~pres & ~_shear_pair_lines(problem, g, anchors, axis, k))
+            if free.size == 0:
+                continue
+            if d == 1:
+                sec = model.crossing_selector([g.face_coordinate(face)]) @ K_b
+                # tension positive through the plane; the force on the body at the
+                # face is the outward traction: + at x+, - at x-
+                rows.append(sp.csr_matrix(sec))
+                t = (cond.traction(xb, np.array([[side_sign(face)]]))[0, 0]
+                     if cond is not None and cond.traction is not None else 0.0)
+                vals.append(np.array([side_sign(face) * t * g.face_area
+                                      * problem.thickness]))
+            else:
+                idx = sel[order_s[free]]
+                rows.append(Fs[k * g.n_surface + idx])
+                vals.append(load[order_s[free], k])
+    B = sp.vstack(rows).tocsr()
+    c = np.concatenate(vals)
+
+    def reaction(x, face):
+        if d != 1:
+            raise ValueError("the Taylor reaction is defined for 1D bars only")
+        return float((model.crossing_selector([g.face_coordinate(face)]) @ K_b @ x[:ni])[0])
+    counts = {"fictitious_nodes": int(g.n_ext - g.n_interior), "constraints": int(B.shape[0])}
+    none = np.zeros(0, dtype=int), np.zeros(0)
+    if solver == "direct":
+        return LinearSystem(model, model.stiffness(P), rhs, *none, ni, B=B, c=c,
+                            reaction=reaction, counts=counts)
+    # the bordered augmented system [[A, B^T], [B, 0]] (dilatations and multipliers as
+    # unknowns) under nested dissection: each block couples within one horizon, so its
+    # separators are half as thick as K's (on the seed-001 plate at h = 0.0125: 6.7 s
+    # against 19.6 s for the Lagrange system of K, same machine, solutions equal to
+    # 5e-13); in 3D the flux rows too act on the dilatations as unknowns (_bond_forces);
+    # a multiplier sits at the mean position of the nodes its row involves
+    A = model.augmented_stiffness(P)
+    absB = abs(B).tocsr()
+    at = (absB @ np.tile(x_int, (d + 1, 1))) / np.asarray(absB.sum(axis=1))
+    B_theta = B[:, d * ni:]
+    if B_theta.nnz == 0:
+        M = sp.bmat([[A, B.T], [B, None]], format="csr")
+        return LinearSystem(model, M, np.r_[rhs, np.zeros(A.shape[0] - rhs.size), c], *none,
+                            ni, solver=solver, coords=np.r_[unknown_coords(model, x_int), at],
+                            reaction=reaction, counts=counts)
+    # rows on the dilatations (3D): the multipliers' forces on the displacements must be
+    # those of the direct system, (B_u + B_theta G)^T lambda with G = A_theta A_e A_U
+    # (theta = G u); B^T alone would put B_theta^T lambda into the dilatation rows and
+    # solve another problem (7 % apart on body3d-manufactured, order 2, h = 0.0625).
+    # Kept sparse by mu = B_theta^T lambda as ni more unknowns at the nodes:
+    # [[A, [G^T; 0], [B_u^T; 0]], [0, I, -B_theta^T], [B, 0, 0]]
+    G = (model.A_theta @ (model.A_e @ model.A_U_full)).tocsr()
+    zero_theta = sp.csr_matrix((ni, ni))
+    M = sp.bmat([[A, sp.vstack([G.T, zero_theta]), sp.vstack([B[:, :d * ni].T,
+                                                                sp.csr_matrix((ni, B.shape[0]))])],
+                 [None, sp.identity(ni, format="csr"), -B_theta.T],
+                 [B, None, None]], format="csr")
+    return LinearSystem(model, M, np.r_[rhs, np.zeros(A.shape[0] - rhs.size + ni), c], *none,
+                        ni, solver=solver, coords=np.r_[unknown_coords(model, x_int), x_int, at],
+                        reaction=reaction, counts=counts)
+
+
+def _taylor_on_shape(problem, order: int) -> LinearSystem:
+    """Taylor's fictitious nodes along the local normal of a shape, the conditions as
+    constraint rows by Lagrange multipliers (``corrections.shape_fictitious``)."""
+    g = problem.body.grid(problem.stencil.reach)
+    # the fictitious layer completes the lattice: every real node keeps its whole cell
+    # (a cut cell's outside part is the fictitious nodes'), so that an affine field, or
+    # a quadratic one on an isotropic stencil, is a solution as on the box
+    g.node_volume[g.interior_ids] = g.volume
+    model = model_of(problem, g, normal_closure(g, problem.shape, order, problem.stencil))
+    ni = g.n_interior
+    x_int = g.x[g.interior_ids]
+    rhs = problem.body_load(x_int, model.node_volume[g.interior_ids][:, None]).T.ravel()
+    B, c, points = condition_rows(model, problem, order, boundary_nodes(g, problem.shape))
+    counts = shape_counts(g, fictitious_nodes=int(np.sum(g.kind == 1)),
+                           constraints=int(B.shape[0]), boundary_points=int(points))
+    none = np.zeros(0, dtype=int), np.zeros(0)
+    # COLAMD: on the hole plate's bordered system at h = 0.0125 m (13,016 unknowns, 622
+    # rows) SuperLU factors in 8.5-10 s with 24 M entries in L + U, against 42-52 s and
+    # 72-76 M with the scenes' minimum degree on A + A^T (the zero block of the
+    # multipliers defeats it)
+    return LinearSystem(model, model.stiffness(model.equilibrium_rows()), rhs, *none, ni,
+                        B=B, c=c, counts=counts, ordering="COLAMD")
+
+
+def _bond_forces(model, solver, bonds=None):
+    """Scalar bond forces (times beta V_a V_b) as a matrix on the solver's unknowns, the
+    flux rows' factor. Direct: of the real displacements (``model.bond_force_matrix``,
+    whose dilatation term couples nodes two horizons apart). Augmented (displacements,
+    then the real dilatations): in 3D [K_e A_e A_U, K_theta A_Theta], each block within
+    one horizon, which (with the mu unknowns of assemble_taylor) takes body3d-traction at
+    h = 0.05 from 11.0 M to 6.2 M non-zeros, 5.3 GB to 2.1 GB and 42 s to 36 s (whole
+    runs, /usr/bin/time; benchmarks/taylor3d.py times the parts); in 2D the bond forces of
+    the displacements beside zero dilatation columns, as before: there the one-horizon
+    form raised the plane-strain plate's condition estimate at h = 0.0125 from 2.1e5 to
+    6.8e9 and moved its errors by 3e-7 (relative). ``bonds``: only these rows
+    (ascending; the flux rows need the face-crossing bonds only)."""
+    if solver == "direct":
+        return model.bond_force_matrix(bonds)
+    ni = model.A_theta.shape[0]
+    rows = model.bond_a.size if bonds is None else len(bonds)
+    if model.dim != 3:
+        return sp.hstack([model.bond_force_matrix(bonds), sp.csr_matrix((rows, ni))])
+    e = (model.A_e @ model.A_U_full).tocsr()
+    K_e, K_theta = ((model.K_e, model.K_theta) if bonds is None
+                    else (sp.csr_matrix(model.K_e)[bonds], sp.csr_matrix(model.K_theta)[bonds]))
+    return sp.hstack([K_e @ e, K_theta @ model.A_Theta]).tocsr()
+
+
+def _corner_lines(problem, g, anchors, axis, k):
+    """Which of the lines of a face (``anchors``, normal ``axis``) run through a corner
+    (or, in 3D, edge) node shared with another face prescribing component ``k`` on its
+    whole face that takes ``k`` over (:func:`yields_component`)."""
+    out = np.zeros(anchors.shape[0], dtype=bool)
+    for other in range(2 * g.dim):
+        cond = problem.conditions.get(FACES[other])
+        if (yields_component(axis, other // 2, k) and cond is not None
+                and cond.where is None and k in cond.prescribed):
+            out |= anchors[:, other // 2] == g.boundary_layer(other)
+    return out
+
+
+def _shear_pair_lines(problem, g, anchors, axis, k):
+    """Which lines of a face (``anchors``, normal ``axis``) give up their flux row of the
+    tangential component ``k`` (3D only): those through an edge cell whose face on axis k
+    has a flux row of component ``axis`` too, when ``axis > k``. The two rows are the
+    shear force of one edge cell on its two faces, sigma_{axis k} and sigma_{k axis}:
+    equal in the continuum, near-equal on the lattice, so imposing both makes the
+    constraint rows (near-)dependent, one direction per body edge (measured on 10 x 7 x 7
+    cells at m = 3: the smallest singular values of the row-normalised B 7e-7 ... 8e-6,
+    concentrated on the edge cells' rows, 1e-4 with one row of each pair dropped;
+    on the quick 10 x 5 x 5 grid B was square and 20 rows short of full rank, full rank
+    without them). The row of the face with the lower axis is kept (either serves: a
+    field meeting the kept row meets the dropped one to the lattice error). In 2D the
+    corner cells hold the same pair; kept there, the published 2D runs unchanged."""
+    out = np.zeros(anchors.shape[0], dtype=bool)
+    if g.dim != 3 or k == axis or axis < k:
+        return out
+    for other in (2 * k, 2 * k + 1):
+        cond = problem.conditions.get(FACES[other])
+        edge = anchors[:, k] == g.boundary_layer(other)
+        if cond is not None and axis in cond.prescribed:
+            edge &= ~(np.ones_like(edge) if cond.where is None else cond.where(anchors))
+        out |= edge
+    return out
+
+
+def _flux_of_unknowns(model, flux, n_surface, solver):
+    """The force of each boundary cell face from the unknowns: :func:`_surface_flux`
+    times :func:`_bond_forces`, the latter of the face-crossing bonds only (the other
+    columns of the flux rows are zero; the same products, row by row)."""
+    used = unique_ids(flux[1])
+    return (_surface_flux(model, flux, n_surface)[:, used]
+            @ _bond_forces(model, solver, used)).tocsr()
+
+
+def _surface_flux(model, flux, n_surface):
+    """Rows (d n_surface x bonds): the force of the face-crossing bonds of every boundary
+    cell face, component-major (sum alpha f_b sign n_b)."""
+    s, bond, alpha, sign = flux
+    d = model.dim
+    w = alpha * sign
+    rows = np.concatenate([k * n_surface + s for k in range(d)])
+    cols = np.tile(bond, d)
+    vals = np.concatenate([w * model.bond_n[bond, k] for k in range(d)])
+    return sp.csr_matrix((vals, (rows, cols)), shape=(d * n_surface, model.bond_a.size))
+
+
+def _match(cells_s, anchors, axis, g):
+    """Positions in ``cells_s`` (surface cells of a face) of each anchor's cell."""
+    key_s = np.ravel_multi_index(tuple(np.delete(cells_s, axis, axis=1).T),
+                                 tuple(np.delete(np.asarray(g.cells), axis)))
+    key_a = np.ravel_multi_index(tuple(np.delete(anchors, axis, axis=1).T),
+                                 tuple(np.delete(np.asarray(g.cells), axis)))
+    pos = np.argsort(key_s)
+    return pos[np.searchsorted(key_s[pos], key_a)]

@@ -42,9 +42,13 @@ matrix is empty.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Callable, Mapping
+from typing import TYPE_CHECKING, Any, Mapping
 
 from ..params import Param
+
+if TYPE_CHECKING:       # the signatures each family takes (imported by the type checker)
+    from ..pd.problem import LinearSystem, StaticProblem
+    from .protocols import ParamCheck, RoleBuild
 
 THEORIES = ("bond-based", "state-based")
 ENTRY_POINT_GROUP = "pdverify.methods"
@@ -54,14 +58,16 @@ ENTRY_POINT_GROUP = "pdverify.methods"
 class Role:
     """What a treatment does for one more problem family (``Treatment.roles``): its
     parameters there, ``build(problem, params)`` (what the family's scenes ask of a
-    treatment: a system, a model's closure, an extrapolation order; the family's
-    docstring says which) and ``checker(context, params, where)`` (refuses parameters
-    before any work; ``context`` is what the family's scenes pass, e.g. a node count).
-    The family fixes the theory and dimension, so a role serves every scene of it."""
+    treatment, typed per family in :mod:`~pdverify.corrections.protocols`:
+    ``WaveExtension``, ``FluxClosure``, ``Clamp``; ``ROLE_PROTOCOLS`` maps a family to
+    its protocol) and ``checker(context, params, where)`` (``ParamCheck``: refuses
+    parameters before any work; ``context`` is what the family's scenes pass, e.g. a node
+    count). The family fixes the theory and dimension, so a role serves every scene of
+    it."""
 
-    build: Callable[[Any, Mapping[str, Any]], Any]
+    build: RoleBuild
     params: tuple[Param, ...] = ()
-    checker: Callable[[Any, Mapping[str, Any], str], None] | None = None
+    checker: ParamCheck | None = None
 
 
 @dataclass(frozen=True)
@@ -182,9 +188,10 @@ class Treatment:
         """Refuse (``InputError``, one line) parameters this treatment cannot run with
         on a box of ``cells`` cells per axis; before any work."""
 
-    def assemble(self, problem, params: Mapping[str, Any]):
+    def assemble(self, problem: StaticProblem, params: Mapping[str, Any]) -> LinearSystem:
         """The :class:`~pdverify.pd.problem.LinearSystem` of ``problem`` under this
-        treatment (problem-family treatments)."""
+        treatment (problem-family treatments; the signature is
+        :class:`~pdverify.corrections.protocols.StaticAssembly`'s)."""
         raise NotImplementedError(f"{self.name} assembles no problem family")
 
     def info(self) -> dict:

@@ -14,7 +14,9 @@ import numpy as np
 
 from ..errors import InputError
 from ..pd import BoxGrid, Closure
+from ..pd.problem import ClampedBox
 from .energy_directional import directional_closure
+from .protocols import ClampedGrid, Params
 
 
 def buffered_grid(lower, upper, spacing: float, depth: float, axis: int):
@@ -40,7 +42,7 @@ def virtual_nodes_closure(grid, lower, upper, horizon: float, influence, axis: i
     return directional_closure(grid, lower, upper, horizon, influence, axes=sides)
 
 
-def clamp(problem, params):
+def clamp(problem: ClampedBox, params: Params) -> ClampedGrid:
     """The ``clamped-sheet`` role: ``(grid, closure, low, high)`` of a
     :class:`~pdverify.pd.problem.ClampedBox` under virtual nodes (the clamps act on the
     buffer layers)."""
@@ -48,10 +50,10 @@ def clamp(problem, params):
                                     problem.horizon, problem.axis)
     closure = virtual_nodes_closure(grid, problem.lower, problem.upper, problem.horizon,
                                     problem.influence, problem.axis, params["correct_sides"])
-    return grid, closure, low, high
+    return ClampedGrid(grid, closure, low, high)
 
 
-def check_layers(_context, params, where) -> None:
+def check_layers(_context, params: Params, where: str) -> None:
     """Buffer layers of thickness delta must be whole numbers of cells."""
     if abs(params["m_ratio"] - round(params["m_ratio"])) > 1e-12:
         raise InputError(f"{where}: m_ratio={params['m_ratio']:g} must be a whole number for "

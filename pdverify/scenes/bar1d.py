@@ -100,7 +100,7 @@ class StaticBar(StaticStateScene):
     the body force b(x) on every node (nodal loads b(x_i) A Delta, Eq. 54).
 
     Every treatment of the ``static-state`` family imposes these in its own way
-    (``pdverify.corrections.static_state``): the uncorrected baseline ``none`` (ERRATA
+    (``pdverify.corrections``): the uncorrected baseline ``none`` (ERRATA
     seed 000) has no fictitious nodes, m_i from Eq. (50) over real neighbours, the
     Dirichlet value on the node nearest the boundary (its classical value u_cl(x_1)) and
     the end force on the node nearest the end; ``taylor-fictitious`` (order n) has

@@ -1,5 +1,5 @@
 """The ``static-state`` family: scenes that describe a static state-based problem and let
-every treatment of the family assemble it (``pdverify.corrections.static_state``).
+every treatment of the family assemble it (``pdverify.corrections.assembly``).
 
 A scene of the family states its body, material, boundary conditions (keyed by face and
 component), loads and reference once in :meth:`StaticStateScene.problem`, and measures a
@@ -85,7 +85,7 @@ class StaticStateScene(Scene):
         layer m deep folds into the unknowns through its stored extrapolation rows;
         surface nodes are unknowns); the dilatation couples nodes 2m spacings apart (m
         in the augmented system of the nested-dissection solve)."""
-        from ..corrections.static_state import footprint
+        from ..corrections.assembly import footprint
         from ..solvers.policy import static_solver
         lengths, _ = self.box(p)
         m, d = p["m_ratio"], len(lengths)

@@ -50,7 +50,7 @@ class ClampedPlate(FemStaticStateScene):
     moment is isotropic: the discrete bulk then has the continuum moduli).
 
     Every treatment of the family imposes the clamp in its own way
-    (``pdverify.corrections.static_state``):
+    (``pdverify.corrections``, each treatment's module):
 
     - the uncorrected baseline: truncated neighbourhoods, m_i over the bonds a node has
       (Eq. 50), the outermost ring of real nodes fixed (ERRATA: the 1D baseline imposes

@@ -187,7 +187,7 @@ class HolePlate(ShapeScene):
     impose a part's prescribed component on the real nodes of the cells its boundary
     samples fall in (the layer nearest a straight face, as on the boxes; along the hole
     the cut cells' nodes) and a traction as the integral of t over the part, each
-    sample's share on the node of its cell (``static_state.boundary_nodes``). The
+    sample's share on the node of its cell (``assembly.boundary_nodes``). The
     fictitious-node, surface-node, mirror-node and PDDO treatments are written for box
     faces (lines of nodes normal to a face, surface nodes on cell faces, mirror points
     across a plane); ``list`` gives each one's reason.

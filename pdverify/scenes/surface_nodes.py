@@ -78,7 +78,7 @@ METHOD_CHOICES = """
 class SurfaceNodeScene(StaticStateScene):
     """Shared description of seed 001's boxes; subclasses state the geometry, loads and
     conditions (:meth:`conditions`), every treatment of the ``static-state`` family
-    imposes them (``pdverify.corrections.static_state``)."""
+    imposes them in its own module of ``pdverify.corrections``."""
 
     seed = "001"
     figure = "seed001-boxes"

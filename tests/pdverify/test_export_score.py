@@ -588,7 +588,7 @@ def test_a_shape_body_exports_its_cut_volumes_and_part_loads(tmp_path):
     their cut volumes, its prescribed part's nodes, and the loads of its traction parts;
     the CSV and PeriLab writers take it as a box's."""
     from types import SimpleNamespace
-    from pdverify.corrections.static_state import assemble_plain
+    from pdverify.corrections.plain import assemble_plain
     from pdverify.decks import csv_files, perilab_files
     from pdverify.exchange import node_set_of
     from pdverify.pd import StateBasedConstants, get_influence, state_based_stencil

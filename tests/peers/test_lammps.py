@@ -152,7 +152,7 @@ def test_a_field_with_lost_bonds_is_a_failed_score(tmp_path):
     # the equilibrium of the bar with its two bonds across the middle cut (a code that
     # lost them) scored in the scene's model: the cut bonds' forces are missing from the
     # balance, far above 10 x the strain
-    from pdverify.corrections.static_state import assemble_plain
+    from pdverify.corrections.plain import assemble_plain
     from pdverify.exchange import score
     from pdverify.pd.closure import Closure
     scene = get_scene("bar1d-traction")

@@ -4,7 +4,9 @@ fictitious nodes along the local normal (exact for the fields its order claims).
 import numpy as np
 import pytest
 
-from pdverify.corrections.static_state import assemble_plain, assemble_taylor, boundary_nodes
+from pdverify.corrections.assembly import boundary_nodes
+from pdverify.corrections.plain import assemble_plain
+from pdverify.corrections.taylor_fictitious import assemble_taylor
 from pdverify.pd import StateBasedConstants, get_influence, state_based_stencil
 from pdverify.pd.build import Body
 from pdverify.pd.problem import FaceCondition, StaticProblem

@@ -118,7 +118,7 @@ def test_finding_035_l_plate_bridging():
     arm to a fictitious node extrapolated from the other takes it to 0.092 (measured;
     the bounds below sit halfway to the measured values' neighbours)."""
     import pdverify.corrections.shape_fictitious as sf
-    from pdverify.corrections.static_state import assemble_taylor
+    from pdverify.corrections.taylor_fictitious import assemble_taylor
     from pdverify.pd.bonds import bond_pairs
     from pdverify.results import Timer
     from pdverify.solvers.front import solve

@@ -19,7 +19,9 @@ import pytest
 import scipy.sparse.linalg as spl
 
 from pdverify.corrections.mirror_nodes import MirrorNodes
-from pdverify.corrections.static_state import _traction_of, assemble_mirror, assemble_pddo
+from pdverify.corrections.assembly import traction_of
+from pdverify.corrections.mirror_nodes import assemble_mirror
+from pdverify.corrections.pddo import assemble_pddo
 from pdverify.pd import StateBasedConstants, get_influence, state_based_stencil
 from pdverify.pd.problem import FaceCondition, StaticProblem
 from pdverify.solvers.front import solve
@@ -101,7 +103,7 @@ def _scene_problem(cells_across):
 
 def _mirror(problem):
     return MirrorNodes(_grid(problem), problem.stencil, dirichlet=problem.prescribed(),
-                       exact=problem.exact, traction=_traction_of(problem),
+                       exact=problem.exact, traction=traction_of(problem),
                        moduli=problem.constants.moduli())
 
 

@@ -11,8 +11,8 @@ Exact for fields that are linear along the normal of each face.
 import numpy as np
 import scipy.sparse as sp
 
-from pdverify.corrections.static_state import impose_on_surface_nodes
-from pdverify.corrections.surface_nodes import nearest_surface_node, surface_node_closure
+from pdverify.corrections.surface_nodes import (impose_on_surface_nodes, nearest_surface_node,
+                                                surface_node_closure)
 from pdverify.corrections.treatment import Treatment
 from pdverify.pd import BoxGrid
 from pdverify.pd.closure import Closure, real_identity, with_rows

@@ -1,0 +1,123 @@
+"""A node-adding treatment written as one module against the ``static-state`` protocol
+(tests/plugins/linear_layer_plugin: fictitious nodes by per-axis linear or constant
+extrapolation, surface-node unknowns carrying the conditions), registered as a plugin
+through the entry point group, run on every scene of its family."""
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pdverify.corrections import registry
+from pdverify.corrections.protocols import ParamCheck, StaticAssembly, conformance
+from pdverify.solvers.front import solve
+
+PLUGIN = Path(__file__).resolve().parents[1] / "plugins" / "linear_layer_plugin"
+sys.path.insert(0, str(PLUGIN))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import pdverify_linear_layer as layer  # noqa: E402
+from test_static_family import EXACT, _problem  # noqa: E402
+
+NAME = "linear-layer"
+
+
+@pytest.fixture
+def registered(monkeypatch):
+    """The plugin as pdverify finds an installed one: through its entry point."""
+    import importlib.metadata as md
+
+    class EP:
+        name, value, group = NAME, "pdverify_linear_layer:METHOD", registry.ENTRY_POINT_GROUP
+
+        def load(self):
+            return layer.METHOD
+
+    monkeypatch.setattr(md, "entry_points", lambda group=None: [EP()])
+    registry.reload()
+    try:
+        assert NAME in registry.treatments(), registry.BROKEN
+        yield registry.treatments()[NAME]
+    finally:
+        monkeypatch.undo()
+        registry.reload()
+
+
+def test_it_meets_the_family_protocol():
+    assert conformance(layer.assemble, StaticAssembly) is None
+    assert conformance(layer.METHOD.assemble, StaticAssembly) is None
+    assert conformance(layer.check, ParamCheck) is None
+
+
+def _error(dim, extrapolation):
+    problem = _problem(dim)
+    system = layer.assemble(problem, {"extrapolation": extrapolation})
+    x, _ = solve(system, where=f"test/{NAME}")
+    g = system.model.grid
+    u = system.displacements(x)[:g.n_interior]
+    ref = problem.exact(g.x[g.interior_ids])
+    return np.abs(u - ref).max() / np.abs(ref).max()
+
+
+@pytest.mark.parametrize("dim", [1, 2, 3])
+def test_linear_extrapolation_is_exact_for_affine_fields(dim):
+    """Affine field, its tractions on the free faces, moment-corrected weights (the
+    discrete material has the continuum moduli): the linear steps reproduce the field on
+    the layer, corners included, so the field is the PD solution (EXACT: round-off,
+    tests/treatments/test_static_family.py)."""
+    assert _error(dim, "linear") < EXACT
+
+
+@pytest.mark.parametrize("dim", [1, 2, 3])
+def test_constant_extrapolation_is_not_so_the_test_can_fail(dim):
+    """Carrying the surface values outwards unchanged misses any gradient normal to a
+    face: far more than round-off (1e-3: measured 6 to 14 %)."""
+    assert _error(dim, "constant") > 1e-3
+
+
+def _coarse(scene):
+    """The scene's own quick case of surface nodes (or of ``none``), with the scene's
+    parameters only: the smallest resolution its report runs."""
+    for method in ("surface-nodes", "none"):
+        for m, params in scene.report_cases(quick=True):
+            if m == method:
+                names = {p.name for p in scene.params}
+                return {k: v for k, v in params.items() if k in names}
+    return {}
+
+
+@pytest.mark.slow
+def test_it_runs_on_every_scene_of_its_family(registered):
+    """Offered on every box of the static-state family and run there (finite errors);
+    refused on the shapes with its ``box_only`` reason; exact to round-off on the
+    traction bar, whose solution is linear (Eq. 64 relative to the largest displacement,
+    as for the built-in surface nodes: tests/corrections/test_plugin.py). Slow tier: the
+    ten runs take ~25 s alone, the two 3D boxes most of it."""
+    import pdverify.scenes as scenes
+    family = [s for s in scenes.all_scenes() if s.family == "static-state"]
+    boxes = [s for s in family if not s.has_shape]
+    assert len(boxes) == 10 and len(family) == 12
+    for scene in family:
+        why = registered.why_not(scene)
+        if scene.has_shape:
+            assert why is not None and "curved or cut boundary" in why, (scene.id, why)
+            continue
+        assert why is None, (scene.id, why)
+        res = scene.run(NAME, _coarse(scene))
+        assert res.status == "ok", (scene.id, res.message)
+        assert res.params["extrapolation"] == "linear", scene.id   # its own default
+        errors = {k: v for k, v in res.metrics.items() if "error" in k}
+        assert errors, (scene.id, res.metrics)
+        assert all(math.isfinite(v) for v in errors.values()
+                   if isinstance(v, float)), (scene.id, errors)
+        assert res.size.get("surface_nodes", 0) > 0 or res.diagnostics, scene.id
+        if scene.id == "bar1d-traction":
+            assert res.metrics["max_error_pct"] < 1e-9
+        if scene.dim == 1:
+            # in 1D each fictitious node has one line and one surface node: the linear
+            # step is the surface nodes' order-1 Taylor series (seed 002 Eqs. 8-9), so
+            # both solve the same system up to the round-off of the Taylor weights
+            # (~1e-15, times condition estimates below 1e7 on these bars: 1e-6 relative)
+            ref = scene.run("surface-nodes", {**_coarse(scene), "order": 1})
+            for k in ("max_error_pct", "rel_l2_error"):
+                assert res.metrics[k] == pytest.approx(ref.metrics[k], rel=1e-6, abs=1e-9)
