@@ -411,3 +411,92 @@ def assemble_bonds(problem: BondProblem, closure=None, own=None) -> BondSystem:
     fixed = np.concatenate(fixed) if fixed else np.zeros(0, dtype=int)
     values = np.concatenate(values) if values else np.zeros(0)
     return BondSystem(model, rhs, fixed, values, parts)
+
+
+@dataclass
+class WaveSystem:
+    """A bond-based bar's explicit-dynamics system (the ``wave-bar`` family,
+    :func:`assemble_wave`): the free accelerations are ``a = A u_free + A_bc u_bc``,
+    ``A = -diag(1/V) K_real @ map`` multiplied out once (a banded matrix plus the few
+    columns an extension adds), ``u_bc`` the prescribed end values at ``x_bc``.
+    ``surface``: the ends' values sit on two surface nodes (no bonds) and every real node
+    is free; else the end real nodes carry them."""
+
+    model: object
+    A: object
+    A_bc: object
+    free: np.ndarray
+    x_bc: np.ndarray
+    surface: bool
+    n_real: int
+
+    @property
+    def spacing(self) -> float:
+        return float(self.model.spacing)
+
+    @property
+    def x_lattice(self) -> np.ndarray:
+        return self.model.grid.x[:, 0]
+
+    @property
+    def n_fict(self) -> int:
+        return int(self.model.grid.layers)
+
+    @property
+    def x_real(self) -> np.ndarray:
+        return self.x_lattice[self.n_fict:self.n_fict + self.n_real]
+
+    @property
+    def x_free(self) -> np.ndarray:
+        return self.x_real[self.free]
+
+    def real_displacements(self, u_free, u_bc=(0.0, 0.0)) -> np.ndarray:
+        """All real nodes' displacements from the free ones (truncated: the end nodes get
+        ``u_bc``)."""
+        u_free = np.asarray(u_free, dtype=float)
+        if self.surface:
+            return u_free
+        out = np.empty(u_free.shape[:-1] + (self.n_real,))
+        out[..., self.free] = u_free
+        out[..., 0], out[..., -1] = u_bc[0], u_bc[1]
+        return out
+
+    def size(self) -> dict:
+        surface = 2 if self.surface else 0
+        return {"nodes": int(self.n_real + 2 * self.n_fict + surface),
+                "real_nodes": int(self.n_real), "fictitious_nodes": int(2 * self.n_fict),
+                "dofs": int(self.free.size), "bonds": self.model.n_bonds(),
+                "operator_nnz": int(self.A.nnz)}
+
+
+def assemble_wave(problem: BondProblem, extension=None) -> WaveSystem:
+    """The :class:`WaveSystem` of a 1D bar ``problem`` whose faces ``x-`` and ``x+`` are
+    prescribed: with a treatment's ``extension`` (its ``wave-bar`` role: a function of
+    the grid giving the fictitious layer's displacement map from the real nodes and two
+    surface nodes at the ends, which carry the prescribed values), else truncated
+    neighbourhoods with the end real nodes held."""
+    import scipy.sparse as sp
+
+    from .build import build_model
+    from .closure import Closure
+    surface = extension is not None
+    closure = ((lambda g: Closure(displacement_map=extension(g),
+                                  n_unknown_nodes=g.n_interior + 2)) if surface else None)
+    model = build_model(problem.body, problem.stencil, problem.material, closure,
+                        layers=problem.stencil.reach if surface else 0)
+    grid = model.grid
+    nr = int(grid.n_interior)
+    full = (sp.diags(-1.0 / model.node_volume[grid.interior_ids]) @ model.reduced()).tocsc()
+    if surface:
+        free = np.arange(nr)
+        origin, length = problem.body.origin[0], problem.body.lengths[0]
+        x_bc = np.array([origin, origin + length])
+        A, A_bc = full[:, :nr].tocsr(), full[:, nr:].tocsr()
+    else:
+        fixed = np.r_[problem.nodes("x-", grid), problem.nodes("x+", grid)]  # no layers
+        free = np.setdiff1d(np.arange(nr), fixed)
+        x_bc = grid.x[grid.interior_ids][fixed, 0]
+        rows = full.tocsr()[free].tocsc()
+        A, A_bc = rows[:, free].tocsr(), rows[:, fixed].tocsr()
+    A.sort_indices()
+    return WaveSystem(model, A, A_bc, free, x_bc, surface, nr)
