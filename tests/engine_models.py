@@ -18,7 +18,7 @@ from pdverify.corrections.taylor_fictitious import (boundary_value_rows, clamped
                                                     fictitious_closure)
 from pdverify.pd import StateBasedConstants, get_influence, state_based_stencil
 from pdverify.pd.build import Body, StateMaterial, build_model
-from pdverify.scenes.bar1d import BAR_PARAMS, bar_model
+from pdverify.scenes.statebar import BAR_PARAMS, bar_model
 from pdverify.scenes.plate2d import ALL_FACES, ORDERING
 from pdverify.solvers.front import solve_constrained, solve_with_dirichlet
 
