@@ -101,7 +101,7 @@ class StaticBar(StaticStateScene):
                         **({"x+": loaded} if force else {})},
             exact=lambda x: self.classical(x[:, 0], p)[:, None],
             body_force=lambda x: self.body_force(x[:, 0], p)[:, None],
-            thickness=p["area"], load_point=p.get("load_point", "surface"),
+            thickness=p["area"], load_point=self.declared(p, "load_point"),
             solver="direct", where=where, complete_m=p["complete_m"])
 
     def check(self, method, p):

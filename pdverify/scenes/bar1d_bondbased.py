@@ -300,9 +300,9 @@ def _micromodulus_table(ratio, value, table):
 class Homogenization(BondBarScene):
     """Seed 004 §3-6.1: a bar in uniaxial tension by equal and opposite end forces.
 
-    Model (:meth:`BondBarScene.bar_problem`, the engine's bond-based model): N points x_i = (i - 1) Delta, Delta = length / (N - 1),
-    linearised bond-based equilibrium Eq. (33); triangular c(xi) = c1 (1 - xi/delta)
-    (Eq. 6) or constant; delta = m Delta (through an element, the element cut in two
+    Model (:meth:`BondBarScene.bar_problem`, the engine's bond-based model): N points
+    x_i = (i - 1) Delta, Delta = length / (N - 1), linearised bond-based equilibrium
+    Eq. (33); triangular c(xi) = c1 (1 - xi/delta) (Eq. 6) or constant; delta = m Delta (through an element, the element cut in two
     counts half) or (m + 1/2) Delta (between elements); full- or half-weight end
     elements. c1 from the discrete horizon (Eqs. 14/22 = 26/30) unless
     calibration=continuum. ``homogenized`` multiplies the bonds (1, 1+k) and (N, N-k),

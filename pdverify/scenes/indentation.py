@@ -231,7 +231,7 @@ class Indentation(BondStaticScene):
         """Like for like: the small-strain FEM for ``kinematics=linear``, the finite-strain
         one (:data:`FINITE_REFERENCE`) for ``nonlinear``."""
         out = super().reference_params(p)
-        if p.get("kinematics") == "nonlinear":
+        if "kinematics" in p and p["kinematics"] == "nonlinear":   # a PD run's (fem: none)
             out.update(FINITE_REFERENCE)
         return out
 
