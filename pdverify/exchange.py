@@ -1,8 +1,9 @@
 """A static scene's uncorrected problem as a node set for another PD code, and the
 score of the displacements that code computed on it (``pdverify export``, ``score``):
 the ``static-state`` family's scenes (state-based; the treatment ``none`` assembles
-them) and the bond-based seed-003 sheets (they build their own model:
-``bond_problem`` and ``measure`` of :class:`pdverify.scenes.sheets.SheetScene`).
+them) and the bond-based seed-003 sheets (a description each, assembled by the generic bond
+assembly: ``bond_problem`` and ``measure`` of
+:class:`pdverify.scenes.bondfamily.BondStaticScene`).
 
 The node set is the ``none`` treatment's: the real nodes of the scene's grid with their
 volumes, the prescribed components of each boundary condition (the nodes nearest the
@@ -55,12 +56,13 @@ _UNIT_ALIASES = {"\u03bcm": "\u00b5m"}
 
 
 def bond_based(scene) -> bool:
-    """A bond-based sheet that builds and measures its own problem
-    (:class:`~pdverify.scenes.sheets.SheetScene` with ``bond_problem`` and ``measure``)."""
-    from .scenes.sheets import SheetScene
-    return (isinstance(scene, SheetScene)
-            and type(scene).bond_problem is not SheetScene.bond_problem
-            and type(scene).measure is not SheetScene.measure)
+    """A bond-based scene that describes and measures its own problem
+    (:class:`~pdverify.scenes.bondfamily.BondStaticScene` with ``bond_problem`` and
+    ``measure``)."""
+    from .scenes.bondfamily import BondStaticScene
+    return (isinstance(scene, BondStaticScene)
+            and type(scene).bond_problem is not BondStaticScene.bond_problem
+            and type(scene).measure is not BondStaticScene.measure)
 
 
 def exportable(scene) -> bool:
@@ -177,11 +179,11 @@ def _horizon_rule(ns: NodeSet) -> str:
 def node_set(scene, overrides=None) -> NodeSet:
     """Assemble the ``none`` system of ``scene`` at ``overrides`` (bad input: InputError
     from the scene's own checks, before any work): by the treatment ``none`` of the
-    static-state family, or by a bond-based sheet's own ``bond_problem``."""
+    static-state family, or by a bond-based sheet's description (``bond_system``)."""
     p = scene.resolve(METHOD, overrides)
     where = f"{scene.id}/{METHOD}"
     if bond_based(scene):
-        return node_set_of(scene, p, *scene.bond_problem(METHOD, p, where))
+        return node_set_of(scene, p, *scene.bond_system(METHOD, p, where))
     problem = scene.problem(p, where)
     treatment = scene.treatment(METHOD)
     return node_set_of(scene, p, problem, treatment.assemble(problem, p))

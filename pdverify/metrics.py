@@ -115,23 +115,28 @@ def error_metrics(x, u, u_ref, dist, horizon, dim) -> tuple[dict, np.ndarray]:
     comp = np.abs(u - u_ref) / scale * 100.0        # (n, d) per-component percent
     mag = np.sqrt(np.sum(comp ** 2, axis=1))         # Eq. (38)
     near = dist <= horizon
+    regions = {"": np.ones(x.shape[0], dtype=bool), "boundary_": near, "interior_": ~near}
+    if dim == 3:
+        return region_errors(mag, regions, {"max_error_pct": None}, u, u_ref), mag
+    columns = {"max_error_pct": None, "max_error_u_pct": 0, "max_error_v_pct": 1}
+    return region_errors(comp, regions, columns, u, u_ref), comp
+
+
+def region_errors(err, regions, columns, u=None, u_ref=None) -> dict:
+    """The one error-by-region function: the largest of the per-node errors ``err``
+    ((n,) or (n, d), in %) over each region, ``regions`` = {metric prefix: node mask} (a
+    region without nodes is left out), one metric per ``columns`` entry {name: column of
+    ``err``, None: every column}; with ``u`` and ``u_ref`` each region's
+    ``rel_l2_error`` after its maxima."""
     out = {}
-
-    def part(prefix, mask):
+    for prefix, mask in regions.items():
         if not np.any(mask):
-            return
-        if dim == 3:
-            out[prefix + "max_error_pct"] = float(mag[mask].max())
-        else:
-            out[prefix + "max_error_pct"] = float(comp[mask].max())
-            out[prefix + "max_error_u_pct"] = float(comp[mask, 0].max())
-            out[prefix + "max_error_v_pct"] = float(comp[mask, 1].max())
-        out[prefix + "rel_l2_error"] = rel_l2_error(u[mask], u_ref[mask])
-
-    part("", np.ones(x.shape[0], dtype=bool))
-    part("boundary_", near)
-    part("interior_", ~near)
-    return out, (mag if dim == 3 else comp)
+            continue
+        for name, col in columns.items():
+            out[prefix + name] = float((err[mask] if col is None else err[mask, col]).max())
+        if u is not None:
+            out[prefix + "rel_l2_error"] = rel_l2_error(u[mask], u_ref[mask])
+    return out
 
 
 def plate_regions(x, lengths, horizon) -> dict:
@@ -155,12 +160,7 @@ def plate_errors(x, u, u_ref, lengths, horizon) -> tuple[dict, np.ndarray]:
     scale = np.max(np.abs(u_ref[:, 0]))
     err = np.abs(u - u_ref) / scale * 100.0
     regions = {"": np.ones(x.shape[0], dtype=bool), **plate_regions(x, lengths, horizon)}
-    out = {}
-    for prefix, mask in regions.items():
-        if not mask.any():
-            continue
-        out[prefix + "max_error_u_pct"] = float(err[mask, 0].max())
-        out[prefix + "max_error_v_pct"] = float(err[mask, 1].max())
+    out = region_errors(err, regions, {"max_error_u_pct": 0, "max_error_v_pct": 1})
     out["rel_l2_error"] = rel_l2_error(u, u_ref)
     return out, err
 

@@ -18,9 +18,13 @@ from pdverify.corrections.taylor_fictitious import (boundary_value_rows, clamped
                                                     fictitious_closure)
 from pdverify.pd import StateBasedConstants, get_influence, state_based_stencil
 from pdverify.pd.build import Body, StateMaterial, build_model
-from pdverify.scenes.bar1d import BAR_PARAMS, bar_model
-from pdverify.scenes.plate2d import ALL_FACES, ORDERING
+from pdverify.scenes.statebar import BAR_PARAMS, bar_model
+from pdverify.scenes.plate2d import ORDERING
 from pdverify.solvers.front import solve_constrained, solve_with_dirichlet
+
+#: the plate's four edges as the grid numbers them (x-, x+, y-, y+: the clamped rows'
+#: argument of ``taylor_fictitious.clamped_rows``)
+ALL_FACES = (0, 1, 2, 3)
 
 
 class StateBox:

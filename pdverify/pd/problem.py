@@ -256,41 +256,114 @@ class LinearSystem(_Unknowns):
         return np.asarray(x[:self.dofs]).reshape(self.dim, self.n_unknown_nodes).T
 
 
+@dataclass(frozen=True)
+class PartCondition:
+    """What one named part of a bond-based body prescribes (:class:`BondProblem`):
+    ``prescribed[k] = value`` holds component k of every node of the part at ``value``
+    (eliminated unknowns); ``force(x) -> (n, d)`` the nodal forces [N] on the part's nodes
+    at positions ``x`` (the scene's load sharing among them)."""
+
+    prescribed: Mapping[int, float] = field(default_factory=dict)
+    force: Callable[[np.ndarray], np.ndarray] | None = None
+
+
 @dataclass
 class BondProblem:
-    """A bond-based scene's problem as its PD run builds it (the seed-003 sheets,
-    ``pdverify.scenes.sheets``: they assemble their own model), beside its
-    :class:`BondSystem`: the node spacing and thickness [m], the micromodulus's shape
-    ``influence`` (c(xi) = c omega(|xi|)), the continuum moduli the constant c was
-    calibrated to (``E`` [Pa], ``nu``: the one the bond-based model represents) and the
-    ``kind`` of the plane (``plane-stress``). ``marks``: node index arrays the scene's
-    ``measure`` reads (the clamped rows); ``loads``, ``supports``: what the scene's loads
-    and prescribed components are, as a sentence each (the export README's)."""
+    """A static bond-based problem as a scene states it once, the twin of
+    :class:`StaticProblem`: the ``body`` (``pdverify.pd.build.Body``), the horizon
+    ``stencil``, the ``material`` (``BondMaterial``: c and the micromodulus's shape
+    ``influence``, c(xi) = c omega(|xi|)), the ``horizon`` delta [m] as the scene gives it,
+    and ``conditions`` keyed by named parts: the body's faces by name (``x-``, ``x+``,
+    ``y-``, ... : the nodes on that face of an ``on-surface`` body, the outermost row of
+    a cell-centred one) and the scene's own sets in ``parts`` (``name: x -> mask`` over
+    the grid's node positions: symmetry lines, held points). Parts not listed are free
+    and unloaded. :func:`assemble_bonds` turns it into a :class:`BondSystem` under a
+    treatment's closure (a bond method: the same closure serves the state-based family)
+    or, where the treatment has a role in the description's ``family``, its own grid and
+    clamp nodes (``clamped-sheet``: virtual nodes' buffer layers, :class:`ClampedBox`).
 
-    spacing: float
-    thickness: float
-    influence: object
+    ``E`` [Pa], ``nu``: the continuum moduli c was calibrated to (``nu`` the one the
+    bond-based model represents); ``kind``: the plane (``plane-stress``); ``loads``,
+    ``supports``: what the conditions are, as a sentence each (the export README's)."""
+
+    body: object
+    stencil: object
+    material: object
+    horizon: float
+    conditions: Mapping[str, PartCondition]
     E: float
     nu: float
     kind: str
-    marks: dict = field(default_factory=dict)
+    parts: Mapping[str, Callable[[np.ndarray], np.ndarray]] = field(default_factory=dict)
+    family: str | None = None
     loads: str = ""
     supports: str = ""
+
+    def __post_init__(self):
+        faces = FACES[:2 * len(self.body.lengths)]
+        clash = [k for k in self.parts if k in faces]
+        bad = [k for k in self.conditions if k not in faces and k not in self.parts]
+        if clash or bad:
+            raise ValueError(f"parts {clash + bad}: a condition names a face {faces} or a "
+                             f"part {tuple(self.parts)}; a part is not named as a face")
+
+    @property
+    def spacing(self) -> float:
+        return float(self.body.spacing)
+
+    @property
+    def thickness(self) -> float:
+        return float(self.body.thickness)
+
+    @property
+    def influence(self):
+        return self.material.influence
+
+    @property
+    def dim(self) -> int:
+        return len(self.body.lengths)
+
+    def nodes(self, name: str, grid) -> np.ndarray:
+        """Node numbers of the part ``name`` on ``grid`` (a face or a scene's set)."""
+        x = grid.x
+        if name in self.parts:
+            return np.flatnonzero(self.parts[name](x))
+        axis, side = divmod(face_number(name), 2)
+        lo = self.body.origin[axis]
+        bound = lo + self.body.lengths[axis] if side else lo
+        if self.body.placement != "on-surface":
+            bound += (-0.5 if side else 0.5) * self.body.spacing
+        return np.flatnonzero(np.isclose(x[:, axis], bound))
+
+    def clamped_box(self) -> ClampedBox:
+        """The :class:`ClampedBox` of a ``clamped-sheet`` description: the body's box
+        with the two faces of one axis prescribed."""
+        axes = {face_number(k) // 2 for k, c in self.conditions.items()
+                if k in FACES and c.prescribed}
+        if len(axes) != 1:
+            raise ValueError(f"a clamped box prescribes the faces of one axis, not {axes}")
+        lower = tuple(self.body.origin)
+        upper = tuple(o + L for o, L in zip(self.body.origin, self.body.lengths))
+        return ClampedBox(lower, upper, self.spacing, self.horizon, self.influence,
+                          axis=axes.pop())
 
 
 @dataclass
 class BondSystem(_Unknowns):
-    """A bond-based scene's linear system: ``model.K u = rhs`` over every node of the
+    """A bond-based problem's linear system: ``model.K u = rhs`` over every node of the
     model's grid (component-major) with the unknowns ``fixed`` (component-major indices)
     prescribed at ``values``. It reads as a :class:`LinearSystem` without constraint
     rows or extra unknowns (``B``, ``offset``: None), so the node set
     (:mod:`pdverify.nodeset`) and its checks take it as they take a treatment's system;
-    K is the model's, assembled on first use."""
+    K is the model's, assembled on first use. ``parts``: the node numbers of every named
+    part of the description on the model's grid (a treatment's own clamp nodes where
+    it brought them)."""
 
     model: object
     rhs: np.ndarray
     fixed: np.ndarray
     values: np.ndarray
+    parts: dict = field(default_factory=dict)
     B = None
     offset = None
 
@@ -302,3 +375,128 @@ class BondSystem(_Unknowns):
     def n_unknown_nodes(self) -> int:
         return int(self.model.grid.n_ext)
 
+
+def assemble_bonds(problem: BondProblem, closure=None, own=None) -> BondSystem:
+    """The :class:`BondSystem` of ``problem``: the model of its body, stencil and
+    material under a bond method's ``closure`` (None: uncorrected), or under ``own`` =
+    ``(grid, closure, {face: nodes})``, what a treatment's role in the description's
+    family brings (its grid, closure and the nodes that carry those faces' conditions;
+    the body is then laid out cell-centred). Every part's prescribed components are
+    eliminated at their values, its forces added to the right-hand side."""
+    from dataclasses import replace
+
+    from .build import build_model
+    from .closure import Closure
+    body, grid, faces = problem.body, None, {}
+    if own is not None:
+        grid, closure, faces = own
+        body = replace(body, placement="cell-centred", boundary_volume="partial")
+    model = build_model(body, problem.stencil, problem.material,
+                        Closure() if closure is None else closure, grid=grid)
+    g = model.grid
+    n, d = g.n_ext, g.dim
+    parts = {name: (np.asarray(faces[name]) if name in faces else problem.nodes(name, g))
+             for name in (*problem.conditions, *problem.parts)}
+    rhs = np.zeros(d * n)
+    fixed, values = [], []
+    for name, cond in problem.conditions.items():
+        ids = parts[name]
+        if cond.force is not None:
+            force = cond.force(g.x[ids])
+            for k in range(d):
+                rhs[k * n + ids] += force[:, k]
+        for k, value in cond.prescribed.items():
+            fixed.append(k * n + ids)
+            values.append(np.full(ids.size, float(value)))
+    fixed = np.concatenate(fixed) if fixed else np.zeros(0, dtype=int)
+    values = np.concatenate(values) if values else np.zeros(0)
+    return BondSystem(model, rhs, fixed, values, parts)
+
+
+@dataclass
+class WaveSystem:
+    """A bond-based bar's explicit-dynamics system (the ``wave-bar`` family,
+    :func:`assemble_wave`): the free accelerations are ``a = A u_free + A_bc u_bc``,
+    ``A = -diag(1/V) K_real @ map`` multiplied out once (a banded matrix plus the few
+    columns an extension adds), ``u_bc`` the prescribed end values at ``x_bc``.
+    ``surface``: the ends' values sit on two surface nodes (no bonds) and every real node
+    is free; else the end real nodes carry them."""
+
+    model: object
+    A: object
+    A_bc: object
+    free: np.ndarray
+    x_bc: np.ndarray
+    surface: bool
+    n_real: int
+
+    @property
+    def spacing(self) -> float:
+        return float(self.model.spacing)
+
+    @property
+    def x_lattice(self) -> np.ndarray:
+        return self.model.grid.x[:, 0]
+
+    @property
+    def n_fict(self) -> int:
+        return int(self.model.grid.layers)
+
+    @property
+    def x_real(self) -> np.ndarray:
+        return self.x_lattice[self.n_fict:self.n_fict + self.n_real]
+
+    @property
+    def x_free(self) -> np.ndarray:
+        return self.x_real[self.free]
+
+    def real_displacements(self, u_free, u_bc=(0.0, 0.0)) -> np.ndarray:
+        """All real nodes' displacements from the free ones (truncated: the end nodes get
+        ``u_bc``)."""
+        u_free = np.asarray(u_free, dtype=float)
+        if self.surface:
+            return u_free
+        out = np.empty(u_free.shape[:-1] + (self.n_real,))
+        out[..., self.free] = u_free
+        out[..., 0], out[..., -1] = u_bc[0], u_bc[1]
+        return out
+
+    def size(self) -> dict:
+        surface = 2 if self.surface else 0
+        return {"nodes": int(self.n_real + 2 * self.n_fict + surface),
+                "real_nodes": int(self.n_real), "fictitious_nodes": int(2 * self.n_fict),
+                "dofs": int(self.free.size), "bonds": self.model.n_bonds(),
+                "operator_nnz": int(self.A.nnz)}
+
+
+def assemble_wave(problem: BondProblem, extension=None) -> WaveSystem:
+    """The :class:`WaveSystem` of a 1D bar ``problem`` whose faces ``x-`` and ``x+`` are
+    prescribed: with a treatment's ``extension`` (its ``wave-bar`` role: a function of
+    the grid giving the fictitious layer's displacement map from the real nodes and two
+    surface nodes at the ends, which carry the prescribed values), else truncated
+    neighbourhoods with the end real nodes held."""
+    import scipy.sparse as sp
+
+    from .build import build_model
+    from .closure import Closure
+    surface = extension is not None
+    closure = ((lambda g: Closure(displacement_map=extension(g),
+                                  n_unknown_nodes=g.n_interior + 2)) if surface else None)
+    model = build_model(problem.body, problem.stencil, problem.material, closure,
+                        layers=problem.stencil.reach if surface else 0)
+    grid = model.grid
+    nr = int(grid.n_interior)
+    full = (sp.diags(-1.0 / model.node_volume[grid.interior_ids]) @ model.reduced()).tocsc()
+    if surface:
+        free = np.arange(nr)
+        origin, length = problem.body.origin[0], problem.body.lengths[0]
+        x_bc = np.array([origin, origin + length])
+        A, A_bc = full[:, :nr].tocsr(), full[:, nr:].tocsr()
+    else:
+        fixed = np.r_[problem.nodes("x-", grid), problem.nodes("x+", grid)]  # no layers
+        free = np.setdiff1d(np.arange(nr), fixed)
+        x_bc = grid.x[grid.interior_ids][fixed, 0]
+        rows = full.tocsr()[free].tocsc()
+        A, A_bc = rows[:, free].tocsr(), rows[:, fixed].tocsr()
+    A.sort_indices()
+    return WaveSystem(model, A, A_bc, free, x_bc, surface, nr)

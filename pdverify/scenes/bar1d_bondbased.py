@@ -13,16 +13,17 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .. import budget
-from ..corrections.homogenized import (bond_bar, homogenization_factors, micromodulus_factor,
-                                       split_horizon_ratio)
 from ..errors import InputError, NumericalError
 from ..metrics import fitted_frequency, max_error_of_peak_pct, rel_l2_error
 from ..papers_data import Formula, load_tables
 from ..params import Param, at_least, positive
+from ..pd import build_stencil, get_influence
+from ..pd.bar1d import bar_micromodulus, micromodulus_factor, split_horizon_ratio
+from ..pd.build import Body, BondMaterial
+from ..pd.problem import BondProblem, BondSystem, PartCondition, assemble_bonds
 from ..solvers.explicit import central_difference
 from ..solvers.modal import exact_stability_limit, min_angular_frequency
 from ..solvers.front import solve_constrained
-from ..corrections.registry import plugin_call
 from . import Outcome, Published, Scene, register
 from .base import truncation_problem
 
@@ -61,82 +62,72 @@ def bar_params(horizon_ratio=4.0, E=1.0):
     )
 
 
-class BondBar:
-    """A seed-004 bar: the engine's bond-based model (built by
-    :func:`pdverify.corrections.homogenized.bond_bar`) and the analyses the scenes need.
+def equation_rows(model) -> np.ndarray:
+    """Dense S / (c1 A) of a seed-004 bar ``model``: row i is the left-hand side of Eq. (33)
+    / (c1 A) for point i. K u = the external nodal forces, and the paper's non-symmetric
+    S of S u = -b (force per unit volume, App. 2) is -diag(1/V) K."""
+    return -(model.K.toarray() / model.node_volume[:, None]) / (model.c * model.thickness)
 
-    ``K`` is the symmetric stiffness (K u = external nodal forces). The paper's
-    non-symmetric matrix S of Su = -b (force per unit volume, App. 2) is -diag(1/V) K;
-    :meth:`equation_rows` returns it divided by c1 A, the scaling of the printed
-    equations (34)-(98).
+
+def cut_stiffness(model) -> sp.csr_matrix:
+    """F with F d = the force through every cut, d_c = u_{c+1} - u_c (c = 1..N-1).
+
+    A bond i-j crosses the cuts i..j-1 and its extension is the sum of their gaps
+    (G d); the force through cut c is the summed force of the bonds crossing it,
+    so F = G^T diag(s) G, banded (half-width = the bond reach) and SPD.
     """
+    i, j, s = model.bond_a, model.bond_b, model.bond_stiffness
+    span = j - i
+    rows = np.repeat(np.arange(i.size), span)
+    start = np.repeat(np.cumsum(span) - span, span)
+    cols = np.repeat(i, span) + (np.arange(rows.size) - start)
+    G = sp.csr_matrix((np.ones(rows.size), (rows, cols)),
+                      shape=(i.size, model.grid.n_ext - 1))
+    return (G.T @ sp.diags(s) @ G).tocsr()
 
-    def __init__(self, *, nodes, spacing, horizon_ratio, E, area=1.0, end_weight="full",
-                 micromodulus="triangular", calibration="discrete", end_factors=(),
-                 closure=None):
-        self.model = bond_bar(nodes=nodes, spacing=spacing, horizon_ratio=horizon_ratio, E=E,
-                              area=area, end_weight=end_weight, micromodulus=micromodulus,
-                              calibration=calibration, end_factors=end_factors,
-                              closure=closure)
-        self.nodes, self.spacing, self.E, self.area = nodes, spacing, E, area
-        self.m, self.beta = split_horizon_ratio(horizon_ratio)
-        self.end_factors = (tuple(float(a) for a in end_factors) if len(end_factors)
-                            else tuple((closure.info if closure else {}).get("end_factors", ())))
-        self.c1 = self.model.c
-        self.K = self.model.K
-        self.x = self.model.grid.x[:, 0]
-        self.volume = self.model.node_volume
 
-    def equation_rows(self) -> np.ndarray:
-        """Dense S / (c1 A): row i is the left-hand side of Eq. (33) / (c1 A) for point i."""
-        return -(self.K.toarray() / self.volume[:, None]) / (self.c1 * self.area)
+def end_force_displacement(model, force: float) -> np.ndarray:
+    """Displacements of a bar ``model`` under -force at point 1 and +force at point N,
+    centre at rest.
 
-    def lumped_mass(self, density: float) -> np.ndarray:
-        """Nodal masses rho V_i (half at both ends for half-weight end elements)."""
-        return self.model.lumped_mass(density)
+    Node i's equation is flux(i-1) - flux(i) + f_i = 0, so end forces +-F put the force
+    F through every cut: N - 1 equations F d = F 1 for the N - 1 gaps. This statically
+    determinate form is solved instead of K u = f with a pinned node because its
+    condition number stays bounded as N grows (K's grows like N^2, which costs about
+    1e-12 of f(N) at N = 1001), and the strain factor needs round-off accuracy there.
+    """
+    N = model.grid.n_ext
+    F = cut_stiffness(model).tocsc()
+    gaps = spla.spsolve(F, np.full(N - 1, float(force)))
+    if not np.all(np.isfinite(gaps)):
+        raise NumericalError("end-loaded bar: the cut system gave non-finite gaps")
+    u = np.concatenate([[0.0], np.cumsum(gaps)])
+    return u - 0.5 * (u[(N - 1) // 2] + u[N // 2])
 
-    def cut_stiffness(self) -> sp.csr_matrix:
-        """F with F d = the force through every cut, d_c = u_{c+1} - u_c (c = 1..N-1).
 
-        A bond i-j crosses the cuts i..j-1 and its extension is the sum of their gaps
-        (G d); the force through cut c is the summed force of the bonds crossing it,
-        so F = G^T diag(s) G, banded (half-width = the bond reach) and SPD.
-        """
-        i, j, s = self.model.bond_a, self.model.bond_b, self.model.bond_stiffness
-        span = j - i
-        rows = np.repeat(np.arange(i.size), span)
-        start = np.repeat(np.cumsum(span) - span, span)
-        cols = np.repeat(i, span) + (np.arange(rows.size) - start)
-        G = sp.csr_matrix((np.ones(rows.size), (rows, cols)), shape=(i.size, self.nodes - 1))
-        return (G.T @ sp.diags(s) @ G).tocsr()
+def end_factors(model) -> tuple:
+    """The end-bond factors a closure put on the bar (``homogenized``; () for others)."""
+    return tuple(model.closure.info.get("end_factors", ()))
 
-    def end_force_displacement(self, force: float) -> np.ndarray:
-        """Displacements under -force at point 1 and +force at point N, centre at rest.
 
-        Node i's equation is flux(i-1) - flux(i) + f_i = 0, so end forces +-F put the force
-        F through every cut: N - 1 equations F d = F 1 for the N - 1 gaps. This statically
-        determinate form is solved instead of K u = f with a pinned node because its
-        condition number stays bounded as N grows (K's grows like N^2, which costs about
-        1e-12 of f(N) at N = 1001), and the strain factor needs round-off accuracy there.
-        """
-        F = self.cut_stiffness().tocsc()
-        gaps = spla.spsolve(F, np.full(self.nodes - 1, float(force)))
-        if not np.all(np.isfinite(gaps)):
-            raise NumericalError("end-loaded bar: the cut system gave non-finite gaps")
-        u = np.concatenate([[0.0], np.cumsum(gaps)])
-        N = self.nodes
-        return u - 0.5 * (u[(N - 1) // 2] + u[N // 2])
-
-    def size(self) -> dict:
-        return {"nodes": int(self.nodes), "dofs": int(self.nodes), "bonds": self.model.n_bonds()}
+def bar_size(model) -> dict:
+    n = int(model.grid.n_ext)
+    return {"nodes": n, "dofs": n, "bonds": model.n_bonds()}
 
 
 class BondBarScene(Scene):
-    """Shared checks and bar construction of the seed-004 scenes.
+    """Shared checks and bar description of the seed-004 scenes.
 
-    Besides ``none`` and ``homogenized`` the scenes take the registry's bond-based
-    methods (``energy``, ``volume``, plugins), which correct the uncorrected bar with
-    ``none``'s parameters; the scene's metrics and load stay as they are.
+    A bar is a description (:meth:`bar_problem`, a
+    :class:`~pdverify.pd.problem.BondProblem`: N points x_i = (i - 1) Delta on the
+    surface, each carrying the element volume A Delta, or A Delta / 2 at both ends with
+    ``end_weight=half``; the micromodulus c1 of ``calibration``; end forces and held
+    points as named parts), which the generic assembly turns into a system under the
+    run's closure (:meth:`bar`): ``homogenized`` (end-bond factors) and the registry's
+    other bond methods (``energy``, ``volume``, plugins) close the uncorrected bar with
+    ``none``'s parameters; the scene's metrics and load stay as they are. Each scene
+    then solves the system its own way (statically determinate cuts, Lagrange rows for
+    the held points, explicit dynamics).
     """
 
     seed = "004"
@@ -156,17 +147,31 @@ class BondBarScene(Scene):
                              f"2m + 1 = {2 * m + 1} points, one horizon family)")
         t = self.bond_methods().get(method)
         if t is not None:
+            from ..corrections.registry import plugin_call
             plugin_call(t, "check", t.check, (p["nodes"],), p, where)
 
     def estimate(self, method, p):
         m, _ = split_horizon_ratio(p["horizon_ratio"])
         return budget.linear_system(p["nodes"], 1, 1, m + 1)
 
-    def bar(self, method, p, nodes, spacing) -> "BondBar":
-        return BondBar(nodes=nodes, spacing=spacing, horizon_ratio=float(p["horizon_ratio"]),
-                       E=p["E"], area=AREA, end_weight=p["end_weight"],
-                       micromodulus=p["micromodulus"], calibration=p["calibration"],
-                       closure=self.bond_closure(method, p))
+    def bar_problem(self, p, nodes, spacing, conditions=None, parts=None) -> BondProblem:
+        """The bar of ``nodes`` points ``spacing`` apart with ``conditions`` on its
+        named parts (``x-``, ``x+``: the end points; ``parts``: the scene's sets)."""
+        ratio = float(p["horizon_ratio"])
+        body = Body(((nodes - 1) * spacing,), (0.0,), spacing, placement="on-surface",
+                    boundary_volume="partial" if p["end_weight"] == "half" else "full",
+                    thickness=AREA)
+        c1 = bar_micromodulus(ratio, E=p["E"], area=AREA, spacing=spacing,
+                              micromodulus=p["micromodulus"], calibration=p["calibration"])
+        return BondProblem(body, build_stencil(1, ratio),
+                           BondMaterial(c1, get_influence(p["micromodulus"])),
+                           ratio * spacing, dict(conditions or {}), p["E"], None, "bar",
+                           parts=dict(parts or {}))
+
+    def bar(self, method, p, nodes, spacing, conditions=None, parts=None) -> BondSystem:
+        """:meth:`bar_problem` assembled under the closure of ``method``."""
+        return assemble_bonds(self.bar_problem(p, nodes, spacing, conditions, parts),
+                              self.bond_closure(method, p))
 
 
 # --------------------------------------------------------------------------- Sec. 6.1
@@ -295,9 +300,9 @@ def _micromodulus_table(ratio, value, table):
 class Homogenization(BondBarScene):
     """Seed 004 §3-6.1: a bar in uniaxial tension by equal and opposite end forces.
 
-    Model (``BondBar``, the engine's bond-based model): N points x_i = (i - 1) Delta, Delta = length / (N - 1),
-    linearised bond-based equilibrium Eq. (33); triangular c(xi) = c1 (1 - xi/delta)
-    (Eq. 6) or constant; delta = m Delta (through an element, the element cut in two
+    Model (:meth:`BondBarScene.bar_problem`, the engine's bond-based model): N points
+    x_i = (i - 1) Delta, Delta = length / (N - 1), linearised bond-based equilibrium
+    Eq. (33); triangular c(xi) = c1 (1 - xi/delta) (Eq. 6) or constant; delta = m Delta (through an element, the element cut in two
     counts half) or (m + 1/2) Delta (between elements); full- or half-weight end
     elements. c1 from the discrete horizon (Eqs. 14/22 = 26/30) unless
     calibration=continuum. ``homogenized`` multiplies the bonds (1, 1+k) and (N, N-k),
@@ -398,24 +403,36 @@ class Homogenization(BondBarScene):
                     for c in ("discrete", "continuum") for w in ("full", "half")]
         return out
 
-    def strain_factor(self, bar: BondBar, stress: float) -> tuple[float, np.ndarray]:
-        u = bar.end_force_displacement(stress * bar.area)
-        length = (bar.nodes - 1) * bar.spacing
-        return float((u[-1] - u[0]) / length * bar.E / stress), u
+    def end_loaded(self, method, p, nodes, spacing) -> BondSystem:
+        """The bar with -sigma A on point 1 and +sigma A on point N."""
+        F = p["stress"] * AREA
+        return self.bar(method, p, nodes, spacing,
+                        {"x-": PartCondition(force=lambda x: np.full((len(x), 1), -F)),
+                         "x+": PartCondition(force=lambda x: np.full((len(x), 1), F))})
+
+    def strain_factor(self, system: BondSystem, p) -> tuple[float, np.ndarray]:
+        """f(N) and u of the end-loaded bar :meth:`end_loaded`, solved in the statically
+        determinate form of :func:`end_force_displacement` (its end force: the load of
+        the right end's part)."""
+        model = system.model
+        u = end_force_displacement(model, float(system.rhs[-1]))
+        length = (model.grid.n_ext - 1) * model.spacing
+        return float((u[-1] - u[0]) / length * p["E"] / p["stress"]), u
 
     def solve(self, method, p, timer):
         N = p["nodes"]
         with timer.phase("setup"):
-            bar = self.bar(method, p, N, p["length"] / (N - 1))
+            bar = self.end_loaded(method, p, N, p["length"] / (N - 1))
+            model = bar.model
         with timer.phase("solve"):
-            f, u = self.strain_factor(bar, p["stress"])
-        x = bar.x - 0.5 * p["length"]
+            f, u = self.strain_factor(bar, p)
+        x = model.grid.x[:, 0] - 0.5 * p["length"]
         u_cl = p["stress"] / p["E"] * x
         with timer.phase("sweep"):  # f(N) over N for the report's Table-12 figure
-            m = bar.m
+            m, _ = split_horizon_ratio(p["horizon_ratio"])
             sweep_n = np.unique(np.round(np.geomspace(2 * m + 1, self.SWEEP_MAX, 24)).astype(int))
-            sweep_f = np.array([self.strain_factor(self.bar(method, p, n, 1.0 / (n - 1)),
-                                                   p["stress"])[0] for n in sweep_n])
+            sweep_f = np.array([self.strain_factor(self.end_loaded(method, p, n, 1.0 / (n - 1)),
+                                                   p)[0] for n in sweep_n])
         metrics = {
             "strain_factor": f,
             "micromodulus_factor": micromodulus_factor(float(p["horizon_ratio"]),
@@ -424,18 +441,18 @@ class Homogenization(BondBarScene):
             "rel_l2_error": rel_l2_error(u, u_cl),
             # Table 14: b_1 / (c1 A) = C sigma Delta / E with b_1 = sigma / (w Delta) on an
             # end element of weight w, so C = E / (c1 A Delta^2 w): a check on c1
-            "end_load_C": bar.E / (bar.c1 * bar.area * bar.spacing ** 2
-                                   * (0.5 if p["end_weight"] == "half" else 1.0)),
+            "end_load_C": p["E"] / (model.c * AREA * model.spacing ** 2
+                                    * (0.5 if p["end_weight"] == "half" else 1.0)),
             # Tables 6, 7, 11: the factor on the bond (1, 1 + k)
             **{f"end_factor_{k}": a for k, a in
-               enumerate(bar.end_factors[:FACTOR_METRICS], start=1)},
+               enumerate(end_factors(model)[:FACTOR_METRICS], start=1)},
         }
         limit, spread = strain_factor_limit(sweep_n, sweep_f)
         if limit is not None:
             metrics["strain_factor_limit"] = limit
         fields = {"x": x, "u": u, "u_ref": u_cl, "sweep_nodes": sweep_n, "sweep_f": sweep_f}
-        return Outcome(metrics=metrics, size=bar.size(), fields=fields,
-                       diagnostics={"end_factors": list(bar.end_factors), "c1": bar.c1,
+        return Outcome(metrics=metrics, size=bar_size(model), fields=fields,
+                       diagnostics={"end_factors": list(end_factors(model)), "c1": model.c,
                                     "strain_factor_limit_spread": spread})
 
 
@@ -508,6 +525,17 @@ class Constraints(BondBarScene):
                              "(the full bar's midpoint is a point)")
         super().check(method, p)
 
+    @staticmethod
+    def conditions(held, left, right):
+        """``(conditions, parts)`` of a bar with the points ``held`` (indices) at rest and
+        the end forces ``left``, ``right`` (none where zero)."""
+        def end(F):
+            return PartCondition(force=lambda x: np.full((len(x), 1), F))
+        conditions = {"held": PartCondition({0: 0.0}), "x+": end(right)}
+        if left:
+            conditions["x-"] = end(left)
+        return conditions, {"held": lambda x: np.isin(np.arange(len(x)), held)}
+
     def solve(self, method, p, timer):
         m, _ = split_horizon_ratio(p["horizon_ratio"])
         n_a = p["nodes"]
@@ -521,18 +549,18 @@ class Constraints(BondBarScene):
             "c": (n_c, list(range(m)), 0.0, -(m - 1) * spacing),
         }
         with timer.phase("setup"):
-            bars = {k: self.bar(method, p, n, spacing) for k, (n, *_rest) in specs.items()}
+            bars = {k: self.bar(method, p, n, spacing, *self.conditions(held, left, force))
+                    for k, (n, held, left, _x0) in specs.items()}
         u, x, info = {}, {}, {}
         with timer.phase("solve"):
-            for k, (n, held, left, x0) in specs.items():
-                f = np.zeros(n)
-                f[0] += left
-                f[-1] += force
-                B = np.zeros((len(held), n))
-                B[np.arange(len(held)), held] = 1.0
-                u[k], _, info[k] = solve_constrained(bars[k].K, f, B, np.zeros(len(held)),
+            for k, (n, _held, _left, x0) in specs.items():
+                system = bars[k]      # the held points as Lagrange rows (seed 004 §6.2)
+                held = system.fixed
+                B = np.zeros((held.size, n))
+                B[np.arange(held.size), held] = 1.0
+                u[k], _, info[k] = solve_constrained(system.K, system.rhs, B, system.values,
                                                      where=f"{self.id}/{method} bar ({k})")
-                x[k] = x0 + bars[k].x
+                x[k] = x0 + system.model.grid.x[:, 0]
         half_a = u["a"][n_a // 2:]
         scale = np.max(np.abs(u["a"]))
         u_cl = p["stress"] / p["E"] * x["a"]
@@ -700,9 +728,11 @@ class Vibration(BondBarScene):
         c = rao.wave_speed(p["E"], p["density"])
         f1 = rao.first_mode_frequency(length=L, wave_speed=c)
         with timer.phase("setup"):
-            bar = self.bar(method, p, N, spacing)
-            x = bar.x - bar.x[last]          # distance from the (last) held point
-            mass = bar.lumped_mass(p["density"])
+            bar = self.bar(method, p, N, spacing, {"held": PartCondition({0: 0.0})},
+                           {"held": lambda x: np.isin(np.arange(len(x)), held)})
+            model, held = bar.model, bar.fixed
+            x = model.grid.x[:, 0] - model.grid.x[last, 0]   # from the (last) held point
+            mass = model.lumped_mass(p["density"])
             dt_limit = exact_stability_limit(bar.K, mass, fixed=held)
             dt = p["dt_factor"] * dt_limit
             steps = int(np.ceil(p["periods"] / f1 / dt))
@@ -732,13 +762,13 @@ class Vibration(BondBarScene):
         fields = {"t": run.history_times, "u_free": free_end, "u_free_ref": free_ref,
                   "u_next": run.history[:, 0], "u_next_ref": ref[:, 0],
                   "amplitude": eps * L, "period": 1.0 / f1}
-        size = {**bar.size(), "steps": steps}
+        size = {**bar_size(model), "steps": steps}
         # Rao's series is summed exactly (d'Alembert), so its only error is rounding
         # (manufactured.vibration1d.exact_sum_error_bound), in % of eps L like the error
         bound_pct = 100.0 * rao.exact_sum_error_bound(
             strain=eps, length=L, wave_speed=c,
             t_max=float(run.history_times[-1])) / (eps * L)
-        diagnostics = {**run.info, "end_factors": list(bar.end_factors),
+        diagnostics = {**run.info, "end_factors": list(end_factors(model)),
                        "reference_error_bound_pct": bound_pct}
         out = Outcome(metrics=metrics, size=size, fields=fields, diagnostics=diagnostics)
         problem = truncation_problem(

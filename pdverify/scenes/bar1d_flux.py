@@ -1,4 +1,14 @@
-"""Seed 000 §2.2: surface effect of a bar under constant strain (Tables 1, 2 and B1)."""
+"""Seed 000 §2.2: surface effect of a bar under constant strain (Tables 1, 2 and B1).
+
+Not a description of the ``static-state`` family: the scene solves nothing. It imposes
+u = eps x on every real node and applies the model's discrete operators to it (the bond
+forces, the section selector of Eq. 60, the weighted volumes), and its treatments serve it
+through their ``flux-bar`` role, a closure of the bar's grid. A ``StaticProblem`` with
+every node prescribed would offer it the family's other treatments (surface nodes, mirror
+nodes, PDDO), whose extra unknowns and rows the force through a section does not read.
+The bar itself (parameters, model, checks) is the seed-000 bar of
+:mod:`pdverify.scenes.statebar`.
+"""
 from __future__ import annotations
 
 import numpy as np
@@ -8,7 +18,7 @@ from manufactured import bar1d as closed
 from ..params import Param, positive
 from ..pd import INFLUENCES
 from . import Outcome, Published, Scene, register
-from .bar1d import BAR_PARAMS, bar_estimate, bar_model, check_bar_grid
+from .statebar import BAR_PARAMS, bar_estimate, bar_model, check_bar_grid
 
 _FEATURES = closed.flux_features()  # (1.26285..., 0.77160..., 0.39403...)
 #: the paper's printed values of the continuum's features (tau_max / tau_inf at x/delta,

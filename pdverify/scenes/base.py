@@ -372,6 +372,20 @@ class Scene:
         from ..corrections.registry import broken_method
         return broken_method(name)
 
+    def declared(self, params: Mapping[str, Any], name: str):
+        """``params[name]`` where the run's method takes the parameter ``name``; else its
+        default as this scene declares it (its own parameters, then its methods' in
+        order), ``None`` where the scene declares no parameter of that name. A
+        description reads a treatment's parameter this way (the baseline's
+        ``load_point``, which the other treatments do not read): the default stays the
+        declaration's, stated once."""
+        if name in params:
+            return params[name]
+        for q in (*self.params, *(q for m in self.all_methods for q in m.params)):
+            if q.name == name:
+                return q.default
+        return None
+
     def bond_closure(self, method: str, params: Mapping[str, Any]) -> Closure:
         """The :class:`~pdverify.pd.closure.Closure` of a bond method; the uncorrected
         ``Closure()`` for the scene's own methods."""

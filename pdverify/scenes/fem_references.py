@@ -35,7 +35,8 @@ def _field_param(name, field, cls_name) -> Param:
     return Param(name, field.default, doc, _float_check(field.default))
 
 
-def _reference_module():
+def reference_module():
+    """The FEM reference package (``reference_fem``)."""
     import reference_fem  # heavy (scikit-fem): imported only when a FEM scene runs
     return reference_fem
 
@@ -58,7 +59,7 @@ class FemReference(Scene):
     function: str = ""
 
     def _cls(self):
-        return getattr(_reference_module(), self.params_class)
+        return getattr(reference_module(), self.params_class)
 
     @property
     def params(self):
@@ -76,7 +77,7 @@ class FemReference(Scene):
         return budget.quadratic_elements(self._cls()(**p).finest_cells())
 
     def solve(self, method, p, timer):
-        rf = _reference_module()
+        rf = reference_module()
         with timer.phase("solve"):
             res = getattr(rf, self.function)(**p)
         last = res.refinement[-1]
@@ -180,4 +181,4 @@ class FemAndPD(FemReference):
 
     def fem_reference(self, p):
         """The converged FEM reference at this scene's shared params (cached on disk)."""
-        return getattr(_reference_module(), self.function)(**self.reference_params(p))
+        return getattr(reference_module(), self.function)(**self.reference_params(p))

@@ -10,16 +10,17 @@ from .. import budget
 from ..errors import InputError, NumericalError
 from ..params import Param, at_least, open_interval, positive
 from ..pd import get_influence
-from ..pd.build import Body, BondMaterial, build_model
+from ..pd.build import Body, BondMaterial
 from ..pd.influence import bond_based_nu
 from ..pd.nonlinear import LinearBondBased, NonlinearBondBased
+from ..pd.problem import BondProblem, PartCondition, assemble_bonds
 from ..solvers.iterative import Lattice
 from ..solvers.newton import NEWTON_RTOL, DirichletLinearSolver, newton
 from ..solvers.policy import NEWTON_CG_FROM_UNKNOWNS, SPD_LATTICE_SOLVERS, newton_solver
 from . import Outcome, Published, register
 from .base import ExpectedFailure
-from .fem_references import FEM, FemAndPD, _reference_module
-from .sheets import PAPER, PD_COMMON, SheetScene, _grid_check
+from .bondfamily import PAPER, PD_COMMON, BondStaticScene, check_horizon_grid
+from .fem_references import FEM, reference_module
 
 #: Output depths left out of the force comparison: the first one (0.1 mm), where the
 #: sticking law catches a whole chord in one increment and the reference itself depends on
@@ -56,7 +57,7 @@ NEO_HOOKEAN = {**FINITE_REFERENCE, "law": "neo-hookean"}
 
 
 @register
-class Indentation(FemAndPD):
+class Indentation(BondStaticScene):
     """Seed 003 §4.2 (Figs. 4 and 5): block 40 x 40 mm, rigid cylinder R = 15 mm pressed
     into the middle of the top edge to 2 mm; the parts of the surface it reaches stick to
     it ("move without slip along with the indenter surface").
@@ -230,7 +231,7 @@ class Indentation(FemAndPD):
         """Like for like: the small-strain FEM for ``kinematics=linear``, the finite-strain
         one (:data:`FINITE_REFERENCE`) for ``nonlinear``."""
         out = super().reference_params(p)
-        if p.get("kinematics") == "nonlinear":
+        if "kinematics" in p and p["kinematics"] == "nonlinear":   # a PD run's (fem: none)
             out.update(FINITE_REFERENCE)
         return out
 
@@ -255,7 +256,7 @@ class Indentation(FemAndPD):
                              "~0.1 %; below it no node is caught and there is no force)")
 
     def check_pd(self, where, method, p):
-        rf = _reference_module()
+        rf = reference_module()
         try:
             rf.IndentationParams(**self.reference_params(p))
         except (TypeError, ValueError) as exc:
@@ -264,7 +265,7 @@ class Indentation(FemAndPD):
         if abs(p["nu"] - nu) > 1e-12:
             raise InputError(f"{where}: nu={p['nu']:g} is not allowed; bond-based PD in plane "
                              f"stress represents only nu = 1/3 ({nu:.6g})")
-        _grid_check(where, (("width", p["width"]), ("height", p["height"])), p["spacing"],
+        check_horizon_grid(where, (("width", p["width"]), ("height", p["height"])), p["spacing"],
                     p["horizon"], "spacing")
         if round(p["width"] / p["spacing"]) % 2:
             raise InputError(f"{where}: width={p['width']:g} must be an even number of "
@@ -313,16 +314,27 @@ class Indentation(FemAndPD):
             out += [("none", dict(v)) for v in UNSTATED_CHOICES]
         return out
 
-    def solve_pd(self, method, p, timer):
+    def bond_problem(self, p, where):
+        """The block, its material and its held bottom face; the indenter's face ``y+``
+        takes its sticking contact step by step (:func:`indent`), which no static
+        condition states."""
         W, H, h, delta = p["width"], p["height"], p["spacing"], p["horizon"]
+        return BondProblem(
+            Body((W, H), (-W / 2, -H), h, placement="on-surface",
+                 boundary_volume=p["node_volumes"], thickness=p["thickness"]),
+            self.stencil(p, delta / h),
+            BondMaterial(self.micromodulus(p, delta), get_influence(p["micromodulus"])),
+            delta, {"y-": PartCondition({0: 0.0, 1: 0.0})}, p["E"],
+            bond_based_nu(2, "stress"), "plane-stress",
+            supports="the bottom face y = -height held (u = 0); the top face y = 0 "
+                     "under the rigid indenter, sticking contact")
+
+    def solve_pd(self, method, p, timer):
+        h, delta = p["spacing"], p["horizon"]
         where = f"{self.id}/{method}"
         with timer.phase("setup"):
-            body = Body((W, H), (-W / 2, -H), h, placement="on-surface",
-                        boundary_volume=p["node_volumes"], thickness=p["thickness"])
-            material = BondMaterial(SheetScene.micromodulus(p, delta),
-                                    get_influence(p["micromodulus"]))
-            model = build_model(body, SheetScene.stencil(p, delta / h), material,
-                                self.bond_closure(method, p))
+            model = assemble_bonds(self.bond_problem(p, where),
+                                   self.bond_closure(method, p)).model
             grid = model.grid
             kin = (NonlinearBondBased if p["kinematics"] == "nonlinear" else LinearBondBased)(
                 model, mirror_axis=0 if p["symmetry"] == "half" else None)

@@ -20,7 +20,6 @@ from .family import FemStaticStateScene
 #: runs 1.2-1.8x), every run ok, rel_l2_error the same to 1e-12 relative.
 ORDERING = "MMD_AT_PLUS_A"
 
-ALL_FACES = (0, 1, 2, 3)
 #: the paper's discretisation (Table 4; the published remarks sit beside these runs only)
 TABLE4 = {"spacing": 0.1, "m_ratio": 3.0, "quadrature": "partial-volume",
           "influence": "hyperbolic", "corners": "normal-only"}
@@ -157,7 +156,7 @@ class ClampedPlate(FemStaticStateScene):
     def problem(self, p, where):
         inf = get_influence(p["influence"])
         b = p["body_force"]
-        if p.get("ring_value", "reference") == "zero":
+        if self.declared(p, "ring_value") == "zero":
             def value(x):
                 return np.zeros_like(x)
         else:

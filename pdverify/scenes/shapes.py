@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
-from ..metrics import rel_l2_error
+from ..metrics import region_errors, rel_l2_error
 from ..params import Param, at_least, positive
 from ..pd import QUADRATURES, StateBasedConstants, get_influence, state_based_stencil
 from ..pd.problem import FaceCondition, StaticProblem
@@ -48,10 +48,7 @@ def shape_errors(x, u, u_ref, shape, horizon, regions=()) -> tuple[dict, np.ndar
     masks = {"": np.ones(len(x), dtype=bool), "boundary_": near, "interior_": ~near}
     for name in regions:
         masks[f"{name}_"] = near & (part == shape.part_names.index(name))
-    out = {}
-    for prefix, mask in masks.items():
-        if mask.any():
-            out[prefix + "max_error_pct"] = float(err[mask].max())
+    out = region_errors(err, masks, {"max_error_pct": None})
     out["rel_l2_error"] = rel_l2_error(u, u_ref)
     return out, err
 
@@ -133,7 +130,7 @@ class ShapeScene(FemStaticStateScene):
             StateBasedConstants("plane-stress", p["E"], p["nu"]), inf,
             self.conditions(p), exact=value, thickness=p["thickness"], solver="direct",
             ordering=ORDERING, where=where, shape=self.shape(p),
-            jitter=float(p.get("jitter", 0.0)), jitter_seed=int(p.get("jitter_seed", 0)))
+            jitter=float(p["jitter"]), jitter_seed=int(p["jitter_seed"]))
 
     def measure(self, p, problem, system, x, info):
         ref = self.reference_of(p)

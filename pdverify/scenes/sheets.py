@@ -7,29 +7,13 @@ from .. import budget
 from ..errors import InputError
 from ..metrics import rel_l2_error
 from ..params import Param, at_least, positive
-from ..pd import bond_micromodulus, build_stencil, get_influence
-from ..pd.build import Body, BondMaterial, build_model
+from ..pd import get_influence
+from ..pd.build import Body, BondMaterial
 from ..pd.influence import bond_based_nu
-from ..pd.problem import BondProblem, BondSystem, ClampedBox
-from ..solvers.front import solve_with_dirichlet
-from ..solvers.iterative import Lattice
-from ..solvers.policy import AUTO_ITERATIVE_UNKNOWNS, SPD_LATTICE_SOLVERS
-from . import Outcome, Published, register, whole_cells
-from .fem_references import FemAndPD
+from ..pd.problem import BondProblem, PartCondition
+from . import Outcome, Published, register
+from .bondfamily import PAPER, PD_COMMON, BondStaticScene, check_horizon_grid
 
-MICROMODULI = ("constant", "conical")
-#: seed 003's node volumes (ERRATA) and the horizon quadrature that reproduces Tables 1-2
-PD_COMMON = (
-    Param("micromodulus", "constant", "c(xi): constant (the paper's) or conical (Le and Bobaru)",
-          choices=MICROMODULI),
-    Param("quadrature", "full-cells", "horizon quadrature: whole cells of the nodes with "
-          "|xi| <= delta (reproduces Tables 1 and 2; Peridigm's default) or the exact cell "
-          "fractions inside the horizon", choices=("full-cells", "partial-volume")),
-    Param("solver", "auto", "linear solver: direct (sparse LU), cg (conjugate gradients, "
-          "two-level smoothed aggregation one horizon wide) or auto (cg from "
-          f"{AUTO_ITERATIVE_UNKNOWNS} free unknowns)", choices=SPD_LATTICE_SOLVERS),
-)
-PAPER = {"micromodulus": "constant", "quadrature": "full-cells"}
 #: the grids and loads of the papers' tables (the published values stand beside these only,
 #: not beside the convergence studies' other levels)
 TABLE1_GRID = {"spacing": 0.001, "horizon": 0.005, "traction": 1e6, "E": 1e9}
@@ -39,18 +23,14 @@ TABLE2_GRID = {"side_factor": 4.0, "m_ratio": 6.0, "horizon": 0.005, "strain": 0
 TABLE2_LOAD = {k: v for k, v in TABLE2_GRID.items() if k != "m_ratio"}
 
 
-class SheetScene(FemAndPD):
-    """Shared machinery of the seed-003 sheets: the FEM reference (method ``fem``) and the
-    bond-based PD runs of one scene (see :class:`FemAndPD` for the params' split).
 
-    A sheet's PD run is :meth:`bond_problem` (its model and conditions), a linear solve,
-    and :meth:`measure` (its metrics and fields from a displacement field); ``pdverify
-    score`` measures another code's field on the ``none`` problem the same way
-    (:mod:`pdverify.exchange`)."""
+class SheetScene(BondStaticScene):
+    """Shared checks of the seed-003 sheets: the FEM reference (method ``fem``) and the
+    bond-based PD runs of one scene, each a description (:meth:`bond_problem`) run by
+    :class:`~pdverify.scenes.bondfamily.BondStaticScene` (see :class:`FemAndPD` for the
+    params' split)."""
 
     figure = "sheets"
-    closure_theory = "bond-based"
-    dim = 2
 
     def check_pd(self, where, method, p):
         nu = bond_based_nu(2, "stress")
@@ -67,52 +47,6 @@ class SheetScene(FemAndPD):
 
     def check_sheet(self, where, method, p):
         raise NotImplementedError
-
-    def bond_problem(self, method, p, where) -> tuple[BondProblem, BondSystem]:
-        """The PD run's problem at ``p``: its description (spacing, thickness, the
-        micromodulus's shape, E and nu, the nodes ``measure`` reads) and its linear system
-        (the model with the treatment ``method``'s closure or grid, nodal forces,
-        prescribed components and values)."""
-        raise NotImplementedError
-
-    def measure(self, p, problem, system, x, info) -> Outcome:
-        """Metrics, fields and size of the displacements ``x`` (the system's unknowns,
-        component-major over the model's grid) with the solver's ``info``."""
-        raise NotImplementedError
-
-    # ----------------------------------------------------------------- PD helpers
-    @staticmethod
-    def stencil(p, m_ratio):
-        return build_stencil(2, m_ratio, quadrature=p["quadrature"])
-
-    @staticmethod
-    def micromodulus(p, horizon):
-        """c of a complete continuous horizon, plane stress (ERRATA seed 003)."""
-        return bond_micromodulus(p["micromodulus"], 2, p["E"], horizon, plane="stress")
-
-    @staticmethod
-    def solve_fixed(model, fixed, values, where, f=None, solver="direct"):
-        """K u = f with the given DOFs prescribed; returns (u, reactions K u - f, info).
-
-        ``solver``: see :func:`~pdverify.solvers.front.solve_with_dirichlet`; CG's
-        aggregates are one horizon (m nodes) wide."""
-        K = model.K
-        rhs = np.zeros(K.shape[0]) if f is None else f
-        order = np.argsort(fixed)
-        g = model.grid
-        u, info = solve_with_dirichlet(  # bond-based K with Dirichlet rows removed: SPD
-            K, rhs, fixed[order], values[order], where=where, spd=True, solver=solver,
-            lattice=Lattice.component_major(g.index, g.x, g.dim),
-            aggregate_width=int(round(model.m_ratio)))
-        return u, K @ u - rhs, info
-
-
-def _grid_check(where, lengths, spacing, horizon, label):
-    whole_cells(where, spacing, lengths, label)
-    m = horizon / spacing
-    if m < 2 - 1e-12:
-        raise InputError(f"{where}: horizon / spacing = {m:g} must be >= 2 (m = delta / Delta; "
-                         "the paper uses 5 and 6)")
 
 
 def _relative_errors(u, u_ref):
@@ -194,7 +128,7 @@ class TensionSheet(SheetScene):
                                     p["horizon"] / h, dense_allowed=True)
 
     def check_sheet(self, where, method, p):
-        _grid_check(where, (("width", p["width"]), ("length", p["length"])), p["spacing"],
+        check_horizon_grid(where, (("width", p["width"]), ("length", p["length"])), p["spacing"],
                     p["horizon"], "spacing")
         for name in ("width", "length"):
             if round(p[name] / p["spacing"]) % 2:
@@ -219,55 +153,37 @@ class TensionSheet(SheetScene):
                 out += [(m, {"spacing": h}) for m in ("none", "energy-directional")]
         return out
 
-    def bond_problem(self, method, p, where):
+    def bond_problem(self, p, where):
         W, H, h, delta = p["width"], p["length"], p["spacing"], p["horizon"]
         sigma, t = p["traction"], p["thickness"]
-        body = Body((W, H), (-W / 2, -H / 2), h, placement="on-surface", thickness=t)
-        material = BondMaterial(self.micromodulus(p, delta), get_influence(p["micromodulus"]))
-        model = build_model(body, self.stencil(p, delta / h), material,
-                            self.bond_closure(method, p))
-        grid = model.grid
-        n, x = grid.n_ext, grid.x
-        f = np.zeros(2 * n)
-        for side in (-1, 1):
-            ends = np.flatnonzero(np.isclose(x[:, 1], side * H / 2))
-            w = (np.where(np.isclose(np.abs(x[ends, 0]), W / 2), 0.5, 1.0)
-                 if p["load_sharing"] == "tributary" else np.ones(ends.size))
-            f[n + ends] = side * sigma * W * t * w / w.sum()
-        fixed = np.r_[np.flatnonzero(np.isclose(x[:, 0], 0.0)),
-                      n + np.flatnonzero(np.isclose(x[:, 1], 0.0))]
-        share = ("by the length each represents (corners half)"
-                 if p["load_sharing"] == "tributary" else "equally")
-        problem = BondProblem(
-            model.spacing, model.thickness, material.influence, p["E"],
-            bond_based_nu(2, "stress"), "plane-stress",
+        tributary = p["load_sharing"] == "tributary"
+
+        def end_force(side):
+            def force(x):
+                w = (np.where(np.isclose(np.abs(x[:, 0]), W / 2), 0.5, 1.0) if tributary
+                     else np.ones(len(x)))
+                f = np.zeros((len(x), 2))
+                f[:, 1] = side * sigma * W * t * w / w.sum()
+                return f
+            return force
+        share = ("by the length each represents (corners half)" if tributary
+                 else "equally")
+        return BondProblem(
+            Body((W, H), (-W / 2, -H / 2), h, placement="on-surface", thickness=t),
+            self.stencil(p, delta / h),
+            BondMaterial(self.micromodulus(p, delta), get_influence(p["micromodulus"])),
+            delta,
+            {"y-": PartCondition(force=end_force(-1)), "y+": PartCondition(force=end_force(1)),
+             "symmetry-x": PartCondition({0: 0.0}), "symmetry-y": PartCondition({1: 0.0})},
+            p["E"], bond_based_nu(2, "stress"), "plane-stress",
+            parts={"symmetry-x": lambda x: np.isclose(x[:, 0], 0.0),
+                   "symmetry-y": lambda x: np.isclose(x[:, 1], 0.0)},
             loads=(f"the end force traction x width x thickness = {sigma * W * t:.6g} N on "
                    f"each end y = +-length/2, shared among that end's nodes {share} "
                    "(nodal forces in y, outward)"),
             supports=("u_x = 0 on the nodes of x = 0 and u_y = 0 on those of y = 0 (the "
                       "closed form's symmetry lines, inside the sheet; nodes lie on its "
                       "surface)"))
-        return problem, BondSystem(model, f, fixed, np.zeros(fixed.size))
-
-    def solve_pd(self, method, p, timer):
-        where = f"{self.id}/{method}"
-        with timer.phase("setup"):
-            problem, system = self.bond_problem(method, p, where)
-        model = system.model
-
-        def solve_none():
-            return self.solve_fixed(model, system.fixed, system.values, where, system.rhs,
-                                    solver=p["solver"])
-        t = self.offered().get(method)
-        peer = getattr(t, "peer_solve_bonds", None)
-        with timer.phase("solve"):
-            if peer is not None:       # another code solves it (pdverify.peers)
-                u, info, peer_metrics, trouble = peer(self, p, problem, system, where,
-                                                      solve_none)
-            else:
-                u, _, info = solve_none()
-        outcome = self.measure(p, problem, system, u, info)
-        return outcome if peer is None else t.finish(outcome, peer_metrics, trouble, where)
 
     def measure(self, p, problem, system, x, info):
         W, H, h, delta, sigma = (p["width"], p["length"], p["spacing"], p["horizon"],
@@ -390,7 +306,7 @@ class ClampedSheet(SheetScene):
         if p["m_ratio"] < 2:
             raise InputError(f"{where}: m_ratio={p['m_ratio']:g} must be >= 2 (the paper uses 6)")
         L = p["side_factor"] * delta
-        _grid_check(where, (("side", L),), delta / p["m_ratio"], delta, "horizon/m_ratio")
+        check_horizon_grid(where, (("side", L),), delta / p["m_ratio"], delta, "horizon/m_ratio")
         self.treatment(method).check_for(self.family, None, p, where)
 
     def cases(self, quick=False):
@@ -405,53 +321,31 @@ class ClampedSheet(SheetScene):
                       ("energy-directional", {"node_volumes": "full"}),
                       ("energy-directional", {"micromodulus": "conical"})]
 
-    def bond_problem(self, method, p, where):
+    def bond_problem(self, p, where):
         delta, t = p["horizon"], p["thickness"]
         L = p["side_factor"] * delta
         h = delta / p["m_ratio"]
-        lo, hi = (-L / 2, -L / 2), (L / 2, L / 2)
         uy = p["strain"] * L / 2
         inf = get_influence(p["micromodulus"])
-        treatment = self.treatment(method)
-        if treatment.role(self.family) is not None:      # its own grid and clamp nodes
-            grid, closure, bottom, top = treatment.build_for(
-                self.family, ClampedBox(lo, hi, h, delta, inf, axis=1), p)
-            body = Body((L, L), lo, h, thickness=t)
-        else:
-            body = Body((L, L), lo, h, placement="on-surface",
-                        boundary_volume=p["node_volumes"], thickness=t)
-            grid = body.grid()
-            y = grid.x[:, 1]
-            top = np.flatnonzero(np.isclose(y, L / 2))
-            bottom = np.flatnonzero(np.isclose(y, -L / 2))
-            closure = self.bond_closure(method, p)
-        # the grid: the body's, or the treatment's own (virtual nodes: buffer layers)
-        model = build_model(body, self.stencil(p, p["m_ratio"]),
-                            BondMaterial(self.micromodulus(p, delta), inf), closure,
-                            grid=grid)
-        n = grid.n_ext
-        fixed = np.r_[top, bottom, n + top, n + bottom]
-        values = np.r_[np.zeros(top.size + bottom.size), np.full(top.size, uy),
-                       np.full(bottom.size, -uy)]
-        problem = BondProblem(
-            model.spacing, model.thickness, inf, p["E"], bond_based_nu(2, "stress"),
-            "plane-stress", marks={"top": top},
+        # node_volumes is the baseline's and the closures' parameter (baseline_extra); a
+        # treatment with its own grid (a role in the family) lays the body out itself
+        volumes = p["node_volumes"] if "node_volumes" in p else "partial"
+        return BondProblem(
+            Body((L, L), (-L / 2, -L / 2), h, placement="on-surface",
+                 boundary_volume=volumes, thickness=t),
+            self.stencil(p, p["m_ratio"]), BondMaterial(self.micromodulus(p, delta), inf),
+            delta, {"y+": PartCondition({0: 0.0, 1: uy}),
+                    "y-": PartCondition({0: 0.0, 1: -uy})},
+            p["E"], bond_based_nu(2, "stress"), "plane-stress", family=self.family,
             loads="none: the sheet is driven by its clamped rows alone",
             supports=(f"the outermost rows y = +-L/2 clamped: u_x = 0 and u_y = +-strain "
                       f"L / 2 = +-{uy:.6g} m (nodes lie on the sheet's surface); the "
                       "sides are free"))
-        return problem, BondSystem(model, np.zeros(2 * n), fixed, values)
 
-    def solve_pd(self, method, p, timer):
-        where = f"{self.id}/{method}"
-        with timer.phase("setup"):
-            problem, system = self.bond_problem(method, p, where)
-        with timer.phase("solve"):
-            u, _, info = self.solve_fixed(system.model, system.fixed, system.values, where,
-                                          system.rhs, solver=p["solver"])
+    def measure_run(self, p, problem, system, x, info, timer):
         with timer.phase("reference"):
             ref = self.fem_reference(p)
-        return self._measure(p, problem, system, u, info, ref)
+        return self._measure(p, problem, system, x, info, ref)
 
     def measure(self, p, problem, system, x, info):
         return self._measure(p, problem, system, x, info, self.fem_reference(p))
@@ -461,7 +355,7 @@ class ClampedSheet(SheetScene):
         delta, t = p["horizon"], p["thickness"]
         L = p["side_factor"] * delta
         h = delta / p["m_ratio"]
-        model, top = system.model, problem.marks["top"]
+        model, top = system.model, system.parts["y+"]
         grid = model.grid
         n = grid.n_ext
         u = np.asarray(x)

@@ -37,8 +37,8 @@ from ..params import Param, at_least, open_interval, positive
 from ..pd import (StateBasedConstants, bond_micromodulus, build_stencil, get_influence,
                   state_based_stencil)
 from ..pd.build import Body, BondMaterial, StateMaterial, build_model
-from ..pd.influence import INFLUENCES
-from ..pd.problem import FACES, FaceCondition, StaticProblem
+from ..pd.influence import INFLUENCES, bond_based_nu
+from ..pd.problem import FACES, BondProblem, FaceCondition, StaticProblem, assemble_bonds
 from . import MethodSpec, Outcome, Published, Scene, register, whole_cells
 from ..corrections.builtin import BASELINE
 from .family import StaticStateScene
@@ -108,7 +108,10 @@ def treatment_ratios(system, strain) -> np.ndarray:
 
 
 class StiffnessScene(Scene):
-    """Shared machinery: subclasses build the model of a method (``build``)."""
+    """Shared machinery: subclasses build the model of a method (``build``). The
+    bond-based ones describe their body and material once (:meth:`bond_problem`, a
+    :class:`~pdverify.pd.problem.BondProblem` without conditions: every node is given
+    u = eps . x) and build it by the generic assembly under the method's closure."""
 
     reference = "analytic"
     figure = "stiffness"
@@ -122,6 +125,11 @@ class StiffnessScene(Scene):
         raise NotImplementedError
 
     def build(self, method, p, closure):
+        """The model under ``closure``: the description's (bond-based scenes)."""
+        return assemble_bonds(self.bond_problem(p, self.id), closure).model
+
+    def bond_problem(self, p, where) -> BondProblem:
+        """The body, stencil and material of a bond-based stiffness scene."""
         raise NotImplementedError
 
     def horizon(self, p):
@@ -235,13 +243,14 @@ class SheetStiffness(StiffnessScene):
                 if name != "none" and not t.unavailable]
         return [("none", {}), ("none", {"m_ratio": 6.0})]
 
-    def build(self, method, p, closure):
+    def bond_problem(self, p, where):
         W, H, h = p["width"], p["length"], p["spacing"]
         delta = self.horizon(p)
         c = bond_micromodulus(p["micromodulus"], 2, p["E"], delta, plane="stress")
-        return build_model(Body((W, H), (0.0, 0.0), h, placement="on-surface"),
+        return BondProblem(Body((W, H), (0.0, 0.0), h, placement="on-surface"),
                            build_stencil(2, p["m_ratio"], quadrature=p["quadrature"]),
-                           BondMaterial(c, get_influence(p["micromodulus"])), closure)
+                           BondMaterial(c, get_influence(p["micromodulus"])), delta, {},
+                           p["E"], bond_based_nu(2, "stress"), "plane-stress")
 
 
 #: why a treatment of the static-state family without fictitious or surface nodes
@@ -436,12 +445,13 @@ class BondBoxStiffness(StiffnessScene):
     def lengths(self, p):
         return box_lengths(p)
 
-    def build(self, method, p, closure):
+    def bond_problem(self, p, where):
         lengths = self.lengths(p)
         c = bond_micromodulus(p["micromodulus"], 3, p["E"], self.horizon(p))
-        return build_model(Body(lengths, (0.0,) * 3, p["spacing"]),
+        return BondProblem(Body(lengths, (0.0,) * 3, p["spacing"]),
                            build_stencil(3, p["m_ratio"], quadrature=p["quadrature"]),
-                           BondMaterial(c, get_influence(p["micromodulus"])), closure)
+                           BondMaterial(c, get_influence(p["micromodulus"])),
+                           self.horizon(p), {}, p["E"], bond_based_nu(3), "3d")
 
 
 @register

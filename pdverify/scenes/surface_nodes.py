@@ -10,7 +10,7 @@ from manufactured import surface3d as closed
 from ..metrics import error_metrics, surface_error_pct
 from ..params import Param, at_least, open_interval, positive
 from ..pd import QUADRATURES, StateBasedConstants, get_influence, state_based_stencil
-from ..pd.problem import FACES, FaceCondition, StaticProblem
+from ..pd.problem import FaceCondition, StaticProblem
 from ..solvers.policy import ND3D_FROM_UNKNOWNS, ND_FROM_UNKNOWNS, STATIC_SOLVERS
 from . import Outcome, Published, influence_param, register, require_influence
 from .base import ExpectedFailure
@@ -91,7 +91,7 @@ class SurfaceNodeScene(StaticStateScene):
     def body_force(self, x, p, constants, horizon):
         return np.zeros_like(x)
 
-    #: (face, component) that carries the uniform traction p["traction"]; None: unloaded
+    #: (face name, component) that carries the uniform traction p["traction"]; None: unloaded
     uniform_load = None
 
     def traction(self, x, normal, face, p, constants, horizon):
@@ -108,7 +108,8 @@ class SurfaceNodeScene(StaticStateScene):
         raise NotImplementedError
 
     def loaded_faces(self, p):
-        """Faces whose traction is applied (the others are free or prescribed)."""
+        """Names of the faces whose traction is applied (the others are free or
+        prescribed)."""
         raise NotImplementedError
 
     # ----------------------------------------------------------------- the problem
@@ -122,7 +123,7 @@ class SurfaceNodeScene(StaticStateScene):
         horizon = p["m_ratio"] * p["spacing"]
         conditions = {}
         for face in self.loaded_faces(p):
-            conditions[FACES[face]] = FaceCondition(traction=functools.partial(
+            conditions[face] = FaceCondition(traction=functools.partial(
                 self._traction, face=face, p=p, c=c, horizon=horizon))
         for name, (prescribed, part) in self.conditions(p).items():
             old = conditions.get(name, FaceCondition())
@@ -134,7 +135,7 @@ class SurfaceNodeScene(StaticStateScene):
                                 p["quadrature"]),
             c, inf, conditions, exact=lambda x: self.exact(x, p),
             body_force=lambda x: self.body_force(x, p, c, horizon),
-            face_load="centre" if p.get("surface_load", "face-mean") == "centre"
+            face_load="centre" if self.declared(p, "surface_load") == "centre"
             else "face-mean", load_point=p.get("load_point", "surface"),
             solver=p["solver"], where=where)
 
@@ -233,7 +234,7 @@ class Body3DTraction(Body3D):
     seed = "001 §4.1"
     reference = "analytic"
     params = BODY_PARAMS + (Param("traction", 10e6, "traction p on x = l_x [Pa]", positive),)
-    uniform_load = (1, 0)  # p along x on x = l_x
+    uniform_load = ("x+", 0)  # p along x on x = l_x
     published = (
         Published("max_error_pct", "> 30", "seed 001 §4.1 (Fig. 9a)", method="none",
                   where=PAPER_QUADRATURE, deviation="001-table1-traction",
@@ -248,7 +249,7 @@ class Body3DTraction(Body3D):
                                                ly=p["ly"], lz=p["lz"])
 
     def loaded_faces(self, p):
-        return (1, 2, 3, 4, 5)
+        return ("x+", "y-", "y+", "z-", "z+")
 
 
     def conditions(self, p):
@@ -357,7 +358,7 @@ class Body3DManufactured(Body3D):
                                             horizon=horizon)
 
     def loaded_faces(self, p):
-        return (1, 2, 3, 4, 5)
+        return ("x+", "y-", "y+", "z-", "z+")
 
     def conditions(self, p):
         return {"x-": ((0, 1, 2), None)}
@@ -472,7 +473,7 @@ class Plate2DPlaneStrain(SurfaceNodeScene):
         GEOMETRY,
         SOLVER,
     )
-    uniform_load = (3, 1)  # p along y on y = l_y
+    uniform_load = ("y+", 1)  # p along y on y = l_y
 
     def constants(self, p):
         return StateBasedConstants("plane-" + p["plane"], p["E"], p["nu"])
@@ -485,7 +486,7 @@ class Plate2DPlaneStrain(SurfaceNodeScene):
                                          plane=p["plane"])
 
     def loaded_faces(self, p):
-        return (1, 3)
+        return ("x+", "y+")
 
 
     def conditions(self, p):

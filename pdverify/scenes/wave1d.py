@@ -1,6 +1,15 @@
-"""Seed 002: a Gaussian pulse in a fixed-fixed PD bar, surface nodes against the analytic PD series."""
-from __future__ import annotations
+"""Seed 002: a Gaussian pulse in a fixed-fixed PD bar, surface nodes against the analytic PD series.
 
+The scene is a description (:func:`wave_problem`: a
+:class:`~pdverify.pd.problem.BondProblem` of the bar with both end faces held, family
+``wave-bar``) that the wave family's assembly (:func:`~pdverify.pd.problem.assemble_wave`)
+turns into an explicit-dynamics system under the treatment's extension; the scene then
+steps it and measures. It is not a static bond system (:func:`~pdverify.pd.problem.
+assemble_bonds`): the family's unknowns evolve in time, the end values act through the
+operator's boundary columns ``A_bc``, and its treatments give a fictitious layer's
+extension (their ``wave-bar`` role), not a closure of the bonds.
+"""
+from __future__ import annotations
 
 import numpy as np
 
@@ -9,12 +18,12 @@ from manufactured import wave1d as analytic
 import scipy.sparse as sp
 
 from .. import budget
-from ..corrections.surface_nodes import wave_extension
 from ..errors import InputError, NumericalError
 from ..metrics import max_error_of_peak_pct, rel_l2_error
 from ..params import Param, at_least, positive
-from ..pd import Closure, bond_micromodulus, build_stencil, get_influence
-from ..pd.build import Body, BondMaterial, build_model
+from ..pd import bond_micromodulus, build_stencil, get_influence
+from ..pd.build import Body, BondMaterial
+from ..pd.problem import BondProblem, PartCondition, WaveSystem, assemble_wave
 from ..pd.closure import real_identity, with_rows
 from ..solvers.explicit import central_difference
 from . import Outcome, Published, Scene, cell_count, register
@@ -22,7 +31,6 @@ from .base import truncation_problem
 
 #: The instants of Fig. 5 at which the error is measured [s].
 SAMPLE_TIMES = (0.05e-3, 0.10e-3, 0.15e-3, 0.20e-3)
-
 
 
 def lattice_symbol(k, *, horizon: float, m_ratio: float):
@@ -41,106 +49,48 @@ def lattice_symbol(k, *, horizon: float, m_ratio: float):
     return np.sum(2.0 * c * (1.0 - np.cos(np.multiply.outer(k, xi))), axis=-1)
 
 
-class WaveBar:
-    """A bar [0, l] of 1D bond-based PD (seed 002 Eq. 3) with one of three boundary treatments.
+def wave_problem(length, horizon, m_ratio, wave_speed) -> BondProblem:
+    """A bar [0, l] of 1D bond-based PD (seed 002 Eq. 3), both ends held (u = 0).
 
     The engine's bond-based model with the hyperbolic influence delta/|xi| and the
     micromodulus c = v^2 / delta^2 of energy equivalence (rho = 1, unit area), so that
     -(K u)_i / V_i = sum_j v^2 beta_j Delta (u_j - u_i) / (delta xi^2) is Eq. (3). Real
     nodes sit at the cell centres x_i = (i - 1/2) Delta, i = 1..N, Delta = delta / m
-    (Fig. 2; N = 100, 250, 1000 for m = 10, 25, 100).
+    (Fig. 2; N = 100, 250, 1000 for m = 10, 25, 100)."""
+    spacing = horizon / m_ratio
+    n = length / spacing
+    if abs(n - round(n)) > 1e-9 * n:
+        raise ValueError(f"spacing {spacing} does not divide length {length}")
+    material = BondMaterial(bond_micromodulus("hyperbolic", 1, wave_speed ** 2, horizon),
+                            get_influence("hyperbolic"))
+    held = PartCondition({0: 0.0})
+    return BondProblem(Body((length,), (0.0,), spacing), build_stencil(1, m_ratio), material,
+                       horizon, {"x-": held, "x+": held}, wave_speed ** 2, None, "bar",
+                       family="wave-bar")
 
-    ``extension`` (what a treatment's ``wave-bar`` role gives): a function of the grid
-    returning the fictitious layer's displacement map from the real nodes and two
-    surface nodes at x = 0 and x = l, which carry the Dirichlet values and have no bonds
-    (seed 002 Figs. 3-4: surface nodes, :func:`~pdverify.corrections.surface_nodes.
-    wave_extension`; the default is theirs at ``taylor_order``), or ``None``: truncated
-    neighbourhoods, the first and last real node held at the end values.
-    :meth:`odd_image` is the extension the sine series of Eq. (11) implies,
-    u(x_s - xi) = 2 u_s - u(x_s + xi), which isolates the quadrature error from the
-    extrapolation's model error.
 
-    In every case the free accelerations are ``a = A u_free + A_bc u_bc`` with
-    ``A = -diag(1/V) K_real @ map`` multiplied out once (N x N, a banded matrix plus the
-    few columns the extrapolation adds): one sparse product per time step.
-    """
+def wave_bar(length, horizon, m_ratio, wave_speed, extension) -> WaveSystem:
+    """:func:`wave_problem` assembled with a treatment's ``extension`` (its ``wave-bar``
+    role: surface nodes at x = 0 and x = l carry the end values, seed 002 Figs. 3-4;
+    :func:`odd_image`) or ``None`` (truncated neighbourhoods, the first and last real
+    node held); see :func:`~pdverify.pd.problem.assemble_wave`."""
+    return assemble_wave(wave_problem(length, horizon, m_ratio, wave_speed), extension)
 
-    def __init__(self, length, horizon, m_ratio, wave_speed, extension=..., taylor_order=1):
-        if extension is ...:
-            extension = wave_extension(None, {"order": taylor_order})
-        self.length, self.horizon = length, horizon
-        self.surface = surface = extension is not None
-        self.spacing = horizon / m_ratio
-        n = length / self.spacing
-        if abs(n - round(n)) > 1e-9 * n:
-            raise ValueError(f"spacing {self.spacing} does not divide length {length}")
-        self.n_real = nr = int(round(n))
-        if surface and nr < taylor_order + 1:
-            raise ValueError(f"order {taylor_order} needs at least {taylor_order + 1} "
-                             f"real nodes, got {nr}")
-        stencil = build_stencil(1, m_ratio)
-        material = BondMaterial(bond_micromodulus("hyperbolic", 1, wave_speed ** 2, horizon),
-                                get_influence("hyperbolic"))
-        self.model = build_model(
-            Body((length,), (0.0,), self.spacing), stencil, material,
-            (lambda g: Closure(displacement_map=extension(g), n_unknown_nodes=nr + 2))
-            if surface else None, layers=stencil.reach if surface else 0)
-        grid = self.model.grid
-        self.x_lattice = grid.x[:, 0]
-        self.n_fict = grid.layers
-        full = (sp.diags(-1.0 / self.model.node_volume[grid.interior_ids])
-                @ self.model.reduced()).tocsc()
-        if surface:
-            self.free = np.arange(nr)
-            self.x_bc = np.array([0.0, length])
-            self.A, self.A_bc = full[:, :nr].tocsr(), full[:, nr:].tocsr()
-        else:
-            self.free = np.arange(1, nr - 1)
-            fixed = np.array([0, nr - 1])
-            self.x_bc = self.x_real[fixed]
-            rows = full.tocsr()[self.free].tocsc()
-            self.A, self.A_bc = rows[:, self.free].tocsr(), rows[:, fixed].tocsr()
-        self.A.sort_indices()
 
-    @staticmethod
-    def odd_image(grid):
-        """Fictitious node at -(j + 1/2) Delta (and its mirror at the right end) from
-        2 u_s - u_j, unknowns [real u (N), surface values (2)]."""
-        nr, nf = grid.n_interior, grid.layers
-        j = np.arange(nf)
-        left = np.flatnonzero(grid.index[:, 0] < 0)[::-1]      # -(j + 1/2) Delta, j = 0..
-        right = np.flatnonzero(grid.index[:, 0] >= nr)          # l + (j + 1/2) Delta
-        rows = np.r_[left, left, right, right]
-        cols = np.r_[j, np.full(nf, nr), nr - 1 - j, np.full(nf, nr + 1)]
-        vals = np.r_[-np.ones(nf), np.full(nf, 2.0), -np.ones(nf), np.full(nf, 2.0)]
-        block = sp.csr_matrix((vals, (np.arange(rows.size), cols)), shape=(rows.size, nr + 2))
-        return with_rows(real_identity(grid, nr + 2), rows, block)
-
-    @property
-    def x_real(self) -> np.ndarray:
-        return self.x_lattice[self.n_fict:self.n_fict + self.n_real]
-
-    @property
-    def x_free(self) -> np.ndarray:
-        return self.x_real[self.free]
-
-    def real_displacements(self, u_free, u_bc=(0.0, 0.0)) -> np.ndarray:
-        """All real nodes' displacements from the free ones (truncated: the end nodes get
-        ``u_bc``)."""
-        u_free = np.asarray(u_free, dtype=float)
-        if self.surface:
-            return u_free
-        out = np.empty(u_free.shape[:-1] + (self.n_real,))
-        out[..., self.free] = u_free
-        out[..., 0], out[..., -1] = u_bc[0], u_bc[1]
-        return out
-
-    def size(self) -> dict:
-        surface = 2 if self.surface else 0
-        return {"nodes": int(self.n_real + 2 * self.n_fict + surface),
-                "real_nodes": int(self.n_real), "fictitious_nodes": int(2 * self.n_fict),
-                "dofs": int(self.free.size), "bonds": self.model.n_bonds(),
-                "operator_nnz": int(self.A.nnz)}
+def odd_image(grid):
+    """The extension the sine series of Eq. (11) implies, u(x_s - xi) = 2 u_s - u(x_s +
+    xi), which isolates the quadrature error from the extrapolation's model error:
+    fictitious node at -(j + 1/2) Delta (and its mirror at the right end) from 2 u_s -
+    u_j, unknowns [real u (N), surface values (2)]."""
+    nr, nf = grid.n_interior, grid.layers
+    j = np.arange(nf)
+    left = np.flatnonzero(grid.index[:, 0] < 0)[::-1]      # -(j + 1/2) Delta, j = 0..
+    right = np.flatnonzero(grid.index[:, 0] >= nr)          # l + (j + 1/2) Delta
+    rows = np.r_[left, left, right, right]
+    cols = np.r_[j, np.full(nf, nr), nr - 1 - j, np.full(nf, nr + 1)]
+    vals = np.r_[-np.ones(nf), np.full(nf, 2.0), -np.ones(nf), np.full(nf, 2.0)]
+    block = sp.csr_matrix((vals, (np.arange(rows.size), cols)), shape=(rows.size, nr + 2))
+    return with_rows(real_identity(grid, nr + 2), rows, block)
 
 
 @register
@@ -177,7 +127,7 @@ class Wave1DSurfaceNodes(Scene):
     Findings: the error falls at first order in 1/m because the one-point quadrature of
     Eq. (3) leaves out the node's own cell (psi - psi_h = k^2 / (2m), see
     ``lattice_symbol``). Order-1 extrapolation is not the odd extension the
-    analytic series implies (``WaveBar(extension=WaveBar.odd_image)``): the two discrete solutions
+    analytic series implies (``wave_bar(..., extension=odd_image)``): the two discrete solutions
     differ by about 0.27-0.28 % of the peak at m = 25 and 100 alike (order 2: 0.11-0.09 %).
     That gap is below the quadrature error for m <= 100, so the paper's convergence shows,
     but it bounds it beyond a few hundred (at m = 400 the order-1 error, 0.33 %, already
@@ -249,8 +199,7 @@ class Wave1DSurfaceNodes(Scene):
         wave_speed = float(np.sqrt(p["E"] / p["rho"]))
         with timer.phase("setup"):
             extension = self.treatment(method).build_for(self.family, None, p)
-            bar = WaveBar(length, horizon, float(p["m_ratio"]), wave_speed,
-                          extension=extension, taylor_order=p.get("order", 1))
+            bar = wave_bar(length, horizon, float(p["m_ratio"]), wave_speed, extension)
             u0 = analytic.gaussian_pulse(bar.x_free, length=length)
             steps = [int(round(t / p["dt"])) for t in SAMPLE_TIMES]
         with timer.phase("solve"):

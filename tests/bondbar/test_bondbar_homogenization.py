@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from pdverify.corrections.homogenized import micromodulus_factor
-from pdverify.scenes.bar1d_bondbased import BondBar
+from pdverify.corrections.homogenized import bond_bar
+from pdverify.scenes.bar1d_bondbased import end_force_displacement
 from pdverify.corrections.homogenized import homogenization_factors
 from pdverify.errors import InputError
 from pdverify.scenes.bar1d_bondbased import TABLE12
@@ -83,10 +84,10 @@ def strain_factor(nodes, ratio, weight="full", method="none", shape="triangular"
     """f(N) = (u_N - u_1) E / (L sigma) of a bar of length L = 1 (Table 12)."""
     E, sigma = 2.0, 3.0
     factors = homogenization_factors(float(ratio), weight, shape) if method == "homogenized" else ()
-    bar = BondBar(nodes=nodes, spacing=1.0 / (nodes - 1), horizon_ratio=float(ratio), E=E,
+    bar = bond_bar(nodes=nodes, spacing=1.0 / (nodes - 1), horizon_ratio=float(ratio), E=E,
                     end_weight=weight, micromodulus=shape, calibration=calibration,
                     end_factors=factors)
-    u = bar.end_force_displacement(sigma * bar.area)
+    u = end_force_displacement(bar, sigma * bar.thickness)
     return (u[-1] - u[0]) * E / sigma
 
 
@@ -176,7 +177,7 @@ def test_an_mth_factor_would_homogenise_half_weight_between_elements(m):
     # homogenization_factors: 2 x Eq. (99) on bonds (1, 1+k), k < m, and 2 on (1, m + 1).
     factors = [2 * float(f) for f in eq99_corrected(m)] + [2.0]
     for n in (2 * m + 1, 2 * m + 4, 301):
-        bar = BondBar(nodes=n, spacing=1.0 / (n - 1), horizon_ratio=m + 0.5, E=1.0,
+        bar = bond_bar(nodes=n, spacing=1.0 / (n - 1), horizon_ratio=m + 0.5, E=1.0,
                         end_weight="half", end_factors=factors)
-        u = bar.end_force_displacement(bar.area)
+        u = end_force_displacement(bar, bar.thickness)
         assert abs(u[-1] - u[0] - 1.0) <= F_TOL

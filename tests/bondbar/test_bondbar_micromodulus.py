@@ -4,7 +4,7 @@ import pytest
 
 from pdverify.corrections.homogenized import (bond_profile, micromodulus_c1, micromodulus_factor,
                                              split_horizon_ratio)
-from pdverify.scenes.bar1d_bondbased import BondBar
+from pdverify.corrections.homogenized import bond_bar
 
 EPS = np.finfo(float).eps
 #: c1 is E over a sum of at most 2m positive O(m^2) terms: a few ulps, at m <= 40 below 1e-14.
@@ -90,10 +90,10 @@ def test_constant_micromodulus_through_an_element_needs_no_discrete_correction(m
 def test_table14_end_equation_coefficient(ratio, weight, C):
     # App. 1, Eq. (A1.7): b_1/(c1 A) = C sigma Delta / E, with b_1 = sigma A / V_1.
     E, sigma, spacing = 7.0, 3.0, 0.25
-    bar = BondBar(nodes=21, spacing=spacing, horizon_ratio=ratio, E=E, area=0.3,
+    bar = bond_bar(nodes=21, spacing=spacing, horizon_ratio=ratio, E=E, area=0.3,
                     end_weight=weight)
-    b1 = sigma * bar.area / bar.volume[0]
-    np.testing.assert_allclose(b1 / (bar.c1 * bar.area) / (sigma * spacing / E), C,
+    b1 = sigma * bar.thickness / bar.node_volume[0]
+    np.testing.assert_allclose(b1 / (bar.c * bar.thickness) / (sigma * spacing / E), C,
                                rtol=RTOL_SUM)
 
 
@@ -114,3 +114,18 @@ def test_profile_drops_the_triangle_tip_and_keeps_partial_volumes():
 def test_horizon_ratio_must_be_whole_or_half_whole(bad):
     with pytest.raises(ValueError, match="whole or half-whole"):
         split_horizon_ratio(bad)
+
+
+@pytest.mark.parametrize("ratio", [1.5, 2.0, 4.0, 4.5, 6.5])
+@pytest.mark.parametrize("shape", ["triangular", "constant"])
+@pytest.mark.parametrize("calibration", ["discrete", "continuum"])
+def test_the_scenes_bar_description_calibrates_c1_as_the_homogenized_bar(ratio, shape,
+                                                                       calibration):
+    # the scenes describe their bar with pdverify.pd.bar1d; the homogenisation's own bar
+    # (corrections.homogenized) keeps a copy of the calibration until it reads it from
+    # there: the same operations, so equal to the last bit (rtol 0)
+    from pdverify.pd import bar1d
+    args = dict(E=7.0, area=0.3, spacing=0.25, micromodulus=shape, calibration=calibration)
+    assert bar1d.bar_micromodulus(ratio, **args) == micromodulus_c1(ratio, **args)
+    assert bar1d.micromodulus_factor(ratio, shape) == micromodulus_factor(ratio, shape)
+    assert bar1d.split_horizon_ratio(ratio) == split_horizon_ratio(ratio)

@@ -2,7 +2,8 @@
 import numpy as np
 import pytest
 
-from pdverify.scenes.bar1d_bondbased import BondBar
+from pdverify.corrections.homogenized import bond_bar
+from pdverify.scenes.bar1d_bondbased import end_force_displacement, equation_rows
 from pdverify.solvers.lu import solve_constrained
 
 EPS = np.finfo(float).eps
@@ -71,9 +72,9 @@ def test_rows_match_the_printed_equations(key, homogenized):
     scale, expected = paper_rows(ratio, weight, **letters)
     m = int(ratio)
     # long enough that rows 1..m+1 do not reach the other end
-    bar = BondBar(nodes=4 * m + 3, spacing=0.1, horizon_ratio=ratio, E=2.0, area=0.5,
+    bar = bond_bar(nodes=4 * m + 3, spacing=0.1, horizon_ratio=ratio, E=2.0, area=0.5,
                     end_weight=weight, end_factors=factors)
-    ours = bar.equation_rows()[: expected.shape[0], : expected.shape[1]] * scale
+    ours = equation_rows(bar)[: expected.shape[0], : expected.shape[1]] * scale
     # integer-valued rationals up to 258 * 16/7 from a handful of float operations
     np.testing.assert_allclose(ours, expected, rtol=0, atol=64 * EPS * np.abs(expected).max())
 
@@ -103,16 +104,16 @@ def naive_rows(nodes, ratio, weight, shape):
 @pytest.mark.parametrize("nodes_over", [1, 3])
 def test_vectorised_assembly_equals_pointwise_eq33(ratio, weight, shape, nodes_over):
     nodes = nodes_over * (2 * int(ratio) + 1) + 2
-    bar = BondBar(nodes=nodes, spacing=0.2, horizon_ratio=ratio, E=1.0, end_weight=weight,
+    bar = bond_bar(nodes=nodes, spacing=0.2, horizon_ratio=ratio, E=1.0, end_weight=weight,
                     micromodulus=shape)
     expected = naive_rows(nodes, ratio, weight, shape)
-    np.testing.assert_allclose(bar.equation_rows(), expected, rtol=0,
+    np.testing.assert_allclose(equation_rows(bar), expected, rtol=0,
                                atol=32 * EPS * np.abs(expected).max())
 
 
 @pytest.mark.parametrize("ratio, weight", [(4.0, "half"), (4.5, "full"), (7.0, "full")])
 def test_stiffness_is_symmetric_with_only_the_rigid_mode(ratio, weight):
-    bar = BondBar(nodes=30, spacing=0.1, horizon_ratio=ratio, E=1.0, end_weight=weight,
+    bar = bond_bar(nodes=30, spacing=0.1, horizon_ratio=ratio, E=1.0, end_weight=weight,
                     end_factors=(1.7, 1.2))
     K = bar.K.toarray()
     np.testing.assert_array_equal(K, K.T)  # assembled from symmetric bond entries
@@ -127,21 +128,21 @@ def test_cut_form_equals_a_pinned_displacement_solve(ratio, weight):
     # Two routes to the same equations: K u = f with the centre pinned (condition number
     # ~ N^2 ~ 2e3 at N = 41, so ~1e-12 agreement), and the cut system of the model.
     N = 41
-    bar = BondBar(nodes=N, spacing=0.05, horizon_ratio=ratio, E=3.0, end_weight=weight)
+    bar = bond_bar(nodes=N, spacing=0.05, horizon_ratio=ratio, E=3.0, end_weight=weight)
     f = np.zeros(N)
     f[0], f[-1] = -2.0, 2.0
     B = np.zeros((1, N))
     B[0, N // 2] = 1.0
     u_pinned, _, info = solve_constrained(bar.K, f, B, [0.0])
-    u_cut = bar.end_force_displacement(2.0)
+    u_cut = end_force_displacement(bar, 2.0)
     np.testing.assert_allclose(u_cut, u_pinned, rtol=0,
                                atol=10 * EPS * info["condition_estimate"] * np.abs(u_pinned).max())
 
 
 def test_bad_model_input_is_rejected():
     with pytest.raises(ValueError, match="2m \\+ 1"):
-        BondBar(nodes=8, spacing=1.0, horizon_ratio=4.0, E=1.0)
+        bond_bar(nodes=8, spacing=1.0, horizon_ratio=4.0, E=1.0)
     with pytest.raises(ValueError, match="end_weight"):
-        BondBar(nodes=9, spacing=1.0, horizon_ratio=4.0, E=1.0, end_weight="quarter")
+        bond_bar(nodes=9, spacing=1.0, horizon_ratio=4.0, E=1.0, end_weight="quarter")
     with pytest.raises(ValueError, match="no bond"):
-        BondBar(nodes=9, spacing=1.0, horizon_ratio=1.0, E=1.0)
+        bond_bar(nodes=9, spacing=1.0, horizon_ratio=1.0, E=1.0)

@@ -44,7 +44,7 @@ def test_the_limit_is_the_form_f_inf_plus_b_over_n_minus_1():
     """Doubling N - 1 halves f - f(inf) (the form), on a constant-micromodulus bar."""
     p = SCENE.resolve("none", {**CONSTANT_LIMIT, "end_weight": "half"})
     n = np.array([251, 501, 1001, 2001])
-    f = np.array([SCENE.strain_factor(SCENE.bar("none", p, k, 1.0 / (k - 1)), 1.0)[0]
+    f = np.array([SCENE.strain_factor(SCENE.end_loaded("none", p, k, 1.0 / (k - 1)), p)[0]
                   for k in n])
     limit, spread = strain_factor_limit(n, f)
     assert spread <= ROUND_OFF

@@ -5,8 +5,15 @@ import scipy.sparse as sp
 from numpy.testing import assert_allclose
 
 from pdverify.errors import NumericalError
-from pdverify.scenes.wave1d import WaveBar
+from pdverify.scenes.wave1d import wave_bar
+from pdverify.corrections.registry import from_name
 from pdverify.solvers.explicit import central_difference, gershgorin_limit, stability_limit
+
+
+def surface_nodes(order=1):
+    """The surface node method's ``wave-bar`` extension at Taylor ``order`` (its role)."""
+    return from_name("surface-nodes").build_for("wave-bar", None, {"order": order})
+
 
 EPS = np.finfo(float).eps
 
@@ -50,7 +57,7 @@ def test_step_above_the_limit_is_refused_naming_the_limit():
 def test_steps_between_gershgorin_and_the_sharp_limit_are_accepted():
     # Gershgorin over-estimates lambda_max of the PD operator (every row sum vs the
     # alternating mode); a step between the two limits is stable and must not be refused.
-    bar = WaveBar(1.0, 0.1, 100, 5000.0)
+    bar = wave_bar(1.0, 0.1, 100, 5000.0, surface_nodes(1))
     K = -bar.A
     bound, sharp = gershgorin_limit(K), stability_limit(K)
     assert bound.dt_limit < sharp.dt_limit
@@ -65,7 +72,7 @@ def test_steps_between_gershgorin_and_the_sharp_limit_are_accepted():
 
 def test_arpack_limit_matches_dense_eigenvalues():
     # ARPACK's extreme eigenvalue at relative tolerance 1e-6 against LAPACK.
-    bar = WaveBar(1.0, 0.1, 10, 5000.0)
+    bar = wave_bar(1.0, 0.1, 10, 5000.0, surface_nodes(1))
     lam = np.linalg.eigvals(-bar.A.toarray())
     assert_allclose(stability_limit(-bar.A).lambda_max, np.max(np.abs(lam)), rtol=1e-6)
 

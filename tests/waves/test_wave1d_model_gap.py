@@ -3,17 +3,24 @@ import numpy as np
 import pytest
 
 from manufactured.wave1d import gaussian_pulse, wave_series
-from pdverify.scenes.wave1d import WaveBar
+from pdverify.scenes.wave1d import odd_image, wave_bar
+from pdverify.corrections.registry import from_name
 from pdverify.scenes.wave1d import SAMPLE_TIMES
 from pdverify.solvers.explicit import central_difference
+
+
+def surface_nodes(order=1):
+    """The surface node method's ``wave-bar`` extension at Taylor ``order`` (its role)."""
+    return from_name("surface-nodes").build_for("wave-bar", None, {"order": order})
+
 
 V, DELTA, DT, PEAK = 5000.0, 0.1, 2e-7, 0.02  # seed 002
 STEPS = [int(round(t / DT)) for t in SAMPLE_TIMES]
 
 
 def solve(m, boundary, order=1):
-    extension = WaveBar.odd_image if boundary == "odd-image" else ...  # else surface nodes
-    bar = WaveBar(1.0, DELTA, m, V, extension=extension, taylor_order=order)
+    extension = odd_image if boundary == "odd-image" else surface_nodes(order)
+    bar = wave_bar(1.0, DELTA, m, V, extension)
     run = central_difference(-bar.A, gaussian_pulse(bar.x_free), 0.0, DT, STEPS[-1],
                              sample_steps=STEPS)
     return bar.x_real, bar.real_displacements(run.u)

@@ -4,10 +4,17 @@ import pytest
 from numpy.testing import assert_allclose
 
 from manufactured.wave1d import nonlocal_factor
-from pdverify.scenes.wave1d import WaveBar, lattice_symbol
+from pdverify.scenes.wave1d import lattice_symbol, odd_image, wave_bar
+from pdverify.corrections.registry import from_name
+
+
+def surface_nodes(order=1):
+    """The surface node method's ``wave-bar`` extension at Taylor ``order`` (its role)."""
+    return from_name("surface-nodes").build_for("wave-bar", None, {"order": order})
+
 
 #: the bar's extensions by name: surface nodes (the default), truncated (``None``)
-EXTENSIONS = {"surface-nodes": ..., "none": None}
+EXTENSIONS = {"surface-nodes": surface_nodes(1), "none": None}
 
 EPS = np.finfo(float).eps
 V, DELTA, L = 5000.0, 0.1, 1.0  # seed 002
@@ -22,12 +29,12 @@ def _roundoff(A, u):
 @pytest.mark.parametrize("m", [10, 25, 100])
 def test_paper_grid_sizes(m):
     # seed 002 Sec. "Results": m = 10, 25, 100 <-> Delta = 10, 4, 1 mm, N = 100, 250, 1000
-    bar = WaveBar(L, DELTA, m, V)
+    bar = wave_bar(L, DELTA, m, V, surface_nodes(1))
     assert bar.n_real == 10 * m
     assert_allclose(bar.spacing, DELTA / m, rtol=4 * EPS)
     assert bar.n_fict == m  # the fictitious layer is delta deep
     assert bar.size()["dofs"] == 10 * m
-    assert WaveBar(L, DELTA, m, V, extension=None).size()["dofs"] == 10 * m - 2
+    assert wave_bar(L, DELTA, m, V, None).size()["dofs"] == 10 * m - 2
 
 
 def test_lattice_symbol_converges_to_psi_at_first_order_in_one_over_m():
@@ -49,7 +56,7 @@ def test_lattice_symbol_converges_to_psi_at_first_order_in_one_over_m():
 def test_operator_on_sine_away_from_the_ends_is_minus_v2_psi_h(boundary):
     # Nodes at least delta from both ends see a complete lattice neighbourhood, so sin(kx)
     # is an eigenvector there with eigenvalue -v^2 psi_h (closed form, to round-off).
-    bar = WaveBar(L, DELTA, 25, V, extension=EXTENSIONS[boundary])
+    bar = wave_bar(L, DELTA, 25, V, EXTENSIONS[boundary])
     x = bar.x_free
     k = 3 * np.pi
     u, s = np.sin(k * x), np.sin(k * bar.x_bc)  # "none" fixes nodes at Delta/2 from the ends
@@ -63,7 +70,7 @@ def test_operator_on_sine_away_from_the_ends_is_minus_v2_psi_h(boundary):
 def test_order_one_fictitious_layer_keeps_linear_fields_force_free():
     # Eqs. (8)-(9) reproduce linear fields in the fictitious layer exactly, so u = a + b x
     # (with the surface nodes on the same line) has zero acceleration at every real node.
-    bar = WaveBar(L, DELTA, 10, V)
+    bar = wave_bar(L, DELTA, 10, V, surface_nodes(1))
     u = 0.3 + 0.7 * bar.x_real
     s = 0.3 + 0.7 * bar.x_bc
     a = bar.A @ u + bar.A_bc @ s
@@ -77,13 +84,13 @@ def test_order_n_fictitious_layer_is_exact_for_quadratics(order):
     # neighbourhood of x^2: a = sum_k c_k 2 xi_k^2 = 2 v^2 sum_k beta_k Delta / delta
     # = 2 v^2 (1 - 1/(2m)) (beta = 1/2 at the horizon). Order 1 does not (near the ends).
     m = 10
-    bar = WaveBar(L, DELTA, m, V, taylor_order=order)
+    bar = wave_bar(L, DELTA, m, V, surface_nodes(order))
     u = bar.x_real ** 2
     s = bar.x_bc ** 2
     a = bar.A @ u + bar.A_bc @ s
     tol = _roundoff(bar.A, u) + _roundoff(bar.A_bc, s)
     assert np.all(np.abs(a - 2 * V ** 2 * (1 - 1 / (2 * m))) <= tol)
-    low = WaveBar(L, DELTA, m, V, taylor_order=1)
+    low = wave_bar(L, DELTA, m, V, surface_nodes(1))
     a1 = low.A @ u + low.A_bc @ s
     assert np.max(np.abs(a1 - 2 * V ** 2 * (1 - 1 / (2 * m)))) > 1e-3 * V ** 2
 
@@ -91,7 +98,7 @@ def test_order_n_fictitious_layer_is_exact_for_quadratics(order):
 def test_surface_node_spectrum_is_real_and_positive_at_order_one():
     # Central differences need a real, non-negative spectrum of -A (Eq. 5); the
     # extrapolation makes A non-symmetric, so check it (dense, m = 10).
-    bar = WaveBar(L, DELTA, 10, V)
+    bar = wave_bar(L, DELTA, 10, V, surface_nodes(1))
     lam = np.linalg.eigvals(-bar.A.toarray())
     assert np.max(np.abs(lam.imag)) <= 1e-9 * np.max(np.abs(lam))
     assert lam.real.min() > 0
@@ -101,7 +108,7 @@ def test_surface_node_spectrum_is_real_and_positive_at_order_one():
 def test_odd_image_makes_every_sine_mode_an_exact_eigenvector(j):
     # The odd image about the surface nodes is the extension the series of Eq. (11)
     # implies: sin(j pi x / l) is then an eigenvector at every real node, ends included.
-    bar = WaveBar(L, DELTA, 10, V, extension=WaveBar.odd_image)
+    bar = wave_bar(L, DELTA, 10, V, odd_image)
     k = j * np.pi / L
     u = np.sin(k * bar.x_real)
     a = bar.A @ u

@@ -9,9 +9,16 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from pdverify.scenes.wave1d import WaveBar
+from pdverify.scenes.wave1d import wave_bar
+from pdverify.corrections.registry import from_name
 from pdverify.report.figures import draw
 from pdverify.scenes import get_scene
+
+
+def surface_nodes(order=1):
+    """The surface node method's ``wave-bar`` extension at Taylor ``order`` (its role)."""
+    return from_name("surface-nodes").build_for("wave-bar", None, {"order": order})
+
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENE = "wave1d-surface-nodes"
@@ -75,7 +82,7 @@ def test_step_above_the_stability_limit_fails_the_run_naming_the_limit():
     # m = 10: the sharp limit 2/sqrt(lambda_max) from LAPACK's eigenvalues of the operator;
     # a step 2 % above it is refused through the CLI (exit 1, failed run), one 2 % below
     # it (but above the Gershgorin bound) runs.
-    bar = WaveBar(1.0, 0.1, 10, 5000.0)
+    bar = wave_bar(1.0, 0.1, 10, 5000.0, surface_nodes(1))
     limit = 2 / np.sqrt(np.max(np.abs(np.linalg.eigvals(-bar.A.toarray()))))
     proc = cli("run", SCENE, "--set", "m_ratio=10", "--set", f"dt={1.02 * limit:.6e}")
     assert proc.returncode == 1, proc.stdout + proc.stderr
