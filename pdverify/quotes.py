@@ -57,11 +57,10 @@ class Quote:
 
 
 def _same(a, b) -> bool:
-    if isinstance(b, float) or isinstance(a, float):
-        try:
-            return math.isclose(float(a), float(b), rel_tol=1e-12, abs_tol=0.0)
-        except (TypeError, ValueError):
-            return False
+    """A param equals a quote's: exactly (3 == 3.0; 0.05 is not 0.049999999999999996,
+    which the convergence studies' levels may be)."""
+    if isinstance(a, bool) or isinstance(b, bool):
+        return a is b
     return a == b
 
 
@@ -169,3 +168,10 @@ def typed_near_records(text: str, results, scenes, allowed=()) -> list[str]:
 def _significant(typed: str) -> int:
     mant = typed.lower().lstrip("-").split("e")[0].replace(".", "").lstrip("0")
     return len(mant)
+
+
+def used(text: str, quotes: dict) -> dict:
+    """The quotes ``text`` uses: a family declared by a comprehension, kept to its members
+    the text names (in a class body: ``doc_quotes = used(__doc__, {...})``)."""
+    names = set(placeholders(text or ""))
+    return {k: q for k, q in quotes.items() if k in names}
