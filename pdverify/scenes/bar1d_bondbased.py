@@ -397,6 +397,13 @@ class Homogenization(BondBarScene):
             # 004-constant-limit)
             out += [("none", {**CONSTANT_LIMIT, "end_weight": w, "calibration": c})
                     for c in ("discrete", "continuum") for w in ("full", "half")]
+            # Tables 1 and 2's f_1(m) at the ratios no case above runs (10, 32, 15.5): the
+            # smallest bar of each (2m + 1 points), so that every printed f_1 stands
+            # beside a run of the full report
+            covered = {o.get("horizon_ratio") for _, o in out}
+            out += [("none", {"horizon_ratio": ratio, "nodes": 2 * int(ratio) + 1})
+                    for _table, rows in MICROMODULUS_TABLES for ratio, _ in rows
+                    if ratio not in covered]
         return out
 
     def strain_factor(self, bar: BondBar, stress: float) -> tuple[float, np.ndarray]:
