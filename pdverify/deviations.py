@@ -65,13 +65,25 @@ class Deviation:
 
 
 def _first_clause(text: str, limit: int = 90) -> str:
-    """A text's opening up to its first full stop or colon, cut at a word near
-    ``limit``: the table's quantity column where an entry has no ``summary``."""
+    """A text's opening up to its first full stop, colon or semicolon (not one of an
+    abbreviation: Eq., Fig., App., ...), cut at a word near ``limit``: the table's
+    quantity column where an entry has no ``summary``."""
     import re
-    head = re.split(r"(?<=[a-z0-9)'])[.:;] ", text, maxsplit=1)[0]
-    if len(head) <= limit:
-        return head
-    return head[:limit].rsplit(" ", 1)[0] + " ..."
+    for m in re.finditer(r"[.:;](?= )", text):
+        word = re.search(r"(\w+)$", text[:m.start()])
+        if m.group() == "." and word and (word.group(1) in _ABBREVIATIONS
+                                          or len(word.group(1)) == 1):
+            continue
+        if m.start() >= 15:
+            text = text[:m.start()]
+            break
+    if len(text) <= limit:
+        return text
+    return text[:limit].rsplit(" ", 1)[0] + " ..."
+
+
+_ABBREVIATIONS = {"Eq", "Eqs", "Fig", "Figs", "App", "Sec", "Secs", "ref", "Ref", "e", "i",
+                  "al", "vs", "cf"}
 
 
 DEVIATIONS = (
@@ -113,7 +125,8 @@ DEVIATIONS = (
               "1 is missing: 1 x 0.5 x 0.5 m, h = 0.05 m, m = 3, E = 200 GPa) in bond-based PD "
               "(nu = 1/4, whole cells inside the horizon, the volumes perifit's API takes), "
               "the formulation the peers' volume and perifit corrections were written for.",
-              "ERRATA 001; scene docstring"),
+              "ERRATA 001; scene docstring",
+              summary="Ours: seed 001's box in bond-based PD (the peers' formulation)"),
     Deviation(("stiffness3d-box",), "finding",
               "energy and PALS beat none under homogeneous strain, volume and perifit do not "
               "({{volume}} and {{perifit}} % against {{none}} %; perifit in six readings): LPS with m over the "
@@ -218,7 +231,9 @@ DEVIATIONS = (
               "mirror nodes and PDDO use the 1D modulus E = lambda + 2 mu. All three are exact "
               "for the traction bar's linear field, surface nodes of order 2 and PDDO for the "
               "uniform load's quadratic one.",
-              "corrections/static_state.py; tests/treatments/test_static_family.py"),
+              "corrections/static_state.py; tests/treatments/test_static_family.py",
+              summary="Ours: seed 001/002's surface nodes, mirror nodes and PDDO on seed 000's "
+                      "bars"),
     Deviation(("plate2d-plane-strain",), "choice",
               "Ours: seed 000's Taylor fictitious nodes with tractions, which seed 000 does not "
               "treat in 2D (its plate is clamped): the force flux of every boundary cell face "
@@ -480,7 +495,8 @@ DEVIATIONS = (
                               {"micromodulus": "constant", "calibration": "continuum",
                                "end_weight": "full", "horizon_ratio": 4.5}, ".5g")},
               summary="§7: f(inf) = 1 only with full-weight ends (constant micromodulus)",
-              ours="f(inf) independent of the end weight", paper="full weight only"),
+              ours="f(inf) the same for both end weights ({{f1}}, continuum c)",
+              paper="1 with full-weight ends only"),
     Deviation(("bar1d-homogenization",), "erratum",
               "App. 2, Eqs. (A2.1.1.4) and (A2.1.1.5) miss the factor 1/m; the homogenising "
               "factors are computed from the equilibrium equations, so they do not inherit it.",
@@ -498,7 +514,9 @@ DEVIATIONS = (
               "inside the body along the bond (D the dimension: a bond-based node's energy per "
               "direction under homogeneous strain is (1/4) s^2 int c xi^D dxi); the box is "
               "the grid's, every face counted.",
-              "corrections/energy_directional.py; tests/treatments/test_energy_directional_cells.py"),
+              "corrections/energy_directional.py; "
+              "tests/treatments/test_energy_directional_cells.py",
+              summary="Ours: seed 003's energy-directional on bond-based bars and boxes"),
     Deviation(("stiffness3d-box-bond",), "finding",
               "energy-directional reduces the surface effect (rms {{rn}} -> {{re}} %, uniaxial "
               "{{un}} -> {{ue}} %) but not its maximum ({{mn}} -> {{me}} %): at the cell-centred "
@@ -525,7 +543,8 @@ DEVIATIONS = (
               "boundary point; on straight parts seed 001's force-flux rows, on arcs the "
               "fit's traction. Seeds 000 and 001 define their methods on boxes.",
               "pd/shapes.py, pd/grid.py ShapeGrid, corrections/shape_fictitious.py; "
-              "tests/shapes/test_shape_engine.py"),
+              "tests/shapes/test_shape_engine.py",
+              summary="Ours: bodies cut from a box's lattice; Taylor along the local normal"),
     Deviation(("plate-hole",), "choice",
               "The quarter plate with its two symmetry planes (u_x = 0 on x = 0, u_y = 0 on "
               "y = 0) is the problem every method solves, so the PD runs have those two "

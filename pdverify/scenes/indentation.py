@@ -134,7 +134,8 @@ class Indentation(FemAndPD):
     Findings (not tuned): at the paper's grid the corrected nonlinear run reaches 2 mm
     {{ed_small}} % below the small-strain FEM; the finite-strain FEM itself is 10.4 % below the
     small-strain one at 2 mm (St Venant-Kirchhoff softens in compression); the linear
-    corrected run is within {{ed_linear}} % of the small-strain FEM. The uncorrected runs are about a
+    corrected run is within {{ed_linear}} % of the small-strain FEM. The uncorrected runs are
+    about a
     third too soft (paper: about 30 %) and fail: nonlinear at {{none_nl}} mm, where the surface node
     under the indenter has squeezed its bond to the next row to 18 % of its length and
     Newton's line search finds no descent (the lattice is about to fold); linear at {{none_l}} mm,

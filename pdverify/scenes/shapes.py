@@ -175,7 +175,8 @@ class HolePlate(ShapeScene):
     of ``reference_fem.hole_plate`` on a mapped mesh of the same shape (9-node
     isoparametric quadrilaterals, the arc to O(h^3)): its field changes on the PD grid by
     0.195, 0.055, 0.0117, {{fem_change}} % over its refinements (the report's table),
-    u_x(W, 0) = {{fem_ux}} m, stress concentration {{fem_scf}}. Checked against Kirsch (its tests): with
+    u_x(W, 0) = {{fem_ux}} m, stress concentration {{fem_scf}}. Checked against Kirsch (its
+    tests): with
     Kirsch's own traction on the outer edges the FEM converges to Kirsch's displacement
     at rate 3.07 (0.070 .. 0.000115 % of max |u|, concentration 2.99988); under uniform
     tension the concentration falls to Kirsch's 3 as the plate grows, {{fem_scf3}}, 3.085,

@@ -124,6 +124,11 @@ def _relative_errors(u, u_ref):
 
 
 # =============================================================================== §4.1.1
+#: the runs the docstrings quote (pdverify.quotes)
+_T1_RUN = {"spacing": 0.001, "micromodulus": "constant", "quadrature": "full-cells"}
+_T2_RUN = {"m_ratio": 6.0, "micromodulus": "constant", "side_factor": 4.0}
+
+
 @register
 class TensionSheet(SheetScene):
     """Seed 003 §4.1.1 (Fig. 2, Table 1): sheet 50 x 100 mm, 1 MPa on the ends y = +-50 mm.
@@ -165,7 +170,7 @@ class TensionSheet(SheetScene):
     id = "sheet2d-tension"
     #: the numbers the docstring quotes from this report's runs (pdverify.quotes)
     doc_quotes = {f"{k[0]}_{s[0]}_{c}": Q(f"max_error_u{c}_pct", k,
-                                         {**{"spacing": 0.001, "micromodulus": "constant", "quadrature": "full-cells"}, "load_sharing": s}, ".3g")
+                                         {**_T1_RUN, "load_sharing": s}, ".3g")
                   for k in ("none", "energy-directional") for s in ("tributary", "equal")
                   for c in ("x", "y")}
     doc_typed = ("2.6", "3.2")   # the paper's print
@@ -359,7 +364,7 @@ class ClampedSheet(SheetScene):
     #: the numbers the docstring quotes from this report's runs (pdverify.quotes)
     doc_quotes = {"fem": Q("tensile_stress_mpa", "fem", fmt=".6g"),
                   **{f"{q}{k}": Q("tensile_stress_mpa", method,
-                                   {**{"m_ratio": 6.0, "micromodulus": "constant", "side_factor": 4.0}, **extra, "quadrature": quad}, ".2f")
+                                   {**_T2_RUN, **extra, "quadrature": quad}, ".2f")
                      for q, quad in (("f", "full-cells"), ("p", "partial-volume"))
                      for k, method, extra in (
                          ("n", "none", {"node_volumes": "partial"}),

@@ -381,7 +381,8 @@ class BoxStiffness(_StateStiffness):
     node misses by {{mirror-nodes}} % near the box's edges and corners, still far below ``none``.
 
     Finding (not tuned): ``energy`` and ``pals`` beat ``none`` here, ``volume`` and
-    ``perifit`` do not (largest surface error {{none}} % against {{volume}} and {{perifit}} %). LPS with m
+    ``perifit`` do not (largest surface error {{none}} % against {{volume}} and {{perifit}} %).
+    LPS with m
     over the truncated family is exact for a node on a flat face in the continuum limit
     (half a ball has the ball's moment ratios), so factors that restore missing volume or
     the ball's operators reweight bonds that needed none. perifit's other readings fail

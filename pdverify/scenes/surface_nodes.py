@@ -188,6 +188,11 @@ class Body3D(SurfaceNodeScene):
         return (p["lx"], p["ly"], p["lz"]), (0.0, -p["ly"] / 2, -p["lz"] / 2)
 
 
+#: the runs the docstrings quote (pdverify.quotes)
+_B3_RUN = {"spacing": 0.05, "m_ratio": 3.0, "surface_load": "face-mean"}
+_P2_RUN = {"spacing": 0.02, "quadrature": "partial-volume", "influence": "gaussian"}
+
+
 @register
 class Body3DTraction(Body3D):
     """Seed 001 §4.1 (Fig. 8): box under the traction p = 10 MPa on x = l_x; Eq. (39).
@@ -295,7 +300,8 @@ class Body3DManufactured(Body3D):
     linear dilatation extrapolation instead it stays 1.83 %; the error peaks on the
     body edges near the tip, where a linear extrapolation misses the x y and x^3 terms.
     With ``surface_load=centre`` (the traction at the face centre times A) the same runs
-    give 2.6 / 1.13 / {{sn3_centre}} % (N = 3 a report run): on the faces y = +-l_y/2 the x^2 shear of Eq. (41) makes
+    give 2.6 / 1.13 / {{sn3_centre}} % (N = 3 a report run): on the faces y = +-l_y/2 the
+    x^2 shear of Eq. (41) makes
     the centre value differ from the resultant by A h^2 tau''/24 (7.2 kN a node here,
     about 0.3 % of the largest face load). The resultant is the exact force on the area
     a surface node represents, so it is our default; the discrete flux sum of Eq. (35)
@@ -308,7 +314,8 @@ class Body3DManufactured(Body3D):
 
     ``taylor-fictitious`` (seed 000's Taylor-extrapolated fictitious nodes, Lagrange rows;
     on the 3D boxes too): order 2 gives {{taylor2}} % at h = 0.05 (surface nodes N = 2:
-    {{sn2}} %), order 1 13.2 % (N = 1: {{sn1}} %); 35-40 s and 2.0-2.2 GB a run (benchmarks/taylor3d.py).
+    {{sn2}} %), order 1 13.2 % (N = 1: {{sn1}} %); 35-40 s and 2.0-2.2 GB a run
+    (benchmarks/taylor3d.py).
     On the quick 10 x 5 x 5 box its constraint rows are dependent (an expected failure).
     """
 
@@ -316,18 +323,18 @@ class Body3DManufactured(Body3D):
     #: the numbers the docstring quotes from this report's runs (pdverify.quotes)
     doc_quotes = {
         **{f"none_{lp}": Q("max_error_pct", "none",
-                             {**{"spacing": 0.05, "m_ratio": 3.0, "surface_load": "face-mean"}, "quadrature": "partial-volume", "load_point": lp}, ".3g")
+                             {**_B3_RUN, "quadrature": "partial-volume", "load_point": lp}, ".3g")
            for lp in ("node", "surface")},
         **{f"sn{n}": Q("max_error_pct", "surface-nodes",
-                        {**{"spacing": 0.05, "m_ratio": 3.0, "surface_load": "face-mean"}, "quadrature": "partial-volume", "order": n}, ".2f")
+                        {**_B3_RUN, "quadrature": "partial-volume", "order": n}, ".2f")
            for n in (1, 2, 3)},
         "sn3_centre": Q("max_error_pct", "surface-nodes",
-                        {**{"spacing": 0.05, "m_ratio": 3.0, "surface_load": "face-mean"}, "quadrature": "partial-volume", "order": 3,
+                        {**_B3_RUN, "quadrature": "partial-volume", "order": 3,
                          "surface_load": "centre"}, ".3g"),
         "sn3_moment": Q("max_error_pct", "surface-nodes",
-                        {**{"spacing": 0.05, "m_ratio": 3.0, "surface_load": "face-mean"}, "quadrature": "moment-corrected", "order": 3}, ".2f"),
+                        {**_B3_RUN, "quadrature": "moment-corrected", "order": 3}, ".2f"),
         "taylor2": Q("max_error_pct", "taylor-fictitious",
-                     {**{"spacing": 0.05, "m_ratio": 3.0, "surface_load": "face-mean"}, "quadrature": "partial-volume", "order": 2}, ".3f")}
+                     {**_B3_RUN, "quadrature": "partial-volume", "order": 2}, ".3f")}
     # a study on another body (0.45 x 0.3 x 0.3 m, m = 3, 4, 5), not a report run
     doc_typed = ("0.69", "0.19", "0.32", "2.30", "0.70", "0.27")
     title = "3D box under manufactured loads (surface node method)"
@@ -445,7 +452,8 @@ class Plate2DPlaneStrain(SurfaceNodeScene):
     (``corrections.pddo``: boundary rows on the outer node layer, PDDO equilibrium
     within 2 delta, LPS beyond; param ``bulk_model``). Each module's
     docstring says which parts are our reading. Findings at h = 0.02 (not tuned):
-    PALS {{palsu}} % in u, {{palsv}} % in v (none: {{noneu}}, {{nonev}} %; SNM {{snu}}, {{snv}} %), so
+    PALS {{palsu}} % in u, {{palsv}} % in v (none: {{noneu}}, {{nonev}} %; SNM {{snu}},
+    {{snv}} %), so
     PALS lowers
     both errors and SNM stays below it, as §5 says; with the full traction condition
     the mirror relations reproduce the plate's affine solution, so MNM gives round-off
@@ -478,7 +486,7 @@ class Plate2DPlaneStrain(SurfaceNodeScene):
     id = "plate2d-plane-strain"
     #: the numbers the docstring quotes from this report's runs (pdverify.quotes)
     doc_quotes = {
-        **{f"{k}{c}": Q(f"max_error_{c}_pct", method, {**{"spacing": 0.02, "quadrature": "partial-volume", "influence": "gaussian"}, "m_ratio": 3.0, **extra}, fmt)
+        **{f"{k}{c}": Q(f"max_error_{c}_pct", method, {**_P2_RUN, "m_ratio": 3.0, **extra}, fmt)
            for k, method, extra, fmt in (
                ("sn", "surface-nodes", {"order": 1}, ".3g"),
                ("pals", "pals", {"load_point": "surface"}, ".3g"),
@@ -490,9 +498,9 @@ class Plate2DPlaneStrain(SurfaceNodeScene):
                                        "gradient_at": "mirror"}, ".3g"))
            for c in ("u", "v")},
         **{f"sn_m{m}": Q("max_error_pct", "surface-nodes",
-                          {**{"spacing": 0.02, "quadrature": "partial-volume", "influence": "gaussian"}, "m_ratio": float(m), "order": 1}, ".2g") for m in (4, 5)},
+                          {**_P2_RUN, "m_ratio": float(m), "order": 1}, ".2g") for m in (4, 5)},
         "sn_hyp": Q("max_error_pct", "surface-nodes",
-                    {**{"spacing": 0.02, "quadrature": "partial-volume", "influence": "gaussian"}, "m_ratio": 3.0, "order": 1, "influence": "hyperbolic"}, ".3g")}
+                    {**_P2_RUN, "m_ratio": 3.0, "order": 1, "influence": "hyperbolic"}, ".3g")}
     doc_typed = ("10",)   # '10 % full': the dense solver's rule
     title = "2D plate in plane strain under traction (surface node method)"
     seed = "001 §5"
