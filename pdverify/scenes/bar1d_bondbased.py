@@ -23,7 +23,7 @@ from ..solvers.explicit import central_difference
 from ..solvers.modal import exact_stability_limit, min_angular_frequency
 from ..solvers.front import solve_constrained
 from ..corrections.registry import plugin_call
-from ..quotes import Quote as Q, used
+from ..quotes import Quote as Q
 from . import Outcome, Published, Scene, register
 from .base import truncation_problem
 

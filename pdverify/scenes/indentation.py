@@ -16,7 +16,7 @@ from ..pd.nonlinear import LinearBondBased, NonlinearBondBased
 from ..solvers.iterative import Lattice
 from ..solvers.newton import NEWTON_RTOL, DirichletLinearSolver, newton
 from ..solvers.policy import NEWTON_CG_FROM_UNKNOWNS, SPD_LATTICE_SOLVERS, newton_solver
-from ..quotes import Quote as Q, used
+from ..quotes import Quote as Q
 from . import Outcome, Published, register
 from .base import ExpectedFailure
 from .fem_references import FEM, FemAndPD, _reference_module

@@ -9,7 +9,7 @@ from ..metrics import plate_errors
 from ..params import Param, at_least, positive
 from ..pd import QUADRATURES, StateBasedConstants, get_influence, state_based_stencil
 from ..pd.problem import FACES, FaceCondition, StaticProblem
-from ..quotes import Quote as Q, used
+from ..quotes import Quote as Q
 from . import Published, influence_param, register, whole_cells
 from .family import FemStaticStateScene
 

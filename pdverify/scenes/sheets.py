@@ -14,7 +14,7 @@ from ..pd.problem import BondProblem, BondSystem, ClampedBox
 from ..solvers.front import solve_with_dirichlet
 from ..solvers.iterative import Lattice
 from ..solvers.policy import AUTO_ITERATIVE_UNKNOWNS, SPD_LATTICE_SOLVERS
-from ..quotes import Quote as Q, used
+from ..quotes import Quote as Q
 from . import Outcome, Published, register, whole_cells
 from .fem_references import FemAndPD
 

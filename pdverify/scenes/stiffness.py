@@ -39,7 +39,7 @@ from ..pd import (StateBasedConstants, bond_micromodulus, build_stencil, get_inf
 from ..pd.build import Body, BondMaterial, StateMaterial, build_model
 from ..pd.influence import INFLUENCES
 from ..pd.problem import FACES, FaceCondition, StaticProblem
-from ..quotes import Quote as Q, used
+from ..quotes import Quote as Q
 from . import MethodSpec, Outcome, Published, Scene, register, whole_cells
 from ..corrections.builtin import BASELINE
 from .family import StaticStateScene

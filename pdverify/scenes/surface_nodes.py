@@ -12,7 +12,7 @@ from ..params import Param, at_least, open_interval, positive
 from ..pd import QUADRATURES, StateBasedConstants, get_influence, state_based_stencil
 from ..pd.problem import FACES, FaceCondition, StaticProblem
 from ..solvers.policy import ND3D_FROM_UNKNOWNS, ND_FROM_UNKNOWNS, STATIC_SOLVERS
-from ..quotes import Quote as Q, used
+from ..quotes import Quote as Q
 from . import Outcome, Published, influence_param, register, require_influence
 from .base import ExpectedFailure
 from .family import StaticStateScene
