@@ -122,8 +122,15 @@ def _next(found, pos) -> int:
     return min(later) if later else pos
 
 
+#: how near a record a typed number counts as a stale or rounded quote of it, besides
+#: being equal as printed: 1 % (catches a quote typed once and left behind when the run
+#: changed, e.g. 128 % for a record of 128.8 %, which prints 129)
+NEAR = 0.01
+
+
 def _printed_as(value: float, typed: str) -> bool:
-    """Whether ``value`` printed with ``typed``'s digits reads ``typed``."""
+    """Whether ``value`` printed with ``typed``'s digits reads ``typed``, or lies within
+    :data:`NEAR` of it."""
     t = float(typed)
     if "e" in typed.lower():
         mant = typed.lower().split("e")[0]
@@ -134,12 +141,13 @@ def _printed_as(value: float, typed: str) -> bool:
         dec = len(typed.split(".")[1]) if "." in typed else 0
         step = 10.0 ** (-dec)
     # a printed value matches a record within half its last digit (round-half either way)
-    return t != 0 and abs(value - t) <= 0.5 * step * (1 + 1e-9)
+    return t != 0 and (abs(value - t) <= 0.5 * step * (1 + 1e-9)
+                       or abs(value - t) <= NEAR * abs(t))
 
 
 def typed_near_records(text: str, results, scenes, allowed=()) -> list[str]:
-    """The typed numbers of ``text`` that equal, as printed, a metric of a run of
-    ``scenes`` in ``results``: one phrase each, naming the run. A number followed by '%'
+    """The typed numbers of ``text`` that equal, as printed (or within :data:`NEAR`), a
+    metric of a run of ``scenes`` in ``results``: one phrase each, naming the run. A number followed by '%'
     is compared with ``*_pct`` metrics as they are and with the others times 100; any
     other number with the metrics as they are (magnitudes too). ``allowed``: numbers the
     text types on purpose (a paper's value that happens to equal ours, a setup). Too

@@ -330,6 +330,8 @@ class Homogenization(BondBarScene):
     """
 
     id = "bar1d-homogenization"
+    #: typed numbers that look like ours on purpose (pdverify.quotes): Table 12's 1.043
+    doc_typed = ("1.043",)
     title = "Bar in uniaxial tension: end-bond homogenisation (triangular micromodulus)"
     seed = "004 §3-6.1"
     reference = "analytic"
