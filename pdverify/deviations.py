@@ -2,10 +2,36 @@
 paper leaves open and what we chose, and published numbers that do not reproduce and
 why. One data file, shown in each scene's section of the report (the scenes' docstrings
 give the detail). Sources: the project's ERRATA.md (checked errata and choices) and the
-scene docstrings (measured findings)."""
+scene docstrings (measured findings).
+
+A number a text quotes from one of this report's runs is a placeholder ``{{name}}``
+declared in the entry's ``quotes`` (:class:`pdverify.quotes.Quote`), formatted from the
+run's record when the report is rendered; numbers the papers print, setups, and numbers a
+study outside the report measured (its test or command named in ``source``) are typed.
+The report shows each entry as a table row: ``summary`` (the quantity), ``ours`` and
+``paper`` (short, with placeholders), the source, and the full text folded."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+
+from .quotes import Quote, resolve
+
+Q = Quote
+
+# the runs the texts quote (params a run must have; see each scene's report cases)
+_B3 = {"spacing": 0.05, "m_ratio": 3.0, "quadrature": "partial-volume",
+       "surface_load": "face-mean"}                 # body3d-manufactured, default grid
+_MIRROR = {"mirror_point": "nearest", "neumann": "full-traction", "gradient_at": "mirror"}
+_P2 = {"spacing": 0.02, "m_ratio": 3.0, "quadrature": "partial-volume",
+       "influence": "gaussian"}                     # plate2d-plane-strain, the paper's grid
+_T2 = {"m_ratio": 6.0, "micromodulus": "constant", "side_factor": 4.0}  # sheet2d-clamped
+_T1 = {"spacing": 0.001, "micromodulus": "constant", "quadrature": "full-cells",
+       "load_sharing": "tributary"}                 # sheet2d-tension, Table 1's grid
+_IND = {"spacing": 0.00025, "substeps": 1, "line_search": "on", "newton_rtol": 1e-8,
+        "node_volumes": "partial", "predictor": "tangent"}  # indentation, paper's grid
+_INDQ = {"spacing": 0.001, "horizon": 0.006}      # indentation, the quick grid
+_W = {"calibration": "discrete", "micromodulus": "triangular"}  # Table 12's bars
+_L = {"spacing": 0.025, "m_ratio": 3.0, "jitter": 0.0}  # plate-l's default grid
 
 
 @dataclass(frozen=True)
@@ -17,6 +43,47 @@ class Deviation:
     source: str
     #: a short name a published entry (``Published.deviation``) cites when ours differs
     key: str = ""
+    #: the numbers the texts quote from this report's runs: ``{{name}}`` -> Quote
+    quotes: dict = field(default_factory=dict)
+    #: typed numbers that look like ours on purpose: a paper's print equal to ours, a
+    #: setup, a study outside the report (named in the text or ``source``)
+    typed: tuple = ()
+    #: the table row: the quantity, ours and the paper's (or the reference's), short
+    summary: str = ""
+    ours: str = ""
+    paper: str = ""
+
+    def render(self, results, scene_id: str) -> dict:
+        """The entry with every placeholder formatted from ``results`` (the report's
+        records; a run not among them says so): kind, key, summary, ours, paper, text,
+        source."""
+        def fill(text):
+            return resolve(text, self.quotes, results, scene_id)
+        return {"kind": self.kind, "key": self.key, "source": self.source,
+                "summary": fill(self.summary or _first_clause(self.text)),
+                "ours": fill(self.ours), "paper": self.paper, "text": fill(self.text)}
+
+
+def _first_clause(text: str, limit: int = 90) -> str:
+    """A text's opening up to its first full stop, colon or semicolon (not one of an
+    abbreviation: Eq., Fig., App., ...), cut at a word near ``limit``: the table's
+    quantity column where an entry has no ``summary``."""
+    import re
+    for m in re.finditer(r"[.:;](?= )", text):
+        word = re.search(r"(\w+)$", text[:m.start()])
+        if m.group() == "." and word and (word.group(1) in _ABBREVIATIONS
+                                          or len(word.group(1)) == 1):
+            continue
+        if m.start() >= 15:
+            text = text[:m.start()]
+            break
+    if len(text) <= limit:
+        return text
+    return text[:limit].rsplit(" ", 1)[0] + " ..."
+
+
+_ABBREVIATIONS = {"Eq", "Eqs", "Fig", "Figs", "App", "Sec", "Secs", "ref", "Ref", "e", "i",
+                  "al", "vs", "cf"}
 
 
 DEVIATIONS = (
@@ -26,10 +93,15 @@ DEVIATIONS = (
               "The node at |xi| = delta (m = 3, nodes at cell centres) gets beta = 1/2, and "
               "corrected models use m = A delta^3 at every node (omega = delta/|xi|). The two "
               "belong together: beta = 1/2 makes the stencil's sum of Eq. (25) equal A delta^3. "
-              "With beta = 1 and m = A delta^3 the 'exact' traction case (order 1) is 30.4 % "
+              "With beta = 1 and m = A delta^3 the 'exact' traction case (order 1) is {{off}} % "
               "off (the ERRATA's 'about 30 %'); with beta = 1 and m summed over the same "
               "volumes it is exact again (report cases quadrature=full-cells, "
-              "complete_m=stencil|continuum).", "ERRATA 000; tests/pdverify/test_bar1d.py"),
+              "complete_m=stencil|continuum).", "ERRATA 000; tests/pdverify/test_bar1d.py",
+              quotes={"off": Q("max_error_pct", "taylor-fictitious",
+                               {"quadrature": "full-cells", "complete_m": "continuum"},
+                               ".1f", scene="bar1d-traction")}, typed=("30",),
+              summary="beta = 1/2 at |xi| = delta with m = A delta^3",
+              ours="beta = 1: {{off}} % off", paper="ERRATA: about 30 %"),
     Deviation(("bar1d-traction", "bar1d-uniform-load", "bar1d-linear-load", "bar1d-sine-load"),
               "choice", "Uncorrected baseline as the paper describes it: no fictitious nodes, "
               "m_i from Eq. (50) over real neighbours, the Dirichlet value on the node nearest "
@@ -53,56 +125,86 @@ DEVIATIONS = (
               "1 is missing: 1 x 0.5 x 0.5 m, h = 0.05 m, m = 3, E = 200 GPa) in bond-based PD "
               "(nu = 1/4, whole cells inside the horizon, the volumes perifit's API takes), "
               "the formulation the peers' volume and perifit corrections were written for.",
-              "ERRATA 001; scene docstring"),
+              "ERRATA 001; scene docstring",
+              summary="Ours: seed 001's box in bond-based PD (the peers' formulation)"),
     Deviation(("stiffness3d-box",), "finding",
               "energy and PALS beat none under homogeneous strain, volume and perifit do not "
-              "(61.4 and 55.8 % against 39.4 %; perifit in six readings): LPS with m over the "
+              "({{volume}} and {{perifit}} % against {{none}} %; perifit in six readings): LPS with m over the "
               "truncated family already gives a flat face's node the ball's moment ratios. "
               "In bond-based PD (stiffness3d-box-bond) all three beat none.",
-              "scene docstring; tests/corrections/test_bond_methods.py", key='001-lps-box-peers'),
+              "scene docstring; tests/corrections/test_bond_methods.py", key='001-lps-box-peers',
+              quotes={k: Q("surface_energy_error_pct", k, fmt=".1f")
+                      for k in ("none", "volume", "perifit")},
+              summary="largest surface energy error: volume, perifit against none (LPS)",
+              ours="{{volume}} / {{perifit}} / {{none}} %", paper="(not in seed 001)"),
     Deviation(("body3d-manufactured",), "erratum",
               "Appendix transcription slips (Eqs. 60, 63, 64, Sec. 2.1/2.4, Fig. 8) corrected; "
               "Eqs. (40), (41) as printed are right (checked by quadrature).", "ERRATA 001"),
     Deviation(("body3d-manufactured",), "finding",
-              "Surface nodes with N = 1 give 1.88 % on the stand-in body, limited by the order-1 "
+              "Surface nodes with N = 1 give {{n1}} % on the stand-in body, limited by the order-1 "
               "truncation at the tip; the paper's '< 1 %' needs its missing Table 1. N = 2 and "
-              "3 give 0.32 and 0.26 % (paper: < 1 % and 0.4 %).",
-              "ERRATA 001; scene docstring", key="001-table1-manufactured"),
+              "3 give {{n2}} and {{n3}} % (paper: < 1 % and 0.4 %).",
+              "ERRATA 001; scene docstring", key="001-table1-manufactured",
+              quotes={f"n{k}": Q("max_error_pct", "surface-nodes", {**_B3, "order": k}, ".2f")
+                      for k in (1, 2, 3)},
+              summary="surface nodes N = 1, 2, 3: max error (Eq. 38)",
+              ours="{{n1}} / {{n2}} / {{n3}} %", paper="< 1 / < 1 / 0.4 %"),
     Deviation(("body3d-manufactured",), "finding",
               "Fig. 11's colour bar tops at 0.0021 m; Eq. (42) on the stand-in 1 x 0.5 x 0.5 m "
-              "body peaks at 0.0615 m (max_displacement), 29 times more: the paper's body is "
+              "body peaks at {{peak}} m (max_displacement), {{times}} times more: the paper's body is "
               "smaller, l_x = 0.304 m at the stand-in's aspect ratio (0.3 x 0.15 x 0.15 m: "
               "0.00202 m). On that body at h = 0.0125 m (m = 3) none gives 29.7 % and surface "
               "nodes N = 1 / 3 give 1.14 / 0.16 % (paper: > 130, < 1, 0.4 %): a smaller body "
               "does not reproduce the baseline's > 130 % either (`pdverify run "
               "body3d-manufactured --set lx=0.3 --set ly=0.15 --set lz=0.15 --set "
               "spacing=0.0125`; not a report case: 91 s for N = 3).",
-              "seed 001 Fig. 11; tests/surface/", key="001-fig11-body"),
+              "seed 001 Fig. 11; tests/surface/ (the smaller body: the command above, not a "
+              "report run)", key="001-fig11-body",
+              quotes={"peak": Q("max_displacement", "none", {**_B3, "load_point": "node"},
+                                ".3g"),
+                      "times": Q("max_displacement", "none", {**_B3, "load_point": "node"},
+                                 ".0f", scale=1 / 0.0021)},
+              # the paper's > 130 %; the smaller body's run (the command above)
+              typed=("0.0125", "0.16", "1.14", "29.7", "0.00202", "0.304", "130"),
+              summary="peak displacement of Eq. (42) on the stand-in body",
+              ours="{{peak}} m", paper="Fig. 11: 0.0021 m"),
     Deviation(("body3d-traction",), "finding",
               "The paper's '> 30 %' of the uncorrected box depends on the grid, which its "
-              "missing Table 1 would give: 26.3 % at our default h = 0.05 m, 31.0 % at "
+              "missing Table 1 would give: {{none05}} % at our default h = 0.05 m, 31.0 % at "
               "h = 0.1 m (m = 3; measured, tests/pdverify/test_published.py). Surface nodes "
-              "with N = 1: 0.077 % (paper 0.06 %) on the stand-in body; with "
+              "with N = 1: {{sn1}} % (paper 0.06 %) on the stand-in body; with "
               "quadrature=moment-corrected about 2e-10 %.",
-              "ERRATA 001; scene docstring", key="001-table1-traction"),
+              "ERRATA 001; scene docstring", key="001-table1-traction",
+              quotes={"none05": Q("max_error_pct", "none",
+                                  {"spacing": 0.05, "load_point": "surface",
+                                   "quadrature": "partial-volume", "influence": "gaussian"},
+                                  ".1f"),
+                      "sn1": Q("max_error_pct", "surface-nodes",
+                               {"spacing": 0.05, "order": 1, "quadrature": "partial-volume",
+                                "influence": "gaussian"}, ".2g")},
+              summary="uncorrected box and surface nodes N = 1: max error",
+              ours="{{none05}} % / {{sn1}} %", paper="> 30 % / 0.06 %"),
     Deviation(("plate2d-plane-strain", "stiffness2d-plate"), "choice",
               "Sec. 5 plate (Table 2 missing): 1 x 1 m, E = 200 GPa, nu = 0.3, h = 0.02 m, m = 3, "
               "u = 0 on x = 0, v = 0 on y = 0, 240 MPa on y = l_y; exact field Eq. (43); the "
               "quoted 2D constants are plane-strain ones.", "ERRATA 001"),
     Deviation(("plate2d-plane-strain",), "finding",
-              "At m = 3 the exact-partial-area lattice is itself 1.2 % off for a linear field, "
+              "At m = 3 the exact-partial-area lattice is itself {{lat}} % off for a linear field, "
               "so surface nodes are judged with quadrature=moment-corrected (round-off) or at "
               "m >= 5; the paper's ordering of PALS, MNM and PDDO only partly holds (mirror "
               "nodes with the full traction relation and PDDO are exact for the affine field).",
-              "ERRATA 001; scene docstring", key='001-plate-lattice'),
+              "ERRATA 001; scene docstring", key='001-plate-lattice',
+              quotes={"lat": Q("max_error_pct", "surface-nodes", {**_P2, "order": 1}, ".2g")},
+              summary="the m = 3 lattice's own error for the affine field",
+              ours="{{lat}} % (surface nodes)", paper="(not stated)"),
     Deviation(("plate2d-plane-strain",), "finding",
               "Seed 001 §5.4's MNM pattern ('close in x except one corner', 'worst in y') "
               "is shown by none of the readings we run (h = 0.02, not tuned): full traction "
               "with the nearest or corrected mirror node or the gradient at the boundary "
               "point, and PDDO with the LPS or a PDDO bulk (stand-in for the paper's "
-              "non-ordinary one), give round-off; normal derivatives only give 97.6 % in u, "
-              "20.4 % in v; the Neumann step from the mirror point gives 1.93 % in u and "
-              "0.721 % in v, at corners, below PALS. Why none can: the exact field (Eq. 43) "
+              "non-ordinary one), give round-off; normal derivatives only give {{nu}} % in u, "
+              "{{nv}} % in v; the Neumann step from the mirror point gives {{mu}} % in u and "
+              "{{mv}} % in v, at corners, below PALS. Why none can: the exact field (Eq. 43) "
               "is affine and every real node's neighbourhood is complete, so readings exact "
               "for affine fields give round-off; a wrong boundary strain makes another "
               "homogeneous state, where the free face x = l_x ties the u error to the v "
@@ -110,7 +212,18 @@ DEVIATIONS = (
               "2 delta layer with the fictitious nodes' own dilatations (exact for affine "
               "fields whenever its displacement relations are).",
               "scene docstring; tests/corrections/test_mirror_pddo.py",
-              key="001-s5-mnm-readings"),
+              key="001-s5-mnm-readings",
+              quotes={"nu": Q("max_error_pct", "mirror-nodes",
+                              {**_P2, **_MIRROR, "neumann": "normal-only"}),
+                      "nv": Q("max_error_v_pct", "mirror-nodes",
+                              {**_P2, **_MIRROR, "neumann": "normal-only"}),
+                      "mu": Q("max_error_pct", "mirror-nodes",
+                              {**_P2, **_MIRROR, "mirror_point": "at-mirror-point"}),
+                      "mv": Q("max_error_v_pct", "mirror-nodes",
+                              {**_P2, **_MIRROR, "mirror_point": "at-mirror-point"})},
+              summary="MNM readings: max error in u, v (normal-only; from the mirror point)",
+              ours="{{nu}} / {{nv}} %; {{mu}} / {{mv}} %",
+              paper="'close in x except one corner', 'worst in y'"),
     # --- treatments beyond their papers' scenes (the static-state family; ours) -----------
     Deviation(("bar1d-traction", "bar1d-uniform-load", "bar1d-linear-load", "bar1d-sine-load"),
               "choice",
@@ -119,20 +232,29 @@ DEVIATIONS = (
               "mirror nodes and PDDO use the 1D modulus E = lambda + 2 mu. All three are exact "
               "for the traction bar's linear field, surface nodes of order 2 and PDDO for the "
               "uniform load's quadratic one.",
-              "corrections/surface_nodes.py, mirror_nodes.py, pddo.py; tests/treatments/test_static_family.py"),
+              "corrections/surface_nodes.py, mirror_nodes.py, pddo.py; tests/treatments/test_static_family.py",
+              summary="Ours: seed 001/002's surface nodes, mirror nodes and PDDO on seed 000's "
+                      "bars"),
     Deviation(("plate2d-plane-strain",), "choice",
               "Ours: seed 000's Taylor fictitious nodes with tractions, which seed 000 does not "
               "treat in 2D (its plate is clamped): the force flux of every boundary cell face "
               "(seed 001's face-crossing bonds, Eq. 35) by Lagrange multipliers; the affine "
               "solution is reproduced to round-off with moment-corrected weights and carries "
-              "the discrete material's moduli error (1.20 / 0.51 %, as surface nodes) with "
+              "the discrete material's moduli error ({{u}} / {{v}} %, as surface nodes) with "
               "exact partial areas.",
-              "corrections/taylor_fictitious.py; tests/treatments/test_static_family.py"),
+              "corrections/taylor_fictitious.py; tests/treatments/test_static_family.py",
+              quotes={"u": Q("max_error_pct", "taylor-fictitious",
+                             {**_P2, "order": 1}, ".3g"),
+                      "v": Q("max_error_v_pct", "taylor-fictitious",
+                             {**_P2, "order": 1}, ".2g")},
+              summary="seed 000's Taylor fictitious nodes with tractions on the 2D plate",
+              ours="{{u}} / {{v}} % (u / v)", paper="(not in seed 000)"),
     Deviation(("body3d-manufactured",), "finding",
               "Seed 001 §5's mirror nodes and PDDO, run here by us (the paper shows them on "
               "the 2D plate only), stay far from surface nodes on the cubic manufactured "
-              "field: at h = 0.05 mirror nodes 132 % and PDDO 40 % against surface nodes' "
-              "0.26 % and none's 128 % (h = 0.1: 151, 188, 0.97, 227 %). Both reproduce "
+              "field: at h = 0.05 mirror nodes {{m05}} % and PDDO {{p05}} % against surface "
+              "nodes' {{s05}} % and none's {{n05}} % (h = 0.1: {{m10}}, {{p10}}, {{s10}}, "
+              "{{n10}} %). Both reproduce "
               "affine fields in 3D (tested). Cause, mirror nodes: their relations are exact "
               "for affine fields only. On a straight reflection (depth s) the Neumann "
               "relation takes the tangential derivatives at the mirror node, not at the "
@@ -163,9 +285,21 @@ DEVIATIONS = (
               "cubic: 0.29, 0.14, 0.067 of the body load) and it converges at second order "
               "from a large constant: rel_l2 1.23, 0.85, 0.47, 0.28, 0.19 over the same h, "
               "fitted 178 (h/m)^2.15, i.e. (delta/0.27 m)^2.15; 1 % would need h = 0.011 m. "
-              "Its 40 % at h = 0.05 is that constant, not a lower rate.",
+              "Its {{p05}} % at h = 0.05 is that constant, not a lower rate.",
               "tests/treatments/test_body3d_mirror_cause.py; "
-              "tests/treatments/test_static_family.py", key='001-body3d-mirror-pddo'),
+              "tests/treatments/test_static_family.py", key='001-body3d-mirror-pddo',
+              quotes={f"{k}{tag}": Q("max_error_pct", method,
+                                     {**_B3, **extra, "spacing": h}, ".3g")
+                      for k, method, extra in (("m", "mirror-nodes", _MIRROR),
+                                               ("p", "pddo", {"bulk_model": "lps"}),
+                                               ("s", "surface-nodes", {"order": 3}),
+                                               ("n", "none", {"load_point": "node"}))
+                      for tag, h in (("05", 0.05), ("10", 0.1))},
+              # the study's numbers (its tests, named in source), not report runs
+              typed=("0.694", "1.23", "0.703", "99.8"),
+              summary="mirror nodes and PDDO on the cubic manufactured field (max error)",
+              ours="MNM {{m05}} %, PDDO {{p05}} %, SNM {{s05}} %, none {{n05}} % (h = 0.05)",
+              paper="(2D plate only in seed 001)"),
     # --- seed 002 ------------------------------------------------------------------------
     Deviation(("wave1d-surface-nodes",), "erratum",
               "Eq. (11) sign: the time factor is cos(v sqrt(psi) t), psi > 0; its Fourier "
@@ -177,9 +311,12 @@ DEVIATIONS = (
     # --- seed 003 ------------------------------------------------------------------------
     Deviation(("sheet2d-clamped",), "erratum",
               "Sec. 4.1.2 swaps the edges: top and bottom (y = +-2 delta) are clamped and "
-              "displaced +-2 delta/100 (an independent FEM gives 10.32 MPa only this way); the "
+              "displaced +-2 delta/100 (an independent FEM, ours, gives {{fem}} MPa only this way); the "
               "virtual-node buffer moves rigidly by +-2 delta/100 (the printed "
-              "2 delta [1 + delta/12]/100 is dimensionally inconsistent).", "ERRATA 003"),
+              "2 delta [1 + delta/12]/100 is dimensionally inconsistent).", "ERRATA 003",
+              quotes={"fem": Q("tensile_stress_mpa", "fem", fmt=".4g")},
+              summary="Sec. 4.1.2: clamped edges and the buffer's displacement",
+              ours="FEM {{fem}} MPa", paper="Table 2 FEM: 10.32 MPa"),
     Deviation(("sheet2d-*", "stiffness2d-sheet", "block2d-indentation"), "choice",
               "Plane stress, nu = 1/3, unit thickness, micromodulus calibrated to a complete "
               "continuous horizon; nodes on the surface with half (edge) and quarter (corner) "
@@ -200,21 +337,41 @@ DEVIATIONS = (
     Deviation(("stiffness2d-sheet",), "finding",
               "§4.1.2's 'deviations from exact isotropy are less than 2 %' (m = 1/6) does not "
               "say how the deviation is measured. The spread of the bulk's uniaxial stiffness "
-              "over the lattice directions (bulk_anisotropy_pct) gives 1.69 % (holds); "
+              "over the lattice directions (bulk_anisotropy_pct) gives {{spread}} % (holds); "
               "C11 against 3 C12 (bond-based isotropy, bulk_anisotropy_c11_3c12_pct) gives "
-              "3.26 % (a known difference). Both are in every run record.",
+              "{{cauchy}} % (a known difference). Both are in every run record.",
               "pdverify/scenes/stiffness.py; tests/pdverify/test_issue53_texts.py",
-              key="003-anisotropy-measure"),
+              key="003-anisotropy-measure",
+              quotes={"spread": Q("bulk_anisotropy_pct", "none", {"m_ratio": 6.0}, ".2f",
+                                  scene="stiffness2d-sheet"),
+                      "cauchy": Q("bulk_anisotropy_c11_3c12_pct", "none", {"m_ratio": 6.0},
+                                  ".2f", scene="stiffness2d-sheet")},
+              summary="bulk anisotropy at m = 1/6, two measures",
+              ours="{{spread}} % (spread) / {{cauchy}} % (C11 vs 3 C12)", paper="< 2 %"),
     Deviation(("sheet2d-clamped",), "erratum",
               "The text's 'about 4 %' gain from correcting the side surfaces is about 2 % of "
               "the reference: Table 2's own rows give (8.64 - 8.43) / 10.32 = 2.0 %.",
-              "ERRATA 003"),
+              "ERRATA 003", typed=("10.32", "2.0", "8.64", "8.43"),   # Table 2's print
+              summary="gain from correcting the side surfaces", ours="",
+              paper="text: about 4 %; Table 2: 2.0 %"),
     Deviation(("sheet2d-clamped",), "finding",
               "The horizon quadrature is unstated: with whole cells (full-cells, Peridigm's "
-              "default; ours) the four PD rows of Table 2 come out 4.14, 10.18, 8.41 and "
-              "8.73 MPa against the printed 4.17, 10.21, 8.43, 8.64 (within 1.1 %, not within "
-              "the printed digits); exact partial areas give 4.17, 10.33, 8.57, 8.89.",
-              "scene docstring", key="003-table2-quadrature"),
+              "default; ours) the four PD rows of Table 2 come out {{fn}}, {{fe}}, {{fv}} and "
+              "{{fs}} MPa against the printed 4.17, 10.21, 8.43, 8.64 (not within the printed "
+              "digits); exact partial areas "
+              "give {{pn}}, {{pe}}, {{pv}}, {{ps}}.",
+              "scene docstring", key="003-table2-quadrature",
+              quotes={f"{q}{k}": Q("tensile_stress_mpa", method, {**_T2, **extra,
+                                                                  "quadrature": quad}, ".2f")
+                      for q, quad in (("f", "full-cells"), ("p", "partial-volume"))
+                      for k, method, extra in (
+                          ("n", "none", {"node_volumes": "partial"}),
+                          ("e", "energy-directional", {"node_volumes": "partial"}),
+                          ("v", "virtual-nodes", {"correct_sides": False}),
+                          ("s", "virtual-nodes", {"correct_sides": True}))},
+              typed=("4.17", "10.21", "8.43", "8.64"),   # Table 2's print
+              summary="Table 2's four PD rows (MPa), whole cells",
+              ours="{{fn}}, {{fe}}, {{fv}}, {{fs}}", paper="4.17, 10.21, 8.43, 8.64"),
     Deviation(("sheet2d-tension",), "choice",
               "Table 1 does not say how the error is normalised near the symmetry lines nor how "
               "the end force is shared: the symmetry lines are left out (as Fig. 2 blacks them "
@@ -222,10 +379,18 @@ DEVIATIONS = (
               "other reading); *_norm_pct and *_continuum_pct are the other normalisations.",
               "ERRATA 003; scene docstring"),
     Deviation(("sheet2d-tension",), "finding",
-              "Uncorrected: 301 % in u_x and 84 % in u_y against the paper's 82 % / 291 % (the "
-              "components the other way round: a column swap in Table 1 or another unstated "
-              "choice); corrected 3.09 % / 3.01 % (paper 2.6 % / 3.2 %).", "scene docstring",
-              key="003-table1"),
+              "Uncorrected: {{nx}} % in u_x and {{ny}} % in u_y against the paper's 82 % / 291 % "
+              "(the components the other way round: a column swap in Table 1 or another "
+              "unstated choice); corrected {{ex}} % / {{ey}} % (paper 2.6 % / 3.2 %).",
+              "scene docstring", key="003-table1",
+              quotes={f"{k}{c}": Q(f"max_error_u{c}_pct", method, _T1, fmt)
+                      for k, method, fmt in (("n", "none", ".3g"),
+                                             ("e", "energy-directional", ".3g"))
+                      for c in ("x", "y")},
+              typed=("2.6", "3.2"),
+              summary="Table 1: max error in u_x / u_y, uncorrected and corrected",
+              ours="{{nx}} / {{ny}} %; {{ex}} / {{ey}} %",
+              paper="82 / 291 %; 2.6 / 3.2 %"),
     Deviation(("block2d-indentation",), "choice",
               "E = 1 GPa, bottom fixed, sides free, depth in >= 20 steps, surface nodes stick "
               "once reached; the PD model is geometrically nonlinear and the reference a "
@@ -233,41 +398,89 @@ DEVIATIONS = (
               "ERRATA 003"),
     Deviation(("block2d-indentation",), "finding",
               "The peers' corrections (energy, volume, perifit) delay the uncorrected collapse "
-              "but do not prevent it: at the paper's grid each fails by a Newton stall at "
-              "1.0-1.1 mm (none: 0.7 mm); seed 003's directional factor reaches 2 mm.",
-              "scene docstring", key='003-indentation-peers'),
+              "but do not prevent it: at the paper's grid each fails by a Newton stall, energy "
+              "at {{energy}} mm, volume at {{volume}} mm, perifit at {{perifit}} mm (none: "
+              "{{none}} mm); seed 003's "
+              "directional factor reaches {{ed}} mm.",
+              "scene docstring", key='003-indentation-peers',
+              quotes={**{k: Q("failure_depth_mm", k, {**_IND, "kinematics": "nonlinear"},
+                              ".1f") for k in ("energy", "volume", "perifit", "none")},
+                      "ed": Q("depth_reached_mm", "energy-directional",
+                              {**_IND, "kinematics": "nonlinear"}, ".1f")},
+              summary="depth where each correction fails (paper's grid)",
+              ours="energy {{energy}}, volume {{volume}}, none {{none}}, energy-directional "
+                   "reaches {{ed}} mm", paper="none: about 0.4 mm"),
     Deviation(("block2d-indentation",), "finding",
-              "The uncorrected nonlinear run fails at 0.7 mm (Newton finds no descent as the "
+              "The uncorrected nonlinear run fails at {{none}} mm (Newton finds no descent as the "
               "lattice under the indenter is about to fold), the paper's at about 0.4 mm; the "
               "same 0.7 mm comes with 4x finer steps. The paper's solver, load step, "
               "surface-node volumes and stopping rule are unstated; swept one at a time "
-              "(report cases, the table beside Fig. 4): without the tangent predictor 0.5 mm "
-              "(the closest), without the line search or with a 1e-4 stopping rule 0.7 mm, "
-              "full surface-node volumes 1.3 mm: no single choice gives 0.4 mm.",
+              "(report cases, the table beside Fig. 4): without the tangent predictor {{pred}} "
+              "mm (the closest), without the line search {{ls}} mm or with a 1e-4 stopping "
+              "rule {{tol}} mm, full surface-node volumes {{vol}} mm: no single choice gives "
+              "0.4 mm.",
               "scene docstring; tests/pdverify/test_indentation_sweep.py",
-              key="003-indentation-failure"),
+              key="003-indentation-failure",
+              quotes={k: Q("failure_depth_mm", "none",
+                           {**_IND, "kinematics": "nonlinear", **over}, ".1f")
+                      for k, over in (("none", {}), ("pred", {"predictor": "none"}),
+                                      ("ls", {"line_search": "off"}),
+                                      ("tol", {"newton_rtol": 1e-4}),
+                                      ("vol", {"node_volumes": "full"}))},
+              summary="uncorrected nonlinear run: depth where it fails",
+              ours="{{none}} mm (closest reading: {{pred}} mm)", paper="about 0.4 mm"),
     Deviation(("block2d-indentation",), "finding",
               "'The surface correction reduces this discrepancy to about 6 %' does not say "
-              "against which FEM: at the paper's grid (161 x 161 nodes) ours is 5.3 % against "
-              "the finite-strain St Venant-Kirchhoff reference (outside 6 +- 0.5) and 5.8 % "
-              "against the small-strain one (within); on the quick report's grid (41 x 41) "
-              "4.8 % and 6.3 %. The uncorrected 'about 30 % smaller' holds against "
-              "the finite-strain one (-30.7 %). Both readings are in every run record.",
-              "the full report's records; compare --against-published",
-              key="003-indentation-reference"),
+              "against which FEM: at the paper's grid (161 x 161 nodes) ours is {{fin}} % "
+              "against the finite-strain St Venant-Kirchhoff reference (outside 6 +- 0.5) "
+              "and {{small}} % against the small-strain one (within); on the quick report's "
+              "grid (41 x 41) {{qfin}} % and {{qsmall}} %. The uncorrected 'about 30 % "
+              "smaller' holds against the finite-strain one ({{bias}} %). Both readings are "
+              "in every run record.",
+              "this report's records; compare --against-published",
+              key="003-indentation-reference",
+              quotes={"fin": Q("force_error_pct", "energy-directional",
+                               {**_IND, "kinematics": "nonlinear"}, ".1f"),
+                      "small": Q("force_error_pct_vs_small_strain", "energy-directional",
+                                 {**_IND, "kinematics": "nonlinear"}, ".1f"),
+                      "qfin": Q("force_error_pct", "energy-directional",
+                                {**_INDQ, "kinematics": "nonlinear"}, ".1f"),
+                      "qsmall": Q("force_error_pct_vs_small_strain", "energy-directional",
+                                  {**_INDQ, "kinematics": "nonlinear"}, ".1f"),
+                      "bias": Q("force_bias_pct", "none",
+                                {**_IND, "kinematics": "nonlinear"}, ".1f")},
+              typed=("30",),
+              summary="corrected force error: against which FEM (paper's grid)",
+              ours="{{fin}} % finite strain / {{small}} % small strain",
+              paper="about 6 %"),
     # --- seed 004 ------------------------------------------------------------------------
     Deviation(("bar1d-homogenization",), "erratum",
               "Table 12, half-weight ends, delta = 3 Delta: f(N) = (N+3)/(N-1) exactly, so "
               "f(7) = 5/3, not 1.043; Eq. (99) indexed in reverse; Eqs. (29), (32): m >= 11 and "
-              ">= 16.", "ERRATA 004", key="004-table12-f7"),
+              ">= 16.", "ERRATA 004", key="004-table12-f7",
+              typed=("1.043",)),   # the paper's print
     Deviation(("bar1d-homogenization",), "finding",
-              "Table 12, full-weight ends, delta = 4 Delta: f(9) = 1.2178540 (ours, the "
-              "equilibrium solve, to round-off) rounds to 1.2179, the paper prints 1.2178. "
-              "The same table rounds its other four-decimal cells (f(7) = 1.2303515 printed "
-              "1.2304, f(9) = 1.3188750 printed 1.3189), so the print is not read as cut: a "
-              "known difference of 0.54 units in the last digit (the paper's fitted "
+              "Table 12, full-weight ends, delta = 4 Delta: f(9) = {{f9}} (ours, the "
+              "equilibrium solve, to round-off) rounds to {{f9r}}, the paper prints 1.2178. "
+              "The same table rounds its other four-decimal cells (f(7) = {{f7}} printed "
+              "1.2304, f(9) = {{f9b}} printed 1.3189), so the print is not read as cut: a "
+              "known difference of {{units}} units in the last digit (the paper's fitted "
               "(27N + 20)/(27(N - 1)) gives 1.2176).",
-              "tests/bondbar/test_bondbar_homogenization.py", key="004-table12-f9-digits"),
+              "tests/bondbar/test_bondbar_homogenization.py", key="004-table12-f9-digits",
+              quotes={"f9": Q("strain_factor", "none", {**_W, "end_weight": "full",
+                                                        "horizon_ratio": 4.0}, ".7f"),
+                      "f9r": Q("strain_factor", "none", {**_W, "end_weight": "full",
+                                                         "horizon_ratio": 4.0}, ".4f"),
+                      "units": Q("strain_factor", "none", {**_W, "end_weight": "full",
+                                                           "horizon_ratio": 4.0}, ".2f",
+                                 minus=1.2178, scale=1e4),
+                      "f7": Q("strain_factor", "none", {**_W, "end_weight": "full",
+                                                        "horizon_ratio": 3.5}, ".7f"),
+                      "f9b": Q("strain_factor", "none", {**_W, "end_weight": "full",
+                                                         "horizon_ratio": 4.5}, ".7f")},
+              typed=("1.2304", "1.3189", "1.2178", "1.2176"),
+              summary="Table 12, full weight, delta = 4 Delta: f(9)",
+              ours="{{f9}}", paper="1.2178"),
     Deviation(("bar1d-homogenization",), "finding",
               "§7 says that with a constant micromodulus (its ref. [1]) the classical limit "
               "f(inf) = 1 is reached only with full-weight end elements. In our bar the "
@@ -275,12 +488,18 @@ DEVIATIONS = (
               "fixed elongation), and f(inf) does not depend on the end weight in either "
               "calibration: 1 for both with c1 from the discrete horizon, and with the "
               "continuum's c = 2E/(A delta^2) the bulk's softening c1(m)/c, Eq. (27)'s "
-              "f_1(m): 1.0125 for both at delta = 4.5 Delta (1 at 4 Delta). "
+              "f_1(m): {{f1}} for both at delta = 4.5 Delta (1 at 4 Delta). "
               "Only b does (full 2.75, half 7.66 at N = 1001, discrete). Reproducing the "
               "claim needs ref. [1]'s conventions, which this paper does not give; both "
               "readings are report runs (micromodulus=constant, end_weight and calibration "
               "each both ways).", "tests/bondbar/test_constant_limit.py",
-              key="004-constant-limit"),
+              key="004-constant-limit",
+              quotes={"f1": Q("micromodulus_factor", "none",
+                              {"micromodulus": "constant", "calibration": "continuum",
+                               "end_weight": "full", "horizon_ratio": 4.5}, ".5g")},
+              summary="§7: f(inf) = 1 only with full-weight ends (constant micromodulus)",
+              ours="f(inf) the same for both end weights ({{f1}}, continuum c)",
+              paper="1 with full-weight ends only"),
     Deviation(("bar1d-homogenization",), "erratum",
               "App. 2, Eqs. (A2.1.1.4) and (A2.1.1.5) miss the factor 1/m; the homogenising "
               "factors are computed from the equilibrium equations, so they do not inherit it.",
@@ -298,13 +517,23 @@ DEVIATIONS = (
               "inside the body along the bond (D the dimension: a bond-based node's energy per "
               "direction under homogeneous strain is (1/4) s^2 int c xi^D dxi); the box is "
               "the grid's, every face counted.",
-              "corrections/energy_directional.py; tests/treatments/test_energy_directional_cells.py"),
+              "corrections/energy_directional.py; "
+              "tests/treatments/test_energy_directional_cells.py",
+              summary="Ours: seed 003's energy-directional on bond-based bars and boxes"),
     Deviation(("stiffness3d-box-bond",), "finding",
-              "energy-directional reduces the surface effect (rms 39.0 -> 30.5 %, uniaxial "
-              "74.3 -> 55.3 %) but not its maximum (83.2 -> 79.7 %): at the cell-centred "
+              "energy-directional reduces the surface effect (rms {{rn}} -> {{re}} %, uniaxial "
+              "{{un}} -> {{ue}} %) but not its maximum ({{mn}} -> {{me}} %): at the cell-centred "
               "box's edges and corners the directions that leave the body within h/2 have no "
               "discrete bond for phi to scale; the bulk stays exact.",
-              "tests/treatments/test_energy_directional_cells.py", key='001-box-bond-directional'),
+              "tests/treatments/test_energy_directional_cells.py", key='001-box-bond-directional',
+              quotes={f"{k}{m[0]}": Q(metric, m, fmt=".1f")
+                      for k, metric in (("r", "surface_energy_rms_pct"),
+                                        ("u", "energy_error_uniaxial_x_pct"),
+                                        ("m", "surface_energy_error_pct"))
+                      for m in ("none", "energy-directional")},
+              summary="surface energy error, none -> energy-directional (rms, uniaxial, max)",
+              ours="{{rn}} -> {{re}}, {{un}} -> {{ue}}, {{mn}} -> {{me}} %",
+              paper="(not in a paper)"),
     # --- ours: bodies that are not boxes (issue 35) -------------------------------------
     Deviation(("plate-hole", "plate-l"), "choice",
               "Ours, not a paper's: the body is cut from the cell-centred lattice of its "
@@ -317,19 +546,30 @@ DEVIATIONS = (
               "boundary point; on straight parts seed 001's force-flux rows, on arcs the "
               "fit's traction. Seeds 000 and 001 define their methods on boxes.",
               "pd/shapes.py, pd/grid.py ShapeGrid, corrections/shape_fictitious.py; "
-              "tests/shapes/test_shape_engine.py"),
+              "tests/shapes/test_shape_engine.py",
+              summary="Ours: bodies cut from a box's lattice; Taylor along the local normal"),
     Deviation(("plate-hole",), "choice",
               "The quarter plate with its two symmetry planes (u_x = 0 on x = 0, u_y = 0 on "
               "y = 0) is the problem every method solves, so the PD runs have those two "
               "faces as boundaries too, as the FEM does; W/a = 5 (the stress concentration "
-              "3.360, not Kirsch's 3: a finite plate).", "reference_fem/hole_plate.py"),
+              "{{scf}}, not Kirsch's 3: a finite plate).", "reference_fem/hole_plate.py",
+              quotes={"scf": Q("scf", "fem", fmt=".3f", scene="plate-hole")},
+              summary="the quarter plate with two symmetry planes, W/a = 5",
+              ours="stress concentration {{scf}}", paper="Kirsch (infinite plate): 3"),
     Deviation(("plate-l",), "finding",
               "Taylor along the normal is worse than the uncorrected model at the re-entrant "
-              "corner (rel L2 0.142 against 0.097 at h = 0.025, order 2), though it reproduces "
+              "corner (rel L2 {{t2}} against {{none}} at h = 0.025, order 2), though it reproduces "
               "a smooth cubic field on the same L-shape to 1.7e-3; a third of the excess is "
               "bonds that bridge the notch from fictitious nodes extrapolated from the other "
-              "arm (dropping those 88 bonds: 0.142 -> 0.092). The scene's docstring has the "
-              "numbers.", "scenes/shapes.py LPlate", key="035-l-plate-bridging"),
+              "arm (dropping those 88 bonds: {{t2}} -> 0.092, a study of the scene's "
+              "docstring, not a report run).", "scenes/shapes.py LPlate",
+              key="035-l-plate-bridging",
+              quotes={"t2": Q("rel_l2_error", "taylor-fictitious", {**_L, "order": 2}, ".3g",
+                              scene="plate-l"),
+                      "none": Q("rel_l2_error", "none", {**_L, "load_point": "surface"},
+                                ".2g", scene="plate-l")},
+              summary="Taylor along the normal at the re-entrant corner (rel L2)",
+              ours="{{t2}} against none's {{none}}", paper="(not in a paper)"),
 )
 
 
@@ -374,6 +614,12 @@ def peer_findings(scene_id: str, results) -> list[Deviation]:
                          + (f"; residual {m['equilibrium_residual']:.2g} in our linear "
                             "model)" if "equilibrium_residual" in m else ")"))
         if parts:
+            ours = " / ".join(f"{100 * r.metrics['peer_diff_to_none']:.2g} %"
+                              for r in (used, same) if r is not None)
             out.append(Deviation((scene_id,), "finding", "; ".join(parts) + ".",
-                                 "this report's peer runs (pdverify/peers)"))
+                                 "this report's peer runs (pdverify/peers)",
+                                 summary=f"{name} against our none (relative L2; "
+                                 + " / ".join(s for s, r in (("as used", used),
+                                                             ("same model", same)) if r)
+                                 + ")", ours=ours, paper="our none"))
     return out

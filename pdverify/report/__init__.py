@@ -516,7 +516,7 @@ def _build_logged(cases, out, final, jobs, progress, client=None, quick=False,
         figs, front, conv = figures_drawn(owned, _draw_all(tasks, jobs, progress))
     with phase("pages_s"):
         for (scene, mine), mine_figs in zip(owned, figs):
-            sections.append((scene, html.scene_section(scene, mine, mine_figs)))
+            sections.append((scene, html.scene_section(scene, mine, mine_figs, records=results)))
     with phase("fields_s"):
         export_fields(results, out)
         if kept is not None:

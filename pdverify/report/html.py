@@ -15,6 +15,7 @@ from ..corrections import describe
 from ..errors import InputError
 from ..papers import PAPERS, seed_of
 from ..published import FIGURE, verdict
+from ..quotes import resolve
 from ..results import CACHED_SETUP
 from ..results import cost_s as run_cost_s
 from ..results import time_s as run_time_s
@@ -245,21 +246,26 @@ def missing_published(scene, results) -> list[str]:
     return list(dict.fromkeys(out))
 
 
-def scene_section(scene, results, figures, deviations=None) -> Markup:
+def scene_section(scene, results, figures, deviations=None, records=None) -> Markup:
     """A scene's section: the deviations box (default: those of
     :mod:`pdverify.deviations`), the docstring folded, the compact table (at most
     :data:`KEY_METRICS` metric columns, the paper's value beneath ours), every metric of
     each run folded (one wrapped cell, so a scene with twenty metrics still fits), the
-    reference's refinement studies and the figures."""
+    reference's refinement studies and the figures. The numbers the deviations and the
+    docstring quote (:mod:`pdverify.quotes`) are formatted from ``records`` (default:
+    ``results``; the whole report's runs, for a text that quotes another scene's)."""
+    records = results if records is None else records
     if deviations is None:
         from ..deviations import for_scene, peer_findings
         deviations = for_scene(scene.id) + peer_findings(scene.id, results)
+    deviations = [d.render(records, scene.id) for d in deviations]
     paper = PAPERS.get(seed_of(scene.seed), {})
     metrics = key_metrics(scene, results)
     return _render(
         "scene.html", scene=scene, headline=headline(scene), deviations=deviations,
         cite=f"{paper['authors']} ({paper['year'] or 'n.d.'})" if paper else "",
-        doc=(type(scene).__doc__ or "").strip(), metrics=metrics,
+        doc=resolve((type(scene).__doc__ or "").strip(), getattr(scene, "doc_quotes", {}),
+                    records, scene.id), metrics=metrics,
         rows=[_row(scene, r, metrics) for r in results],
         refinements=[_refinement(r) for r in results if r.fields.get("refinement")],
         sources=sorted({p.source for p in scene.published}), figures=figures,

@@ -24,6 +24,7 @@ from ..pd.problem import BondProblem, BondSystem, PartCondition, assemble_bonds
 from ..solvers.explicit import central_difference
 from ..solvers.modal import exact_stability_limit, min_angular_frequency
 from ..solvers.front import solve_constrained
+from ..quotes import Quote as Q
 from . import Outcome, Published, Scene, register
 from .base import truncation_problem
 
@@ -334,6 +335,8 @@ class Homogenization(BondBarScene):
     """
 
     id = "bar1d-homogenization"
+    #: typed numbers that look like ours on purpose (pdverify.quotes): Table 12's 1.043
+    doc_typed = ("1.043",)
     title = "Bar in uniaxial tension: end-bond homogenisation (triangular micromodulus)"
     seed = "004 §3-6.1"
     reference = "analytic"
@@ -401,6 +404,13 @@ class Homogenization(BondBarScene):
             # 004-constant-limit)
             out += [("none", {**CONSTANT_LIMIT, "end_weight": w, "calibration": c})
                     for c in ("discrete", "continuum") for w in ("full", "half")]
+            # Tables 1 and 2's f_1(m) at the ratios no case above runs (10, 32, 15.5): the
+            # smallest bar of each (2m + 1 points), so that every printed f_1 stands
+            # beside a run of the full report
+            covered = {o.get("horizon_ratio") for _, o in out}
+            out += [("none", {"horizon_ratio": ratio, "nodes": 2 * int(ratio) + 1})
+                    for _table, rows in MICROMODULUS_TABLES for ratio, _ in rows
+                    if ratio not in covered]
         return out
 
     def end_loaded(self, method, p, nodes, spacing) -> BondSystem:
@@ -617,10 +627,10 @@ class Vibration(BondBarScene):
     held points inside the bar leave the bonds as they are. The figures' curves were lost
     in the text conversion: the paper's values beside ours are Table 13's setup and the
     words of §6.3. In (a) ``modal_frequency_error_pct`` is the lowest mode of the whole
-    bar, the one even about the held midpoint (-1.33 % at delta = 4 Delta), which the odd
+    bar, the one even about the held midpoint ({{modal}} % at delta = 4 Delta), which the odd
     initial field does not excite: the bonds across the midpoint couple the halves, which
     classically decouple at a held point; ``frequency_error_pct`` (the fit to the free
-    end, -0.51 %) is the excited odd mode's. Lumped masses rho V_i. Explicit central
+    end, {{fit}} %) is the excited odd mode's. Lumped masses rho V_i. Explicit central
     differences (``pdverify.solvers.explicit.central_difference``) with
     dt = dt_factor * 2/omega_max, omega_max the largest natural frequency of the discrete
     operator (the paper uses 0.8 times the bound of Madenci & Oterkus; dt_factor > 1 is
@@ -647,6 +657,11 @@ class Vibration(BondBarScene):
     """
 
     id = "bar1d-vibration"
+    #: the numbers the docstring quotes from this report's runs (pdverify.quotes)
+    doc_quotes = {k: Q(metric, "homogenized", {"constraint": "mid", "horizon_ratio": 4.0,
+                                               "nodes": 201}, ".3g")
+                  for k, metric in (("modal", "modal_frequency_error_pct"),
+                                    ("fit", "frequency_error_pct"))}
     title = "Released pre-strained bar, one end fixed: free-end vibration vs Rao's series"
     seed = "004 §6.3"
     reference = "analytic"

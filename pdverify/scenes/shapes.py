@@ -18,6 +18,8 @@ from ..params import Param, at_least, positive
 from ..pd import QUADRATURES, StateBasedConstants, get_influence, state_based_stencil
 from ..pd.problem import FaceCondition, StaticProblem
 from ..pd.shapes import l_shape, quarter_hole
+from ..quotes import Quote as Q
+from ..quotes import used
 from . import influence_param, register, whole_cells
 from .family import FemStaticStateScene
 
@@ -169,11 +171,12 @@ class HolePlate(ShapeScene):
     ``y+`` and the ``hole`` free. FEM (``fem``): the converged quadratic-element reference
     of ``reference_fem.hole_plate`` on a mapped mesh of the same shape (9-node
     isoparametric quadrilaterals, the arc to O(h^3)): its field changes on the PD grid by
-    0.195, 0.055, 0.0117, 0.0018 % over its refinements (the report's table), u_x(W, 0) =
-    1.22584e-3 m, stress concentration 3.3601. Checked against Kirsch (its tests): with
+    0.195, 0.055, 0.0117, {{fem_change}} % over its refinements (the report's table),
+    u_x(W, 0) = {{fem_ux}} m, stress concentration {{fem_scf}}. Checked against Kirsch (its
+    tests): with
     Kirsch's own traction on the outer edges the FEM converges to Kirsch's displacement
     at rate 3.07 (0.070 .. 0.000115 % of max |u|, concentration 2.99988); under uniform
-    tension the concentration falls to Kirsch's 3 as the plate grows, 3.360, 3.085,
+    tension the concentration falls to Kirsch's 3 as the plate grows, {{fem_scf3}}, 3.085,
     3.020, 3.004 at W/a = 5, 10, 20, 40 (3 + ~8.5 (a/W)^2; ours is W/a = 5), and the
     displacement near the hole comes within 0.72 % of Kirsch's at W/a = 20.
 
@@ -197,14 +200,15 @@ class HolePlate(ShapeScene):
     is the report's figure.
 
     Findings at the default grid (h = 0.025 m, measured): Taylor along the normal beats
-    the uncorrected model (max error 3.45 / 3.81 / 2.26 % for orders 1 / 2 / 3 against
-    7.28 %; rel L2 0.022 / 0.021 / 0.016 against 0.031), its largest errors at the hole
-    (where the arc's rows are the fit's traction, not a flux); PALS has the smallest rel
-    L2 (0.014) with its largest error at the hole's ends (4.85 %); the volume correction
-    is worse than none at the loaded edge's corners (8.23 %). Over the refinement (h =
-    0.05, 1/30, 0.025, m = 3) the uncorrected and bond-method errors fall steadily (rel
-    L2 of none 0.049, 0.038, 0.031), Taylor's do not (order 3: 0.030, 0.033, 0.016; order
-    1: 0.154, 0.047, 0.022): with a / delta = 1.3 to 2.7 the hole is within a few
+    the uncorrected model (max error {{t1_max}} / {{t2_max}} / {{t3_max}} % for orders 1 / 2 / 3
+    against {{none_max}} %; rel L2 {{t1_l2}} / {{t2_l2}} / {{t3_l2}} against {{none_l2}}), its
+    largest errors at the hole (where the arc's rows are the fit's traction, not a flux);
+    PALS has the smallest rel L2 ({{pals_l2}}) with its largest error at the hole's ends
+    ({{pals_max}} %); the volume correction is worse than none at the loaded edge's corners
+    ({{volume_max}} %). Over the refinement (h = 0.05, 1/30, 0.025, m = 3) the uncorrected
+    and bond-method errors fall steadily (rel L2 of none {{none_l2_a}}, {{none_l2_b}},
+    {{none_l2}}), Taylor's do not (order 3: {{t3_l2_a}}, {{t3_l2_b}}, {{t3_l2}}; order 1:
+    {{t1_l2_a}}, {{t1_l2_b}}, {{t1_l2}}): with a / delta = 1.3 to 2.7 the hole is within a few
     horizons of every node that sees it, and the fitted slopes in the figure are of three
     pre-asymptotic levels, not rates. Jitter up to 0.4 spacings
     raises the Taylor extension's error (rel L2 0.021 -> 0.031, order 2) and lowers the
@@ -214,6 +218,24 @@ class HolePlate(ShapeScene):
     """
 
     id = "plate-hole"
+    #: typed on purpose: the FEM's Kirsch checks (its tests), not report runs
+    doc_typed = ("3.07", "2.99988", "3.085", "3.020", "3.004")
+    #: the numbers the docstring quotes from this report's runs (pdverify.quotes)
+    doc_quotes = used(__doc__, {
+        "fem_change": Q("field_change_pct", "fem", fmt=".2g"),
+        "fem_ux": Q("ux_load_point", "fem", fmt=".6g"),
+        "fem_scf": Q("scf", "fem", fmt=".5g"),
+        "fem_scf3": Q("scf", "fem", fmt=".3f"),
+        **{f"{k}_{m}{tag}": Q(metric, method, {"spacing": h, "m_ratio": 3.0, "jitter": 0.0,
+                                                **extra}, fmt)
+           for k, method, extra in (("none", "none", {"load_point": "surface"}),
+                                    ("pals", "pals", {"load_point": "surface"}),
+                                    ("volume", "volume", {"load_point": "surface"}),
+                                    ("t1", "taylor-fictitious", {"order": 1}),
+                                    ("t2", "taylor-fictitious", {"order": 2}),
+                                    ("t3", "taylor-fictitious", {"order": 3}))
+           for m, metric, fmt in (("max", "max_error_pct", ".3g"), ("l2", "rel_l2_error", ".2g"))
+           for tag, h in (("", 0.025), ("_a", 0.05), ("_b", 1 / 30))}})
     title = "Plate with a circular hole under remote tension (2D state-based, FEM reference)"
     seed = "ours (issue 35; Kirsch 1898 as the check)"
     params_class, function = "HolePlateParams", "hole_plate"
@@ -249,19 +271,26 @@ class LPlate(ShapeScene):
 
     Finding (what breaks at a re-entrant corner; measured, not tuned): Taylor's
     fictitious nodes along the normal do worse here than the uncorrected model (h = 0.025,
-    rel L2 0.181 / 0.142 / 0.142 for orders 1 / 2 / 3 against 0.097; the error grows
+    rel L2 {{t1}} / {{t2}} / {{t3}} for orders 1 / 2 / 3 against {{none}}; the error grows
     linearly along the lower arm from the re-entrant corner, a rotation of the arm: the
     corner is too stiff). Not the rows: on a smooth cubic field with its body force on
     the same L-shape, x- prescribed and every other part loaded by the field's traction,
     order 2 errs 1.7e-3 (moment-corrected stencil) against 6.0e-2 uncorrected. Part of the
     cause: the fictitious nodes in the notch are extrapolated from one arm and bonded to
     the other, so bonds bridge the notch the singular field opens (u ~ r^0.5445); dropping
-    those 88 bridging bonds takes order 2 from 0.142 to 0.092 (order 1: 0.181 to 0.126).
+    those 88 bridging bonds takes order 2 from {{t2}} to 0.092 (order 1: {{t1}} to 0.126).
     The rest (the clamped-free corners' singularities; the uncorrected model's ring takes
     the FEM values, its advantage here) is not chased further. A fictitious value per
     bond, extrapolated from the real end's side, would remove the bridging; not built."""
 
     id = "plate-l"
+    #: the numbers the docstring quotes from this report's runs (pdverify.quotes)
+    doc_quotes = {
+        "none": Q("rel_l2_error", "none", {"spacing": 0.025, "m_ratio": 3.0, "jitter": 0.0,
+                                           "load_point": "surface"}, ".2g"),
+        **{f"t{k}": Q("rel_l2_error", "taylor-fictitious", {"spacing": 0.025, "m_ratio": 3.0,
+                                                             "jitter": 0.0, "order": k}, ".3g")
+           for k in (1, 2, 3)}}
     title = "L-shaped plate with a re-entrant corner (2D state-based, FEM reference)"
     seed = "ours (issue 35)"
     params_class, function = "LPlateParams", "l_plate"

@@ -13,6 +13,7 @@ from ..pd.influence import bond_based_nu
 from ..pd.problem import BondProblem, PartCondition
 from . import Outcome, Published, register
 from .bondfamily import PAPER, PD_COMMON, BondStaticScene, check_horizon_grid
+from ..quotes import Quote as Q
 
 #: the grids and loads of the papers' tables (the published values stand beside these only,
 #: not beside the convergence studies' other levels)
@@ -57,6 +58,11 @@ def _relative_errors(u, u_ref):
 
 
 # =============================================================================== §4.1.1
+#: the runs the docstrings quote (pdverify.quotes)
+_T1_RUN = {"spacing": 0.001, "micromodulus": "constant", "quadrature": "full-cells"}
+_T2_RUN = {"m_ratio": 6.0, "micromodulus": "constant", "side_factor": 4.0}
+
+
 @register
 class TensionSheet(SheetScene):
     """Seed 003 §4.1.1 (Fig. 2, Table 1): sheet 50 x 100 mm, 1 MPa on the ends y = +-50 mm.
@@ -87,14 +93,21 @@ class TensionSheet(SheetScene):
     E, nu) and ``*_norm_pct`` (normalised by the largest |u_ref| of the component).
 
     Findings (not tuned): with whole-cell quadrature and tributary loads, the corrected
-    sheet gives 3.09 % / 3.01 % (paper: 2.6 % / 3.2 %), the uncorrected one 301 % in u_x
-    and 84 % in u_y: the paper's 82 % / 291 % with the components the other way round
-    (a column swap in Table 1, or another unstated choice; both numbers are shown). With
-    equal end forces the uncorrected errors are 540 % / 159 % and the corrected 34 % /
-    13 %: the corner nodes, which carry half a cell, then get twice their share.
+    sheet gives {{e_t_x}} % / {{e_t_y}} % (paper: 2.6 % / 3.2 %), the uncorrected one {{n_t_x}} %
+    in u_x and {{n_t_y}} % in u_y: the paper's 82 % / 291 % with the components the other
+    way round (a column swap in Table 1, or another unstated choice; both numbers are
+    shown). With equal end forces the uncorrected errors are {{n_e_x}} % / {{n_e_y}} % and
+    the corrected {{e_e_x}} % / {{e_e_y}} %: the corner nodes, which carry half a cell, then
+    get twice their share.
     """
 
     id = "sheet2d-tension"
+    #: the numbers the docstring quotes from this report's runs (pdverify.quotes)
+    doc_quotes = {f"{k[0]}_{s[0]}_{c}": Q(f"max_error_u{c}_pct", k,
+                                         {**_T1_RUN, "load_sharing": s}, ".3g")
+                  for k in ("none", "energy-directional") for s in ("tributary", "equal")
+                  for c in ("x", "y")}
+    doc_typed = ("2.6", "3.2")   # the paper's print
     title = "Sheet under uniaxial tension: directional energy correction (Table 1)"
     seed = "003 §4.1.1"
     reference = "analytic"
@@ -237,7 +250,7 @@ class ClampedSheet(SheetScene):
     clamped and displaced +-L/200 (1 % strain), sides free (ERRATA: the paper swaps the
     edges), plane stress, E = 1 GPa, nu = 1/3, unit thickness, delta = 5 mm, m = 6.
 
-    FEM (``fem``): converged Q2 on graded meshes (``reference_fem``), 10.3159 MPa.
+    FEM (``fem``): converged Q2 on graded meshes (``reference_fem``), {{fem}} MPa.
     PD, bond-based, micromodulus calibrated to a complete continuous horizon:
     - ``none`` (variant 1): 25 x 25 nodes on the sample surface (half volumes on edges,
       quarters at corners; ERRATA), the outermost rows displaced +-L/200 with u_x = 0;
@@ -256,14 +269,26 @@ class ClampedSheet(SheetScene):
     symmetry lines, where both vanish), ``rel_l2_error``.
 
     Finding (not tuned): the horizon quadrature is unstated. Whole cells of the nodes with
-    |xi| <= delta (``quadrature=full-cells``, Peridigm's default; our default) give 4.14,
-    10.18, 8.41 and 8.73 MPa for the four PD rows of Table 2 (paper 4.17, 10.21, 8.43,
-    8.64): all within 1.1 %. Exact partial areas give 4.17, 10.33, 8.57 and 8.89 MPa (the
-    last 2.9 % off). With full volumes on the boundary nodes (``node_volumes=full``) the
+    |xi| <= delta (``quadrature=full-cells``, Peridigm's default; our default) give {{fn}},
+    {{fe}}, {{fv}} and {{fs}} MPa for the four PD rows of Table 2 (paper 4.17, 10.21, 8.43,
+    8.64): all within 1.1 %. Exact partial areas give {{pn}}, {{pe}}, {{pv}} and {{ps}} MPa
+    (the last 2.9 % off). With full volumes on the boundary nodes (``node_volumes=full``) the
     first two come out near 6.6 and 12.2 MPa (ERRATA).
     """
 
     id = "sheet2d-clamped"
+    #: the numbers the docstring quotes from this report's runs (pdverify.quotes)
+    doc_quotes = {"fem": Q("tensile_stress_mpa", "fem", fmt=".6g"),
+                  **{f"{q}{k}": Q("tensile_stress_mpa", method,
+                                   {**_T2_RUN, **extra, "quadrature": quad}, ".2f")
+                     for q, quad in (("f", "full-cells"), ("p", "partial-volume"))
+                     for k, method, extra in (
+                         ("n", "none", {"node_volumes": "partial"}),
+                         ("e", "energy-directional", {"node_volumes": "partial"}),
+                         ("v", "virtual-nodes", {"correct_sides": False}),
+                         ("s", "virtual-nodes", {"correct_sides": True}))}}
+    # Table 2's print; "within 1.1 %": ours against it
+    doc_typed = ("4.17", "10.21", "8.43", "8.64", "1.1")
     title = "Clamped square sheet, 1 % strain: directional correction and virtual nodes (Table 2)"
     seed = "003 §4.1.2"
     reference = "fem"

@@ -39,6 +39,7 @@ from ..pd import (StateBasedConstants, bond_micromodulus, build_stencil, get_inf
 from ..pd.build import Body, BondMaterial, StateMaterial, build_model
 from ..pd.influence import INFLUENCES, bond_based_nu
 from ..pd.problem import FACES, BondProblem, FaceCondition, StaticProblem, assemble_bonds
+from ..quotes import Quote as Q
 from . import MethodSpec, Outcome, Published, Scene, register, whole_cells
 from ..corrections.builtin import BASELINE
 from .family import StaticStateScene
@@ -386,10 +387,11 @@ class BoxStiffness(_StateStiffness):
 
     Finding (not tuned): surface nodes (order 1) and mirror nodes with the corrected
     mirror point give every node the bulk energy (2e-13 %); the method's nearest mirror
-    node misses by 5.7 % near the box's edges and corners, still far below ``none``.
+    node misses by {{mirror-nodes}} % near the box's edges and corners, still far below ``none``.
 
     Finding (not tuned): ``energy`` and ``pals`` beat ``none`` here, ``volume`` and
-    ``perifit`` do not (largest surface error 39.4 % against 61.4 and 55.8 %). LPS with m
+    ``perifit`` do not (largest surface error {{none}} % against {{volume}} and {{perifit}} %).
+    LPS with m
     over the truncated family is exact for a node on a flat face in the continuum limit
     (half a ball has the ball's moment ratios), so factors that restore missing volume or
     the ball's operators reweight bonds that needed none. perifit's other readings fail
@@ -399,6 +401,9 @@ class BoxStiffness(_StateStiffness):
     """
 
     id = "stiffness3d-box"
+    #: the numbers the docstring quotes from this report's runs (pdverify.quotes)
+    doc_quotes = {k: Q("surface_energy_error_pct", k, fmt=".2g" if k == "mirror-nodes" else ".3g")
+                  for k in ("none", "volume", "perifit", "mirror-nodes")}
     title = "3D box under homogeneous strain: nodal energy density against the bulk"
     seed = "001 §4.1"
     kind = "3d"
@@ -463,10 +468,13 @@ class PlateStiffness(_StateStiffness):
     constants of seed 001 §5, E = 200 GPa, nu = 0.3. Methods as ``stiffness3d-box``'s,
     and Taylor's fictitious nodes (seed 000, 2D). Surface nodes, Taylor (orders 1, 2) and
     the corrected mirror point give the bulk energy at every node to round-off; the
-    nearest mirror node misses by 4.7 % near the corners (``none``: 27.5 %).
+    nearest mirror node misses by {{mirror-nodes}} % near the corners (``none``: {{none}} %).
     """
 
     id = "stiffness2d-plate"
+    #: the numbers the docstring quotes from this report's runs (pdverify.quotes)
+    doc_quotes = {k: Q("surface_energy_error_pct", k, fmt=".2g" if k == "mirror-nodes" else ".3g")
+                  for k in ("none", "mirror-nodes")}
     title = "Plane-strain plate under homogeneous strain: nodal energy density against the bulk"
     seed = "001 §5"
     kind = "plane-strain"

@@ -12,6 +12,7 @@ from ..params import Param, at_least, open_interval, positive
 from ..pd import QUADRATURES, StateBasedConstants, get_influence, state_based_stencil
 from ..pd.problem import FaceCondition, StaticProblem
 from ..solvers.policy import ND3D_FROM_UNKNOWNS, ND_FROM_UNKNOWNS, STATIC_SOLVERS
+from ..quotes import Quote as Q
 from . import Outcome, Published, influence_param, register, require_influence
 from .base import ExpectedFailure
 from .family import StaticStateScene
@@ -188,6 +189,11 @@ class Body3D(SurfaceNodeScene):
         return (p["lx"], p["ly"], p["lz"]), (0.0, -p["ly"] / 2, -p["lz"] / 2)
 
 
+#: the runs the docstrings quote (pdverify.quotes)
+_B3_RUN = {"spacing": 0.05, "m_ratio": 3.0, "surface_load": "face-mean"}
+_P2_RUN = {"spacing": 0.02, "quadrature": "partial-volume", "influence": "gaussian"}
+
+
 @register
 class Body3DTraction(Body3D):
     """Seed 001 §4.1 (Fig. 8): box under the traction p = 10 MPa on x = l_x; Eq. (39).
@@ -210,7 +216,7 @@ class Body3DTraction(Body3D):
     motions. Every other surface-node equation is the force flux Eq. (36) = p A (zero on
     the free faces).
 
-    Finding: with exact partial volumes N = 1 gives 0.077 % (paper: 0.06 %); the field is
+    Finding: with exact partial volumes N = 1 gives {{sn1}} % (paper: 0.06 %); the field is
     linear, so all of it is the discrete material's moduli error (3D lattice anisotropy
     4e-4). With ``quadrature=moment-corrected`` the error is about 2e-10 %, i.e. the
     method is exact for this field to round-off (tested).
@@ -230,6 +236,11 @@ class Body3DTraction(Body3D):
     """
 
     id = "body3d-traction"
+    #: the numbers the docstring quotes from this report's runs (pdverify.quotes)
+    doc_quotes = {"sn1": Q("max_error_pct", "surface-nodes",
+                           {"spacing": 0.05, "order": 1, "quadrature": "partial-volume",
+                            "influence": "gaussian"}, ".2g")}
+    doc_typed = ("10",)   # '10 % full': the dense solver's rule
     title = "3D box under simple traction (surface node method)"
     seed = "001 §4.1"
     reference = "analytic"
@@ -280,16 +291,18 @@ class Body3DManufactured(Body3D):
     ``node`` (default) evaluates it at the loaded node, as §4 does for the constraints
     ("the analytical value of the displacement field at their position"); ``surface``
     at the face centre. The baseline's error depends strongly on this choice (about
-    128 % at the node, 76 % on the surface at the default size); the report runs both.
+    {{none_node}} % at the node, {{none_surface}} % on the surface at the default size); the
+    report runs both.
 
     Findings (not tuned; default size, exact partial volumes): surface nodes give
-    1.88 % (N = 1), 0.32 % (N = 2) and 0.26 % (N = 3); the paper reports < 1 % for
+    {{sn1}} % (N = 1), {{sn2}} % (N = 2) and {{sn3}} % (N = 3); the paper reports < 1 % for
     each and 0.4 % at N = 3. N = 1 is limited by its own Taylor truncation: with the
     same run but quadratic displacement extrapolation the error is 0.41 %, with a
     linear dilatation extrapolation instead it stays 1.83 %; the error peaks on the
     body edges near the tip, where a linear extrapolation misses the x y and x^3 terms.
     With ``surface_load=centre`` (the traction at the face centre times A) the same runs
-    give 2.6 / 1.13 / 1.07 %: on the faces y = +-l_y/2 the x^2 shear of Eq. (41) makes
+    give 2.6 / 1.13 / {{sn3_centre}} % (N = 3 a report run): on the faces y = +-l_y/2 the
+    x^2 shear of Eq. (41) makes
     the centre value differ from the resultant by A h^2 tau''/24 (7.2 kN a node here,
     about 0.3 % of the largest face load). The resultant is the exact force on the area
     a surface node represents, so it is our default; the discrete flux sum of Eq. (35)
@@ -297,16 +310,35 @@ class Body3DManufactured(Body3D):
     monotone (on a 0.45 x 0.3 x 0.3 m body at fixed delta = 0.15 m, N = 3: 0.69, 0.19,
     0.32 % at m = 3, 4, 5 with the resultant; 2.30, 0.70, 0.27 % with the centre value),
     so which rule wins at a given m is not a property of the method. With
-    ``quadrature=moment-corrected`` N = 3 gives 0.24 %.
+    ``quadrature=moment-corrected`` N = 3 gives {{sn3_moment}} %.
     Metrics as in ``body3d-traction``.
 
     ``taylor-fictitious`` (seed 000's Taylor-extrapolated fictitious nodes, Lagrange rows;
-    on the 3D boxes too): order 2 gives 0.105 % at h = 0.05 (surface nodes N = 2: 0.32 %),
-    order 1 13.2 % (N = 1: 1.88 %); 35-40 s and 2.0-2.2 GB a run (benchmarks/taylor3d.py).
+    on the 3D boxes too): order 2 gives {{taylor2}} % at h = 0.05 (surface nodes N = 2:
+    {{sn2}} %), order 1 13.2 % (N = 1: {{sn1}} %); 35-40 s and 2.0-2.2 GB a run
+    (benchmarks/taylor3d.py).
     On the quick 10 x 5 x 5 box its constraint rows are dependent (an expected failure).
     """
 
     id = "body3d-manufactured"
+    #: the numbers the docstring quotes from this report's runs (pdverify.quotes)
+    doc_quotes = {
+        **{f"none_{lp}": Q("max_error_pct", "none",
+                             {**_B3_RUN, "quadrature": "partial-volume", "load_point": lp}, ".3g")
+           for lp in ("node", "surface")},
+        **{f"sn{n}": Q("max_error_pct", "surface-nodes",
+                        {**_B3_RUN, "quadrature": "partial-volume", "order": n}, ".2f")
+           for n in (1, 2, 3)},
+        "sn3_centre": Q("max_error_pct", "surface-nodes",
+                        {**_B3_RUN, "quadrature": "partial-volume", "order": 3,
+                         "surface_load": "centre"}, ".3g"),
+        "sn3_moment": Q("max_error_pct", "surface-nodes",
+                        {**_B3_RUN, "quadrature": "moment-corrected", "order": 3}, ".2f"),
+        "taylor2": Q("max_error_pct", "taylor-fictitious",
+                     {**_B3_RUN, "quadrature": "partial-volume", "order": 2}, ".3f")}
+    # a study on another body (0.45 x 0.3 x 0.3 m, m = 3, 4, 5), not a report run
+    # and surface_load=centre at N = 1, 2 (2.6, 1.13 %), not report runs
+    doc_typed = ("0.69", "0.19", "0.32", "2.30", "0.70", "0.27", "2.6", "1.13")
     title = "3D box under manufactured loads (surface node method)"
     seed = "001 §4.2"
     reference = "manufactured"
@@ -405,12 +437,12 @@ class Plate2DPlaneStrain(SurfaceNodeScene):
     the discrete PD material does under sigma = (0, p) (tested to 1e-6), so no boundary
     error remains; but the discrete 2D material at m = 3 with exact partial areas is
     itself off the continuum moduli (its stencil's fourth moment is 1 % anisotropic:
-    C11, C12, C44 off by +0.21, -0.48, -0.72 %), giving 1.20 % in u and 0.51 % in v
-    against Eq. (43). Issue 7 expects < 0.1 %; the material error falls to 0.25 % at
-    m = 4 and 0.098 % at m = 5 (same h), and ``quadrature=moment-corrected`` removes it:
+    C11, C12, C44 off by +0.21, -0.48, -0.72 %), giving {{snu}} % in u and {{snv}} % in v
+    against Eq. (43). Issue 7 expects < 0.1 %; the material error falls to {{sn_m4}} % at
+    m = 4 and {{sn_m5}} % at m = 5 (same h), and ``quadrature=moment-corrected`` removes it:
     the plate is then exact to round-off (about 1e-11 %). The report runs all four, and
     the same pair with ``influence=hyperbolic`` (seed 000's delta/|xi|): its lattice is
-    more anisotropic (3.89 % in u with exact partial areas), and the moment correction
+    more anisotropic ({{sn_hyp}} % in u with exact partial areas), and the moment correction
     again leaves round-off (3e-11 %).
     The 3D stencil at m = 3 is far more isotropic (0.04 %).
 
@@ -422,14 +454,16 @@ class Plate2DPlaneStrain(SurfaceNodeScene):
     (``corrections.pddo``: boundary rows on the outer node layer, PDDO equilibrium
     within 2 delta, LPS beyond; param ``bulk_model``). Each module's
     docstring says which parts are our reading. Findings at h = 0.02 (not tuned):
-    PALS 2.54 % in u, 2.20 % in v (none: 12.3, 7.6 %; SNM 1.20, 0.51 %), so PALS lowers
+    PALS {{palsu}} % in u, {{palsv}} % in v (none: {{noneu}}, {{nonev}} %; SNM {{snu}},
+    {{snv}} %), so
+    PALS lowers
     both errors and SNM stays below it, as §5 says; with the full traction condition
     the mirror relations reproduce the plate's affine solution, so MNM gives round-off
     (1e-11 %): every real node then has a complete neighbourhood, where an affine field
     carries no force whatever the lattice, and the boundary data are the continuum's.
     With the normal derivatives alone (``neumann=normal-only``) the free face x = l_x
-    is held at zero normal strain and MNM is worst in both components (97.6 % in u,
-    20.4 % in v): neither reading gives the paper's 'close in x except one corner, worst
+    is held at zero normal strain and MNM is worst in both components ({{nou}} % in u,
+    {{nov}} % in v): neither reading gives the paper's 'close in x except one corner, worst
     in y', whose Neumann imposition is unstated. PDDO reproduces the affine solution
     too (its operators are exact for quadratics), 'similar to SNM' and here smaller.
 
@@ -438,8 +472,8 @@ class Plate2DPlaneStrain(SurfaceNodeScene):
     ``mirror_point=at-mirror-point`` (the Neumann step from the mirror point),
     ``gradient_at=boundary`` and ``pddo`` with ``bulk_model=pddo`` (a stand-in for the
     paper's non-ordinary bulk). At h = 0.02 (not tuned): corrected, gradient_at=boundary
-    and both PDDO bulks give round-off (1e-11 %), the step from the mirror point 1.93 %
-    in u (at the corner x = l_x, y = 0) and 0.721 % in v (at x = 0, y = l_y), below PALS
+    and both PDDO bulks give round-off (1e-11 %), the step from the mirror point {{amu}} %
+    in u (at the corner x = l_x, y = 0) and {{amv}} % in v (at x = 0, y = l_y), below PALS
     in both. No reading gives 'close in x except one corner, worst in y': Eq. (43) is
     affine and every real node's neighbourhood is complete, so a reading exact for
     affine fields gives round-off; a wrong boundary strain moves the plate to another
@@ -452,6 +486,24 @@ class Plate2DPlaneStrain(SurfaceNodeScene):
     """
 
     id = "plate2d-plane-strain"
+    #: the numbers the docstring quotes from this report's runs (pdverify.quotes)
+    doc_quotes = {
+        **{f"{k}{c}": Q(f"max_error_{c}_pct", method, {**_P2_RUN, "m_ratio": 3.0, **extra}, fmt)
+           for k, method, extra, fmt in (
+               ("sn", "surface-nodes", {"order": 1}, ".3g"),
+               ("pals", "pals", {"load_point": "surface"}, ".3g"),
+               ("none", "none", {"load_point": "surface"}, ".3g"),
+               ("no", "mirror-nodes", {"neumann": "normal-only", "mirror_point": "nearest",
+                                       "gradient_at": "mirror"}, ".3g"),
+               ("am", "mirror-nodes", {"neumann": "full-traction",
+                                       "mirror_point": "at-mirror-point",
+                                       "gradient_at": "mirror"}, ".3g"))
+           for c in ("u", "v")},
+        **{f"sn_m{m}": Q("max_error_pct", "surface-nodes",
+                          {**_P2_RUN, "m_ratio": float(m), "order": 1}, ".2g") for m in (4, 5)},
+        "sn_hyp": Q("max_error_pct", "surface-nodes",
+                    {**_P2_RUN, "m_ratio": 3.0, "order": 1, "influence": "hyperbolic"}, ".3g")}
+    doc_typed = ("10",)   # '10 % full': the dense solver's rule
     title = "2D plate in plane strain under traction (surface node method)"
     seed = "001 §5"
     reference = "analytic"

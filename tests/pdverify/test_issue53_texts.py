@@ -24,10 +24,15 @@ def _one(v) -> str:
 
 
 # ------------------------------------------------------ 1. indentation: 6 % at which grid
+def _text(key, runs, scene):
+    """The deviation's text as the report shows it beside ``runs`` (pdverify.quotes)."""
+    return _deviation(key).render(runs, scene)["text"]
+
+
 def test_indentation_reference_text_quotes_the_quick_grids_run():
     r = get_scene("block2d-indentation").run("energy-directional", QUICK)
     assert r.status == "ok", r.message
-    text = _deviation("003-indentation-reference").text
+    text = _text("003-indentation-reference", [r], "block2d-indentation")
     quick = text.split("on the quick report's grid (41 x 41)")[1]
     assert quick.startswith(f" {_one(r.metrics['force_error_pct'])} and "
                             f"{_one(r.metrics['force_error_pct_vs_small_strain'])}."), text
@@ -37,7 +42,7 @@ def test_indentation_reference_text_quotes_the_quick_grids_run():
 def test_indentation_reference_text_quotes_the_paper_grids_run():
     r = get_scene("block2d-indentation").run("energy-directional")
     assert r.status == "ok", r.message
-    text = _deviation("003-indentation-reference").text
+    text = _text("003-indentation-reference", [r], "block2d-indentation")
     paper = text.split("at the paper's grid (161 x 161 nodes)")[1].split("quick")[0]
     assert f"{_one(r.metrics['force_error_pct'])} against the finite-strain" in paper
     assert f"{_one(r.metrics['force_error_pct_vs_small_strain'])} against the small" in paper
@@ -74,15 +79,20 @@ def test_table2_fem_value_stands_beside_the_fem_run():
 
 
 def test_the_page_says_the_full_report_runs_only_values_a_full_report_run_matches():
-    # bar1d-homogenization's f_1(m) entries (Tables 1, 2) match no run of the full report:
-    # they are named as such, not as values "the full report runs"
+    # bar1d-homogenization's f_1(m) entries of Tables 1, 2 at m = 10, 32 and 15.5 matched
+    # no run of the full report (no case had those ratios): the full report now runs the
+    # smallest bar at each, and the quick report names them as values the full report runs
     scene = get_scene("bar1d-homogenization")
-    unmatched = html.unmatched_published(scene)
-    assert unmatched and all("f_1(m)" in u for u in unmatched), unmatched
+    assert html.unmatched_published(scene) == []
     quick = [SimpleNamespace(method=m, params=scene.resolve(m, o))
              for m, o in scene.report_cases(quick=True)]
     missing = html.missing_published(scene, quick)
-    assert not any(m.startswith(u[:-1]) for u in unmatched for m in missing), missing
+    for value, ratio in (("1.01", 10), ("1.001", 32), ("1.001", 15.5)):
+        assert any(m.startswith(f"micromodulus_factor = {value} (seed 004 Table")
+                   for m in missing), missing
+        run = scene.run("none", {"horizon_ratio": float(ratio), "nodes": 2 * int(ratio) + 1})
+        entry = next(e for e in run.published if e["metric"] == "micromodulus_factor")
+        assert verdict(entry, run.metrics["micromodulus_factor"]) == "holds", entry
 
 
 # ------------------------------------------------------ 3. Table 12's f(9): rounded, not cut
@@ -101,7 +111,12 @@ def test_table12_rounds_its_four_decimal_cells_so_f9_is_a_known_difference():
     cell, entry, f = _f((4.0, "full"))
     assert entry["known_difference"] is True and entry["target"] == 1.2178
     assert verdict(entry, f) == "known difference"
-    assert f"{f:.7f}" in _deviation("004-table12-f9-digits").text
+    runs = [get_scene("bar1d-homogenization").run("none",
+                                                  bb._table12_published(k, bb.TABLE12[k]).where)
+            for k in ((4.0, "full"), (3.5, "full"), (4.5, "full"))]
+    text = _text("004-table12-f9-digits", runs, "bar1d-homogenization")
+    assert f"f(9) = {f:.7f} (ours" in text and f"rounds to {f:.4f}" in text, text
+    assert f"{(f - 1.2178) * 1e4:.2f} units" in text
 
 
 # ------------------------------------------------------ 4. §6.2: the bars seed 004 treats
@@ -125,5 +140,5 @@ def test_anisotropy_claim_is_shown_in_both_readings():
     assert verdict(entries["bulk_anisotropy_pct"], ours["bulk_anisotropy_pct"]) == "holds"
     assert verdict(entries["bulk_anisotropy_c11_3c12_pct"],
                    ours["bulk_anisotropy_c11_3c12_pct"]) == "known difference"
-    text = _deviation("003-anisotropy-measure").text
+    text = _text("003-anisotropy-measure", [r], "stiffness2d-sheet")
     assert all(f"{v:.2f} %" in text for v in ours.values()), (ours, text)

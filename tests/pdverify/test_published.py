@@ -185,7 +185,7 @@ SIX = {"wave1d-surface-nodes": "Eq. (5): u(x_j, t) in the sum means u(x_j, t_n)"
     *SIX.items(),
     ("sheet2d-clamped", "'about 4 %' gain from correcting the side surfaces is about 2 %"),
     ("bar1d-homogenization", "(A2.1.1.4) and (A2.1.1.5) miss the factor 1/m"),
-    ("body3d-traction", "26.3 % at our default h = 0.05 m, 31.0 % at h = 0.1 m"),
+    ("body3d-traction", "% at our default h = 0.05 m, 31.0 % at h = 0.1 m"),
 ])
 def test_the_errata_are_in_their_scenes_box(scene_id, phrase):
     text = str(html.scene_section(get_scene(scene_id), [], []))
@@ -195,8 +195,9 @@ def test_the_errata_are_in_their_scenes_box(scene_id, phrase):
 def test_every_deviation_entry_is_reachable_from_some_scenes_box():
     boxes = " ".join(str(html.scene_section(s, [], [])) for s in all_scenes())
     for d in DEVIATIONS:
-        probe = str(html.Markup.escape(d.text[:60]))
-        assert probe in boxes, d.text[:60]
+        head = d.text.split("{{")[0][:60]   # up to its first quoted number (a record's)
+        probe = str(html.Markup.escape(head))
+        assert probe in boxes, head
 
 
 @pytest.mark.slow
@@ -204,13 +205,15 @@ def test_the_traction_boxs_grid_dependence_is_measured_not_copied():
     """The deviation's 26.3 % (h = 0.05) and 31.0 % (h = 0.1) beside the paper's '> 30 %'
     are what the uncorrected runs give, to the digits the text prints."""
     import re
-    text = next(d.text for d in DEVIATIONS if d.key == "001-table1-traction")
+    scene = get_scene("body3d-traction")
+    runs = {h: scene.run("none", {"spacing": h}) for h in (0.05, 0.1)}
+    d = next(d for d in DEVIATIONS if d.key == "001-table1-traction")
+    text = d.render(list(runs.values()), scene.id)["text"]   # as the report shows it
     printed = dict((float(h), float(v)) for v, h in
                    re.findall(r"(\d+\.\d) % at (?:our default )?h = (0\.\d+) m", text))
     assert set(printed) == {0.05, 0.1}
-    scene = get_scene("body3d-traction")
     for h, value in printed.items():
-        r = scene.run("none", {"spacing": h})
+        r = runs[h]
         assert abs(r.metrics["max_error_pct"] - value) <= 0.05, (h, r.metrics)  # half a unit
         entry = r.published[0]
         assert entry["value"] == "> 30" and entry["deviation"] == "001-table1-traction"

@@ -33,7 +33,8 @@ def _is_call(node, name):
 def _allowed_nodes(tree):
     """Nodes where a method name belongs: a ``cases`` method, the published numbers (a
     ``published = (...)`` assignment or a ``Published(...)`` call), the documented
-    findings (``expected_failures``), and strings that are not method names although
+    findings (``expected_failures``), the runs a docstring quotes (``doc_quotes``, a
+    ``Quote(...)``: they name runs as the published numbers do), and strings that are not method names although
     they may read like one: a parameter's definition (``Param(...)``: a choice such as
     ``predictor="none"``) and dictionaries' keys and values other than a ``"method"``
     key's (field names such as ``"energy"``, parameter values)."""
@@ -44,6 +45,9 @@ def _allowed_nodes(tree):
         if isinstance(node, ast.Assign) and any(
                 isinstance(t, ast.Name) and t.id in ("published", "expected_failures")
                 for t in node.targets):
+            allowed |= {id(n) for n in ast.walk(node)}
+        if isinstance(node, ast.Assign) and any(
+                isinstance(t, ast.Name) and t.id == "doc_quotes" for t in node.targets):
             allowed |= {id(n) for n in ast.walk(node)}
         if _is_call(node, "Published") or _is_call(node, "Param"):
             allowed |= {id(n) for n in ast.walk(node)}
