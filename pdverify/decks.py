@@ -82,7 +82,7 @@ def check_out(path: str) -> str:
     if not str(path).strip():
         raise InputError(f"--out {path!r}: empty path; give a folder")
     given = os.path.abspath(os.path.expanduser(str(path)))
-    outputs.check_target(given, shown=path)               # a name too long, an unwritable parent
+    outputs.check_target(given, shown=path)     # a name too long, an unwritable parent
     full = os.path.realpath(given)
     if full != given:
         outputs.check_target(full, shown=path)

@@ -117,7 +117,9 @@ def rerun_plan(cases, out: str):
         raise InputError(f"--failed: the previous report's results cannot be read "
                          f"({exc})") from None
     previous = {}
-    for run in doc["runs"]:
+    for k, run in enumerate(doc["runs"]):
+        outputs.check_listed(out, run.get("files", []),
+                             f"--failed: the previous report's results.json runs[{k}].files")
         r = RunResult.from_json(run)
         previous.setdefault(r.key, r)
     again = []
@@ -505,6 +507,8 @@ def _keep_fields(results, final, out) -> None:
             head, name = os.path.split(rel)
             new = os.path.join(head, f"{k:03d}-" + name.split("-", 1)[-1])
             src = os.path.join(final, rel)
+            if outputs.outside(final, rel) or outputs.outside(out, new):
+                continue     # never read or write outside the two reports (checked before)
             if os.path.isfile(src):
                 os.makedirs(os.path.join(out, head), exist_ok=True)
                 shutil.copyfile(src, os.path.join(out, new))
