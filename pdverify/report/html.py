@@ -181,7 +181,7 @@ def published_rows(scene, results) -> list[dict]:
     rows = []
     for r in results:
         for p in scene.published_for(r.method, r.params).values():
-            entry = p.entry()
+            entry = p.entry(r.params)
             ours = r.metrics.get(p.metric)
             check = {"equal": "=", "below": "<", "above": ">", "none": ""}[entry["check"]]
             if entry["check"] != "none":
