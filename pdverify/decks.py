@@ -162,8 +162,9 @@ def write_export(ns: NodeSet, fmt: str, out: str) -> list[str]:
     """Write the export of ``ns`` in ``fmt`` into ``out`` (checked by :func:`check_out`);
     returns the files written, relative to ``out``.
 
-    As a report is written: under the lock on ``out`` (:func:`pdverify.outputs.output_lock`:
-    a second export into it exits 2 naming this one), into a staging folder next to it
+    As a report is written: under the lock on ``out``, which the caller holds
+    (:func:`pdverify.outputs.output_lock`, taken by :func:`export_command` before the node
+    set is built: a second export into it exits 2 naming this one), into a staging folder next to it
     that replaces ``out`` as a whole at the end (:func:`pdverify.outputs.swap_in`), after
     checking that its disk takes the files (InputError, exit 2, nothing written). A write
     that fails raises :class:`OutputError` naming the file; the previous export stays as
@@ -186,44 +187,44 @@ def write_export(ns: NodeSet, fmt: str, out: str) -> list[str]:
     need = (sum(len(t.encode("utf-8")) for t in files.values()) + EXPORT_MARGIN
             + (VTU_BYTES_PER_NODE * len(ns.x) if fmt == "vtu" else 0))
     parent, name = os.path.split(out)
-    with outputs.output_lock(out, "export"):
-        _check_state(out, out)                     # what changed while the node set was built
-        outputs.check_free(parent, need, f"--out {out!r} (an export of {len(ns.x)} nodes)")
-        outputs.clean_stale(parent, name, _own_leftover)
-        try:
-            staging = tempfile.mkdtemp(prefix=f".{name}.staging-", dir=parent)
-        except OSError as exc:
-            raise OutputError(f"export: cannot create its staging folder in {parent!r} "
-                              f"({exc.strerror or exc}); nothing was written") from None
-        path = staging
-        try:
-            from .results import umask_mode
-            os.chmod(staging, umask_mode(0o777))   # mkdtemp gives 0700
-            _write_marker(staging, [], complete=False)
-            written = []
-            for rel, text in files.items():
-                path = os.path.join(staging, rel)
-                os.makedirs(os.path.dirname(path), exist_ok=True)
-                with open(path, "w", encoding="utf-8", newline="\n") as fh:
-                    fh.write(text)
-                written.append(rel)
-            if fmt == "vtu":
-                path = os.path.join(staging, "nodes.vtu")
-                write_vtu(ns, path)
-                written.append("nodes.vtu")
-            path = os.path.join(staging, MARKER)
-            _write_marker(staging, set(_tree(staging)) | {MARKER}, complete=True)
-            path = out
-            outputs.swap_in(staging, out)
-        except OSError as exc:
-            previous = ("the previous export in " + repr(out) + " is unchanged"
-                        if os.path.exists(out) else "nothing was written at " + repr(out))
-            shown = os.path.join(out, os.path.relpath(path, staging)) if path != out else out
-            raise OutputError(f"export: cannot write {shown!r} ({exc.strerror or exc}); "
-                              f"{previous}") from exc
-        finally:
-            if os.path.exists(staging):
-                shutil.rmtree(staging, ignore_errors=True)
+    # under the caller's lock on ``out`` (export_command's)
+    _check_state(out, out)                     # what changed while the node set was built
+    outputs.check_free(parent, need, f"--out {out!r} (an export of {len(ns.x)} nodes)")
+    outputs.clean_stale(parent, name, _own_leftover)
+    try:
+        staging = tempfile.mkdtemp(prefix=f".{name}.staging-", dir=parent)
+    except OSError as exc:
+        raise OutputError(f"export: cannot create its staging folder in {parent!r} "
+                          f"({exc.strerror or exc}); nothing was written") from None
+    path = staging
+    try:
+        from .results import umask_mode
+        os.chmod(staging, umask_mode(0o777))   # mkdtemp gives 0700
+        _write_marker(staging, [], complete=False)
+        written = []
+        for rel, text in files.items():
+            path = os.path.join(staging, rel)
+            os.makedirs(os.path.dirname(path), exist_ok=True)
+            with open(path, "w", encoding="utf-8", newline="\n") as fh:
+                fh.write(text)
+            written.append(rel)
+        if fmt == "vtu":
+            path = os.path.join(staging, "nodes.vtu")
+            write_vtu(ns, path)
+            written.append("nodes.vtu")
+        path = os.path.join(staging, MARKER)
+        _write_marker(staging, set(_tree(staging)) | {MARKER}, complete=True)
+        path = out
+        outputs.swap_in(staging, out)
+    except OSError as exc:
+        previous = ("the previous export in " + repr(out) + " is unchanged"
+                    if os.path.exists(out) else "nothing was written at " + repr(out))
+        shown = os.path.join(out, os.path.relpath(path, staging)) if path != out else out
+        raise OutputError(f"export: cannot write {shown!r} ({exc.strerror or exc}); "
+                          f"{previous}") from exc
+    finally:
+        if os.path.exists(staging):
+            shutil.rmtree(staging, ignore_errors=True)
     return sorted(written)
 
 
@@ -242,13 +243,15 @@ def export_command(scene_id: str, *, method=None, overrides=None, fmt: str, out:
     check_method(method)
     if fmt not in FORMATS:
         raise InputError(f"--format {fmt!r}; allowed: {', '.join(FORMATS)}")
+    from .outputs import output_lock
     with budget.assembly_only():
         check_format(scene, scene.resolve(METHOD, overrides), fmt)
         folder = check_out(out)
         check_free(os.path.dirname(folder), MIN_FREE_FILE, f"--out {out!r}")
         check_cache()       # a FEM scene's prescribed values come from its cached reference
-        ns = node_set(scene, overrides)
-    files = write_export(ns, fmt, folder)
+        with output_lock(folder, "export"):   # a second export into it: exit 2, now
+            ns = node_set(scene, overrides)
+            files = write_export(ns, fmt, folder)
     print(f"{scene.id} --method {METHOD}: {len(ns.x)} nodes, {ns.dim}D, horizon "
           f"{ns.horizon:.6g} m (written {export_horizon(ns):.6g} m: see README.md) -> {out} "
           f"({len(files)} files: "

@@ -345,7 +345,7 @@ def _read_csv(path: str, dim: int) -> Displacements:
                 except (ValueError, IndexError):
                     raise InputError(f"displacement file {path!r}: data row {i + 1} is not "
                                      f"{len(cols)} numbers in the named columns: "
-                                     f"{row[:8]!r}") from None
+                                     f"{[c[:20] for c in row[:8]]!r}") from None
     except (UnicodeDecodeError, csv.Error) as exc:
         raise InputError(f"displacement file {path!r} cannot be read as UTF-8 CSV "
                          f"({type(exc).__name__}: {exc})") from None
