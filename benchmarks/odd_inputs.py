@@ -352,7 +352,9 @@ FILE_CASES = [
                                  "tiny/ex"], _nearly_full, 2, _complete_export("tiny/ex")),
     ("export-name-300", EX + ["a" * 300], None, 2, None),
     ("export-parent-is-file", EX + ["plain/ex"], _parent_file, 2, _unchanged("plain")),
-    ("export-foreign-folder", EX + ["."], None, 2, None),
+    ("export-current-folder", EX + ["."], None, 2, None),
+    ("export-foreign-folder", EX + ["foreign"], lambda cwd: os.makedirs(
+        os.path.join(cwd, "foreign", "notes")), 2, None),
     ("export-3d-default", ["export", "body3d-traction", "--format", "csv", "--out", "ex"],
      None, 0, _complete_export()),
     # score: size and shape before reading

@@ -86,6 +86,13 @@ def check_out(path: str) -> str:
     full = os.path.realpath(given)
     if full != given:
         outputs.check_target(full, shown=path)
+    try:
+        cwd = os.path.realpath(os.getcwd())
+    except OSError:
+        cwd = None
+    if cwd is not None and outputs._within(cwd, full):
+        raise InputError(f"--out {path!r} is or contains the current folder, which the "
+                         "export would replace as a whole; give another folder")
     _check_state(full, path)
     return full
 
