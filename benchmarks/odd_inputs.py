@@ -131,6 +131,13 @@ def _export_marker(*entries):
     return setup
 
 
+def _score_marker_outside(cwd):
+    _export(cwd)
+    _marker_add(cwd, "ex", ".pdverify-export", "/etc/passwd")
+    with open(os.path.join(cwd, "ex", "back.csv"), "w") as fh:
+        fh.write("x,ux\n0.025,1e-9\n")
+
+
 def _export_symlink(cwd):
     _export(cwd)
     os.mkdir(os.path.join(cwd, "outside"))
@@ -335,6 +342,8 @@ FILE_CASES = [
     ("marker-lists-absolute", EX + ["ex"], _export_marker("{cwd}/" + VICTIM), 2, None),
     ("marker-lists-via-symlink", EX + ["ex"], _export_symlink, 2,
      _unchanged("outside/kept.txt")),
+    ("score-marker-absolute", ["score", "bar1d-traction", "ex/back.csv", "--name", "c"],
+     _score_marker_outside, 2, None),
     ("report-marker-dotdot", ["report", "--quick", "--only", "bar1d-traction", "--out",
                               "rep"], _report_marker, 2, None),
     ("include-files-outside", ["report", "--quick", "--only", "bar1d-traction", "--include",

@@ -594,6 +594,10 @@ def _export_params(scene, folder: str, given: bool, overrides) -> dict:
             or not isinstance(doc.get("params"), dict) or not isinstance(doc.get("scene"), str)):
         raise InputError(f"{where}: its {MARKER} or problem.json is not pdverify's "
                          f"(schemas {MARKER_SCHEMA} and pdverify.export/1 with scene and params)")
+    from .outputs import check_listed
+    entries = marker.get("entries", [])
+    check_listed(folder, entries if isinstance(entries, list) else [repr(entries)],
+                 f"{where}: its {MARKER}")
     if doc["scene"] != scene.id:
         raise InputError(f"{where} is an export of scene {doc['scene']!r}, not {scene.id!r}")
     try:
