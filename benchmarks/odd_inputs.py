@@ -364,6 +364,12 @@ FILE_CASES = [
     ("export-current-folder", EX + ["."], None, 2, None),
     ("export-foreign-folder", EX + ["foreign"], lambda cwd: os.makedirs(
         os.path.join(cwd, "foreign", "notes")), 2, None),
+    # export solves nothing: a memory limit far below any solve does not refuse it
+    ("export-under-small-memory-limit", ["ENV:PDVERIFY_MAX_MEMORY=1M", "export",
+                                         "body3d-traction", "--format", "csv", "--out", "ex"],
+     None, 0, _complete_export()),
+    ("run-under-small-memory-limit", ["ENV:PDVERIFY_MAX_MEMORY=1M", "run", "body3d-traction"],
+     None, 2, None),
     ("export-3d-default", ["export", "body3d-traction", "--format", "csv", "--out", "ex"],
      None, 0, _complete_export()),
     # score: size and shape before reading
@@ -448,6 +454,9 @@ def classify(argv, timeout, env, setup=None, check=None):
 
 
 def _classify(argv, timeout, env, cwd, check):
+    while argv and argv[0].startswith("ENV:"):     # an environment variable of the case
+        key, _, value = argv[0][4:].partition("=")
+        env, argv = {**env, key: value}, argv[1:]
     before = {p: _digest(os.path.join(cwd, p))
               for p in getattr(check, "wants_before", ())}
     if argv and argv[0] == "CONCURRENT":
