@@ -32,6 +32,7 @@ from __future__ import annotations
 import math
 import os
 import re
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 from .errors import InputError
@@ -165,10 +166,30 @@ def format_bytes(n: float) -> str:
     return f"{n:.0f} B"
 
 
+_ASSEMBLY_ONLY = {"on": False}
+
+
+@contextmanager
+def assembly_only():
+    """While held, :func:`check` refuses only a size that overflows: the command (``pdverify
+    export``) assembles the problem and solves nothing, so the solver's memory estimate,
+    time steps and load increments do not apply to it."""
+    before = _ASSEMBLY_ONLY["on"]
+    _ASSEMBLY_ONLY["on"] = True
+    try:
+        yield
+    finally:
+        _ASSEMBLY_ONLY["on"] = before
+
+
 def check(where: str, estimate: Estimate | None) -> None:
     """Raise :class:`InputError` when ``estimate`` exceeds the memory limit or the step
     ceiling; one line with the estimate, its sizes and the limit."""
     if estimate is None:
+        return
+    if _ASSEMBLY_ONLY["on"]:
+        if not math.isfinite(estimate.memory):
+            raise InputError(f"{where}: the size overflows ({estimate.detail})")
         return
     if estimate.time_steps > MAX_TIME_STEPS:
         raise InputError(f"{where}: needs ~{estimate.time_steps:.3g} time steps "

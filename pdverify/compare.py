@@ -309,18 +309,45 @@ def _load_checked(path: str, what: str) -> dict:
 
 
 def compare_published(path: str, *, stream=None) -> int:
-    """``pdverify compare --against-published RESULTS.json``: check every published entry
-    of every run; 0 when all hold (known differences and statements without a number are
-    listed, not failed), 1 when one fails (listed again at the end), bad input (exit 2,
-    :class:`~pdverify.errors.InputError`): a file that is not a results file or holds no
-    published entry."""
+    """``pdverify compare --against-published RESULTS.json``: check every run of the file
+    against the published entries pdverify's own catalogue holds for its scene, method
+    and params (:func:`pdverify.published.catalogue_rows`: the target, tolerance, check
+    and reproduced value of a known difference come from the package; the file supplies
+    our values only, and its own ``published`` entries are not used); 0 when all hold
+    (known differences and statements without a number are listed, not failed), 1 when
+    one fails (listed again at the end), bad input (exit 2,
+    :class:`~pdverify.errors.InputError`): a file that is not a results file (a NaN or
+    negative tolerance, a number beyond the doubles), a run of a scene this pdverify does
+    not know that claims published entries, a value of ours that is not a finite
+    number, or no run the catalogue holds an entry for."""
+    from .scenes import all_scenes
     stream = stream or sys.stdout
     doc = _load_checked(path, "results file")
-    rows = [row for run in doc["runs"] for row in published.check_run(run)]
+    known = {s.id: s for s in all_scenes()}
+    rows = []
+    for k, run in enumerate(doc["runs"]):
+        scene = known.get(run["scene"])
+        if scene is None:
+            if run.get("published"):
+                raise InputError(f"--against-published {path!r}: runs[{k}] is of scene "
+                                 f"{run['scene']!r}, which this pdverify does not know, so "
+                                 "its published entries cannot be checked against the "
+                                 "package's own")
+            continue
+        for row in published.catalogue_rows(run, scene):
+            ours = row["ours"]
+            if (isinstance(ours, (int, float)) and not isinstance(ours, bool)
+                    and not published.finite_number(ours)):
+                what = (repr(ours) if isinstance(ours, float)
+                        else f"an integer of {len(str(abs(ours)))} digits")
+                raise InputError(f"--against-published {path!r}: runs[{k}].metrics."
+                                 f"{row['entry']['metric']} is {what}; a finite number is "
+                                 "allowed")
+            rows.append(row)
     if not rows:
-        raise InputError(f"--against-published {path!r}: no run holds a 'published' entry "
-                         "(a results file of a pdverify before published values, or of runs "
-                         "the papers print nothing for)")
+        raise InputError(f"--against-published {path!r}: no run has a published entry in "
+                         "pdverify's catalogue (runs the papers print nothing for, or of "
+                         "scenes or params they do not cover)")
     print(format_published(rows), file=stream)
     counts = {v: sum(r["verdict"] == v for r in rows)
               for v in ("holds", "known difference", "not numeric", "fails")}
@@ -330,7 +357,11 @@ def compare_published(path: str, *, stream=None) -> int:
         print(f"fails: {r['scene']} {r['method']} {_pub_params(r['params'])}: {e['metric']} "
               f"= {_pub_fmt(r['ours'])}, paper {_pub_fmt(e['value'])} ({e['source']}; check "
               f"{e['check']} {_pub_fmt(e['target'])} within {_pub_fmt(e['tolerance'])}: "
-              f"{e['tolerance_source']})", file=stream)
+              f"{e['tolerance_source']})"
+              + (f"; known difference {e['deviation']}: ours reproduces "
+                 f"{_pub_fmt(e.get('reproduced'))} within "
+                 f"{_pub_fmt(e.get('reproduced_tolerance'))} ({e.get('reproduced_source')})"
+                 if e.get("known_difference") else ""), file=stream)
     print(f"compare --against-published: {len(rows)} entries, {counts['holds']} hold, "
           f"{counts['known difference']} known differences, {counts['not numeric']} not "
           f"numeric, {counts['fails']} fail; {published.count_text(rows)}", file=stream)

@@ -74,30 +74,48 @@ def check_format(scene, p, fmt: str) -> None:
 # ------------------------------------------------------------------------------ folder
 def check_out(path: str) -> str:
     """``--out DIR``: new, empty, or a previous export (its marker lists everything in
-    it); anything else is InputError before any work. Returns the absolute path."""
+    it, every entry a path inside it); its name fits the file system with the staging
+    folder's suffix and its parent takes files (:func:`pdverify.outputs.check_target`);
+    anything else is InputError before any work. Returns the absolute path, links
+    resolved."""
+    from . import outputs
     if not str(path).strip():
         raise InputError(f"--out {path!r}: empty path; give a folder")
-    full = os.path.realpath(os.path.expanduser(str(path)))
+    given = os.path.abspath(os.path.expanduser(str(path)))
+    outputs.check_target(given, shown=path)     # a name too long, an unwritable parent
+    full = os.path.realpath(given)
+    if full != given:
+        outputs.check_target(full, shown=path)
+    try:
+        cwd = os.path.realpath(os.getcwd())
+    except OSError:
+        cwd = None
+    if cwd is not None and outputs._within(cwd, full):
+        raise InputError(f"--out {path!r} is or contains the current folder, which the "
+                         "export would replace as a whole; give another folder")
+    _check_state(full, path)
+    return full
+
+
+def _check_state(full: str, path) -> None:
     if os.path.exists(full) and not os.path.isdir(full):
         raise InputError(f"--out {path!r} is a file, not a folder")
     if os.path.isdir(full):
-        entries = _tree(full)
+        try:
+            entries = _tree(full)
+        except OSError as exc:
+            raise InputError(f"--out {path!r} cannot be listed ({exc.strerror})") from None
         if entries:
             listed = _marker_entries(full)
             if listed is None:
                 raise InputError(f"--out {path!r} is not empty and holds no pdverify export "
                                  f"(no {MARKER}); choose a new or empty folder")
+            from .outputs import check_listed
+            check_listed(full, sorted(listed), f"--out {path!r}: its {MARKER}")
             foreign = [e for e in entries if e not in listed]
             if foreign:
                 raise InputError(f"--out {path!r} holds {foreign[0]!r}, which pdverify's "
                                  "export did not write; move it or choose another folder")
-    parent = os.path.dirname(full)
-    probe = parent
-    while not os.path.exists(probe):
-        probe = os.path.dirname(probe)
-    if not os.access(probe, os.W_OK):
-        raise InputError(f"--out {path!r}: {probe!r} is not writable")
-    return full
 
 
 def _tree(folder: str) -> list[str]:
@@ -111,9 +129,9 @@ def _tree(folder: str) -> list[str]:
 
 def _marker_entries(folder: str) -> set | None:
     try:
-        with open(os.path.join(folder, MARKER), encoding="utf-8") as fh:
-            doc = json.load(fh)
-    except (OSError, ValueError):
+        with open(os.path.join(folder, MARKER), "rb") as fh:
+            doc = json.loads(fh.read(1 << 22))
+    except (OSError, ValueError, RecursionError):
         return None
     if not isinstance(doc, dict) or doc.get("schema") != MARKER_SCHEMA:
         return None
@@ -123,23 +141,46 @@ def _marker_entries(folder: str) -> set | None:
     return set(entries) | {MARKER}
 
 
-def _clear(folder: str) -> None:
-    """Remove a previous export's files (only what its marker lists; checked before)."""
-    listed = _marker_entries(folder) or set()
-    for e in sorted(listed, key=len, reverse=True):
-        p = os.path.join(folder, e)
-        if e.endswith("/"):
-            if os.path.isdir(p) and not os.listdir(p):
-                os.rmdir(p)
-        elif os.path.isfile(p):
-            os.unlink(p)
+def _own_leftover(path: str) -> bool:
+    """A staging or set-aside folder of an earlier, killed export: an empty folder, or one
+    holding our marker (a staging folder gets it first)."""
+    if os.path.islink(path) or not os.path.isdir(path):
+        return False
+    return not os.listdir(path) or _marker_entries(path) is not None
+
+
+def _write_marker(folder: str, entries, complete: bool) -> None:
+    from . import __version__
+    with open(os.path.join(folder, MARKER), "w", encoding="utf-8") as fh:
+        fh.write(json.dumps({"schema": MARKER_SCHEMA, "pdverify_version": __version__,
+                             "complete": complete, "entries": sorted(entries)},
+                            indent=1) + "\n")
+
+
+#: bytes of nodes.vtu per node, a bound: meshio writes binary VTU (base64, zlib; measured
+#: 8.8 B a node, body3d-traction's 2000 nodes in 17.6 kB); uncompressed, the point data
+#: export writes (coordinates, volume, block id, force, prescribed values: at most 13
+#: doubles, 104 B) is 139 B in base64, doubled for headers and margins
+VTU_BYTES_PER_NODE = 300
+#: room left on the disk beyond the export's own bytes (:data:`pdverify.outputs.MIN_FREE_FILE`)
+EXPORT_MARGIN = 1 << 20
 
 
 def write_export(ns: NodeSet, fmt: str, out: str) -> list[str]:
     """Write the export of ``ns`` in ``fmt`` into ``out`` (checked by :func:`check_out`);
-    returns the files written, relative to ``out``. A write that fails raises
-    :class:`OutputError` naming the file; a format the node set does not take
+    returns the files written, relative to ``out``.
+
+    As a report is written: under the lock on ``out``, which the caller holds
+    (:func:`pdverify.outputs.output_lock`, taken by :func:`export_command` before the
+    node set is built: a second export into it exits 2 naming this one), into a staging
+    folder next to it that replaces ``out`` as a whole at the end (:func:`pdverify.outputs.swap_in`), after
+    checking that its disk takes the files (InputError, exit 2, nothing written). A write
+    that fails raises :class:`OutputError` naming the file; the previous export stays as
+    it was and the staging folder is removed. A format the node set does not take
     (:func:`check_format`) is InputError before any file."""
+    import shutil
+    import tempfile
+    from . import outputs
     check_format(ns.scene, ns.params, fmt)
     files = {"problem.json": dumps(describe_json(ns))}
     if fmt == "csv":
@@ -151,49 +192,74 @@ def write_export(ns: NodeSet, fmt: str, out: str) -> list[str]:
     elif fmt == "lammps":
         files.update(lammps_files(ns))
     files["README.md"] = readme(ns, fmt, sorted(files) + (["nodes.vtu"] if fmt == "vtu" else []))
-    path = out
+    need = (sum(len(t.encode("utf-8")) for t in files.values()) + EXPORT_MARGIN
+            + (VTU_BYTES_PER_NODE * len(ns.x) if fmt == "vtu" else 0))
+    parent, name = os.path.split(out)
+    # under the caller's lock on ``out`` (export_command's)
+    _check_state(out, out)                     # what changed while the node set was built
+    outputs.check_free(parent, need, f"--out {out!r} (an export of {len(ns.x)} nodes)")
+    outputs.clean_stale(parent, name, _own_leftover)
     try:
-        os.makedirs(out, exist_ok=True)
-        _clear(out)
+        staging = tempfile.mkdtemp(prefix=f".{name}.staging-", dir=parent)
+    except OSError as exc:
+        raise OutputError(f"export: cannot create its staging folder in {parent!r} "
+                          f"({exc.strerror or exc}); nothing was written") from None
+    path = staging
+    try:
+        from .results import umask_mode
+        os.chmod(staging, umask_mode(0o777))   # mkdtemp gives 0700
+        _write_marker(staging, [], complete=False)
         written = []
         for rel, text in files.items():
-            path = os.path.join(out, rel)
+            path = os.path.join(staging, rel)
             os.makedirs(os.path.dirname(path), exist_ok=True)
             with open(path, "w", encoding="utf-8", newline="\n") as fh:
                 fh.write(text)
             written.append(rel)
         if fmt == "vtu":
-            path = os.path.join(out, "nodes.vtu")
+            path = os.path.join(staging, "nodes.vtu")
             write_vtu(ns, path)
             written.append("nodes.vtu")
-        entries = sorted(set(_tree(out)) | {MARKER})
-        path = os.path.join(out, MARKER)
-        from . import __version__
-        with open(path, "w", encoding="utf-8") as fh:
-            fh.write(json.dumps({"schema": MARKER_SCHEMA, "pdverify_version": __version__,
-                                 "entries": entries}, indent=1) + "\n")
+        path = os.path.join(staging, MARKER)
+        _write_marker(staging, set(_tree(staging)) | {MARKER}, complete=True)
+        path = out
+        outputs.swap_in(staging, out)
     except OSError as exc:
-        raise OutputError(f"cannot write {path!r} ({exc.strerror or exc})") from exc
+        previous = ("the previous export in " + repr(out) + " is unchanged"
+                    if os.path.exists(out) else "nothing was written at " + repr(out))
+        shown = os.path.join(out, os.path.relpath(path, staging)) if path != out else out
+        raise OutputError(f"export: cannot write {shown!r} ({exc.strerror or exc}); "
+                          f"{previous}") from exc
+    finally:
+        if os.path.exists(staging):
+            shutil.rmtree(staging, ignore_errors=True)
     return sorted(written)
 
 
 # ------------------------------------------------------------------------------ command
 def export_command(scene_id: str, *, method=None, overrides=None, fmt: str, out: str,
                    stream=None) -> int:
-    """``pdverify export``: every check before any work, then assemble and write."""
+    """``pdverify export``: every check before any work (the folder, its name and
+    parent, the disk, the cache; no solver memory estimate: export assembles, it solves
+    nothing), then assemble and write."""
     import sys
+    from . import budget
     from .exchange import check_method, node_set, scene_of
+    from .outputs import MIN_FREE_FILE, check_cache, check_free
     stream = stream or sys.stdout
     scene = scene_of(scene_id)
     check_method(method)
     if fmt not in FORMATS:
         raise InputError(f"--format {fmt!r}; allowed: {', '.join(FORMATS)}")
-    check_format(scene, scene.resolve(METHOD, overrides), fmt)
-    folder = check_out(out)
-    from .outputs import check_cache
-    check_cache()       # a FEM scene's prescribed values come from its cached reference
-    ns = node_set(scene, overrides)
-    files = write_export(ns, fmt, folder)
+    from .outputs import output_lock
+    with budget.assembly_only():
+        check_format(scene, scene.resolve(METHOD, overrides), fmt)
+        folder = check_out(out)
+        check_free(os.path.dirname(folder), MIN_FREE_FILE, f"--out {out!r}")
+        check_cache()       # a FEM scene's prescribed values come from its cached reference
+        with output_lock(folder, "export"):   # a second export into it: exit 2, now
+            ns = node_set(scene, overrides)
+            files = write_export(ns, fmt, folder)
     print(f"{scene.id} --method {METHOD}: {len(ns.x)} nodes, {ns.dim}D, horizon "
           f"{ns.horizon:.6g} m (written {export_horizon(ns):.6g} m: see README.md) -> {out} "
           f"({len(files)} files: "

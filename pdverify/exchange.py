@@ -226,6 +226,51 @@ _U_NAMES = ("u{a}", "u_{a}", "displacement_{a}", "displacements_{a}", "displacem
             "displacements{a}")
 
 
+#: the most bytes a displacement file may hold per node of the export, and the bytes it may
+#: hold beyond that (headers, comments, an Exodus file's metadata): a CSV row of six doubles
+#: in repr is at most 6 x 25 = 150 bytes, a VTU point with a dozen float64 arrays ~130
+#: bytes in base64, and an Exodus node 8 bytes per variable and time step (100 steps of
+#: three displacements and two more variables: 4 kB). A file above this cannot be the
+#: export's displacements and is refused before it is read (a sparse 20 GB file, a file
+#: of another, finer node set).
+SCORE_BYTES_PER_NODE = 4096
+SCORE_BYTES_FIXED = 64 << 20
+
+
+def check_size(path: str, nodes: int) -> None:
+    """InputError naming the file, its size and the limit when ``path`` holds more bytes
+    than the displacements of ``nodes`` nodes can (:data:`SCORE_BYTES_PER_NODE`)."""
+    limit = SCORE_BYTES_FIXED + SCORE_BYTES_PER_NODE * int(nodes)
+    try:
+        size = os.stat(path).st_size
+    except OSError as exc:
+        raise InputError(f"displacement file {path!r} cannot be read ({exc.strerror})") from None
+    if size > limit:
+        raise InputError(f"displacement file {path!r} holds {size} bytes, more than the "
+                         f"displacements of the export's {nodes} nodes can ({limit} bytes at "
+                         f"most: {SCORE_BYTES_FIXED >> 20} MiB and {SCORE_BYTES_PER_NODE} "
+                         "bytes a node); is it the file of another node set?")
+
+
+#: byte-order marks a text file may start with; only UTF-8's is read (and skipped)
+_BOMS = ((b"\xef\xbb\xbf", "UTF-8"), (b"\xff\xfe\x00\x00", "UTF-32"),
+         (b"\x00\x00\xfe\xff", "UTF-32"), (b"\xff\xfe", "UTF-16"), (b"\xfe\xff", "UTF-16"))
+
+
+def _check_text_encoding(path: str) -> None:
+    """A text file in UTF-16 or UTF-32 (its byte-order mark) is InputError naming it."""
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(4)
+    except OSError as exc:
+        raise InputError(f"displacement file {path!r} cannot be read ({exc.strerror})") from None
+    for mark, name in _BOMS:
+        if head.startswith(mark) and name != "UTF-8":
+            raise InputError(f"displacement file {path!r} cannot be read: it starts with a "
+                             f"{name} byte-order mark; save it as UTF-8 (with or without its "
+                             "byte-order mark)")
+
+
 def read_displacements(path: str, dim: int) -> Displacements:
     """Positions and displacements from a CSV (header row: ``x, y, z`` and ``ux, uy,
     uz`` or ``u_x``..., a length unit in brackets scaled to metres (:data:`LENGTH_UNITS`),
@@ -239,6 +284,8 @@ def read_displacements(path: str, dim: int) -> Displacements:
     from .validate import input_file
     input_file(path, "displacement file")
     ext = os.path.splitext(path)[1].lower()
+    if ext in (".csv", ".txt", ".dump", ".lammpstrj"):
+        _check_text_encoding(path)
     if ext in (".csv", ".txt"):
         got = _read_csv(path, dim)
     elif ext == ".vtu":
@@ -265,34 +312,48 @@ def read_displacements(path: str, dim: int) -> Displacements:
 
 
 def _read_csv(path: str, dim: int) -> Displacements:
+    """The CSV read row by row (never the whole text at once): the header row, then the
+    named columns of each data row into one array of doubles."""
+    from array import array
     try:
-        with open(path, encoding="utf-8-sig", newline="") as fh:   # a BOM is skipped
-            lines = [ln for ln in fh if ln.strip() and not ln.lstrip().startswith("#")]
-    except (OSError, UnicodeDecodeError) as exc:
+        fh = open(path, encoding="utf-8-sig", newline="")   # a UTF-8 BOM is skipped
+    except OSError as exc:
         raise InputError(f"displacement file {path!r} cannot be read ({exc})") from None
-    rows = list(csv.reader(io.StringIO("".join(lines))))
-    if not rows:
-        raise InputError(f"displacement file {path!r} is empty (no header row)")
-    names = [_column_name(c) for c in rows[0]]
-    want_x = list(AXES[:dim])
-    want_u = []
-    for a in AXES[:dim]:
-        hit = next((n.format(a=a) for n in _U_NAMES if n.format(a=a) in names), None)
-        want_u.append(hit or f"u{a}")
-    missing = [c for c in want_x + want_u if c not in names]
-    if missing:
-        raise InputError(f"displacement file {path!r}: missing column(s) "
-                         f"{', '.join(missing)}; it has {', '.join(names) or 'none'} "
-                         f"(need {', '.join(want_x)} and {', '.join(f'u{a}' for a in AXES[:dim])})")
-    cols = [names.index(c) for c in want_x + want_u]
-    per_metre = np.array([_per_metre(path, rows[0][c]) for c in cols])
-    data = np.empty((len(rows) - 1, 2 * dim))
-    for i, row in enumerate(rows[1:]):
-        try:
-            data[i] = [float(row[c]) for c in cols]
-        except (ValueError, IndexError):
-            raise InputError(f"displacement file {path!r}: data row {i + 1} is not "
-                             f"{len(cols)} numbers in the named columns: {row!r}") from None
+    try:
+        with fh:
+            reader = csv.reader(ln for ln in fh
+                                if ln.strip() and not ln.lstrip().startswith("#"))
+            header = next(reader, None)
+            if header is None:
+                raise InputError(f"displacement file {path!r} is empty (no header row)")
+            names = [_column_name(c) for c in header]
+            want_x = list(AXES[:dim])
+            want_u = []
+            for a in AXES[:dim]:
+                hit = next((n.format(a=a) for n in _U_NAMES if n.format(a=a) in names), None)
+                want_u.append(hit or f"u{a}")
+            missing = [c for c in want_x + want_u if c not in names]
+            if missing:
+                raise InputError(
+                    f"displacement file {path!r}: missing column(s) {', '.join(missing)}; it "
+                    f"has {', '.join(names) or 'none'} (need {', '.join(want_x)} and "
+                    f"{', '.join(f'u{a}' for a in AXES[:dim])})")
+            cols = [names.index(c) for c in want_x + want_u]
+            per_metre = np.array([_per_metre(path, header[c]) for c in cols])
+            values = array("d")
+            for i, row in enumerate(reader):
+                try:
+                    values.extend(float(row[c]) for c in cols)
+                except (ValueError, IndexError):
+                    raise InputError(f"displacement file {path!r}: data row {i + 1} is not "
+                                     f"{len(cols)} numbers in the named columns: "
+                                     f"{[c[:20] for c in row[:8]]!r}") from None
+    except (UnicodeDecodeError, csv.Error) as exc:
+        raise InputError(f"displacement file {path!r} cannot be read as UTF-8 CSV "
+                         f"({type(exc).__name__}: {exc})") from None
+    except OSError as exc:
+        raise InputError(f"displacement file {path!r} cannot be read ({exc})") from None
+    data = np.frombuffer(values, dtype=float).reshape(-1, 2 * dim).copy()
     _check_finite(path, data)
     data = data / per_metre   # metres (a column in m keeps its values bit for bit)
     return Displacements(path, "csv", data[:, :dim], data[:, dim:])
@@ -535,6 +596,10 @@ def _export_params(scene, folder: str, given: bool, overrides) -> dict:
             or not isinstance(doc.get("params"), dict) or not isinstance(doc.get("scene"), str)):
         raise InputError(f"{where}: its {MARKER} or problem.json is not pdverify's "
                          f"(schemas {MARKER_SCHEMA} and pdverify.export/1 with scene and params)")
+    from .outputs import check_listed
+    entries = marker.get("entries", [])
+    check_listed(folder, entries if isinstance(entries, list) else [repr(entries)],
+                 f"{where}: its {MARKER}")
     if doc["scene"] != scene.id:
         raise InputError(f"{where} is an export of scene {doc['scene']!r}, not {scene.id!r}")
     try:
@@ -578,8 +643,9 @@ def _score_file(scene, path: str, *, name: str, overrides, origin):
     """:func:`score` at ``overrides``, the params of the export ``origin`` (or None)."""
     from .results import RunResult
     scene.resolve(METHOD, overrides)                 # bad --set before reading the file
-    given = read_displacements(path, scene.dim)
     ns = node_set(scene, overrides)
+    check_size(path, len(ns.x))                      # before reading: a size it can have
+    given = read_displacements(path, scene.dim)
     if origin is not None and origin["nodes"] not in (None, len(ns.x)):
         raise InputError(f"the export {origin['folder']!r} has {origin['nodes']} nodes, the "
                          f"node set of its params {len(ns.x)} here (written by pdverify "
@@ -642,7 +708,11 @@ def load_external(paths) -> list:
                                  f"{run['method']!r}, not an external run (external:NAME, "
                                  "written by pdverify score)")
             get_scene(run["scene"])          # an unknown scene: exit 2, close matches
+            from .outputs import check_listed
+            check_listed(os.path.dirname(os.path.abspath(path)), run.get("files", []),
+                         f"--include {path!r}: runs[{k}].files")
             r = RunResult.from_json(run)
+            r.files = []     # the record's own files are not the report's (score writes none)
             if r.key in seen:
                 raise InputError(f"--include: {r.scene} {r.method} is in {seen[r.key]!r} "
                                  f"and {path!r} with the same params")

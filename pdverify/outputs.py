@@ -18,12 +18,15 @@ a probe file, and the output's file system has room for an estimate of the outpu
 """
 from __future__ import annotations
 
+import fcntl
 import glob
 import json
 import os
 import re
+import shutil
 import stat
 import tempfile
+from contextlib import contextmanager
 
 from .errors import InputError
 
@@ -102,6 +105,36 @@ def file_kind(mode: int) -> str:
         if test(mode):
             return name
     return "not a regular file"
+
+
+# ------------------------------------------------------------------------------ listed paths
+
+def outside(folder: str, entry) -> bool:
+    """True when the path ``entry``, which a file of ``folder`` lists (a marker's entry,
+    a results file's ``files``), does not lie inside ``folder`` once joined to it and
+    every link resolved: an absolute path, ``..`` above it, a link pointing out, an
+    empty name or a NUL byte. A file pdverify reads names paths; it never directs where
+    pdverify writes or deletes outside the folder it belongs to."""
+    if not isinstance(entry, str) or not entry.strip("/") or "\0" in entry:
+        return True
+    if os.path.isabs(entry) or entry.startswith("~"):
+        return True
+    base = os.path.realpath(folder)
+    try:
+        full = os.path.realpath(os.path.join(base, entry))
+    except (OSError, ValueError):
+        return True
+    return full == base or not _within(full, base)
+
+
+def check_listed(folder: str, entries, what: str) -> None:
+    """InputError naming the first entry of ``entries`` (listed by ``what``, a file of
+    ``folder``) that lies outside ``folder`` (:func:`outside`)."""
+    for entry in entries:
+        if outside(folder, entry):
+            raise InputError(f"{what} lists {entry!r}, which is not a path inside "
+                             f"{folder!r}; the file is refused (pdverify writes and deletes "
+                             "only inside the folder a file belongs to)")
 
 
 # ------------------------------------------------------------------------------ report folders
@@ -202,6 +235,9 @@ def folder_state(folder: str) -> tuple[str, str]:
         marker = read_marker(folder)
         if marker is None:
             return "foreign", f"its {MARKER} was not written by pdverify"
+        bad = next((e for e in marker["entries"] if outside(folder, e)), None)
+        if bad is not None:
+            return "foreign", f"its {MARKER} lists {bad!r}, which is not a path inside it"
         known = set(marker["entries"]) | {MARKER}
         stray = [e for e in _tree(folder) if e not in known]
         if stray:
@@ -419,3 +455,122 @@ def check_cache() -> None:
 
 def check_out_file_space(path: str, flag: str) -> None:
     check_free(os.path.dirname(path), MIN_FREE_FILE, f"{flag} {path!r}")
+
+
+# ------------------------------------------------------------------------------ lock, stage, swap
+#: what a lock file holds while its holder writes: "pdverify report (pid N)", "pdverify
+#: export (pid N)"
+_LOCK_TEXT = "pdverify "
+
+
+@contextmanager
+def output_lock(out: str, what: str = "report"):
+    """Hold ``<parent>/.<name>.lock`` while ``out`` is written (a report or an export):
+    a second writer into the same folder exits 2 naming the holder instead of
+    interleaving with this one."""
+    parent, name = os.path.split(os.path.abspath(out))
+    path = os.path.join(parent, f".{name}.lock")
+    if os.path.lexists(path) and not _own_lock(path):
+        raise InputError(f"--out {out!r}: {path!r} exists and is not pdverify's lock file; "
+                         "move it away or choose another folder")
+    try:
+        os.makedirs(parent, exist_ok=True)
+        fh = open(path, "a+")
+    except OSError as exc:
+        raise InputError(f"--out {out!r}: cannot create its lock file {path!r} "
+                         f"({exc.strerror or exc})") from None
+    try:
+        fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        fh.seek(0)
+        holder = fh.read().strip() or "another process"
+        fh.close()
+        raise InputError(f"--out {out!r} is being written by {holder}; wait for it or "
+                         "choose another folder") from None
+    try:  # who holds it, for the message of a second writer; a full disk costs only that
+        fh.seek(0)
+        fh.truncate()
+        fh.write(f"{_LOCK_TEXT}{what} (pid {os.getpid()})")
+        fh.flush()
+    except OSError:
+        pass
+    try:
+        yield
+    finally:
+        fh.close()  # releases the lock; the empty lock file may stay
+
+
+def _own_lock(path: str) -> bool:
+    """The lock file is pdverify's: a regular file, empty or holding our holder text."""
+    try:
+        if os.path.islink(path) or not os.path.isfile(path) or os.path.getsize(path) > 200:
+            return False
+        with open(path, "rb") as fh:
+            text = fh.read()
+    except OSError:
+        return False
+    return text == b"" or text.startswith(_LOCK_TEXT.encode())
+
+
+def clean_stale(parent: str, name: str, own) -> None:
+    """Remove staging folders that earlier, killed writers into ``name`` left behind (only
+    while holding the lock, so none of them belongs to a live one), and only those that
+    ``own(path)`` recognises as pdverify's."""
+    for entry in os.listdir(parent):
+        if entry.startswith(f".{name}.staging-") or entry.startswith(f".{name}.old-"):
+            path = os.path.join(parent, entry)
+            if own(path):
+                shutil.rmtree(path, ignore_errors=True)
+
+
+def swap_in(staging: str, out: str) -> None:
+    """Replace ``out`` by ``staging`` as a whole: the old folder is renamed aside, the new
+    one renamed in, the old one deleted. A reader sees the old folder or the new one."""
+    parent, name = os.path.split(out)
+    old = None
+    if os.path.exists(out):
+        old = tempfile.mkdtemp(prefix=f".{name}.old-", dir=parent)
+        os.rmdir(old)
+        os.rename(out, old)
+    try:
+        os.rename(staging, out)
+    except BaseException:
+        if old is not None:
+            os.rename(old, out)
+        raise
+    if old is not None:
+        shutil.rmtree(old, ignore_errors=True)
+
+
+#: the longest suffix a staging or set-aside folder adds to the target's name
+#: (``.NAME.staging-XXXXXXXX``: a dot, ".staging-" and mkdtemp's 8 characters)
+STAGING_EXTRA = len("..staging-") + 8
+
+
+def check_target(out: str, flag: str = "--out", shown=None) -> None:
+    """Before any work: ``out``'s name, with the staging folder's suffix, fits the file
+    system's name limit, and its parent (or the nearest existing ancestor, where it
+    would be created) takes a file. InputError naming ``out`` otherwise."""
+    full = os.path.abspath(out)
+    out = full if shown is None else shown
+    probe = existing_ancestor(os.path.dirname(full))
+    try:
+        limit = os.pathconf(probe, "PC_NAME_MAX")
+    except (OSError, ValueError):
+        limit = 255
+    for part in full.split(os.sep):
+        if len(part.encode("utf-8", "surrogateescape")) > limit:
+            raise InputError(f"{flag} {out!r}: the name {part[:40]!r}... is "
+                             f"{len(part.encode('utf-8', 'surrogateescape'))} bytes, above "
+                             f"the file system's limit of {limit}; choose a shorter name")
+    name = os.path.basename(full)
+    if len(name.encode("utf-8", "surrogateescape")) + STAGING_EXTRA > limit:
+        raise InputError(f"{flag} {out!r}: the name is too long for its staging folder "
+                         f"(at most {limit - STAGING_EXTRA} bytes on this file system); "
+                         "choose a shorter name")
+    if not os.path.isdir(probe):
+        raise InputError(f"{flag} {out!r}: {probe!r} is a file, not a folder")
+    reason = _probe(probe, 1)
+    if reason is not None:
+        raise InputError(f"{flag} {out!r}: cannot write into {probe!r} ({reason}); choose "
+                         "another place")

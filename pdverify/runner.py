@@ -89,7 +89,7 @@ def _failed(case, message) -> RunResult:
     return RunResult(scene=scene_id, method=method, params=params, reference=scene.reference,
                      status="failed", message=message,
                      timings={"setup_s": 0.0, "solve_s": 0.0, "total_s": 0.0},
-                     published=[p.entry() for p in
+                     published=[p.entry(params) for p in
                                 scene.published_for(method, params).values()])
 
 

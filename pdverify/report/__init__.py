@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import errno
-import fcntl
 import hashlib
 import os
 import shutil
@@ -12,6 +11,7 @@ import time
 from contextlib import contextmanager
 
 from .. import outputs
+from ..outputs import output_lock, swap_in as _swap_in  # noqa: F401 (one lock, one swap)
 from ..errors import STOP_REQUESTED, InputError, OutputError
 from ..results import atomic_write_text, run_key, umask_mode, write_results
 from ..exchange import is_external
@@ -40,87 +40,6 @@ def default_out(only=None, quick=False, methods=None) -> str:
             "\0".join(sorted(ids)).encode()).hexdigest()[:6]
         return os.path.join("reports", ("quick-" if quick else "") + "only-" + name)
     return os.path.join("reports", "quick") if quick else DEFAULT_OUT
-
-
-@contextmanager
-def output_lock(out: str):
-    """Hold ``<parent>/.<name>.lock`` for the whole report: a second report into the same
-    folder exits 2 naming the holder instead of interleaving with this one."""
-    parent, name = os.path.split(os.path.abspath(out))
-    path = os.path.join(parent, f".{name}.lock")
-    if os.path.lexists(path) and not _own_lock(path):
-        raise InputError(f"--out {out!r}: {path!r} exists and is not pdverify's lock file; "
-                         "move it away or choose another folder")
-    try:
-        os.makedirs(parent, exist_ok=True)
-        fh = open(path, "a+")
-    except OSError as exc:
-        raise InputError(f"--out {out!r}: cannot create its lock file {path!r} "
-                         f"({exc.strerror or exc})") from None
-    try:
-        fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except BlockingIOError:
-        fh.seek(0)
-        holder = fh.read().strip() or "another process"
-        fh.close()
-        raise InputError(f"--out {out!r} is being written by {holder}; wait for it or "
-                         "choose another folder") from None
-    try:  # who holds it, for the message of a second report; a full disk costs only that
-        fh.seek(0)
-        fh.truncate()
-        fh.write(f"{_LOCK_TEXT} (pid {os.getpid()})")
-        fh.flush()
-    except OSError:
-        pass
-    try:
-        yield
-    finally:
-        fh.close()  # releases the lock; the empty lock file may stay
-
-
-_LOCK_TEXT = "pdverify report"
-
-
-def _own_lock(path: str) -> bool:
-    """The lock file is pdverify's: a regular file, empty or holding our holder text."""
-    try:
-        if os.path.islink(path) or not os.path.isfile(path) or os.path.getsize(path) > 200:
-            return False
-        with open(path, "rb") as fh:
-            text = fh.read()
-    except OSError:
-        return False
-    return text == b"" or text.startswith(_LOCK_TEXT.encode())
-
-
-def _clean_stale(parent: str, name: str) -> None:
-    """Remove staging folders that earlier, killed reports into ``name`` left behind (only
-    while holding the lock, so none of them belongs to a live report), and only those
-    that are pdverify's (:func:`pdverify.outputs.is_own_leftover`)."""
-    for entry in os.listdir(parent):
-        if entry.startswith(f".{name}.staging-") or entry.startswith(f".{name}.old-"):
-            path = os.path.join(parent, entry)
-            if outputs.is_own_leftover(path):
-                shutil.rmtree(path, ignore_errors=True)
-
-
-def _swap_in(staging: str, out: str) -> None:
-    """Replace ``out`` by ``staging`` as a whole: the old folder is renamed aside, the new
-    one renamed in, the old one deleted. A reader sees the old report or the new one."""
-    parent, name = os.path.split(out)
-    old = None
-    if os.path.exists(out):
-        old = tempfile.mkdtemp(prefix=f".{name}.old-", dir=parent)
-        os.rmdir(old)
-        os.rename(out, old)
-    try:
-        os.rename(staging, out)
-    except BaseException:
-        if old is not None:
-            os.rename(old, out)
-        raise
-    if old is not None:
-        shutil.rmtree(old, ignore_errors=True)
 
 
 def build_report(*, out=None, quick=False, only=None, jobs=None, progress=None,
@@ -198,7 +117,9 @@ def rerun_plan(cases, out: str):
         raise InputError(f"--failed: the previous report's results cannot be read "
                          f"({exc})") from None
     previous = {}
-    for run in doc["runs"]:
+    for k, run in enumerate(doc["runs"]):
+        outputs.check_listed(out, run.get("files", []),
+                             f"--failed: the previous report's results.json runs[{k}].files")
         r = RunResult.from_json(run)
         previous.setdefault(r.key, r)
     again = []
@@ -227,6 +148,7 @@ def check_storage(cases, out: str) -> None:
     """Before any work: the cache takes files, and ``out``'s disk has room for the new
     report next to the previous one (which stays until the new one is complete)."""
     outputs.check_cache()
+    outputs.check_target(out)
     outputs.check_free(os.path.dirname(out), estimate_bytes(cases),
                        f"--out {out!r} (a report of {len(cases)} runs)")
 
@@ -238,7 +160,7 @@ def _locked(cases, out, parent, name, jobs, progress, client, quick=False,
     A report that could not be written whole (:class:`OutputError`: a figure, a VTU file,
     a page or results.json failed to write) is not swapped in: the previous report stays,
     the partial one stays in its staging folder, and OutputError names both."""
-    _clean_stale(parent, name)
+    outputs.clean_stale(parent, name, outputs.is_own_leftover)
     try:
         staging = tempfile.mkdtemp(prefix=f".{name}.staging-", dir=parent)
     except OSError as exc:
@@ -585,6 +507,8 @@ def _keep_fields(results, final, out) -> None:
             head, name = os.path.split(rel)
             new = os.path.join(head, f"{k:03d}-" + name.split("-", 1)[-1])
             src = os.path.join(final, rel)
+            if outputs.outside(final, rel) or outputs.outside(out, new):
+                continue     # never read or write outside the two reports (checked before)
             if os.path.isfile(src):
                 os.makedirs(os.path.join(out, head), exist_ok=True)
                 shutil.copyfile(src, os.path.join(out, new))

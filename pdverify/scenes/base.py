@@ -189,6 +189,13 @@ class Published:
     #: ``claim`` (a statement in words or a bound); empty: ``claim`` for words and bounds,
     #: else ``value``
     role: str = ""
+    #: a known difference (``deviation`` without ``expected``): the value WE reproduce, as
+    #: ``(where, text, source)`` triples (the first whose ``where`` matches the run's
+    #: params; ``{}`` matches any), each checked within half a unit in its last digit
+    #: (:func:`pdverify.published.parse`): ours must stay there, or the entry fails.
+    #: ``source`` names where the number comes from (a deviation's text, a test, or "ours,
+    #: recorded from the full report of commit C" where nothing else states it)
+    reproduced: tuple = ()
 
     def applies(self, method: str, params: Mapping[str, Any]) -> bool:
         return _applies(self.method, self.where, method, params)
@@ -204,8 +211,20 @@ class Published:
         check, _, _ = pub.parse(self.value)
         return "claim" if (self.bound is not None or check != "equal") else "value"
 
-    def entry(self) -> dict:
-        """The run record's ``published`` entry (:mod:`pdverify.published`)."""
+    def reproduced_for(self, params: Mapping[str, Any] | None):
+        """(value, tolerance, source) of :attr:`reproduced` for a run's ``params``, or None."""
+        from .. import published as pub
+        for where, text, source in self.reproduced:
+            if params is None or all(params.get(k) == v for k, v in where.items()):
+                check, number, tol = pub.parse(text)
+                if check != "equal" or tol is None:
+                    raise ValueError(f"{self.source}: reproduced {text!r} is not a decimal")
+                return number, tol, source
+        return None
+
+    def entry(self, params: Mapping[str, Any] | None = None) -> dict:
+        """The run record's ``published`` entry (:mod:`pdverify.published`) for a run of
+        ``params`` (None: the first :attr:`reproduced` value)."""
         from .. import published as pub
         check, number, tol = pub.parse(self.value)
         source = pub.DIGITS_SOURCE if check == "equal" else pub.BOUND_SOURCE
@@ -229,6 +248,9 @@ class Published:
         if self.deviation:
             out["deviation"] = self.deviation
             out["known_difference"] = self.expected is None
+            mine = self.reproduced_for(params) if self.expected is None else None
+            if mine is not None:
+                out["reproduced"], out["reproduced_tolerance"], out["reproduced_source"] = mine
         if self.note:
             out["note"] = self.note
         out["role"] = self.entry_role
@@ -460,7 +482,7 @@ class Scene:
         result = RunResult(scene=self.id, method=method, params=params, reference=self.reference,
                            expected_failure=next((e.reason for e in self.expected_failures
                                                   if e.applies(method, params)), ""),
-                           published=[p.entry() for p in
+                           published=[p.entry(params) for p in
                                       self.published_for(method, params).values()])
         timer = Timer()
         budget.release_freed_memory()        # what earlier runs left is not this run's

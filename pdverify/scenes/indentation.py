@@ -227,7 +227,9 @@ class Indentation(BondStaticScene):
         # both readings shown), against the small-strain one 5.8 % (checked; the quick
         # grid's 41 x 41 nodes give 4.8 % and 6.3 %: deviations, 003-indentation-reference)
         Published("force_error_pct", 6, "seed 003 §4.2 (about 6 %)", method="energy-directional",
-                  where=PUBLISHED_AT, deviation="003-indentation-reference"),
+                  where=PUBLISHED_AT, deviation="003-indentation-reference",
+                  reproduced=(({}, "5.3", "deviations 003-indentation-reference (the full "
+                               "report's record at the paper's grid)"),)),
         Published("force_error_pct_vs_small_strain", 6, "seed 003 §4.2 (about 6 %), against "
                   "the small-strain FEM", method="energy-directional", where=PUBLISHED_AT),
         Published("force_bias_pct", -30, "seed 003 §4.2 (about 30 % too soft)", method="none",
@@ -235,7 +237,9 @@ class Indentation(BondStaticScene):
                   tolerance_source="half a unit in the one printed significant digit "
                                    "('about 30 %')"),
         Published("failure_depth_mm", 0.4, "seed 003 §4.2 (about 0.4 mm)", method="none",
-                  where=PUBLISHED_AT, deviation="003-indentation-failure"),
+                  where=PUBLISHED_AT, deviation="003-indentation-failure",
+                  reproduced=(({}, "0.7", "deviations 003-indentation-failure; "
+                               "tests/pdverify/test_indentation_sweep.py"),)),
     )
 
     #: the documented collapses (deviations: seed 003 findings): failures, as expected

@@ -221,7 +221,9 @@ class SheetStiffness(StiffnessScene):
                            where=PAPER_M),
                  Published("bulk_anisotropy_c11_3c12_pct", "< 2", "seed 003 §4.1.2, read as "
                            "|C11 / (3 C12) - 1|", method="none", where=PAPER_M,
-                           deviation="003-anisotropy-measure"))
+                           deviation="003-anisotropy-measure",
+                           reproduced=(({}, "3.26", "deviations 003-anisotropy-measure; "
+                                        "tests/pdverify/test_issue53_texts.py"),)))
 
     def measure_ratios(self, p, model, ratios, counts=None) -> Outcome:
         """:meth:`StiffnessScene.measure_ratios` and the Cauchy reading of the bulk's

@@ -45,7 +45,11 @@ def test_the_tolerance_comes_from_the_printed_digits_or_says_why():
     assert pub.parse("decreases with m, no number printed")[0] == "none"
     e = {"check": "equal", "target": 4.17, "tolerance": 0.005}
     assert pub.verdict(e, 4.174) == "holds" and pub.verdict(e, 4.137) == "fails"
-    assert pub.verdict({**e, "known_difference": True}, 4.137) == "known difference"
+    # a known difference still bounds ours: the value we reproduce, within its tolerance
+    known = {**e, "known_difference": True, "reproduced": 4.14, "reproduced_tolerance": 0.005}
+    assert pub.verdict(known, 4.137) == "known difference"
+    assert pub.verdict(known, 999.0) == "fails" and pub.verdict(known, 4.172) == "holds"
+    assert pub.verdict({**e, "known_difference": True}, 4.137) == "fails"   # none stated
     assert pub.verdict({"check": "above", "target": 30.0, "tolerance": 0.0}, 26.3) == "fails"
 
 
@@ -117,7 +121,7 @@ def test_compare_against_published_bad_input_exits_2(homog_results, tmp_path, ca
     write_results(bare, [get_scene("bar1d-homogenization").run("none", {"micromodulus":
                                                                          "constant"})])
     assert main(["compare", "--against-published", str(bare)]) == 2
-    assert "no run holds a 'published' entry" in capsys.readouterr().err
+    assert "no run has a published entry in pdverify's catalogue" in capsys.readouterr().err
     assert main(["compare", "--against-published", str(tmp_path / "nope.json")]) == 2
     assert main(["compare", str(path), "--against-published", str(path)]) == 2
     doc = json.loads(path.read_text())
