@@ -89,6 +89,19 @@ def distinct_labels(results, base=label) -> list[str]:
     return out
 
 
+def method_colours(results) -> list[str]:
+    """Each run's colour: its method's (:mod:`.palette`), in shades where a figure draws
+    several runs of one method (dark to light in the order given)."""
+    from . import palette
+    count, seen, out = {}, {}, []
+    for r in results:
+        count[r.method] = count.get(r.method, 0) + 1
+    for r in results:
+        k = seen[r.method] = seen.get(r.method, -1) + 1
+        out.append(palette.variant(r.method, k, count[r.method]))
+    return out
+
+
 def _short(v):
     return f"{v:.4g}" if isinstance(v, float) else v
 
@@ -134,6 +147,13 @@ def shared_log_norm(arrays, decades=4.0):
     if lo >= hi:
         lo = hi / 10
     return LogNorm(vmin=lo, vmax=hi, clip=True)
+
+
+#: decades an energy-density map's logarithmic colour scale spans below its largest value:
+#: the densities peak at corners and under contacts (singular in the FEM), where a linear
+#: scale left the rest of the body one colour (plate-l); 4 decades show the bulk's
+#: variation and the layer at the boundary
+ENERGY_DECADES = 4.0
 
 
 def _tidy_axes(fig):

@@ -4,7 +4,8 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 
-from . import distinct_labels, family, label, save as _save
+from . import (distinct_labels, family, label, method_colours, palette,
+               save as _save)
 
 
 @family("bar1d")
@@ -14,11 +15,12 @@ def bar_figures(scene, results, folder):
     ref = results[0].fields
     xf = np.linspace(0.0, ref["length"], 400)
     ax1.plot(xf, scene.classical(xf, results[0].params), "k--", lw=1.2, label="classical (reference)")
-    for r, name in zip(results, distinct_labels(results)):
+    for r, name, colour in zip(results, distinct_labels(results), method_colours(results)):
         f = r.fields
-        ax1.plot(f["x"], f["u"], "o-", ms=3, lw=1, label=name)
+        mk = palette.marker(r.method)
+        ax1.plot(f["x"], f["u"], "-", marker=mk, ms=3, lw=1, color=colour, label=name)
         err = np.where(f["error_pct"] > 0, f["error_pct"], np.nan)
-        ax2.semilogy(f["x"], err, "o-", ms=3, lw=1, label=name)
+        ax2.semilogy(f["x"], err, "-", marker=mk, ms=3, lw=1, color=colour, label=name)
     ax1.set_xlabel("x [m]")
     ax1.set_ylabel("u [m]")
     ax1.legend(fontsize=8)

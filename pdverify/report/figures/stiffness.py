@@ -4,7 +4,7 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 
-from . import family, node_image, save
+from . import family, node_image, palette, save
 
 
 def _mid_line(r):
@@ -32,8 +32,9 @@ def stiffness(scene, runs, folder):
     for ax, state in zip(np.atleast_1d(axes), shown):
         for r in runs:
             idx = _mid_line(r)
-            ax.plot(r.fields["x"][idx, 0], r.fields[f"ratio_{state}"][idx], ".-", ms=3,
-                    label=r.method)
+            st = palette.style(r.method)
+            ax.plot(r.fields["x"][idx, 0], r.fields[f"ratio_{state}"][idx], "-",
+                    marker=st.marker, ms=3, color=st.colour, label=r.method)
         ax.axhline(1.0, color="k", lw=0.6)
         ax.set_title(f"{state.replace('_', ' ')}", fontsize=9)
         ax.set_xlabel("x [m] (line through the middle)")

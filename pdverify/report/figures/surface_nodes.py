@@ -7,8 +7,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from ...results import cost_s
-from . import (ROUND_OFF, distinct_labels, family, label, number_panel, round_off,
-               save as _save, shared_log_norm)
+from . import (ROUND_OFF, distinct_labels, family, label, method_colours, number_panel,
+               palette, round_off, save as _save, shared_log_norm)
 from .fields3d import _grid_values
 
 
@@ -125,7 +125,9 @@ def _maps_3d(scene, results, folder):
                              gridspec_kw={"width_ratios": [2, 2, 2, 1], "wspace": 0.3,
                                           "hspace": 0.5}, squeeze=False, sharex="col",
                              sharey="col")
-    fig.subplots_adjust(top=1 - 0.55 / (1.75 * len(runs) + 0.7))
+    height = 1.75 * len(runs) + 0.7
+    # room above the first row for the suptitle, its run's name and the layer titles
+    fig.subplots_adjust(top=1 - 0.75 / height)
     im = None
     for row, (r, err) in enumerate(zip(runs, errs)):
         f = r.fields
@@ -146,10 +148,12 @@ def _maps_3d(scene, results, folder):
             continue
         for col, (ax, (title, z, ext, (a, b))) in enumerate(zip(axes[row], panels)):
             im = ax.imshow(z, origin="lower", extent=ext, cmap="viridis", norm=norm)
-            ax.set_title(title, fontsize=7)
-            if col == 0:   # the run's name above its row, left
-                ax.text(0, 1.22, f"{_label(r)} (max {vmax:.3g} %)", fontsize=8,
-                        fontweight="bold", transform=ax.transAxes)
+            if row == 0:   # the layers once, as column heads
+                ax.set_title(title, fontsize=7)
+            if col == 0:   # the run's name above its row, left, clear of the heads
+                ax.annotate(f"{_label(r)} (max {vmax:.3g} %)", (0, 1), xycoords="axes fraction",
+                            xytext=(0, 15 if row == 0 else 4), textcoords="offset points",
+                            fontsize=8, fontweight="bold", va="bottom")
             ax.tick_params(labelsize=6)
             if row == len(runs) - 1:
                 ax.set_xlabel(f"{a} [m]", fontsize=6.5)
@@ -158,7 +162,7 @@ def _maps_3d(scene, results, folder):
         cb = fig.colorbar(im, ax=axes.ravel().tolist(), shrink=0.6, pad=0.02)
         cb.set_label("|eps| [%] (Eq. 38), log", fontsize=7)
     fig.suptitle(f"{scene.id}: nodal error of every method at its defaults, one colour scale",
-                 fontsize=9)
+                 fontsize=9, y=1 - 0.12 / height, va="top")
     name = _save(fig, folder, f"{scene.id}-maps.png")
     return [(name, "Magnitude of the nodal error of Eq. (38) on four node layers (as Figs. 9 "
                    "and 12 of seed 001), one row per method at its default parameters, all "
@@ -168,11 +172,23 @@ def _maps_3d(scene, results, folder):
 
 
 def _cost(scene, results, folder):
+    """Error against cost, one point per run in its method's colour and marker
+    (:mod:`.palette`; a method's several runs in its shades); errors at round-off are
+    drawn on a floor below the others, marked, not at 1e-15."""
+    from ...convergence import EXACT
     fig, ax = plt.subplots(figsize=(6.5, 4))
-    for r, name in zip(results, distinct_labels(results, _label)):
-        t = cost_s(r.timings)
-        ax.loglog(max(t, 1e-4), max(r.metrics["max_error_pct"], 1e-16), "o", ms=6,
-                  label=name)
+    errs = [r.metrics["max_error_pct"] for r in results]
+    real = [e for e in errs if e > EXACT * 100]
+    floor = min(real) / 5 if real else EXACT * 100
+    for r, name, e, colour in zip(results, distinct_labels(results, _label), errs,
+                                  method_colours(results)):
+        t = max(cost_s(r.timings), 1e-4)
+        exact = e <= EXACT * 100
+        ax.loglog(t, floor if exact else e, "v" if exact else palette.marker(r.method),
+                  ms=7 if exact else 6, color=colour, mfc="none" if exact else colour,
+                  mew=1.4, ls="none", label=name + (" (exact to round-off)" if exact else ""))
+    if len(real) < len(errs):
+        ax.axhline(floor, color="0.6", lw=0.8, ls=":")
     ax.set_xlabel("setup + solve time [s] (cached setup at the time it took)")
     ax.set_ylabel("max_error_pct")
     ax.grid(True, which="both", alpha=0.3)
@@ -180,7 +196,10 @@ def _cost(scene, results, folder):
     ax.set_title(f"{scene.id}: error against cost")
     return [(_save(fig, folder, f"{scene.id}-cost.png"),
              "Largest nodal error against the run's setup + solve time (the metrics computed "
-             "afterwards not counted), one point per run.")]
+             "afterwards not counted), one point per run, colour and marker per method as in "
+             "every figure of the report (a method's several runs in its shades); hollow "
+             f"triangles on the dotted floor: runs exact to round-off (error <= {EXACT * 100:g} "
+             "%), drawn there instead of at round-off level.")]
 
 
 def where_max(fields, k, reach) -> str:
