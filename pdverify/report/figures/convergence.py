@@ -61,6 +61,9 @@ def exact_floor(entries):
 #: how far below a panel's smallest real error its floor lies (a third of a decade and a
 #: half: the floor's markers stay apart from the lowest real point)
 FLOOR_FACTOR = 5.0
+#: the factor between the floor marks of two methods exact in one panel (a fifth of a
+#: decade: the triangles stay apart on the log axis, all below the floor factor)
+EXACT_STAGGER = 1.3
 #: the y range of a panel whose every error is round-off: just above the EXACT bound
 ALL_EXACT_SPAN = (1e-10, 1e-6)
 
@@ -68,11 +71,12 @@ ALL_EXACT_SPAN = (1e-10, 1e-6)
 def study_panel(ax, entries):
     """One study panel: a line per method in its colour and marker (:mod:`.palette`), the
     round-off levels (error <= EXACT) as hollow downward triangles on the panel's floor
-    (:func:`exact_floor`) and the reference slopes; returns the floor."""
+    (:func:`exact_floor`; a second exact method a step :data:`EXACT_STAGGER` above it,
+    still below the smallest real error) and the reference slopes; returns the floor."""
     from ...convergence import EXACT
     floor = exact_floor(entries)
     at = floor if floor is not None else ALL_EXACT_SPAN[0] * 10
-    any_exact = False
+    any_exact = 0
     for e in entries:
         st = palette.style(e["method"])
         pts = [(lv["h"], lv["error"]) for lv in e["levels"] if lv["error"] is not None]
@@ -80,14 +84,16 @@ def study_panel(ax, entries):
             continue
         real = [(h, v) for h, v in pts if v > EXACT]
         exact = [h for h, v in pts if v <= EXACT]
-        # the line runs through the real levels; a round-off level sits on the floor
-        line = [(h, v if v > EXACT else at) for h, v in pts]
+        # the line runs through the real levels; a round-off level sits on the floor, each
+        # method's a step of EXACT_STAGGER above the last one's, so that none hides another
+        mark = at * EXACT_STAGGER ** any_exact
+        line = [(h, v if v > EXACT else mark) for h, v in pts]
         ax.loglog(*zip(*line), "-", color=st.colour, lw=1.2, alpha=0.6 if exact else 1.0)
         if real:
             ax.loglog(*zip(*real), st.marker, ls="none", ms=4.5, color=st.colour)
         if exact:
-            any_exact = True
-            ax.loglog(exact, [at] * len(exact), "v", ls="none", ms=6, mfc="none",
+            any_exact += 1
+            ax.loglog(exact, [mark] * len(exact), "v", ls="none", ms=6, mfc="none",
                       mec=st.colour, mew=1.3)
         ax.plot([], [], "-", marker=st.marker, ms=4.5, color=st.colour, label=_legend(e))
     _reference_slopes(ax, entries, None)
