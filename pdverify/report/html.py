@@ -37,7 +37,18 @@ def short_caption(caption: str, limit: int = 70) -> str:
     return head
 
 
+def short_captions(figures) -> str:
+    """The short titles of ``(file, caption)`` pairs for a folded list, each once, with
+    how many figures share it (a scene's three FEM references: one title, x 3)."""
+    counts = {}
+    for _, caption in figures:
+        head = short_caption(caption)
+        counts[head] = counts.get(head, 0) + 1
+    return "; ".join(h + (f" (x {n})" if n > 1 else "") for h, n in counts.items())
+
+
 _ENV.filters["short_caption"] = short_caption
+_ENV.filters["short_captions"] = short_captions
 
 
 def lead_figures(scene_id: str, figures) -> tuple[list, int]:

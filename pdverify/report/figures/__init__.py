@@ -149,11 +149,29 @@ def shared_log_norm(arrays, decades=4.0):
     return LogNorm(vmin=lo, vmax=hi, clip=True)
 
 
-#: decades an energy-density map's logarithmic colour scale spans below its largest value:
-#: the densities peak at corners and under contacts (singular in the FEM), where a linear
-#: scale left the rest of the body one colour (plate-l); 4 decades show the bulk's
-#: variation and the layer at the boundary
-ENERGY_DECADES = 4.0
+#: the percentiles of the positive values between which an energy-density map's
+#: logarithmic colour scale runs (:func:`energy_norm`; the Fig. 3 maps of seed 003 use the
+#: same): the densities are singular at re-entrant and clamped corners and under a
+#: contact's edge, so the top is capped below the singular nodes' values; with a linear
+#: scale, or one up to the singular value, all but the corner was one colour (plate-l)
+ENERGY_PERCENTILES = (1.0, 99.5)
+
+
+def energy_norm(arrays):
+    """One logarithmic colour scale for energy-density maps, from the
+    :data:`ENERGY_PERCENTILES` of their positive values (values beyond take the end
+    colours); None when no value is positive."""
+    from matplotlib.colors import LogNorm
+    pos = np.concatenate([np.asarray(a, dtype=float).ravel() for a in arrays])
+    pos = pos[np.isfinite(pos) & (pos > 0)]
+    if pos.size == 0:
+        return None
+    lo, hi = (float(v) for v in np.percentile(pos, ENERGY_PERCENTILES))
+    if not lo < hi:
+        lo, hi = float(pos.min()), float(pos.max())
+    if not lo < hi:
+        lo = hi / 10
+    return LogNorm(vmin=lo, vmax=hi, clip=True)
 
 
 def _tidy_axes(fig):

@@ -23,7 +23,9 @@ def bar_figures(scene, results, folder):
         ax2.semilogy(f["x"], err, "-", marker=mk, ms=3, lw=1, color=colour, label=name)
     ax1.set_xlabel("x [m]")
     ax1.set_ylabel("u [m]")
-    ax1.legend(fontsize=8)
+    # right of the panels, outside the data
+    ax2.legend(*ax1.get_legend_handles_labels(), fontsize=8, loc="upper left",
+               bbox_to_anchor=(1.02, 1.0), frameon=False)
     ax1.set_title(f"{scene.id}: displacement")
     ax2.set_xlabel("x [m]")
     ax2.set_ylabel("relative error [%] (Eq. 64)")

@@ -5,8 +5,7 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 
-from . import (ENERGY_DECADES, family, fem_then_pd, node_image, palette, save,
-               shared_log_norm)
+from . import ENERGY_PERCENTILES, energy_norm, family, fem_then_pd, node_image, palette, save
 
 def _style(r):
     """The run's method colour and marker (:mod:`.palette`); solid nonlinear, dotted
@@ -115,9 +114,7 @@ def indentation_figures(scene, results, folder):
     ax.set_ylabel("force [kN per m of thickness]")
     ax.set_title("Fig. 4 of seed 003: indentation curves")
     ax.grid(alpha=0.3)
-    # below the axes: inside, it covered the curves and the failure crosses
-    ax.legend(fontsize=7.5, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=1,
-              frameon=False)
+
     ins = ax.inset_axes([0.08, 0.55, 0.35, 0.4])
     _curves(ins, fem, runs, inset=True)
     ins.set_xlim(0, 0.5 + 1e-9)
@@ -135,8 +132,10 @@ def indentation_figures(scene, results, folder):
     ax2.set_title("how close the lattice is to folding (0: a node reaches the next row)")
     ax2.set_ylim(0, 1.05)
     ax2.grid(alpha=0.3)
-    ax2.legend(fontsize=7.5, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2,
-               frameon=False)
+    # one legend for both panels (the right one draws the same runs in the same colours
+    # and line styles), below them: inside, it covered the curves and the failure crosses
+    fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncol=2,
+               fontsize=7.5, frameon=False)
     out.append((save(fig, folder, f"{scene.id}-fig4.png"),
                 f"Fig. 4 of seed 003: indentation force against depth {grid_words(runs)}, "
                 f"{fem_label(kin)} (the reference"
@@ -146,7 +145,8 @@ def indentation_figures(scene, results, folder):
                 "the directional correction and with the energy, volume (and perifit) "
                 "corrections, nonlinear (solid) and linear (dotted) kinematics; "
                 "crosses in a run's colour: where it fails (the curve stops at its last equilibrium). "
-                "Right: the shortest bond's current length over its reference length, per depth."))
+                "Right: the shortest bond's current length over its reference length, per depth, "
+                "each run in its colour and line style of the left panel (one legend below)."))
     sweep = _sweep_table(scene, pd_runs, folder)
     if sweep is not None:
         out.append(sweep)
@@ -179,9 +179,9 @@ def _fig5(scene, r, folder):
     fig, axes = plt.subplots(3, 2, figsize=(10, 13), layout="constrained")
     for k, ((title, ref, pd), (a_ref, a_pd)) in enumerate(zip(rows, axes)):
         lo, hi = min(ref.min(), pd.min()), max(ref.max(), pd.max())
-        # the energy density peaks under the indenter's corners: a log scale (down to
-        # ENERGY_DECADES below the top), where a linear one shows one colour elsewhere
-        norm = shared_log_norm([ref, pd], ENERGY_DECADES) if k == 2 else None
+        # the energy density peaks under the contact's edges: a log scale
+        # (:func:`energy_norm`), where a linear one shows one colour elsewhere
+        norm = energy_norm([ref, pd]) if k == 2 else None
         for ax, vals, who in ((a_ref, ref, "FEM"), (a_pd, pd, "PD, corrected")):
             img, ext = node_image(x, h, vals, unit=1e3)
             im = (ax.imshow(img, origin="lower", extent=ext, cmap="viridis", norm=norm)
@@ -196,7 +196,8 @@ def _fig5(scene, r, folder):
             f"{fem_label(f.get('fem_kinematics', 'linear'))} (left, evaluated at the PD "
             "nodes) beside "
             "corrected nonlinear PD (right), one colour scale per row (the energy density's "
-            f"logarithmic, {ENERGY_DECADES:g} decades below its largest value).")
+            f"logarithmic, from the {ENERGY_PERCENTILES[0]:g}th to the "
+            f"{ENERGY_PERCENTILES[1]:g}th percentile of its values).")
 
 
 #: the solver choices the sweep varies (the scene's ``UNSTATED_CHOICES`` and the grid's

@@ -39,7 +39,9 @@ def stiffness(scene, runs, folder):
         ax.set_title(f"{state.replace('_', ' ')}", fontsize=9)
         ax.set_xlabel("x [m] (line through the middle)")
     np.atleast_1d(axes)[0].set_ylabel("W_i / W_bulk")
-    np.atleast_1d(axes)[-1].legend(fontsize=7)
+    # one legend for the panels, right of them (inside, it covered the profiles' ends)
+    handles, labels = np.atleast_1d(axes)[-1].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside right upper", fontsize=7, frameon=False)
     out.append((save(fig, folder, f"{scene.id}-profiles.png"),
                 "Nodal strain energy density over the bulk lattice's, along the line through "
                 "the middle of the body in x, under a unit uniaxial stretch along x (normal "
