@@ -23,14 +23,14 @@ def _run(scene, method, over=None, status="ok", t=0.5, fields=None, **metrics):
                      timings={"setup_s": t / 4, "solve_s": t / 2, "total_s": t})
 
 
-def _keep(monkeypatch, module):
+def _keep(monkeypatch, module, attr="save"):
     """Keep the figures ``module`` saves (open, for inspection) instead of writing them."""
     kept = []
 
     def save(fig, folder, name):
         kept.append(fig)
         return name
-    monkeypatch.setattr(module, "save", save)
+    monkeypatch.setattr(module, attr, save)
     return kept
 
 
@@ -184,3 +184,27 @@ def test_every_scene_is_on_the_page_with_its_secondary_parts_folded():
     assert html.published_rows(bar, bar_runs)
     assert 'class="pub"' in page and 'class="pub"' not in visible
     assert '<details class="fold"><summary>Published values beside ours: ' in page
+
+
+def test_bar_errors_exact_to_round_off_sit_on_a_floor(monkeypatch):
+    """The bars' nodal error panel: a run exact to round-off (1e-13 %) is drawn on a floor
+    below the smallest real error, not at 1e-13 % (before: the axis ran down to 1e-13)."""
+    from pdverify.report.figures import bar1d
+    bar = get_scene("bar1d-uniform-load")
+    x = np.linspace(0.025, 0.975, 20)
+
+    def fields(err):
+        return {"x": x, "u": x * 1e-4, "error_pct": err, "length": 1.0}
+    runs = [_run(bar, "none", fields=fields(np.linspace(1.0, 10.0, 20))),
+            _run(bar, "pddo", fields=fields(np.full(20, 3e-13))),
+            _run(bar, "taylor-fictitious", {"order": 2}, fields=fields(np.full(20, 1e-13)))]
+    kept = _keep(monkeypatch, bar1d, "_save")
+    bar1d.bar_figures(bar, runs, "unused")
+    ax2 = kept[0].axes[1]
+    ys = np.concatenate([np.asarray(line.get_ydata(), float) for line in ax2.get_lines()])
+    ys = ys[np.isfinite(ys)]
+    floor = 1.0 / 5
+    assert ys.min() >= floor * (1 - 1e-12)                    # nothing at round-off level
+    assert ax2.get_ylim()[0] > 1e-2
+    labels = [line.get_label() for line in kept[0].axes[0].get_lines()]
+    assert sum("exact to round-off" in lab for lab in labels) == 2
