@@ -1,6 +1,7 @@
 """Figures of seed 001: error maps (Figs. 9, 12, 14, 15) and error against cost."""
 from __future__ import annotations
 
+import textwrap
 import warnings
 
 import matplotlib.pyplot as plt
@@ -53,6 +54,10 @@ def _defaults(scene, results):
     return default_runs(scene, results)
 
 
+#: characters per line of a 2D map's title (its panel is 2.2 in wide, the title 7.5 pt)
+TITLE_CHARS = 30
+
+
 def _maps_2d(scene, results, folder):
     """One small-multiples figure: a column per method (:func:`_columns_2d`), the Eq. (44)
     error in u (top row) and v (bottom row), one logarithmic colour scale per row shared
@@ -61,9 +66,14 @@ def _maps_2d(scene, results, folder):
     cols = _columns_2d(scene, results)
     if not cols:
         return []
-    fig, axes = plt.subplots(2, len(cols), figsize=(2.2 * len(cols) + 1.2, 4.8),
+    # the panels' titles take up to `lines` lines (7.5 pt: 0.125 in each); the figure grows
+    # by them and its top margin holds them under the suptitle
+    lines = max(len(textwrap.wrap(title, TITLE_CHARS)) for title, _ in cols) + 1
+    height = 4.8 + 2 * 0.125 * (lines - 2)
+    fig, axes = plt.subplots(2, len(cols), figsize=(2.2 * len(cols) + 1.2, height),
                              squeeze=False, sharex=True, sharey=True,
-                             gridspec_kw={"wspace": 0.08, "hspace": 0.45})
+                             gridspec_kw={"wspace": 0.08, "hspace": 0.45 + 0.1 * (lines - 2)})
+    fig.subplots_adjust(top=1 - (0.125 * lines + 0.3) / height)
     norms = []
     for k, comp in enumerate(("u (Fig. 14)", "v (Fig. 15)")):
         maps = [_grid_values(r.fields, r.fields["error"][:, k]).T for _, r in cols]
@@ -73,7 +83,10 @@ def _maps_2d(scene, results, folder):
         im = None
         for col, ((title, r), z) in enumerate(zip(cols, maps)):
             ax = axes[k, col]
-            head = f"{title}\n{comp}: max {np.nanmax(z):.3g} %"
+            # a long run name wrapped to the panel's width (2.2 in at 7.5 pt: about 30
+            # characters), so that neighbouring titles do not run into each other
+            head = "\n".join(textwrap.wrap(title, TITLE_CHARS)
+                              + [f"{comp}: max {np.nanmax(z):.3g} %"])
             if norm is None or round_off(z, 100.0):
                 number_panel(ax, f"round-off:\nmax {np.nanmax(z):.2g} %", head)
                 continue
@@ -88,7 +101,7 @@ def _maps_2d(scene, results, folder):
             cb.ax.tick_params(labelsize=6)
     fig.suptitle(f"{scene.id}: Eq. (44) errors of every method "
                  f"(h = {cols[0][1].params['spacing']:g} m; one colour scale per row)",
-                 fontsize=9)
+                 fontsize=9, y=1 - 0.08 / height, va="top")
     name = _save(fig, folder, f"{scene.id}-maps.png")
     _LAST_NORMS[:] = norms
     return [(name, "Seed 001 §5, Figs. 14 (u, top) and 15 (v, bottom) for every method: "
