@@ -27,6 +27,48 @@ _ENV = jinja2.Environment(
     undefined=jinja2.StrictUndefined, keep_trailing_newline=False)
 
 
+def short_caption(caption: str, limit: int = 70) -> str:
+    """A figure's short title for a folded list: its caption up to the first colon or
+    full stop (at most ``limit`` characters, cut at a word)."""
+    text = re.sub(r"<[^>]+>", "", str(caption)).strip()
+    head = re.split(r":\s|(?<!Fig)(?<!Figs)(?<!Eq)(?<!Eqs)(?<!e\.g)(?<!i\.e)(?<!\d)\.(?:\s|$)",
+                    text, maxsplit=1)[0]
+    if len(head) > limit:
+        head = head[:limit].rsplit(" ", 1)[0] + "..."
+    return head
+
+
+def short_captions(figures) -> str:
+    """The short titles of ``(file, caption)`` pairs for a folded list, each once, with
+    how many figures share it (a scene's three FEM references: one title, x 3)."""
+    counts = {}
+    for _, caption in figures:
+        head = short_caption(caption)
+        counts[head] = counts.get(head, 0) + 1
+    return "; ".join(h + (f" (x {n})" if n > 1 else "") for h, n in counts.items())
+
+
+_ENV.filters["short_caption"] = short_caption
+_ENV.filters["short_captions"] = short_captions
+
+
+def lead_figures(scene_id: str, figures) -> tuple[list, int]:
+    """The scene's figures in the page's order and how many of them it shows unfolded:
+    the first figure of the scene's own (a reproduced figure of the paper, an error map)
+    leads, the FEM reference's field and force-depth figures (``SCENE-K.png``,
+    ``SCENE-K-force.png``) follow it, and the rest is folded (:data:`LEAD_FIGURES`)."""
+    fem = re.compile(re.escape(scene_id) + r"-\d+(-force)?\.png")
+    own = [f for f in figures if not fem.fullmatch(f[0])]
+    ref = [f for f in figures if fem.fullmatch(f[0])]
+    return own + ref, min(LEAD_FIGURES, len(figures))
+
+
+#: figures of a scene shown unfolded: one, so that every scene shows its main picture and
+#: the page stays under 50,000 px at 1400 px wide (issue 52; 80,500 px with all 65 of the
+#: full report's figures open, ``benchmarks/page_height.py``)
+LEAD_FIGURES = 1
+
+
 def _render(template: str, **context) -> Markup:
     return Markup(_ENV.get_template(template).render(**context))
 
@@ -272,9 +314,11 @@ def scene_section(scene, results, figures, deviations=None, records=None) -> Mar
                     records, scene.id), metrics=metrics,
         rows=[_row(scene, r, metrics) for r in results],
         refinements=[_refinement(r) for r in results if r.fields.get("refinement")],
-        sources=sorted({p.source for p in scene.published}), figures=figures,
+        sources=sorted({p.source for p in scene.published}),
+        figures=(lead := lead_figures(scene.id, figures))[0], lead=lead[1],
         published=(pub := published_rows(scene, results)),
         published_counts=published_counts(pub) if pub else "",
+        published_fails=sum(p["verdict"] == "fails" for p in pub),
         missing=missing_published(scene, results) if results else [],
         unmatched=unmatched_published(scene))
 

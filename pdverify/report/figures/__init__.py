@@ -89,6 +89,19 @@ def distinct_labels(results, base=label) -> list[str]:
     return out
 
 
+def method_colours(results) -> list[str]:
+    """Each run's colour: its method's (:mod:`.palette`), in shades where a figure draws
+    several runs of one method (dark to light in the order given)."""
+    from . import palette
+    count, seen, out = {}, {}, []
+    for r in results:
+        count[r.method] = count.get(r.method, 0) + 1
+    for r in results:
+        k = seen[r.method] = seen.get(r.method, -1) + 1
+        out.append(palette.variant(r.method, k, count[r.method]))
+    return out
+
+
 def _short(v):
     return f"{v:.4g}" if isinstance(v, float) else v
 
@@ -132,6 +145,31 @@ def shared_log_norm(arrays, decades=4.0):
     hi = float(pos.max())
     lo = max(float(pos.min()), hi * 10.0 ** -decades)
     if lo >= hi:
+        lo = hi / 10
+    return LogNorm(vmin=lo, vmax=hi, clip=True)
+
+
+#: the percentiles of the positive values between which an energy-density map's
+#: logarithmic colour scale runs (:func:`energy_norm`; the Fig. 3 maps of seed 003 use the
+#: same): the densities are singular at re-entrant and clamped corners and under a
+#: contact's edge, so the top is capped below the singular nodes' values; with a linear
+#: scale, or one up to the singular value, all but the corner was one colour (plate-l)
+ENERGY_PERCENTILES = (1.0, 99.5)
+
+
+def energy_norm(arrays):
+    """One logarithmic colour scale for energy-density maps, from the
+    :data:`ENERGY_PERCENTILES` of their positive values (values beyond take the end
+    colours); None when no value is positive."""
+    from matplotlib.colors import LogNorm
+    pos = np.concatenate([np.asarray(a, dtype=float).ravel() for a in arrays])
+    pos = pos[np.isfinite(pos) & (pos > 0)]
+    if pos.size == 0:
+        return None
+    lo, hi = (float(v) for v in np.percentile(pos, ENERGY_PERCENTILES))
+    if not lo < hi:
+        lo, hi = float(pos.min()), float(pos.max())
+    if not lo < hi:
         lo = hi / 10
     return LogNorm(vmin=lo, vmax=hi, clip=True)
 

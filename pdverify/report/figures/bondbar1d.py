@@ -5,7 +5,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.lines import Line2D
 
-from . import family, save as _save
+from . import family, palette, save as _save
 
 def _case(r) -> str:
     return f"{r.params['horizon_ratio']:g}, {r.params['end_weight']}"
@@ -91,21 +91,21 @@ def constraint_figures(scene, results, folder):
     fig, axes = plt.subplots(1, 4, figsize=(17, 4), layout="constrained")
     titles = {"a": "(a) full bar, midpoint held", "b": "(b) half bar, end point held",
               "c": "(c) half bar, m end points held"}
-    markers = {"none": "o", "homogenized": "s", "energy": "^", "volume": "v"}
+    markers = {r.method: palette.marker(r.method) for r in results}
     for r in results:
         f = r.fields
         for ax, k in zip(axes[:3], "abc"):
             ax.plot(f[f"x_{k}"], f[f"u_{k}"], markers.get(r.method, "d") + "-", ms=4, lw=0.8,
-                    mfc="none", label=r.method)
+                    mfc="none", color=palette.colour(r.method), label=r.method)
         n_a = f["x_a"].size
         half = f["u_a"][n_a // 2:]
         m = f["x_c"].size - f["x_b"].size + 1
         scale = np.max(np.abs(f["u_a"]))
         mk = markers.get(r.method, "d")
         axes[3].plot(f["x_b"], (f["u_b"] - half) / scale, mk + "-", ms=4, lw=0.8,
-                     mfc="none", label=f"{r.method}: (b) - (a)")
+                     mfc="none", color=palette.colour(r.method), label=f"{r.method}: (b) - (a)")
         axes[3].plot(f["x_b"], (f["u_c"][m - 1:] - half) / scale, mk + "--", ms=4,
-                     lw=0.8, label=f"{r.method}: (c) - (a)")
+                     lw=0.8, color=palette.colour(r.method), label=f"{r.method}: (c) - (a)")
     s = results[0].fields["stress_over_E"]
     for ax, k in zip(axes[:3], "abc"):
         x = results[0].fields[f"x_{k}"]
@@ -158,7 +158,8 @@ def vibration_figures(scene, results, folder):
                 ax.plot(first.fields["t"] / T, first.fields[f"u_{key}_ref"], "k-", lw=1.4,
                         label="Rao, Eq. (105)")
                 for r in mine:
-                    ax.plot(r.fields["t"] / T, r.fields[f"u_{key}"], lw=0.9, label=r.method)
+                    ax.plot(r.fields["t"] / T, r.fields[f"u_{key}"], lw=0.9,
+                            color=palette.colour(r.method), label=r.method)
                 ax.set_title(f"Fig. {fig_no}{letter}: u_{point:g}, delta = {ratio:g} Delta"
                              if point is not None else f"Fig. {fig_no}{letter}, delta = "
                              f"{ratio:g} Delta")

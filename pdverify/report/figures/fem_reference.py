@@ -4,7 +4,7 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 
-from . import family, number_panel, round_off, save
+from . import ENERGY_PERCENTILES, energy_norm, family, number_panel, round_off, save
 
 
 @family("fem-reference")
@@ -28,7 +28,12 @@ def fem_figures(scene, results, folder):
                 number_panel(ax, f"uniform: {np.nanmean(data):.6g}\n(range "
                                  f"{np.nanmax(data) - np.nanmin(data):.2g}, round-off)", title)
                 continue
-            pc = ax.pcolormesh(g["x"], g["y"], data, shading="auto", cmap="viridis")
+            if title.startswith("strain energy"):
+                title += ", log"
+            # the energy density on a log scale (:func:`energy_norm`): it is singular at
+            # re-entrant corners, where a linear scale leaves the rest one colour
+            norm = energy_norm([data]) if title.startswith("strain energy") else None
+            pc = ax.pcolormesh(g["x"], g["y"], data, shading="auto", cmap="viridis", norm=norm)
             ax.set_aspect("equal")
             ax.set_title(title)
             fig.colorbar(pc, ax=ax, shrink=0.8)
@@ -39,7 +44,10 @@ def fem_figures(scene, results, folder):
             axes[2].set_title("refinement study")
             axes[2].grid(True, which="both", alpha=0.3)
         name = save(fig, folder, f"{scene.id}-{k}.png")
-        out.append((name, "Converged FEM field (displacement magnitude, strain energy density) "
+        lo, hi = ENERGY_PERCENTILES
+        out.append((name, "Converged FEM field (displacement magnitude, strain energy density on a "
+                          f"log scale from the {lo:g}th to the {hi:g}th percentile of its values, "
+                          "so that a singular corner does not take the whole scale) "
                           "and the change of the compared quantity per refinement level (drawn from two "
                           "changes on; a uniform field shows its value: its range is "
                           "round-off)."))

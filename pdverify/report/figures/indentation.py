@@ -5,17 +5,13 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 
-from . import family, fem_then_pd, node_image, save
-
-#: colour and marker per method; solid nonlinear, dotted linear kinematics
-METHOD_STYLE = {"none": ("tab:red", "s"), "energy-directional": ("tab:blue", "o"),
-                "energy": ("tab:orange", "^"), "volume": ("tab:purple", "v"),
-                "perifit": ("tab:brown", "D")}
-
+from . import ENERGY_PERCENTILES, energy_norm, family, fem_then_pd, node_image, palette, save
 
 def _style(r):
-    color, marker = METHOD_STYLE.get(r.method, ("gray", "."))
-    return color, "-" if r.params["kinematics"] == "nonlinear" else ":", marker
+    """The run's method colour and marker (:mod:`.palette`); solid nonlinear, dotted
+    linear kinematics."""
+    st = palette.style(r.method)
+    return st.colour, "-" if r.params["kinematics"] == "nonlinear" else ":", st.marker
 
 
 def _paper_grid(r):
@@ -95,9 +91,10 @@ def _curves(ax, fem, runs, inset=False):
             d = r.metrics["failure_depth_mm"]
             ax.plot([d], [np.interp(d, f["depths"] * 1e3, f["forces"] / 1e3,
                                     right=f["forces"][-1] / 1e3)],
-                    "x", color="tab:green", ms=12, mew=3,
-                    label=None if crossed else "run fails (lattice folds / Newton stops)")
-            crossed = True
+                    "x", color=color, ms=11, mew=2.5, zorder=5)
+    if not crossed and any(r.status != "ok" for r in runs):
+        ax.plot([], [], "x", color="0.3", ms=9, mew=2.5, ls="none",
+                label="x: where a run fails (lattice folds / Newton stops), its colour")
 
 
 @family("indentation", failed=True)
@@ -117,7 +114,7 @@ def indentation_figures(scene, results, folder):
     ax.set_ylabel("force [kN per m of thickness]")
     ax.set_title("Fig. 4 of seed 003: indentation curves")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8, loc="lower right")
+
     ins = ax.inset_axes([0.08, 0.55, 0.35, 0.4])
     _curves(ins, fem, runs, inset=True)
     ins.set_xlim(0, 0.5 + 1e-9)
@@ -135,7 +132,10 @@ def indentation_figures(scene, results, folder):
     ax2.set_title("how close the lattice is to folding (0: a node reaches the next row)")
     ax2.set_ylim(0, 1.05)
     ax2.grid(alpha=0.3)
-    ax2.legend(fontsize=8)
+    # one legend for both panels (the right one draws the same runs in the same colours
+    # and line styles), below them: inside, it covered the curves and the failure crosses
+    fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncol=2,
+               fontsize=7.5, frameon=False)
     out.append((save(fig, folder, f"{scene.id}-fig4.png"),
                 f"Fig. 4 of seed 003: indentation force against depth {grid_words(runs)}, "
                 f"{fem_label(kin)} (the reference"
@@ -144,8 +144,9 @@ def indentation_figures(scene, results, folder):
                 + ") and PD without correction, with "
                 "the directional correction and with the energy, volume (and perifit) "
                 "corrections, nonlinear (solid) and linear (dotted) kinematics; "
-                "green crosses: where a run fails (the curve stops at its last equilibrium). "
-                "Right: the shortest bond's current length over its reference length, per depth."))
+                "crosses in a run's colour: where it fails (the curve stops at its last equilibrium). "
+                "Right: the shortest bond's current length over its reference length, per depth, "
+                "each run in its colour and line style of the left panel (one legend below)."))
     sweep = _sweep_table(scene, pd_runs, folder)
     if sweep is not None:
         out.append(sweep)
@@ -176,11 +177,16 @@ def _fig5(scene, r, folder):
             ("u_x [mm]", f["u_ref"][:, 0] * 1e3, f["u"][:, 0] * 1e3),
             ("strain energy density [MJ/m^3]", f["energy_ref"] / 1e6, f["energy"] / 1e6)]
     fig, axes = plt.subplots(3, 2, figsize=(10, 13), layout="constrained")
-    for (title, ref, pd), (a_ref, a_pd) in zip(rows, axes):
+    for k, ((title, ref, pd), (a_ref, a_pd)) in enumerate(zip(rows, axes)):
         lo, hi = min(ref.min(), pd.min()), max(ref.max(), pd.max())
+        # the energy density peaks under the contact's edges: a log scale
+        # (:func:`energy_norm`), where a linear one shows one colour elsewhere
+        norm = energy_norm([ref, pd]) if k == 2 else None
         for ax, vals, who in ((a_ref, ref, "FEM"), (a_pd, pd, "PD, corrected")):
             img, ext = node_image(x, h, vals, unit=1e3)
-            im = ax.imshow(img, origin="lower", extent=ext, cmap="viridis", vmin=lo, vmax=hi)
+            im = (ax.imshow(img, origin="lower", extent=ext, cmap="viridis", norm=norm)
+                  if norm is not None else
+                  ax.imshow(img, origin="lower", extent=ext, cmap="viridis", vmin=lo, vmax=hi))
             ax.set_title(f"{who}: {title}", fontsize=10)
             ax.set_xlabel("x [mm]")
         a_ref.set_ylabel("y [mm]")
@@ -189,7 +195,9 @@ def _fig5(scene, r, folder):
             "Fig. 5 of seed 003 at 2 mm depth: u_y, u_x and strain-energy density, "
             f"{fem_label(f.get('fem_kinematics', 'linear'))} (left, evaluated at the PD "
             "nodes) beside "
-            "corrected nonlinear PD (right), one colour scale per row.")
+            "corrected nonlinear PD (right), one colour scale per row (the energy density's "
+            f"logarithmic, from the {ENERGY_PERCENTILES[0]:g}th to the "
+            f"{ENERGY_PERCENTILES[1]:g}th percentile of its values).")
 
 
 #: the solver choices the sweep varies (the scene's ``UNSTATED_CHOICES`` and the grid's

@@ -9,7 +9,7 @@ import math
 import matplotlib.pyplot as plt
 import numpy as np
 
-from . import save
+from . import palette, save
 from ..html import cost_s, headline_pct, is_exact
 from ..summary import headline
 
@@ -18,7 +18,6 @@ COLUMNS = 4
 #: a run faster than this is drawn at it, so that it stays on the log time axis (the
 #: timer's resolution is far finer; 0.1 ms is below every run's setup)
 MIN_TIME_S = 1e-4
-_MARKERS = "osD^v<>phX*P8"
 
 
 def pareto_front(points):
@@ -70,10 +69,9 @@ def pareto(scenes, results, folder) -> list[tuple[str, str]]:
     if not data:
         return []
     methods = sorted({p[2] for d in data for p in d["points"]}, key=lambda m: (m != "none", m))
-    # tab20's dark shades first, then its light ones: neighbours in the list differ
-    colours = {m: plt.get_cmap("tab20")((2 * k) % 20 + (2 * k) // 20 % 2)
-               for k, m in enumerate(methods)}
-    markers = {m: _MARKERS[k % len(_MARKERS)] for k, m in enumerate(methods)}
+    # the report's one colour and marker per method (:mod:`.palette`)
+    colours = {m: palette.colour(m) for m in methods}
+    markers = {m: palette.marker(m) for m in methods}
     rows = math.ceil(len(data) / COLUMNS)
     fig, axes = plt.subplots(rows, COLUMNS, figsize=(3.3 * COLUMNS, 2.6 * rows),
                              squeeze=False, gridspec_kw={"wspace": 0.38, "hspace": 0.5})

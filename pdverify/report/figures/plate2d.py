@@ -5,7 +5,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from ...scenes.plate2d import TABLE4 as PAPER
-from . import family, fem_then_pd, node_image, save
+from . import family, fem_then_pd, node_image, palette, save
+from .shapes import taylor_style
 
 #: the params of Table 4's runs (the maps); the sweeps vary spacing, m_ratio, quadrature
 TABLE4 = {**PAPER, "ring_value": "reference"}
@@ -67,8 +68,8 @@ def _error_maps(scene, runs, folder):
 
 
 def _sweep(ax, runs, x_of, xlabel, title):
-    styles = {("none", None): ("k", "s"), 1: ("tab:red", "o"), 2: ("tab:orange", "^"),
-              3: ("tab:green", "D")}
+    styles = {("none", None): (palette.colour("none"), palette.marker("none")),
+              **{n: taylor_style(n) for n in (1, 2, 3)}}
     drawn = False
     for quad, ls in (("partial-volume", "-"), ("moment-corrected", "--")):
         for key, (colour, marker) in styles.items():

@@ -5,11 +5,20 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 
-from . import family, fem_then_pd, node_image, save
+from . import family, fem_then_pd, node_image, palette, save
 
-STYLE = {"none": ("k", "s"), "energy": ("tab:blue", "v"), "volume": ("tab:purple", "P"),
-         "pals": ("tab:brown", "X"), 1: ("tab:red", "o"), 2: ("tab:orange", "^"),
-         3: ("tab:green", "D")}
+def taylor_style(order: int) -> tuple[str, str]:
+    """The Taylor method's colour in a shade per order 1, 2, 3 (dark to light) and its
+    marker (:mod:`.palette`)."""
+    return (palette.variant("taylor-fictitious", int(order) - 1, 3),
+            palette.marker("taylor-fictitious"))
+
+
+def _style(key) -> tuple[str, str]:
+    if isinstance(key, int):
+        return taylor_style(key)
+    st = palette.style(key)
+    return st.colour, st.marker
 
 
 def _key(r):
@@ -62,7 +71,7 @@ def _lines(ax, runs, x_of, metric, xlabel, spread=False):
         xs = sorted({x_of(r) for r in rs})
         if len(xs) < 2:
             continue
-        colour, marker = STYLE.get(key, ("tab:gray", "."))
+        colour, marker = _style(key)
         by = [np.array([r.metrics[metric] for r in rs if x_of(r) == x]) for x in xs]
         mean = np.array([b.mean() for b in by])
         name = _name(next(r for r in rs))

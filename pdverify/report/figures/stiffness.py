@@ -4,7 +4,7 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 
-from . import family, node_image, save
+from . import family, node_image, palette, save
 
 
 def _mid_line(r):
@@ -32,13 +32,16 @@ def stiffness(scene, runs, folder):
     for ax, state in zip(np.atleast_1d(axes), shown):
         for r in runs:
             idx = _mid_line(r)
-            ax.plot(r.fields["x"][idx, 0], r.fields[f"ratio_{state}"][idx], ".-", ms=3,
-                    label=r.method)
+            st = palette.style(r.method)
+            ax.plot(r.fields["x"][idx, 0], r.fields[f"ratio_{state}"][idx], "-",
+                    marker=st.marker, ms=3, color=st.colour, label=r.method)
         ax.axhline(1.0, color="k", lw=0.6)
         ax.set_title(f"{state.replace('_', ' ')}", fontsize=9)
         ax.set_xlabel("x [m] (line through the middle)")
     np.atleast_1d(axes)[0].set_ylabel("W_i / W_bulk")
-    np.atleast_1d(axes)[-1].legend(fontsize=7)
+    # one legend for the panels, right of them (inside, it covered the profiles' ends)
+    handles, labels = np.atleast_1d(axes)[-1].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside right upper", fontsize=7, frameon=False)
     out.append((save(fig, folder, f"{scene.id}-profiles.png"),
                 "Nodal strain energy density over the bulk lattice's, along the line through "
                 "the middle of the body in x, under a unit uniaxial stretch along x (normal "

@@ -1,14 +1,15 @@
 """Figures of seed 001: error maps (Figs. 9, 12, 14, 15) and error against cost."""
 from __future__ import annotations
 
+import textwrap
 import warnings
 
 import matplotlib.pyplot as plt
 import numpy as np
 
 from ...results import cost_s
-from . import (ROUND_OFF, distinct_labels, family, label, number_panel, round_off,
-               save as _save, shared_log_norm)
+from . import (ROUND_OFF, distinct_labels, family, label, method_colours, number_panel,
+               palette, round_off, save as _save, shared_log_norm)
 from .fields3d import _grid_values
 
 
@@ -53,6 +54,10 @@ def _defaults(scene, results):
     return default_runs(scene, results)
 
 
+#: characters per line of a 2D map's title (its panel is 2.2 in wide, the title 7.5 pt)
+TITLE_CHARS = 30
+
+
 def _maps_2d(scene, results, folder):
     """One small-multiples figure: a column per method (:func:`_columns_2d`), the Eq. (44)
     error in u (top row) and v (bottom row), one logarithmic colour scale per row shared
@@ -61,9 +66,14 @@ def _maps_2d(scene, results, folder):
     cols = _columns_2d(scene, results)
     if not cols:
         return []
-    fig, axes = plt.subplots(2, len(cols), figsize=(2.2 * len(cols) + 1.2, 4.8),
+    # the panels' titles take up to `lines` lines (7.5 pt: 0.125 in each); the figure grows
+    # by them and its top margin holds them under the suptitle
+    lines = max(len(textwrap.wrap(title, TITLE_CHARS)) for title, _ in cols) + 1
+    height = 4.8 + 2 * 0.125 * (lines - 2)
+    fig, axes = plt.subplots(2, len(cols), figsize=(2.2 * len(cols) + 1.2, height),
                              squeeze=False, sharex=True, sharey=True,
-                             gridspec_kw={"wspace": 0.08, "hspace": 0.45})
+                             gridspec_kw={"wspace": 0.08, "hspace": 0.45 + 0.1 * (lines - 2)})
+    fig.subplots_adjust(top=1 - (0.125 * lines + 0.3) / height)
     norms = []
     for k, comp in enumerate(("u (Fig. 14)", "v (Fig. 15)")):
         maps = [_grid_values(r.fields, r.fields["error"][:, k]).T for _, r in cols]
@@ -73,7 +83,10 @@ def _maps_2d(scene, results, folder):
         im = None
         for col, ((title, r), z) in enumerate(zip(cols, maps)):
             ax = axes[k, col]
-            head = f"{title}\n{comp}: max {np.nanmax(z):.3g} %"
+            # a long run name wrapped to the panel's width (2.2 in at 7.5 pt: about 30
+            # characters), so that neighbouring titles do not run into each other
+            head = "\n".join(textwrap.wrap(title, TITLE_CHARS)
+                              + [f"{comp}: max {np.nanmax(z):.3g} %"])
             if norm is None or round_off(z, 100.0):
                 number_panel(ax, f"round-off:\nmax {np.nanmax(z):.2g} %", head)
                 continue
@@ -88,7 +101,7 @@ def _maps_2d(scene, results, folder):
             cb.ax.tick_params(labelsize=6)
     fig.suptitle(f"{scene.id}: Eq. (44) errors of every method "
                  f"(h = {cols[0][1].params['spacing']:g} m; one colour scale per row)",
-                 fontsize=9)
+                 fontsize=9, y=1 - 0.08 / height, va="top")
     name = _save(fig, folder, f"{scene.id}-maps.png")
     _LAST_NORMS[:] = norms
     return [(name, "Seed 001 §5, Figs. 14 (u, top) and 15 (v, bottom) for every method: "
@@ -125,7 +138,9 @@ def _maps_3d(scene, results, folder):
                              gridspec_kw={"width_ratios": [2, 2, 2, 1], "wspace": 0.3,
                                           "hspace": 0.5}, squeeze=False, sharex="col",
                              sharey="col")
-    fig.subplots_adjust(top=1 - 0.55 / (1.75 * len(runs) + 0.7))
+    height = 1.75 * len(runs) + 0.7
+    # room above the first row for the suptitle, its run's name and the layer titles
+    fig.subplots_adjust(top=1 - 0.75 / height)
     im = None
     for row, (r, err) in enumerate(zip(runs, errs)):
         f = r.fields
@@ -146,10 +161,12 @@ def _maps_3d(scene, results, folder):
             continue
         for col, (ax, (title, z, ext, (a, b))) in enumerate(zip(axes[row], panels)):
             im = ax.imshow(z, origin="lower", extent=ext, cmap="viridis", norm=norm)
-            ax.set_title(title, fontsize=7)
-            if col == 0:   # the run's name above its row, left
-                ax.text(0, 1.22, f"{_label(r)} (max {vmax:.3g} %)", fontsize=8,
-                        fontweight="bold", transform=ax.transAxes)
+            if row == 0:   # the layers once, as column heads
+                ax.set_title(title, fontsize=7)
+            if col == 0:   # the run's name above its row, left, clear of the heads
+                ax.annotate(f"{_label(r)} (max {vmax:.3g} %)", (0, 1), xycoords="axes fraction",
+                            xytext=(0, 15 if row == 0 else 4), textcoords="offset points",
+                            fontsize=8, fontweight="bold", va="bottom")
             ax.tick_params(labelsize=6)
             if row == len(runs) - 1:
                 ax.set_xlabel(f"{a} [m]", fontsize=6.5)
@@ -158,7 +175,7 @@ def _maps_3d(scene, results, folder):
         cb = fig.colorbar(im, ax=axes.ravel().tolist(), shrink=0.6, pad=0.02)
         cb.set_label("|eps| [%] (Eq. 38), log", fontsize=7)
     fig.suptitle(f"{scene.id}: nodal error of every method at its defaults, one colour scale",
-                 fontsize=9)
+                 fontsize=9, y=1 - 0.12 / height, va="top")
     name = _save(fig, folder, f"{scene.id}-maps.png")
     return [(name, "Magnitude of the nodal error of Eq. (38) on four node layers (as Figs. 9 "
                    "and 12 of seed 001), one row per method at its default parameters, all "
@@ -168,11 +185,23 @@ def _maps_3d(scene, results, folder):
 
 
 def _cost(scene, results, folder):
+    """Error against cost, one point per run in its method's colour and marker
+    (:mod:`.palette`; a method's several runs in its shades); errors at round-off are
+    drawn on a floor below the others, marked, not at 1e-15."""
+    from ...convergence import EXACT
     fig, ax = plt.subplots(figsize=(6.5, 4))
-    for r, name in zip(results, distinct_labels(results, _label)):
-        t = cost_s(r.timings)
-        ax.loglog(max(t, 1e-4), max(r.metrics["max_error_pct"], 1e-16), "o", ms=6,
-                  label=name)
+    errs = [r.metrics["max_error_pct"] for r in results]
+    real = [e for e in errs if e > EXACT * 100]
+    floor = min(real) / 5 if real else EXACT * 100
+    for r, name, e, colour in zip(results, distinct_labels(results, _label), errs,
+                                  method_colours(results)):
+        t = max(cost_s(r.timings), 1e-4)
+        exact = e <= EXACT * 100
+        ax.loglog(t, floor if exact else e, "v" if exact else palette.marker(r.method),
+                  ms=7 if exact else 6, color=colour, mfc="none" if exact else colour,
+                  mew=1.4, ls="none", label=name + (" (exact to round-off)" if exact else ""))
+    if len(real) < len(errs):
+        ax.axhline(floor, color="0.6", lw=0.8, ls=":")
     ax.set_xlabel("setup + solve time [s] (cached setup at the time it took)")
     ax.set_ylabel("max_error_pct")
     ax.grid(True, which="both", alpha=0.3)
@@ -180,7 +209,10 @@ def _cost(scene, results, folder):
     ax.set_title(f"{scene.id}: error against cost")
     return [(_save(fig, folder, f"{scene.id}-cost.png"),
              "Largest nodal error against the run's setup + solve time (the metrics computed "
-             "afterwards not counted), one point per run.")]
+             "afterwards not counted), one point per run, colour and marker per method as in "
+             "every figure of the report (a method's several runs in its shades); hollow "
+             f"triangles on the dotted floor: runs exact to round-off (error <= {EXACT * 100:g} "
+             "%), drawn there instead of at round-off level.")]
 
 
 def where_max(fields, k, reach) -> str:

@@ -6,7 +6,7 @@ import numpy as np
 
 from manufactured import wave1d as analytic
 
-from . import family, save
+from . import family, method_colours, save
 
 
 def _group(r) -> str:
@@ -93,6 +93,8 @@ def wave_figures(scene, results, folder):
 
     # m-convergence with fitted slopes
     fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    # each group in its method's colour (:mod:`.palette`; orders of one method in shades)
+    group_colours = method_colours([runs[0] for runs in groups.values()])
     for g, (gname, runs) in enumerate(groups.items()):
         m = np.array([r.params["m_ratio"] for r in runs], dtype=float)
         for key, mk in (("max_error_pct", "o-"), ("boundary_error_pct", "s--")):
@@ -101,7 +103,7 @@ def wave_figures(scene, results, folder):
             if m.size >= 2:
                 slope = -np.polyfit(np.log(m), np.log(e), 1)[0]
                 lab += f" (order {slope:.2f})"
-            ax.loglog(m, e, mk, ms=5, color=colors[g % len(colors)], label=lab)
+            ax.loglog(m, e, mk, ms=5, color=group_colours[g], label=lab)
     ax.set_xlabel("m-ratio (delta fixed)")
     ax.set_ylabel("error [% of 0.02 m]")
     ax.grid(True, which="both", alpha=0.3)
