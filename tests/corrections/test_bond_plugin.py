@@ -55,9 +55,18 @@ def test_offered_wherever_volume_is(plugin):
 
 
 def _models():
-    from tests.corrections.test_bond_methods import bond_model, state_model
-    return [bond_model(cells=(14, 14)), state_model(cells=(11, 11, 11)),
-            bond_model(m=3.0, cells=(12, 9), placement="on-surface")]
+    """A bond-based 2D box (cell-centred and on-surface nodes) and a state-based 3D box."""
+    from pdverify.pd import (BondBasedModel, BoxGrid, StateBasedConstants, StateBasedModel,
+                             build_stencil, get_influence, state_based_stencil)
+
+    def bond_model(cells, placement="cell-centred"):
+        g = BoxGrid(tuple(float(c) for c in cells), (0.0, 0.0), 1.0, placement=placement)
+        return BondBasedModel(g, build_stencil(2, 3.0), 1.0, get_influence("constant"))
+    inf = get_influence("gaussian")
+    state = StateBasedModel(BoxGrid((11.0, 11.0, 11.0), (0.0,) * 3, 1.0, 0),
+                            state_based_stencil(3, 2.0, 1.0, inf),
+                            StateBasedConstants("3d", 1.0, 0.3), inf)
+    return [bond_model((14, 14)), state, bond_model((12, 9), "on-surface")]
 
 
 def test_interior_is_untouched_and_the_means_identity(plugin):
