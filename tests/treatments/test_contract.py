@@ -276,3 +276,32 @@ def test_a_whole_faces_only_treatment_is_refused_where_part_of_a_face_is_prescri
     reason = t.why_not(get_scene("body3d-traction"))
     assert reason and "prescribes a component on part of a face" in reason
     assert t.why_not(get_scene("body3d-manufactured")) is None
+
+
+#: the modules of ``pdverify.corrections`` a scene may import: the generic ones (the
+#: registry, the family's shared assembly, the plugin signatures), never a correction
+GENERIC_CORRECTIONS = {"pdverify.corrections", "pdverify.corrections.registry",
+                       "pdverify.corrections.assembly", "pdverify.corrections.protocols",
+                       "pdverify.corrections.treatment"}
+
+
+def _specific_corrections(graph):
+    return sorted((m, t) for m, ts in graph.items() if m.startswith("pdverify.scenes")
+                  for t in ts if t.startswith("pdverify.corrections")
+                  and t not in GENERIC_CORRECTIONS
+                  and t.rsplit(".", 1)[0] not in GENERIC_CORRECTIONS - {"pdverify.corrections"})
+
+
+def test_no_scene_imports_a_specific_correction():
+    """A scene reaches a treatment through the registry only (issue 51); what a scene
+    measures with (work densities, the bar's calibration) lives in ``pdverify.pd``."""
+    assert _specific_corrections(_graph()) == []
+
+
+def test_the_correction_import_check_can_fail():
+    graph = {"pdverify.scenes.x": {"pdverify.corrections.factors",
+                                   "pdverify.corrections.factors.work_density",
+                                   "pdverify.corrections.registry",
+                                   "pdverify.corrections.registry.plugin_call"}}
+    assert [t for _, t in _specific_corrections(graph)] == [
+        "pdverify.corrections.factors", "pdverify.corrections.factors.work_density"]
