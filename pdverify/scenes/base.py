@@ -60,7 +60,7 @@ def influence_param(default: str, source: str) -> Param:
 
 def require_influence(scene_id: str, method: str, p: dict, allowed: str, why: str) -> None:
     """Refuse (one line, exit 2) an ``influence`` the scene's reference is not derived for."""
-    if p.get("influence", allowed) != allowed:
+    if p["influence"] != allowed:
         raise InputError(f"{scene_id} --method {method}: influence={p['influence']} is not "
                          f"supported here; allowed: {allowed} ({why})")
 

@@ -305,3 +305,24 @@ def test_the_correction_import_check_can_fail():
                                    "pdverify.corrections.registry.plugin_call"}}
     assert [t for _, t in _specific_corrections(graph)] == [
         "pdverify.corrections.factors", "pdverify.corrections.factors.work_density"]
+
+
+def _fallback_defaults(text: str) -> list[str]:
+    """``p.get(NAME, DEFAULT)`` / ``params.get(NAME, DEFAULT)``: a default stated again
+    beside its declaration."""
+    import re
+    return re.findall(r"\b(?:p|params|q)\.get\(\s*['\"]\w+['\"]\s*,[^)]*\)", text)
+
+
+def test_scenes_read_declared_defaults_not_fallbacks():
+    """A scene reads a parameter's default from its declaration (``Scene.declared``, the
+    treatment's parameter), never from a second literal beside the lookup (issue 51)."""
+    found = {p.name: _fallback_defaults(p.read_text())
+             for p in (PACKAGE / "scenes").glob("*.py")}
+    assert {k: v for k, v in found.items() if v} == {}
+
+
+def test_the_fallback_grep_can_fail():
+    assert _fallback_defaults('x = p.get("solver", "direct")\nq.get("order", 2) == 2\n'
+                              'y = p.get("solver") == "auto"') == [
+        'p.get("solver", "direct")', 'q.get("order", 2)']
