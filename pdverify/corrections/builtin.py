@@ -19,12 +19,10 @@ from .plain import assemble_plain
 from .protocols import GridClosure, ParamCheck, Params, StaticAssembly
 from .surface_nodes import MAX_ORDER, assemble_surface_nodes, check_wave_order, wave_extension
 from .taylor_fictitious import CORNER_RULES, assemble_taylor, fictitious_closure
-from .treatment import Role, Treatment
+from .treatment import BASELINE, Role, Treatment
 from .virtual_nodes import check_layers, clamp
 
 FAMILY = ("static-state",)
-#: the uncorrected baseline's name (``Treatment.baseline``)
-BASELINE = "none"
 
 
 @dataclass(frozen=True)

@@ -40,6 +40,7 @@ from ..pd.influence import INFLUENCES, bond_based_nu
 from ..pd.problem import FACES, BondProblem, FaceCondition, StaticProblem, assemble_bonds
 from ..pd.work import uniaxial, work_density
 from . import MethodSpec, Outcome, Published, Scene, register, whole_cells
+from ..corrections.treatment import BASELINE
 from .family import StaticStateScene
 
 AXES = "xyz"
@@ -281,7 +282,7 @@ class _StateStiffness(StiffnessScene, StaticStateScene):
     kind = "3d"
     #: the baseline as the stiffness boxes measure it (no loads, so not the family's
     #: ``none``, whose parameter says where loads act)
-    methods = (MethodSpec("none"),)
+    methods = (MethodSpec(BASELINE),)
 
     def box(self, p):
         lengths = self.lengths(p)
