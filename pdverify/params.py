@@ -22,6 +22,10 @@ class Param:
 
     ``check`` returns ``None`` when a value is allowed, else a short phrase such as
     ``"must be > 0"``; ``choices`` restricts string or numeric values to a set.
+    ``scene_default``: a scene may set this parameter's default (its
+    ``treatment_defaults``, by name); a parameter that does not declare it keeps its own
+    default on every scene, whatever the scene's defaults of other parameters of the same
+    name.
     """
 
     name: str
@@ -29,6 +33,7 @@ class Param:
     doc: str = ""
     check: Check | None = None
     choices: tuple | None = None
+    scene_default: bool = False
 
     @property
     def kind(self) -> type:

@@ -19,12 +19,10 @@ from .plain import assemble_plain
 from .protocols import GridClosure, ParamCheck, Params, StaticAssembly
 from .surface_nodes import MAX_ORDER, assemble_surface_nodes, check_wave_order, wave_extension
 from .taylor_fictitious import CORNER_RULES, assemble_taylor, fictitious_closure
-from .treatment import Role, Treatment
+from .treatment import BASELINE, Role, Treatment
 from .virtual_nodes import check_layers, clamp
 
 FAMILY = ("static-state",)
-#: the uncorrected baseline's name (``Treatment.baseline``)
-BASELINE = "none"
 
 
 @dataclass(frozen=True)
@@ -103,14 +101,15 @@ def _pddo(problem: StaticProblem, p: Params) -> LinearSystem:
 
 LOAD_POINT = Param("load_point", "surface", "where the uncorrected model evaluates a "
                    "surface load: at the node it is applied to (like its constraints) or "
-                   "at the face centre on the surface", choices=LOAD_POINTS)
-ORDER = Param("order", 1, "Taylor truncation order n", at_least(1))
+                   "at the face centre on the surface", choices=LOAD_POINTS,
+                   scene_default=True)
+ORDER = Param("order", 1, "Taylor truncation order n", at_least(1), scene_default=True)
 CORNERS = Param("corners", "normal-only", "constrained components on the lines through a "
                 "corner node where two faces prescribe the same component (seed 000 "
                 "Remark 4): the normal one only, or both (over-constrained: singular)",
                 choices=CORNER_RULES)
 SURFACE_ORDER = Param("order", 1, "Taylor truncation order N (displacements N, "
-                      "dilatations N - 1)", _order_check)
+                      "dilatations N - 1)", _order_check, scene_default=True)
 MIRROR_PARAMS = (
     Param("neumann", "full-traction", "how a face's traction sets the gradient in the "
           "mirror relation: the full traction condition with the tangential derivatives "

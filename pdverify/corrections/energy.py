@@ -12,7 +12,7 @@ Our choices where the sources leave room:
   bulk is then untouched (G = 1 exactly away from the surface) and the correction is
   about the surface alone. Peridynamics.jl divides the continuum W by the discrete one,
   which also rescales the bulk by the lattice's quadrature error.
-- W_i is the model's own energy density at node i (``factors.work_density``: the
+- W_i is the model's own energy density at node i (``pdverify.pd.work.work_density``: the
   work of node i's own force state on its bonds). For bond-based models this is the
   sum Peridynamics.jl uses. For state-based models Peridynamics.jl takes the
   bond-based sum too, but an LPS model with m over the truncated family already
@@ -35,7 +35,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..pd.closure import Closure
-from .factors import guarded_ratio, uniaxial, work_density
+from ..pd.work import uniaxial, work_density
+from .factors import guarded_ratio
 
 
 def axis_factors(model) -> np.ndarray:

@@ -1,4 +1,6 @@
-"""End-bond homogenisation of 1D bond-based bars (seed 004 §3-5): the bar and its factors."""
+"""End-bond homogenisation of 1D bond-based bars (seed 004 §3-5): the bar and its factors.
+The horizon ratio (m, beta) and the micromodulus constant c1 are the bar's
+(:mod:`pdverify.pd.bar1d`), as the scenes describe it."""
 from __future__ import annotations
 
 from functools import lru_cache
@@ -6,32 +8,11 @@ from functools import lru_cache
 import numpy as np
 
 from ..errors import InputError
-from ..pd import BondBasedModel, Closure, bond_micromodulus, build_stencil, get_influence
+from ..pd import BondBasedModel, Closure, build_stencil, get_influence
+from ..pd.bar1d import bar_micromodulus, check_micromodulus, split_horizon_ratio
 from ..pd.build import Body, BondMaterial, build_model
 
-MICROMODULI = ("triangular", "constant")
 END_WEIGHTS = ("full", "half")
-CALIBRATIONS = ("discrete", "continuum")
-
-
-def split_horizon_ratio(horizon_ratio: float) -> tuple[int, float]:
-    """(m, beta) with delta = (m + beta) Delta and beta in {0, 1/2} (seed 004 Eq. 7, Fig. 2).
-
-    beta = 0: the horizon runs through the middle of element m ("through an element");
-    beta = 1/2: it falls on the border between elements m and m + 1 ("between elements").
-    Raises ``ValueError`` for any other ratio.
-    """
-    twice = 2.0 * float(horizon_ratio)
-    if not np.isfinite(twice) or abs(twice - round(twice)) > 1e-12 or round(twice) < 2:
-        raise ValueError(f"horizon_ratio={horizon_ratio!r} must be a whole or half-whole number "
-                         ">= 1 (delta = m Delta or (m + 1/2) Delta)")
-    twice_int = int(round(twice))
-    return twice_int // 2, 0.5 * (twice_int % 2)
-
-
-def _check_micromodulus(micromodulus: str) -> None:
-    if micromodulus not in MICROMODULI:
-        raise ValueError(f"micromodulus={micromodulus!r}; allowed: {', '.join(MICROMODULI)}")
 
 
 def bond_profile(horizon_ratio: float, micromodulus: str = "triangular"):
@@ -43,40 +24,13 @@ def bond_profile(horizon_ratio: float, micromodulus: str = "triangular"):
     which is the m(1/2 + beta) term of Eq. (9). Offsets whose weight vanishes (the
     triangle's tip at k = m when beta = 0) are dropped.
     """
-    _check_micromodulus(micromodulus)
+    check_micromodulus(micromodulus)
     split_horizon_ratio(horizon_ratio)
     stencil = build_stencil(1, float(horizon_ratio))
     k = stencil.half_offsets[:, 0]
     weight = get_influence(micromodulus).omega(k, float(horizon_ratio)) * stencil.half_beta
     keep = weight > 0
     return k[keep], weight[keep]
-
-
-def micromodulus_c1(horizon_ratio: float, *, E: float, area: float, spacing: float,
-                    micromodulus: str = "triangular", calibration: str = "discrete") -> float:
-    """The micromodulus constant c1 of Eq. (6) (c = c1 for the constant micromodulus).
-
-    ``discrete``: equate the strain energy density of the discrete horizon to E eps^2 / 2,
-    W_m = (c1 s^2 A / 2) sum_k c_k/c1 v_k k Delta^2 (Eqs. 9, 18), which gives Eq. (14)
-    (beta = 0, = Eq. 26) and Eq. (22) (beta = 1/2, = Eq. 30) for the triangular
-    micromodulus. ``continuum``: c_inf = 6E/(A delta^2) (triangular) or 2E/(A delta^2)
-    (constant), exact only for infinitely many points in the horizon. Both are the
-    engine's :func:`pdverify.pd.bond_micromodulus` in 1D.
-    """
-    if calibration not in CALIBRATIONS:
-        raise ValueError(f"calibration={calibration!r}; allowed: {', '.join(CALIBRATIONS)}")
-    _check_micromodulus(micromodulus)
-    split_horizon_ratio(horizon_ratio)
-    return bond_micromodulus(micromodulus, 1, E, horizon_ratio * spacing, area=area,
-                             calibration=calibration, spacing=spacing,
-                             stencil=build_stencil(1, float(horizon_ratio)))
-
-
-def micromodulus_factor(horizon_ratio: float, micromodulus: str = "triangular") -> float:
-    """c1(m) / c_inf, the function f_1(m) of Eqs. (27) and (31) (Tables 1 and 2)."""
-    args = dict(E=1.0, area=1.0, spacing=1.0, micromodulus=micromodulus)
-    return (micromodulus_c1(horizon_ratio, calibration="discrete", **args)
-            / micromodulus_c1(horizon_ratio, calibration="continuum", **args))
 
 
 def end_bond_closure(nodes: int, end_factors) -> Closure:
@@ -125,8 +79,8 @@ def bond_bar(*, nodes: int, spacing: float, horizon_ratio: float, E: float, area
                          "give one")
     body = Body(((nodes - 1) * spacing,), (0.0,), spacing, placement="on-surface",
                 boundary_volume="partial" if end_weight == "half" else "full", thickness=area)
-    c1 = micromodulus_c1(horizon_ratio, E=E, area=area, spacing=spacing,
-                         micromodulus=micromodulus, calibration=calibration)
+    c1 = bar_micromodulus(horizon_ratio, E=E, area=area, spacing=spacing,
+                          micromodulus=micromodulus, calibration=calibration)
     return build_model(body, build_stencil(1, float(horizon_ratio)),
                        BondMaterial(c1, get_influence(micromodulus)),
                        closure if closure is not None else end_bond_closure(nodes, factors))

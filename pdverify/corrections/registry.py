@@ -320,6 +320,12 @@ def _scene_param_clash(method: Treatment) -> str | None:
         if taken:
             return (f"its parameter {sorted(taken)[0]!r} is a parameter of scene {scene.id} "
                     "(it would replace the scene's value); rename it")
+        for q in method.params:    # a scene default it takes must be one it allows
+            if q.scene_default and q.name in getattr(scene, "treatment_defaults", {}):
+                try:
+                    q.convert(scene.treatment_defaults[q.name], f"scene {scene.id}'s default")
+                except InputError as exc:
+                    return str(exc)
     return None
 
 

@@ -272,6 +272,23 @@ def assemble_surface_nodes(problem, order: int) -> LinearSystem:
     return impose_on_surface_nodes(problem, g, closure, flux)
 
 
+def surface_node_model(problem, order: int):
+    """``(model, P)`` of seed 001's surface node method on ``problem``'s box: the model
+    with its fictitious layer and surface nodes, and its rows over the grid's state
+    (:func:`surface_node_rows`), before any condition is imposed."""
+    g = problem.body.grid(problem.stencil.reach)
+    closure, flux = surface_node_closure(g, problem.stencil, order)
+    return surface_node_rows(problem, g, closure, flux)
+
+
+def surface_node_rows(problem, g, closure, flux):
+    """``(model, P)``: the model of a surface-node closure on the grid ``g`` and its
+    rows, the real nodes' equilibrium, then each surface node's force flux (``flux``,
+    seed 001 Eq. 36)."""
+    model = model_of(problem, g, closure)
+    return model, (model.equilibrium_rows() + flux_rows(model, flux)).tocsr()
+
+
 def impose_on_surface_nodes(problem, g, closure, flux) -> LinearSystem:
     """The system of a closure whose unknowns are the real nodes, then one surface node
     per boundary cell face (``closure.n_unknown_nodes``): a prescribed component is set
@@ -279,10 +296,9 @@ def impose_on_surface_nodes(problem, g, closure, flux) -> LinearSystem:
     its force flux (``flux``, seed 001 Eq. 36) equal to the face's load (zero on a free
     face). Shared by ``surface-nodes`` and any treatment that carries the conditions on
     surface nodes (a plugin's, e.g.)."""
-    model = model_of(problem, g, closure)
+    model, P = surface_node_rows(problem, g, closure, flux)
     d, ni, nu_ = g.dim, g.n_interior, model.n_unknown_nodes
     solver = static_solver(problem.solver, d, d * nu_)
-    P = (model.equilibrium_rows() + flux_rows(model, flux)).tocsr()
     # in 3D the extrapolation rows are wide (order N: (N + 1)(2 ceil(N/2) + 1)^2 sources),
     # so the displacement map is multiplied in last; in 1D and 2D the products keep the
     # order the runs' numbers were made with (the gain there is small)

@@ -52,6 +52,9 @@ if TYPE_CHECKING:       # the signatures each family takes (imported by the type
 
 THEORIES = ("bond-based", "state-based")
 ENTRY_POINT_GROUP = "pdverify.methods"
+#: the uncorrected baseline's name (``Treatment.baseline``; a scene that declares its own
+#: baseline run names it so)
+BASELINE = "none"
 
 
 @dataclass(frozen=True)

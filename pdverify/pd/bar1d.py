@@ -3,11 +3,8 @@
 of points x_i = (i - 1) Delta (the engine's :func:`~pdverify.pd.bond_micromodulus` in 1D,
 calibrated on the discrete horizon or the continuum). A scene describes its bar with
 these (:class:`~pdverify.pd.problem.BondProblem`) and the end-bond homogenisation
-(``pdverify.corrections.homogenized``) closes it like any bond method.
-
-``corrections/homogenized.py`` still carries its own copies of :func:`split_horizon_ratio`
-and the c1 calibration (its ``micromodulus_c1``); they give the same numbers and are to be
-read from here once that module is next edited.
+(``pdverify.corrections.homogenized``) closes it like any bond method; its own bar and
+factors read the horizon ratio and the calibration from here.
 """
 from __future__ import annotations
 
@@ -17,6 +14,13 @@ from .bonds import build_stencil
 from .influence import bond_micromodulus
 
 CALIBRATIONS = ("discrete", "continuum")
+#: seed 004's micromodulus shapes: Eq. (6)'s triangle, or constant
+MICROMODULI = ("triangular", "constant")
+
+
+def check_micromodulus(micromodulus: str) -> None:
+    if micromodulus not in MICROMODULI:
+        raise ValueError(f"micromodulus={micromodulus!r}; allowed: {', '.join(MICROMODULI)}")
 
 
 def split_horizon_ratio(horizon_ratio: float) -> tuple[int, float]:
@@ -36,12 +40,17 @@ def split_horizon_ratio(horizon_ratio: float) -> tuple[int, float]:
 
 def bar_micromodulus(horizon_ratio: float, *, E: float, area: float, spacing: float,
                      micromodulus: str = "triangular", calibration: str = "discrete") -> float:
-    """The micromodulus constant c1 of seed 004 Eq. (6) (c = c1 for the constant one):
-    ``discrete`` equates the strain energy density of the discrete horizon to E eps^2 / 2
-    (Eqs. 14/22), ``continuum`` takes c_inf = 6E/(A delta^2) (triangular) or 2E/(A
-    delta^2) (constant)."""
+    """The micromodulus constant c1 of seed 004 Eq. (6) (c = c1 for the constant one).
+
+    ``discrete``: equate the strain energy density of the discrete horizon to E eps^2 / 2,
+    W_m = (c1 s^2 A / 2) sum_k c_k/c1 v_k k Delta^2 (Eqs. 9, 18), which gives Eq. (14)
+    (beta = 0, = Eq. 26) and Eq. (22) (beta = 1/2, = Eq. 30) for the triangular
+    micromodulus. ``continuum``: c_inf = 6E/(A delta^2) (triangular) or 2E/(A delta^2)
+    (constant), exact only for infinitely many points in the horizon. Both are the
+    engine's :func:`pdverify.pd.bond_micromodulus` in 1D."""
     if calibration not in CALIBRATIONS:
         raise ValueError(f"calibration={calibration!r}; allowed: {', '.join(CALIBRATIONS)}")
+    check_micromodulus(micromodulus)
     split_horizon_ratio(horizon_ratio)
     return bond_micromodulus(micromodulus, 1, E, horizon_ratio * spacing, area=area,
                              calibration=calibration, spacing=spacing,

@@ -103,7 +103,7 @@ class StaticBar(StaticStateScene):
             exact=lambda x: self.classical(x[:, 0], p)[:, None],
             body_force=lambda x: self.body_force(x[:, 0], p)[:, None],
             thickness=p["area"], load_point=self.declared(p, "load_point"),
-            solver="direct", where=where, complete_m=p["complete_m"])
+            solver=self.fixed_solver, where=where, complete_m=p["complete_m"])
 
     def check(self, method, p):
         check_bar_grid(self.id, method, p, min_horizons=2.0)

@@ -60,7 +60,7 @@ def influence_param(default: str, source: str) -> Param:
 
 def require_influence(scene_id: str, method: str, p: dict, allowed: str, why: str) -> None:
     """Refuse (one line, exit 2) an ``influence`` the scene's reference is not derived for."""
-    if p.get("influence", allowed) != allowed:
+    if p["influence"] != allowed:
         raise InputError(f"{scene_id} --method {method}: influence={p['influence']} is not "
                          f"supported here; allowed: {allowed} ({why})")
 
@@ -305,7 +305,9 @@ class Scene:
     dim: int | None = None
     #: overrides of the offered treatments' report cases under ``--quick``
     quick_overrides: Mapping[str, Any] = {}
-    #: the scene's defaults of treatment parameters (e.g. a Taylor order), by name
+    #: the scene's defaults of treatment parameters (e.g. a Taylor order), by name; they
+    #: apply to the parameters that declare ``scene_default`` only, each checked as a
+    #: given value is (its type, choices and check)
     treatment_defaults: Mapping[str, Any] = {}
     #: why no treatment beyond the scene's own ``methods`` applies (one line), e.g. a
     #: reference that is the uncorrected model's own; None: the registry decides
@@ -344,11 +346,15 @@ class Scene:
         """Why a treatment of this scene's family cannot serve it (None: it can)."""
         return None
 
-    def _with_defaults(self, params) -> tuple[Param, ...]:
+    def _with_defaults(self, params, method: str) -> tuple[Param, ...]:
+        """``params`` with this scene's :attr:`treatment_defaults` applied to those that
+        declare ``scene_default``; a default a parameter does not allow is bad input."""
         if not self.treatment_defaults:
             return tuple(params)
-        return tuple(replace(q, default=self.treatment_defaults[q.name])
-                     if q.name in self.treatment_defaults else q for q in params)
+        return tuple(
+            replace(q, default=q.convert(self.treatment_defaults[q.name],
+                                         f"{self.id} --method {method} (the scene's default)"))
+            if q.scene_default and q.name in self.treatment_defaults else q for q in params)
 
     @property
     def all_methods(self) -> tuple[MethodSpec, ...]:
@@ -360,7 +366,7 @@ class Scene:
         base = next((t.params_for(self) for t in offered.values() if t.baseline), ())
         return own + tuple(
             MethodSpec(k, self._with_defaults((base if t.kind == "closure" else ())
-                                              + t.params_for(self)))
+                                              + t.params_for(self), k))
             for k, t in offered.items())
 
     def method(self, name: str) -> MethodSpec:

@@ -26,6 +26,9 @@ class StaticStateScene(Scene):
     family = "static-state"
     theory = "state-based"
     methods = ()
+    #: the linear solver of a scene that declares no ``solver`` parameter (its
+    #: :meth:`problem` states it); one that declares it reads the run's value
+    fixed_solver = "direct"
 
     # ----------------------------------------------------------------- description
     def box(self, p):
@@ -93,7 +96,7 @@ class StaticStateScene(Scene):
         extra, fictitious = footprint(self.treatment(method).footprint, cells, m)
         nodes = math.prod(cells) + extra
         rows = budget.BYTES_PER_NONZERO * fictitious * d * d * budget.lattice_neighbours(d, m)
-        solver = static_solver(p.get("solver", "direct"), d, d * nodes)
+        solver = static_solver(self.declared(p, "solver") or self.fixed_solver, d, d * nodes)
         if d == 3 and solver == "nested-dissection":
             return budget.nested_dissection_3d(nodes, d + 1, m, extra_bytes=rows)
         return budget.linear_system(nodes, d, d, 2 * m, dense_allowed=True, extra_bytes=rows)
@@ -118,7 +121,7 @@ class StaticStateScene(Scene):
             return t.finish(self.measure(p, problem, system, x, info), metrics, trouble, where)
         with timer.phase("solve"):
             x, info = solve_system(system, where=where, ordering=problem.ordering)
-            if p.get("solver") == "auto":
+            if self.declared(p, "solver") == "auto":     # the user's auto: say what it chose
                 info["solver_choice"] = auto_note(system.solver, system.dofs)
         return self.measure(p, problem, system, x, info)
 

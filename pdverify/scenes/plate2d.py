@@ -115,6 +115,8 @@ class ClampedPlate(FemStaticStateScene):
     seed = "000 §6.2"
     figure = "plate2d"
     dim = 2
+    #: nested dissection from policy.ND_FROM_UNKNOWNS unknowns (``ORDERING``'s note)
+    fixed_solver = "auto"
     params_class, function = "PlateParams", "clamped_plate"
     shared = ("length", "width", "thickness", "E", "nu", "body_force")
     pd_params = (
@@ -174,7 +176,8 @@ class ClampedPlate(FemStaticStateScene):
             StateBasedConstants("plane-stress", p["E"], p["nu"]), inf,
             {face: clamped for face in FACES[:4]}, exact=value,
             body_force=lambda x: np.c_[np.full(len(x), b), np.zeros(len(x))],
-            thickness=p["thickness"], solver="auto", ordering=ORDERING, where=where)
+            thickness=p["thickness"], solver=self.fixed_solver, ordering=ORDERING,
+            where=where)
 
     def measure(self, p, problem, system, x, info):
         ref = self.reference_of(p)

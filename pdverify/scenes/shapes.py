@@ -130,7 +130,7 @@ class ShapeScene(FemStaticStateScene):
             lengths, origin, float(p["spacing"]),
             state_based_stencil(2, p["m_ratio"], p["spacing"], inf, p["quadrature"]),
             StateBasedConstants("plane-stress", p["E"], p["nu"]), inf,
-            self.conditions(p), exact=value, thickness=p["thickness"], solver="direct",
+            self.conditions(p), exact=value, thickness=p["thickness"], solver=self.fixed_solver,
             ordering=ORDERING, where=where, shape=self.shape(p),
             jitter=float(p["jitter"]), jitter_seed=int(p["jitter_seed"]))
 
@@ -152,11 +152,11 @@ class ShapeScene(FemStaticStateScene):
         for h in self.delta_sweep:
             out += [(m, {**q, "spacing": h}) for m, q in runs]
         # the jitter study: the baseline, a bond method, the fictitious nodes (order 2)
-        jittered = ("none", "energy", "taylor-fictitious")
+        jittered = (("none", {}), ("energy", {}), ("taylor-fictitious", {"order": 2}))
         for j in self.jitter_sweep:
             for seed in self.jitter_seeds:
                 out += [(m, {**q, "jitter": j, "jitter_seed": seed}) for m, q in runs
-                        if m in jittered and q.get("order", 2) == 2]
+                        if (m, q) in jittered]
         return out
 
 

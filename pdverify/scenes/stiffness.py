@@ -4,7 +4,7 @@ Every node of a plain grid is given u = eps . x for a set of homogeneous strains
 uniaxial stretch along each axis and a pure shear in each coordinate plane). The strain
 energy density W_i of each node (the work of its own force state on its bonds:
 bond-based half of each bond's energy, LPS and PALS their node energies;
-``pdverify.corrections.factors.work_density``) is divided by a node's of the bulk
+``pdverify.pd.work.work_density``) is divided by a node's of the bulk
 lattice (complete neighbourhoods; ``bulk_work_density``). A perfect surface correction
 gives W_i / W_bulk = 1 everywhere; the uncorrected model is softer (bond-based) or, for
 LPS with m over the truncated family, softer in some states and stiffer in others near
@@ -32,16 +32,16 @@ import itertools
 import numpy as np
 
 from .. import budget
-from ..corrections.factors import uniaxial, work_density
 from ..params import Param, at_least, open_interval, positive
 from ..pd import (StateBasedConstants, bond_micromodulus, build_stencil, get_influence,
                   state_based_stencil)
 from ..pd.build import Body, BondMaterial, StateMaterial, build_model
 from ..pd.influence import INFLUENCES, bond_based_nu
 from ..pd.problem import FACES, BondProblem, FaceCondition, StaticProblem, assemble_bonds
+from ..pd.work import uniaxial, work_density
 from ..quotes import Quote as Q
 from . import MethodSpec, Outcome, Published, Scene, register, whole_cells
-from ..corrections.builtin import BASELINE
+from ..corrections.treatment import BASELINE
 from .family import StaticStateScene
 
 AXES = "xyz"

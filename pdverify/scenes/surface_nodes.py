@@ -155,8 +155,20 @@ class SurfaceNodeScene(StaticStateScene):
             c, inf, conditions, exact=lambda x: self.exact(x, p),
             body_force=lambda x: self.body_force(x, p, c, horizon),
             face_load="centre" if self.declared(p, "surface_load") == "centre"
-            else "face-mean", load_point=p.get("load_point", "surface"),
+            else "face-mean", load_point=self.load_point(p),
             solver=p["solver"], where=where)
+
+    def load_point(self, p):
+        """Where the run's method evaluates a face load (``load_point``): the run's value
+        where its method takes the parameter (the uncorrected model and the bond methods,
+        at this scene's default), else the uncorrected model's own declared default: a
+        treatment that loads its own nodes does not read it, and the LAMMPS peer, which
+        exports the uncorrected system, keeps the declaration's value (not this scene's
+        ``treatment_defaults``)."""
+        if "load_point" in p:
+            return p["load_point"]
+        baseline = next(t for t in self.offered().values() if t.baseline)
+        return next(q.default for q in baseline.params_for(self) if q.name == "load_point")
 
     def _traction(self, x, normal, face, p, c, horizon):
         return self.traction(x, normal, face, p, c, horizon)

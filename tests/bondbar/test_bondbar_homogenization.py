@@ -4,7 +4,7 @@ from fractions import Fraction as Fr
 import numpy as np
 import pytest
 
-from pdverify.corrections.homogenized import micromodulus_factor
+from pdverify.pd.bar1d import micromodulus_factor
 from pdverify.corrections.homogenized import bond_bar
 from pdverify.scenes.bar1d_bondbased import end_force_displacement
 from pdverify.corrections.homogenized import homogenization_factors

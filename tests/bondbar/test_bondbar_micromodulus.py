@@ -2,9 +2,9 @@
 import numpy as np
 import pytest
 
-from pdverify.corrections.homogenized import (bond_profile, micromodulus_c1, micromodulus_factor,
-                                             split_horizon_ratio)
-from pdverify.corrections.homogenized import bond_bar
+from pdverify.corrections.homogenized import bond_bar, bond_profile
+from pdverify.pd.bar1d import bar_micromodulus as micromodulus_c1
+from pdverify.pd.bar1d import micromodulus_factor, split_horizon_ratio
 
 EPS = np.finfo(float).eps
 #: c1 is E over a sum of at most 2m positive O(m^2) terms: a few ulps, at m <= 40 below 1e-14.
@@ -115,17 +115,3 @@ def test_horizon_ratio_must_be_whole_or_half_whole(bad):
     with pytest.raises(ValueError, match="whole or half-whole"):
         split_horizon_ratio(bad)
 
-
-@pytest.mark.parametrize("ratio", [1.5, 2.0, 4.0, 4.5, 6.5])
-@pytest.mark.parametrize("shape", ["triangular", "constant"])
-@pytest.mark.parametrize("calibration", ["discrete", "continuum"])
-def test_the_scenes_bar_description_calibrates_c1_as_the_homogenized_bar(ratio, shape,
-                                                                       calibration):
-    # the scenes describe their bar with pdverify.pd.bar1d; the homogenisation's own bar
-    # (corrections.homogenized) keeps a copy of the calibration until it reads it from
-    # there: the same operations, so equal to the last bit (rtol 0)
-    from pdverify.pd import bar1d
-    args = dict(E=7.0, area=0.3, spacing=0.25, micromodulus=shape, calibration=calibration)
-    assert bar1d.bar_micromodulus(ratio, **args) == micromodulus_c1(ratio, **args)
-    assert bar1d.micromodulus_factor(ratio, shape) == micromodulus_factor(ratio, shape)
-    assert bar1d.split_horizon_ratio(ratio) == split_horizon_ratio(ratio)

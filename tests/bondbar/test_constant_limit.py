@@ -5,7 +5,7 @@ holds for every Table 12 cell."""
 import numpy as np
 import pytest
 
-from pdverify.corrections.homogenized import micromodulus_factor
+from pdverify.pd.bar1d import micromodulus_factor
 from pdverify.scenes import get_scene
 from pdverify.scenes.bar1d_bondbased import CONSTANT_LIMIT, TABLE12, strain_factor_limit
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from pdverify.corrections.energy import axis_factors, energy_factors
-from pdverify.corrections.factors import uniaxial, work_density
+from pdverify.pd.work import uniaxial, work_density
 from pdverify.corrections.registry import bond_methods
 from pdverify.corrections.volume import horizon_volumes, volume_factors
 from pdverify.errors import InputError

@@ -4,7 +4,7 @@ derivative of its energy."""
 import numpy as np
 import pytest
 
-from pdverify.corrections.factors import work_density
+from pdverify.pd.work import work_density
 from pdverify.corrections.pals import matching_basis, pals_closure
 from pdverify.errors import NumericalError
 from pdverify.pd import (BoxGrid, StateBasedConstants, StateBasedModel, get_influence,

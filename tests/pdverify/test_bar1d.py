@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from engine_models import StateBar
 from pdverify.scenes import get_scene
+from descriptions import bar_system
 
 EPS = np.finfo(float).eps
 
@@ -81,20 +81,21 @@ def test_reaction_is_the_force_flux_at_the_clamp():
 def test_complete_neighbourhood_weighted_volume_is_A_delta_cubed(m_ratio):
     # seed 000 Eq. (25): m_inf = A delta^3; with beta = 1/2 at |xi| = delta (ERRATA) the
     # discrete sum is exact: 2 sum_k k beta_k = m^2. Tolerance: a few ulps of the sum.
-    bar = StateBar(dict(length=1.0, area=0.01, E=1e9, nu=0.3, spacing=0.05, m_ratio=m_ratio), 1)
-    assert bar.model.m_inf == pytest.approx(0.01 * bar.horizon ** 3, rel=20 * EPS)
+    bar = bar_system("taylor-fictitious", order=1, m_ratio=m_ratio).model
+    assert bar.m_inf == pytest.approx(0.01 * bar.horizon ** 3, rel=20 * EPS)
 
 
 def test_bulk_operator_is_exact_on_cubics(rng):
     # seed 000 App. C: in a complete neighbourhood the discrete operator gives
     # -(K u)_i / V = E u''(x_i) exactly for cubic u (odd moments cancel); checked at
     # nodes farther than 2 delta from the ends. Tolerance: eps * ||K|| ||u|| / ||K u||-scale.
-    bar = StateBar(dict(length=1.0, area=0.01, E=1e9, nu=0.3, spacing=0.05, m_ratio=3.0))
+    bar = bar_system("none")          # Table 3's bar, truncated neighbourhoods
+    g = bar.model.grid
     c = rng.normal(size=4)
-    x = bar.x_real
+    x = g.x[g.interior_ids, 0]
     u = c[0] + c[1] * x + c[2] * x ** 2 + c[3] * x ** 3
     upp = 2 * c[2] + 6 * c[3] * x
-    inner = (x > 2 * bar.horizon) & (x < 1 - 2 * bar.horizon)
+    inner = (x > 2 * bar.model.horizon) & (x < 1 - 2 * bar.model.horizon)
     lhs = -(bar.K @ u)[inner] / (0.01 * 0.05)
     scale = abs(bar.K).max() * np.abs(u).max() / (0.01 * 0.05)
     np.testing.assert_allclose(lhs, 1e9 * upp[inner], rtol=0, atol=200 * EPS * scale)

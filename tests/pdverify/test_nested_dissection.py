@@ -7,7 +7,9 @@ import scipy.sparse.linalg as spla
 from pdverify.errors import NumericalError
 from pdverify.pd import StateBasedConstants
 from pdverify.scenes import get_scene
-from engine_models import StateBox
+from pdverify.corrections.plain import assemble_plain
+from pdverify.corrections.surface_nodes import assemble_surface_nodes
+from descriptions import box_problem
 from pdverify.solvers.policy import ND3D_FROM_UNKNOWNS, ND_FROM_UNKNOWNS, static_solver
 from pdverify.solvers.ordering import nested_dissection
 from pdverify.solvers.nested import solve_nested
@@ -111,17 +113,23 @@ def test_singular_system_is_refused():
 
 @pytest.mark.parametrize("order", [None, 1, 2])
 def test_augmented_schur_complement_is_the_stiffness(order):
-    """Eliminating the dilatation unknowns gives back K (exact up to round-off)."""
-    box = StateBox((0.3, 0.2), (0.0, 0.0), 0.02, 3.0,
-                   StateBasedConstants("plane-strain", 200e9, 0.3), order=order)
-    A = box.augmented()
-    K = box.stiffness()
+    """Eliminating the dilatation unknowns gives back K (exact up to round-off): the
+    systems the package assembles for the direct and the nested-dissection solves of a
+    free box, uncorrected (``order=None``) or with surface nodes."""
+    def assembled(solver):
+        problem = box_problem((0.3, 0.2), (0.0, 0.0), 0.02, 3.0,
+                              StateBasedConstants("plane-strain", 200e9, 0.3), solver=solver)
+        return (assemble_plain(problem) if order is None
+                else assemble_surface_nodes(problem, order))
+    augmented = assembled("nested-dissection")
+    A = augmented.K
+    K = assembled("direct").K
     n = K.shape[0]
     schur = A[:n, :n] + A[:n, n:] @ A[n:, :n]     # A22 = -I
     assert abs(A[n:, n:] + sp.identity(A.shape[0] - n)).max() == 0
     assert abs(schur - K).max() <= 1e3 * EPS * abs(K).max()
     assert A.nnz < K.nnz
-    assert box.unknown_coords().shape == (A.shape[0], 2)
+    assert augmented.coords.shape == (A.shape[0], 2)
 
 
 @pytest.mark.parametrize("mixed_from", [None, 0])

@@ -3,7 +3,9 @@ import numpy as np
 import pytest
 
 from pdverify.corrections.taylor import taylor_extrapolation_weights
-from engine_models import StateBar
+from pdverify.corrections.taylor_fictitious import boundary_value_rows
+from pdverify.pd.problem import face_number
+from descriptions import bar_system
 
 EPS = np.finfo(float).eps
 
@@ -13,8 +15,8 @@ def test_fictitious_displacements_reproduce_polynomials(order, rng):
     # seed 000 §3: a Taylor series of order n is exact for degree <= n. Tolerance:
     # eps times the extrapolation amplification ||W||_inf (sum of |weights|) times the
     # size of the field, the round-off of evaluating W @ u.
-    bar = StateBar(dict(length=1.0, area=0.01, E=1e9, nu=0.3, spacing=0.05, m_ratio=3.0), order)
-    A_U = bar.model.A_U.toarray()
+    bar = bar_system("taylor-fictitious", order=order).model
+    A_U = bar.A_U.toarray()
     amp = np.abs(A_U).sum(axis=1).max()
     for _ in range(3):
         for degree in range(order + 1):
@@ -31,8 +33,8 @@ def test_fictitious_displacements_reproduce_polynomials(order, rng):
 @pytest.mark.parametrize("order", [1, 2, 3, 4, 5])
 def test_fictitious_dilatations_reproduce_degree_n_minus_1(order, rng):
     # seed 000 Eq. (47): dilatations are extrapolated with order n - 1.
-    bar = StateBar(dict(length=1.0, area=0.01, E=1e9, nu=0.3, spacing=0.05, m_ratio=3.0), order)
-    A = bar.model.A_Theta.toarray()
+    bar = bar_system("taylor-fictitious", order=order).model
+    A = bar.A_Theta.toarray()
     amp = np.abs(A).sum(axis=1).max()
     coef = rng.normal(size=order)
     th = np.polyval(coef, bar.grid.x[:, 0])
@@ -42,11 +44,11 @@ def test_fictitious_dilatations_reproduce_degree_n_minus_1(order, rng):
 @pytest.mark.parametrize("order", [1, 3, 5])
 def test_boundary_value_row_is_exact(order, rng):
     # seed 000 Eq. (58): the Dirichlet row extrapolates u to x = 0 exactly for degree <= n.
-    bar = StateBar(dict(length=1.0, area=0.01, E=1e9, nu=0.3, spacing=0.05, m_ratio=3.0), order)
+    g = bar_system("taylor-fictitious", order=order).model.grid
     coef = rng.normal(size=order + 1)
-    for side, point in (("left", 0.0), ("right", 1.0)):
-        row = bar.boundary_value_row(side)
-        got = row @ np.polyval(coef, bar.x_real)
+    for face, point in (("x-", 0.0), ("x+", 1.0)):
+        row = boundary_value_rows(g, order, face_number(face))[0].toarray()[0]
+        got = row @ np.polyval(coef, g.x[g.interior_ids, 0])
         assert got == pytest.approx(np.polyval(coef, point),
                                     abs=50 * EPS * np.abs(row).sum() * np.abs(coef).sum())
 

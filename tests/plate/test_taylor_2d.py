@@ -1,14 +1,20 @@
 """Seed 000 §6.1: the Taylor fictitious closure in 2D (and 3D) is exact for polynomials of
 degree <= n, and the corrected plate recovers a discrete manufactured solution (issue 15)."""
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
 
 from pdverify.corrections.taylor import monomial_exponents
-from pdverify.corrections.taylor_fictitious import clamped_rows, extrapolation_map
+from pdverify.corrections.taylor_fictitious import (assemble_taylor, clamped_rows,
+                                                    extrapolation_map)
 from pdverify.errors import NumericalError
 from pdverify.pd import BoxGrid, StateBasedConstants
-from engine_models import StatePlate
+from pdverify.pd.problem import FACES, FaceCondition
+from pdverify.scenes.plate2d import ORDERING
+from pdverify.solvers.front import solve
+from descriptions import box_problem
 
 EPS = np.finfo(float).eps
 
@@ -63,10 +69,35 @@ def test_clamped_rows_give_boundary_values(order, rng):
     assert B.shape[0] == 2 * (2 * 10 + 2 * 7) - 8
 
 
-def _plate(order, corners="normal-only", spacing=0.1):
+def _plate(order, field=np.zeros_like, corners="normal-only", spacing=0.1):
+    """Seed 000's plate clamped all round, described (its edges by name, the prescribed
+    values ``field``) and assembled by ``taylor-fictitious`` (Eq. 58's rows as constraints
+    B x = c); the tests set the loads."""
     c = StateBasedConstants("plane-stress", 1e9, 0.2)
-    return StatePlate((1.2, 0.8), spacing, 3.0, c, "hyperbolic", order, thickness=0.05,
-                      corners=corners)
+    clamped = FaceCondition(prescribed=(0, 1))
+    problem = box_problem((1.2, 0.8), (0.0, 0.0), spacing, 3.0, c, influence="hyperbolic",
+                          conditions={face: clamped for face in FACES[:4]}, exact=field,
+                          solver="direct", thickness=0.05)
+    return assemble_taylor(problem, order, corners)
+
+
+def rows_of_state(system, field):
+    """K u for the exact field at every node (fictitious included), dilatations of
+    complete neighbourhoods: the discrete operator applied to the field itself."""
+    m = system.model
+    x = m.grid.x
+    return m.rows_of_state(field(x), m.dilatation_of_field(field, x))
+
+
+def solved(system, f):
+    """The real nodes' displacements (n, 2) with K u = f and the constraint rows."""
+    x, info = solve(replace(system, rhs=f), where="plate", ordering=ORDERING)
+    return x.reshape(2, -1).T, info
+
+
+def real_x(system):
+    g = system.model.grid
+    return g.x[g.interior_ids]
 
 
 @pytest.mark.parametrize("order", [1, 2, 3])
@@ -77,23 +108,19 @@ def test_manufactured_polynomial_is_recovered_to_round_off(order, rng):
     # return the polynomial: exact extrapolation at edges and corners and exact Eq. (58)
     # rows. Tolerance: the solver's backward error (relative residual, ~eps) times its
     # condition estimate bounds the forward error; a factor 100 covers the norm change.
-    plate = _plate(order)
     for degree in range(1, order + 1):
         field = random_polynomial(2, degree, rng)
-        f = plate.rows_of_state(field)
-        c = field(plate.constraint_points)[np.arange(plate.B.shape[0]),
-                                           plate.constraint_components]
-        u, info = plate.solve(f, boundary_values=c)
-        want = field(plate.x)
+        plate = _plate(order, field)
+        u, info = solved(plate, rows_of_state(plate, field))
+        want = field(real_x(plate))
         err = np.abs(u - want).max() / np.abs(want).max()
         assert err < 100 * EPS * info["condition_estimate"], (degree, err)
         assert err < 1e-10   # and absolutely: cond ~1e3 here, so ~1e-11 at most
     # degree n + 1 is not recovered: the test can fail
     field = random_polynomial(2, order + 1, rng)
-    f = plate.rows_of_state(field)
-    c = field(plate.constraint_points)[np.arange(plate.B.shape[0]), plate.constraint_components]
-    u, _ = plate.solve(f, boundary_values=c)
-    want = field(plate.x)
+    plate = _plate(order, field)
+    u, _ = solved(plate, rows_of_state(plate, field))
+    want = field(real_x(plate))
     # 1e4 x the round-off bound: a real miss, not noise
     assert np.abs(u - want).max() / np.abs(want).max() > 1e-6
 
@@ -102,7 +129,7 @@ def test_both_components_on_corner_lines_over_constrain():
     # Remark 4: constraining u and v on both lines through a corner node over-constrains
     # it; the Lagrange system is then exactly singular, and the run says so
     plate = _plate(1, corners="both")
-    f = np.ones(2 * plate.x.shape[0])
+    f = np.ones(2 * real_x(plate).shape[0])
     with pytest.raises(NumericalError, match="singular"):
-        plate.solve(f)
+        solved(plate, f)
     assert sp.linalg.norm(plate.B) > 0

@@ -5,8 +5,9 @@ import pytest
 from pdverify.pd.bonds import (fourth_moment_anisotropy, moment_corrected_volumes,
                                partial_volumes, stencil_offsets)
 from pdverify.pd.problem import face_resultant
+from pdverify.corrections.surface_nodes import surface_node_model
 from pdverify.pd import StateBasedConstants
-from engine_models import StateBox
+from descriptions import box_problem
 
 # Sums of a few hundred terms of size <= 1: 1e-13 is ~500 eps of summation round-off.
 SUM_ATOL = 1e-13
@@ -46,7 +47,8 @@ def _discrete_moduli(kind, quadrature, m_ratio=3.0):
     dim = 3 if kind == "3d" else 2
     h = 0.02
     L = (h * 8,) * dim
-    model = StateBox(L, (0.0,) * dim, h, m_ratio, c, order=1, quadrature=quadrature)
+    model, P = surface_node_model(box_problem(L, (0.0,) * dim, h, m_ratio, c,
+                                              quadrature=quadrature), 1)
     g = model.grid
     out = []
     shear = np.zeros((dim, dim))
@@ -54,7 +56,7 @@ def _discrete_moduli(kind, quadrature, m_ratio=3.0):
     for eps in (np.diag([1.0] + [0.0] * (dim - 1)), shear):
         def u(x, eps=eps):
             return x @ eps.T
-        rows = model.rows_of_state(u(g.x), model.dilatation_of_field(u, g.x))
+        rows = model.rows_of_state(u(g.x), model.dilatation_of_field(u, g.x), P)
         flux = rows.reshape(dim, -1).T[g.n_interior:] / g.face_area
         out.append(flux)
     uni, shear = out

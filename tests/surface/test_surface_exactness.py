@@ -10,12 +10,19 @@ from itertools import product
 import numpy as np
 import pytest
 
+from pdverify.corrections.surface_nodes import surface_node_model
 from pdverify.corrections.taylor import monomial_exponents
-from pdverify.solvers.front import solve_with_dirichlet
 from pdverify.pd import StateBasedConstants
-from engine_models import StateBox
+from pdverify.solvers.front import solve_with_dirichlet
+from descriptions import box_problem
 
 EPS = np.finfo(float).eps
+
+
+def surface_box(lengths, origin, h, m_ratio, c, order):
+    """``(model, P)`` of the surface node method of ``order`` on a box described with no
+    conditions (gaussian influence, partial volumes): the tests impose their own."""
+    return surface_node_model(box_problem(lengths, origin, h, m_ratio, c), order)
 
 
 def _poly_field(rng, dim, degree, scale):
@@ -37,18 +44,18 @@ CASES = [("plane-strain", (0.4, 0.3), (0.0, 0.0), 0.05, n) for n in (1, 2, 3)] +
 @pytest.mark.parametrize("kind,lengths,origin,h,order", CASES)
 def test_polynomial_field_recovered_to_round_off(rng, kind, lengths, origin, h, order):
     c = StateBasedConstants(kind, 200e9, 0.3)
-    model = StateBox(lengths, origin, h, 3.0, c, order=order)
+    model, P = surface_box(lengths, origin, h, 3.0, c, order)
     g = model.grid
     d, ni, nu_ = g.dim, g.n_interior, model.n_unknown_nodes
     u = _poly_field(rng, d, order, 1e-3)
     U = u(g.x)
     theta = model.dilatation_of_field(u, g.x)
-    rhs = model.rows_of_state(U, theta)            # loads = discrete operator of the field
+    rhs = model.rows_of_state(U, theta, P)         # loads = discrete operator of the field
     exact = np.concatenate([U[g.interior_ids], u(g.surface_x)]).T.ravel()
     # Dirichlet on the surface nodes of face 0 (all components), force flux elsewhere
     s0 = np.flatnonzero(g.surface_face == 0)
     fixed = np.sort(np.concatenate([k * nu_ + ni + s0 for k in range(d)]))
-    sol, info = solve_with_dirichlet(model.stiffness(), rhs, fixed, exact[fixed], where="exactness")
+    sol, info = solve_with_dirichlet(model.stiffness(P), rhs, fixed, exact[fixed], where="exactness")
     err = np.linalg.norm(sol - exact) / np.linalg.norm(exact)
     # forward error <= cond * eps times a modest factor for the size of the system
     # (LU backward error ~ n^(1/2) eps in practice; we allow 10 * sqrt(n))
@@ -61,7 +68,7 @@ def test_extrapolation_is_exact_for_degree_n_only(rng):
     """Order N reproduces degree N in the fictitious layer, not degree N + 1."""
     c = StateBasedConstants("plane-strain", 200e9, 0.3)
     for order in (1, 2, 3):
-        model = StateBox((0.4, 0.3), (0.0, 0.0), 0.05, 3.0, c, order=order)
+        model, _ = surface_box((0.4, 0.3), (0.0, 0.0), 0.05, 3.0, c, order)
         g = model.grid
         fict = ~g.is_interior
         for degree, exact in ((order, True), (order + 1, False)):
@@ -80,14 +87,14 @@ def test_face_crossing_weights_give_the_discrete_stress(rng):
     so a homogeneous strain gives the same flux on every node of a face, corners included.
     """
     c = StateBasedConstants("3d", 200e9, 0.3)
-    model = StateBox((0.3, 0.25, 0.3), (0.0, 0.0, 0.0), 0.05, 3.0, c, order=1)
+    model, P = surface_box((0.3, 0.25, 0.3), (0.0, 0.0, 0.0), 0.05, 3.0, c, 1)
     g = model.grid
     eps = rng.uniform(-1, 1, (3, 3)) * 1e-3
     eps = eps + eps.T
 
     def u(x):
         return x @ eps.T
-    rows = model.rows_of_state(u(g.x), model.dilatation_of_field(u, g.x))
+    rows = model.rows_of_state(u(g.x), model.dilatation_of_field(u, g.x), P)
     flux = rows.reshape(3, -1).T[g.n_interior:] / g.face_area
     for face in range(6):
         f = flux[g.surface_face == face]
@@ -108,9 +115,8 @@ def test_the_map_multiplied_in_last_gives_the_same_rows(order):
     entrywise |difference| <= 2 gamma_n |R||A_e||A_U| with n the largest number of terms
     along the chain, gamma_n = n u / (1 - n u), u = eps / 2."""
     c = StateBasedConstants("3d", 200e9, 0.3)
-    box = StateBox((0.4, 0.3, 0.3), (0.0, -0.15, -0.15), 0.05, 3.0, c, order=order)
-    model = box.model
-    rows = [box.P @ model.K_e, model.A_theta]
+    model, P = surface_box((0.4, 0.3, 0.3), (0.0, -0.15, -0.15), 0.05, 3.0, c, order)
+    rows = [P @ model.K_e, model.A_theta]
     ref = model.unknown_rows(rows)
     new = model.unknown_rows(rows, map_last=True)
     most = lambda A: int(np.diff(A.tocsr().indptr).max())  # noqa: E731

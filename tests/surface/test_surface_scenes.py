@@ -3,8 +3,9 @@ import numpy as np
 import pytest
 
 from pdverify.scenes import get_scene
+from pdverify.corrections.surface_nodes import surface_node_model
 from pdverify.pd import StateBasedConstants
-from engine_models import StateBox
+from descriptions import box_problem
 
 
 @pytest.fixture(scope="module")
@@ -30,13 +31,13 @@ def _discrete_plate_strain_error(p, m_ratio):
     force flux of a unit strain, and sigma = (0, p) gives the homogeneous strains.
     """
     c = StateBasedConstants("plane-strain", p["E"], p["nu"])
-    model = StateBox((0.3, 0.3), (0.0, 0.0), 0.02, m_ratio, c, order=1)
+    model, P = surface_node_model(box_problem((0.3, 0.3), (0.0, 0.0), 0.02, m_ratio, c), 1)
     g = model.grid
     eps = np.diag([1.0, 0.0])
 
     def u(x):
         return x @ eps.T
-    rows = model.rows_of_state(u(g.x), model.dilatation_of_field(u, g.x)).reshape(2, -1).T
+    rows = model.rows_of_state(u(g.x), model.dilatation_of_field(u, g.x), P).reshape(2, -1).T
     flux = rows[g.n_interior:] / g.face_area
     C11 = flux[g.face_start[1], 0]
     C12 = flux[g.face_start[3], 1]

@@ -280,3 +280,53 @@ def test_a_whole_faces_only_treatment_is_refused_where_part_of_a_face_is_prescri
     reason = t.why_not(get_scene("body3d-traction"))
     assert reason and "prescribes a component on part of a face" in reason
     assert t.why_not(get_scene("body3d-manufactured")) is None
+
+
+#: the modules of ``pdverify.corrections`` a scene may import: the generic ones (the
+#: registry, the family's shared assembly, the plugin signatures), never a correction
+GENERIC_CORRECTIONS = {"pdverify.corrections", "pdverify.corrections.registry",
+                       "pdverify.corrections.assembly", "pdverify.corrections.protocols",
+                       "pdverify.corrections.treatment"}
+
+
+def _specific_corrections(graph):
+    return sorted((m, t) for m, ts in graph.items() if m.startswith("pdverify.scenes")
+                  for t in ts if t.startswith("pdverify.corrections")
+                  and t not in GENERIC_CORRECTIONS
+                  and t.rsplit(".", 1)[0] not in GENERIC_CORRECTIONS - {"pdverify.corrections"})
+
+
+def test_no_scene_imports_a_specific_correction():
+    """A scene reaches a treatment through the registry only (issue 51); what a scene
+    measures with (work densities, the bar's calibration) lives in ``pdverify.pd``."""
+    assert _specific_corrections(_graph()) == []
+
+
+def test_the_correction_import_check_can_fail():
+    graph = {"pdverify.scenes.x": {"pdverify.corrections.factors",
+                                   "pdverify.corrections.factors.work_density",
+                                   "pdverify.corrections.registry",
+                                   "pdverify.corrections.registry.plugin_call"}}
+    assert [t for _, t in _specific_corrections(graph)] == [
+        "pdverify.corrections.factors", "pdverify.corrections.factors.work_density"]
+
+
+def _fallback_defaults(text: str) -> list[str]:
+    """``p.get(NAME, DEFAULT)`` / ``params.get(NAME, DEFAULT)``: a default stated again
+    beside its declaration."""
+    import re
+    return re.findall(r"\b(?:p|params|q)\.get\(\s*['\"]\w+['\"]\s*,[^)]*\)", text)
+
+
+def test_scenes_read_declared_defaults_not_fallbacks():
+    """A scene reads a parameter's default from its declaration (``Scene.declared``, the
+    treatment's parameter), never from a second literal beside the lookup (issue 51)."""
+    found = {p.name: _fallback_defaults(p.read_text())
+             for p in (PACKAGE / "scenes").glob("*.py")}
+    assert {k: v for k, v in found.items() if v} == {}
+
+
+def test_the_fallback_grep_can_fail():
+    assert _fallback_defaults('x = p.get("solver", "direct")\nq.get("order", 2) == 2\n'
+                              'y = p.get("solver") == "auto"') == [
+        'p.get("solver", "direct")', 'q.get("order", 2)']
