@@ -45,7 +45,8 @@ class SceneSummary:
     best_error: float | None  # its headline error as a fraction
     best_time_s: float | None
     runs: int
-    failed: list            # (method, message) of the failed runs
+    failed: list            # (method, message) of the runs that count as failures
+    expected: int = 0       # documented failures that happened (not failures of the report)
 
 
 def summarise(scene, runs) -> SceneSummary:
@@ -59,13 +60,15 @@ def summarise(scene, runs) -> SceneSummary:
         scene=scene.id, metric=headline(scene), best=best,
         best_error=values.get(best), runs=len(runs),
         best_time_s=time_s(picked[best].timings) if best else None,
-        failed=[(r.method, r.message) for r in runs if r.counts_as_failure])
+        failed=[(r.method, r.message) for r in runs if r.counts_as_failure],
+        expected=sum(r.outcome == "expected-failure" for r in runs))
 
 
 # -- the end-of-report summary (one row per scene) -----------------------------------------
-SUMMARY_COLUMNS = ("scene", "best method", "error", "time", "runs", "failed", "first failure")
-#: right-aligned columns: error, time, runs, failed
-_NUMERIC = (2, 3, 4, 5)
+SUMMARY_COLUMNS = ("scene", "best method", "error", "time", "runs", "failed",
+                   "failed as expected", "first failure")
+#: right-aligned columns: error, time, runs, failed, failed as expected
+_NUMERIC = (2, 3, 4, 5, 6)
 #: a failure message is cut to this many characters in the summary
 FAILURE_WIDTH = 60
 
@@ -88,27 +91,34 @@ def summary_row(s: SceneSummary) -> list[str]:
     first = _shorten(f"{s.failed[0][0]}: {s.failed[0][1]}") if s.failed else ""
     return [s.scene, s.best or "-", error,
             "-" if s.best_time_s is None else f"{s.best_time_s:.2f} s",
-            str(s.runs), str(len(s.failed)), first]
+            str(s.runs), str(len(s.failed)), str(s.expected), first]
 
 
-def _columns(summaries) -> int:
-    """How many of :data:`SUMMARY_COLUMNS` to show: 'first failure' only if a run failed."""
-    n = len(SUMMARY_COLUMNS)
-    return n if any(s.failed for s in summaries) else n - 1
+def _columns(summaries) -> list[int]:
+    """Which of :data:`SUMMARY_COLUMNS` to show: 'failed as expected' only if a documented
+    failure happened, 'first failure' only if a run failed."""
+    shown = list(range(len(SUMMARY_COLUMNS)))
+    if not any(s.failed for s in summaries):
+        shown.remove(SUMMARY_COLUMNS.index("first failure"))
+    if not any(s.expected for s in summaries):
+        shown.remove(SUMMARY_COLUMNS.index("failed as expected"))
+    return shown
 
 
 def format_summary(summaries) -> str:
     """The summary as fixed-width plain text: a header, then one row per scene: the best
     method at default parameters, its headline error (in %, the metric named unless it is
-    ``rel_l2_error``) and total time, the number of runs and of failed runs, and (if any
-    run failed) the first failure's message, shortened."""
-    n = _columns(summaries)
-    rows = [list(SUMMARY_COLUMNS[:n])] + [summary_row(s)[:n] for s in summaries]
-    widths = [max(len(r[i]) for r in rows) for i in range(n)]
+    ``rel_l2_error``) and total time, the number of runs and of failed runs (those that
+    count: documented failures are apart, in 'failed as expected', shown when one
+    happened), and (if any run failed) the first failure's message, shortened."""
+    shown = _columns(summaries)
+    rows = [[SUMMARY_COLUMNS[i] for i in shown]] + [[summary_row(s)[i] for i in shown]
+                                                     for s in summaries]
+    widths = [max(len(r[j]) for r in rows) for j in range(len(shown))]
     lines = []
     for r in rows:
         cells = [c.rjust(w) if i in _NUMERIC else c.ljust(w)
-                 for i, (c, w) in enumerate(zip(r, widths))]
+                 for i, c, w in zip(shown, r, widths)]
         lines.append("  ".join(cells).rstrip())
     return "\n".join(lines)
 
@@ -125,11 +135,15 @@ def summary_table(summaries):
                   header_style="bold underline", box=None, padding=(0, 1), pad_edge=False)
     rows = [summary_row(s) for s in summaries]
     value = max([len(r[2].split(" %")[0]) + 2 for r in rows] + [5])  # '1.2e-13 %'
-    for i, name in enumerate(SUMMARY_COLUMNS[:-1]):
+    shown = [i for i in _columns(summaries) if SUMMARY_COLUMNS[i] != "first failure"]
+    for i in shown:
+        name = SUMMARY_COLUMNS[i]
         table.add_column(name, justify="right" if i in _NUMERIC else "left",
                          no_wrap=name != "error", min_width=value if name == "error" else None)
     for s, row in zip(summaries, rows):
-        table.add_row(*row[:-1], style="red" if s.failed else None)
+        # red for failures that count; a documented failure is expected (pytest's yellow)
+        table.add_row(*[row[i] for i in shown],
+                      style="red" if s.failed else "yellow" if s.expected else None)
     failures = [Text(f"  {s.scene}: {row[-1]}", style="red")
                 for s, row in zip(summaries, rows) if s.failed]
     if not failures:
@@ -139,15 +153,19 @@ def summary_table(summaries):
 
 def print_summary(scenes, results, stream) -> None:
     """Print the end-of-report summary of ``scenes`` (Scene objects) from ``results`` to
-    ``stream``: a rich table on a terminal, :func:`format_summary` text otherwise. A
+    ``stream``: a rich table on a terminal, :func:`format_summary` text otherwise (and
+    always in the report's log, when ``stream`` is a :class:`~pdverify.progress.Tee`). A
     summary that cannot be made costs only itself (a note), never the report."""
-    from ..progress import is_terminal
+    from ..progress import is_terminal, screen_and_log
     try:
         summaries = [summarise(scene, [r for r in results if r.scene == scene.id])
                      for scene in scenes]
-        if is_terminal(stream):
+        screen, log = screen_and_log(stream)
+        if is_terminal(screen):
             from rich.console import Console
-            Console(file=stream, force_terminal=True).print(summary_table(summaries))
+            Console(file=screen, force_terminal=True).print(summary_table(summaries))
+            if log is not None:
+                print(format_summary(summaries), file=log)
         else:
             print(format_summary(summaries), file=stream)
     except Exception as exc:  # a display problem must not lose the report

@@ -80,3 +80,118 @@ def test_the_indentation_findings_are_documented():
     # and the 3D Taylor run on body3d-manufactured's quick box (dependent constraint rows)
     assert {s.id for s in all_scenes() if s.expected_failures} == {"block2d-indentation",
                                                                    "body3d-manufactured"}
+
+
+# -- shown as expected while the report runs, in its log and in its summary (issue 52) --------
+import io
+import re
+
+ANSI = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]")
+#: rich's red foreground (the colour of a failure that counts)
+RED = "\x1b[31m"
+
+CASES = [("bar1d-traction", "none", {}), ("bar1d-traction", "energy", {}),
+         ("bar1d-traction", "volume", {})]
+
+
+class FakeTTY(io.StringIO):
+    def isatty(self):
+        return True
+
+
+def _finished(shown, k, res):
+    shown.started(k)
+    shown.finished(k, res)
+
+
+def test_live_display_counts_expected_failures_apart_and_not_in_red():
+    from pdverify.progress import RunProgress, Tee
+    from pdverify.runner import run_line
+    screen, log = FakeTTY(), io.StringIO()
+    stream = Tee(screen, log)
+    with RunProgress(CASES, 2, stream, line=lambda k, r: run_line(CASES[k], r)) as shown:
+        _finished(shown, 0, _run("failed", "documented"))
+        _finished(shown, 1, _run("ok"))
+        shown.tick()
+        head = ANSI.sub("", screen.getvalue())
+        assert "2/3 runs (1 failed as expected)" in head and "failed)" not in head
+        _finished(shown, 2, _run("failed"))
+        shown.tick()
+    drawn = screen.getvalue()
+    text = ANSI.sub("", drawn)
+    assert "3/3 runs (1 failed, 1 failed as expected)" in text
+    first = next(line for line in drawn.splitlines() if "[1/3]" in line)
+    third = next(line for line in drawn.splitlines() if "[3/3]" in line)
+    assert "failed as expected: boom" in first and "FAILED" not in first
+    assert RED not in first and RED in third
+    # the log: the plain lines only, never the live display's frames
+    lines = log.getvalue().splitlines()
+    assert "\x1b" not in log.getvalue() and len(lines) == 3
+    assert "... failed as expected: boom (" in lines[0] and "... FAILED: boom (" in lines[2]
+    assert all(line.startswith(f"[{k}/3] ") for k, line in enumerate(lines, 1))
+
+
+def test_plain_lines_say_failed_as_expected():
+    from pdverify.progress import RunProgress
+    from pdverify.runner import run_line
+    stream = io.StringIO()
+    with RunProgress(CASES, 1, stream, line=lambda k, r: run_line(CASES[k], r)) as shown:
+        _finished(shown, 0, _run("failed", "documented"))
+        _finished(shown, 1, _run("ok", "documented"))
+    first, second = stream.getvalue().splitlines()
+    assert "... failed as expected: boom (" in first and "FAILED" not in first
+    assert "... ok, UNEXPECTED PASS: documented to fail (documented) (" in second
+
+
+def test_summary_shows_expected_failures_apart():
+    from pdverify.report.summary import format_summary, summarise, summary_table
+    from rich.console import Console
+    scene = get_scene("bar1d-traction")
+    runs = [_run("ok"), _run("failed", "documented")]
+    runs[0].method = "energy"
+    s = summarise(scene, runs)
+    assert s.failed == [] and s.expected == 1
+    text = format_summary([s])
+    head, row = text.splitlines()
+    assert head.split()[-3:] == ["failed", "as", "expected"] and "first failure" not in head
+    assert row.split()[-2:] == ["0", "1"]
+    console = Console(file=io.StringIO(), force_terminal=True, width=150)
+    console.print(summary_table([s]))
+    drawn = console.file.getvalue()
+    assert "failed as expected" in ANSI.sub("", drawn) and RED not in drawn
+
+
+def test_report_log_has_plain_lines_on_a_terminal(tmp_path):
+    """A report whose stderr is a terminal (a pseudo-terminal here) draws the live
+    display there, and its report.log holds the plain lines: no screen frames."""
+    import os
+    import pty
+    import subprocess
+    import sys
+    out = tmp_path / "rep"
+    main_fd, child_fd = pty.openpty()
+    env = {**os.environ, "COLUMNS": "120", "LINES": "40", "TERM": "xterm"}
+    proc = subprocess.Popen([sys.executable, "-m", "pdverify", "report", "--quick", "--only",
+                             "bar1d-traction", "--out", str(out), "--jobs", "2"],
+                            stdin=subprocess.DEVNULL, stdout=child_fd, stderr=child_fd, env=env)
+    os.close(child_fd)
+    screen = b""
+    while True:
+        try:
+            chunk = os.read(main_fd, 65536)
+        except OSError:     # EIO: the child closed the terminal
+            break
+        if not chunk:
+            break
+        screen += chunk
+    assert proc.wait(timeout=600) == 0, screen.decode(errors="replace")[-2000:]
+    os.close(main_fd)
+    assert b"\x1b[" in screen                            # the live display was drawn
+    log = (out / "report.log").read_text()
+    assert "\x1b" not in log and "\r" not in log
+    lines = log.splitlines()
+    runs = [line for line in lines if re.match(r"^\[\d+/\d+\] bar1d-traction ", line)]
+    n = int(runs[0].split("/")[1].split("]")[0])
+    assert len(runs) == n                                # each run once, not per frame
+    assert lines[-1].startswith("report: ")
+    assert any(line.startswith("scene ") for line in lines)   # the plain summary
