@@ -538,13 +538,16 @@ def _build_logged(cases, out, final, jobs, progress, client=None, quick=False,
     failed = outcomes.count("failed")
     expected = outcomes.count("expected-failure")
     passed = [r for r in results if r.outcome == "unexpected-pass"]
-    from .summary import print_summary
+    from .summary import load_note, print_summary
     print_summary(scenes, results, progress)  # one row per scene, before the last line
     if slots:                                 # the local pool (not a Dask cluster)
         print(critical_path(slots, cases), file=progress)
     heaviest = largest_memory(results)
     if heaviest:
         print(heaviest, file=progress)
+    loads = load_note(results, doc.get("machine", {}).get("cpus"))
+    if loads:
+        print(loads, file=progress)
     for r in passed:   # strict: a documented failure that no longer happens
         print(f"unexpected pass: {r.scene}/{r.method} is ok, but it is documented to fail "
               f"({r.expected_failure}); update the finding", file=progress)

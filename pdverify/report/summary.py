@@ -170,3 +170,36 @@ def print_summary(scenes, results, stream) -> None:
             print(format_summary(summaries), file=stream)
     except Exception as exc:  # a display problem must not lose the report
         print(f"summary failed: {type(exc).__name__}: {exc}", file=stream)
+
+
+# -- the machine's load over the runs ------------------------------------------------------
+#: A report notes the machine's load when the runs' shares of a core differ by more than
+#: this factor: each run records the 1-minute load average at its start and end
+#: (``resources.load_start``, ``load_end``: :func:`pdverify.budget.load_average`), and
+#: above the CPU count the runnable processes share the cores, so a run can take up to
+#: max(1, load / CPUs) times its time on an idle machine. 1.5: a run time half again as long
+#: is more than the run-to-run spread of a run at one load (a few %, the quick report's
+#: repeats in benchmarks/report_cost.py)
+LOAD_FACTOR = 1.5
+
+
+def load_note(results, cpus) -> str:
+    """A sentence saying how the machine's load varied over the runs of ``results`` on
+    ``cpus`` CPUs, when it varied by more than :data:`LOAD_FACTOR` in shares of a core;
+    empty otherwise, or when no run recorded its load."""
+    loads = [v for r in results for v in (r.resources.get("load_start"),
+                                            r.resources.get("load_end"))
+             if isinstance(v, (int, float)) and not isinstance(v, bool)]
+    if not loads or not cpus or cpus < 1:
+        return ""
+    low, high = min(loads), max(loads)
+    factor = max(1.0, high / cpus) / max(1.0, low / cpus)
+    if factor <= LOAD_FACTOR:
+        return ""
+    return (f"The machine's load varied while the runs ran: the 1-minute load average was "
+            f"{low:.1f} to {high:.1f} on {cpus} CPUs. Above the CPU count the runs share "
+            f"the cores, so a run's time may be up to {factor:.1f} times what it would be "
+            f"at the lowest load: compare run times at similar loads (each run's load is "
+            f"in its time's hover text and in results.json, resources.load_start and "
+            f"load_end).")
+

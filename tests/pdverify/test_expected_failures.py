@@ -195,3 +195,50 @@ def test_report_log_has_plain_lines_on_a_terminal(tmp_path):
     assert len(runs) == n                                # each run once, not per frame
     assert lines[-1].startswith("report: ")
     assert any(line.startswith("scene ") for line in lines)   # the plain summary
+
+
+# -- each run's record carries the machine's load; the report says when it varied -------------
+def test_a_run_records_the_machine_load_and_compare_ignores_it(tmp_path):
+    import json
+    import os
+    from pdverify.compare import compare_docs
+    from pdverify.results import RunResult
+    r = get_scene("bar1d-traction").run("none")
+    if not hasattr(os, "getloadavg"):
+        pytest.skip("no os.getloadavg")
+    assert r.resources["load_start"] >= 0 and r.resources["load_end"] >= 0
+    assert RunResult.from_json(r.to_json()).resources == r.resources
+    doc = {"runs": [r.to_json()]}
+    other = json.loads(json.dumps(doc))
+    other["runs"][0]["resources"].update(load_start=99.0, load_end=42.0)
+    assert compare_docs(doc, other) == []       # not a number to compare
+
+
+def _loaded(start, end):
+    return RunResult("bar1d-traction", "none", {}, "analytic", status="ok",
+                     resources={"load_start": start, "load_end": end})
+
+
+def test_the_report_notes_a_load_that_varied():
+    from pdverify.report.summary import LOAD_FACTOR, load_note
+    # on 2 CPUs, loads up to 2 leave each run a core: no note
+    assert load_note([_loaded(0.1, 1.9), _loaded(2.0, 0.5)], 2) == ""
+    assert load_note([_run("ok")], 2) == ""               # nothing recorded
+    # a load of 15 shares 2 cores among 15 processes: up to 7.5 times as long
+    note = load_note([_loaded(0.5, 1.0), _loaded(15.0, 14.0)], 2)
+    assert "0.5 to 15.0 on 2 CPUs" in note and "7.5 times" in note
+    # the factor is the threshold: just below, no note; just above, a note
+    assert load_note([_loaded(2.0, 2.0), _loaded(2 * LOAD_FACTOR, 2.0)], 2) == ""
+    assert load_note([_loaded(2.0, 2.0), _loaded(2 * LOAD_FACTOR + 0.1, 2.0)], 2)
+
+
+def test_the_page_shows_the_load_note_and_each_runs_load():
+    from pdverify.report import html
+    scene = get_scene("bar1d-traction")
+    runs = [_loaded(0.5, 1.0), _loaded(15.0, 14.0)]
+    runs[1].method = "energy"
+    doc = {"runs": [r.to_json() for r in runs], "machine": {"cpus": 2, "python": "3"},
+           "schema": "pdverify.results/1", "pdverify_version": "0", "created": "now"}
+    text = html.page(doc, [(scene, html.scene_section(scene, runs, []))], 1.0, runs)
+    assert "The machine&#39;s load varied" in text or "The machine's load varied" in text
+    assert "machine load 15.0-14.0 (1-minute average)" in text
