@@ -188,8 +188,14 @@ def test_report_prints_the_summary_before_its_last_line(quick_report):
     assert rows[0].split()[1] in {"taylor-fictitious", "surface-nodes", "mirror-nodes", "pddo"}
     assert rows[1].split()[1] == "energy-directional"
     # each finished run's line; a heartbeat (progress.HEARTBEAT_S) when a minute passed
-    # without one, as on a loaded machine
-    assert all(LINE.match(line) or line.startswith("... running: ") for line in lines[:head])
+    # without one, as on a loaded machine; then the figure phase's lines
+    figures = [k for k, line in enumerate(lines[:head]) if line.startswith("figures")]
+    assert figures and figures == list(range(figures[0], head))
+    assert lines[figures[0]].startswith("figures: drawing ")
+    tasks = int(lines[figures[0]].split()[2])
+    assert len(figures) == tasks + 1 and lines[head - 1].startswith(f"figures {tasks}/{tasks}: ")
+    assert all(LINE.match(line) or line.startswith("... running: ")
+               for line in lines[:figures[0]])
 
 
 def test_list_shows_the_choices_of_a_choice_param(capsys):
