@@ -18,7 +18,8 @@ from ..published import FIGURE, verdict
 from ..results import CACHED_SETUP
 from ..results import cost_s as run_cost_s
 from ..results import time_s as run_time_s
-from .summary import default_run, headline, headline_value, load_note, summarise
+from .summary import (configurations, default_run, headline, headline_value, load_note,
+                      summarise)
 
 _ENV = jinja2.Environment(
     loader=jinja2.PackageLoader("pdverify.report", "templates"),
@@ -362,10 +363,13 @@ def _pct_text(pct: float) -> str:
 
 
 def best_run(scene, method, runs):
-    """The run of ``method`` with the lowest headline error among ``runs`` (ties: the
+    """The best configuration of ``method``: among its runs on the default run's problem
+    and grid (:func:`~pdverify.report.summary.configurations`: jitter, geometry and
+    refinement are not configurations), the one with the lowest headline error (ties: the
     cheaper one), or None when none has a headline error."""
-    mine = [(abs(headline_pct(scene, r)), cost_s(r), k, r) for k, r in enumerate(runs)
-            if r.method == method and headline_pct(scene, r) is not None]
+    mine = [(abs(headline_pct(scene, r)), cost_s(r), k, r)
+            for k, r in enumerate(configurations(scene, method, runs))
+            if headline_pct(scene, r) is not None]
     return min(mine)[3] if mine else None
 
 

@@ -37,6 +37,40 @@ def default_run(scene, method, runs):
     return next((r for r in mine if r.params == defaults), mine[0] if mine else None)
 
 
+#: Scene parameters that are settings of the model or method (a quadrature rule, an
+#: influence function, a micromodulus, a calibration, a solver), not of the problem: the
+#: other scene parameters define the problem (geometry, material, load)
+SETTINGS = frozenset({"quadrature", "influence", "micromodulus", "complete_m",
+                      "end_weight", "calibration", "solver"})
+#: Method parameters that define the problem or its discretisation, not a setting of the
+#: method: the grid and its refinement (spacing, horizon, m_ratio, nodes, levels, mesh
+#: cells and grading, time steps), the lattice's jitter, the kinematics and where the load
+#: acts. A run that changes one is another problem or a finer grid
+PROBLEM = frozenset({"spacing", "horizon", "horizon_ratio", "m_ratio", "nodes", "levels",
+                     "cells", "arc_cells", "radial_cells", "elements", "fine_depth",
+                     "fine_half_width", "grading_power", "grading_ratio", "sample_spacing",
+                     "dt", "dt_factor", "n_steps", "substeps", "uniform_study", "jitter",
+                     "jitter_seed", "kinematics", "load_point", "symmetry"})
+
+
+def problem_params(scene) -> set:
+    """The names of the parameters that define ``scene``'s problem and discretisation
+    (every parameter of the scene but :data:`SETTINGS`, and :data:`PROBLEM`)."""
+    return {p.name for p in scene.params if p.name not in SETTINGS} | PROBLEM
+
+
+def configurations(scene, method, runs) -> list:
+    """The runs of ``method`` that are configurations of its default run
+    (:func:`default_run`): the same problem on the same grid, other settings of the
+    method only (:func:`problem_params` equal); the default run among them."""
+    default = default_run(scene, method, runs)
+    if default is None:
+        return []
+    fixed = problem_params(scene)
+    return [r for r in runs if r.method == method
+            and all(r.params.get(k) == default.params.get(k) for k in fixed)]
+
+
 @dataclass
 class SceneSummary:
     scene: str
