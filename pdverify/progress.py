@@ -12,6 +12,11 @@ import time
 
 #: at most this many runs in flight are listed by name in the live display
 SHOWN_IN_FLIGHT = 8
+#: the ETA's calibration of known times (:meth:`RunProgress.predicted`) starts as if this
+#: many seconds of runs had taken their predicted time (a prior at speed 1): replayed on
+#: the full and quick reports' records (benchmarks/eta_replay.py), the first runs to end,
+#: hundredths of a second each, otherwise set the speed of the whole report
+SPEED_PRIOR_S = 20.0
 #: how often the local pool wakes to refresh the live display's clock [s]
 TICK_S = 0.25
 #: on a non-terminal, a heartbeat line names the runs in flight at least this often [s]
@@ -172,8 +177,11 @@ class RunProgress:
         """Each case's predicted seconds from its cost (:attr:`costs`), calibrated by the
         finished runs (ratios of sums, so the long runs weigh most):
 
-        - a previous time: times the ratio of this report's to the previous report's
-          times over the finished runs that have one (1 before any finished);
+        - a previous or measured time ("known"): times the ratio of this report's to
+          those times over the finished runs that have one (1 before any finished);
+        - a cold reference's time ("reference": a run that computes its scene's
+          reference, its measured time with a cold cache): times the same ratio, never
+          part of it (on a warm cache the run takes a fraction of that time);
         - a size (the budget's model, in its own unit): times the seconds per unit of
           the finished runs of the same scene (a size is comparable within a scene only:
           across scenes, fixed costs that the model does not see dominate small runs);
@@ -181,8 +189,10 @@ class RunProgress:
           None before any run finished."""
         known = [(self._took[k], c) for k, (kd, c) in enumerate(self.costs)
                  if kd == "known" and k in self._took and c]
-        total = sum(c for _, c in known)
-        speed = sum(t for t, _ in known) / total if total > 0 else 1.0
+        # the ratio starts from SPEED_PRIOR_S seconds at the predicted speed: the first
+        # runs done are short ones, whose ratio alone says little
+        speed = ((sum(t for t, _ in known) + SPEED_PRIOR_S)
+                 / (sum(c for _, c in known) + SPEED_PRIOR_S))
         per_scene: dict[str, list[float]] = {}
         for k, (kind, cost) in enumerate(self.costs):
             if kind == "size" and k in self._took and cost:
@@ -193,7 +203,7 @@ class RunProgress:
         out = []
         for k, (kind, cost) in enumerate(self.costs):
             acc = per_scene.get(self.cases[k][0])
-            if kind == "known" and cost is not None:
+            if kind in ("known", "reference") and cost is not None:
                 out.append(cost * speed)
             elif kind == "size" and cost and acc and acc[1] > 0:
                 out.append(cost * acc[0] / acc[1])
@@ -204,18 +214,22 @@ class RunProgress:
     def eta(self) -> float | None:
         """Seconds left: the predicted times (:meth:`predicted`) of the runs not started
         and what is left of those in flight, over the worker count (so it assumes that
-        every worker stays busy); None while nothing predicts the runs left."""
+        every worker stays busy), and at least what is left of the longest; None while
+        nothing predicts the runs left."""
         pred = self.predicted()
         now = time.monotonic()
-        left = 0.0
+        left = longest = 0.0
         for k in range(self.total):
             if k in self._took:
                 continue
             if pred[k] is None:
                 return None
             start = self.in_flight.get(k)
-            left += max(pred[k] - (now - start if start is not None else 0.0), 0.0)
-        return left / self.workers
+            mine = max(pred[k] - (now - start if start is not None else 0.0), 0.0)
+            left += mine
+            longest = max(longest, mine)
+        # a run is not shared out among workers: the report lasts at least its longest
+        return max(left / self.workers, longest)
 
     # -- events (main process only) -------------------------------------------------------
     def started(self, k: int, timed: bool = True) -> None:
