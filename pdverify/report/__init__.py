@@ -213,7 +213,7 @@ def rerun_plan(cases, out: str):
 
 
 #: Bytes a report needs on disk, per run and once (figures of the overview, pages), from
-#: the largest --quick --only SCENE report per run measured: see the README's "Storage".
+#: the largest --quick --only SCENE report per run measured: see "Storage" in docs/command-line.md.
 REPORT_BYTES_PER_RUN = 256_000
 REPORT_BYTES_FIXED = 2_000_000
 
