@@ -19,9 +19,23 @@ runs done). A report whose records wrote the table measures only the calibration
 another report's records (another commit, another load, a cold cache) measure the model.
 
 ``--write-table``: writes :data:`pdverify.schedule.MEASURED_TIMES` from a full and a quick
-report's results.json (each run's ``total_s``; for a run that computes its scene's
+report's results.json (each run's ``total_s``, the full report's where both have it; for a run that computes its scene's
 reference, the seconds its reference study and converged solution took when computed:
 ``reference_study_s`` + ``reference_converged_setup_s`` + ``reference_converged_solve_s``).
+
+Measured (issue 52; the table from the full report of 7c77775, alone on the machine, and a
+quick report of the same code under load 15-20; median |error| per quarter, the worst
+in brackets):
+
+- full, warm, three reports of other commits (``final``, ``new``, ``base`` of that day):
+  measured 1 / 7 / 4 / 9 %, 5 / 12 / 9 / 11 %, 14 / 28 / 28 / 17 % (worst -34 %); size
+  model 73 / 42 / 2 / 12 %, 77 / 44 / 5 / 10 %, 136 / 35 / 22 / 10 % (worst +622 %, and
+  no ETA before the first run ends);
+- quick, warm, under load: measured 32 / 23 / 38 / 48 % (the runs 1.6 times slower than
+  the table: the ETA too low until the calibration catches up); size model 72 / 40 / 16 /
+  52 %;
+- quick, cold (an empty FEM cache), under load: measured 62 / 37 / 29 / 54 %; size model
+  518 / 437 / 38 / 175 %.
 """
 from __future__ import annotations
 
@@ -52,7 +66,8 @@ def write_table(full: str, quick: str) -> None:
                    "s": round(float(t["total_s"]), 4)}
             if computes_reference((r["scene"], r["method"], {})):
                 row["cold_s"] = round(sum(float(t.get(k, 0.0)) for k in COLD_KEYS), 4)
-            rows[run_key(r["scene"], r["method"], r["params"])] = row
+            # a run in both reports keeps the first's time (the full report's)
+            rows.setdefault(run_key(r["scene"], r["method"], r["params"]), row)
     doc = {"about": "measured run times the progress ETA starts from (pdverify.schedule."
                     "MEASURED_TIMES); written by benchmarks/eta_replay.py --write-table "
                     f"from {full} and {quick}",
