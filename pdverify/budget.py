@@ -326,6 +326,17 @@ def release_freed_memory() -> None:
         pass
 
 
+def load_average() -> float | None:
+    """The machine's 1-minute load average (``os.getloadavg``: the runnable and waiting
+    processes, averaged), None where the system does not offer it. A run's time is
+    comparable with another's only at similar loads: at a load above the CPU count the
+    runs share the cores."""
+    try:
+        return float(os.getloadavg()[0])
+    except (OSError, AttributeError):
+        return None
+
+
 def reset_peak_rss() -> bool:
     """Linux: set this process's peak resident size (``VmHWM``) back to its current size
     (``/proc/self/clear_refs``, value 5), so that :func:`peak_rss` measures from now.

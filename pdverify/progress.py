@@ -12,6 +12,11 @@ import time
 
 #: at most this many runs in flight are listed by name in the live display
 SHOWN_IN_FLIGHT = 8
+#: the ETA's calibration of known times (:meth:`RunProgress.predicted`) starts as if this
+#: many seconds of runs had taken their predicted time (a prior at speed 1): replayed on
+#: the full and quick reports' records (benchmarks/eta_replay.py), the first runs to end,
+#: hundredths of a second each, otherwise set the speed of the whole report
+SPEED_PRIOR_S = 20.0
 #: how often the local pool wakes to refresh the live display's clock [s]
 TICK_S = 0.25
 #: on a non-terminal, a heartbeat line names the runs in flight at least this often [s]
@@ -51,6 +56,30 @@ class Tee:
         return is_terminal(self.stream)
 
 
+def screen_and_log(stream):
+    """``(screen, log)`` of a progress stream: a :class:`Tee`'s two streams (what is drawn
+    for a terminal goes to ``screen`` only, and ``log`` gets plain text), else ``(stream,
+    None)``."""
+    if isinstance(stream, Tee):
+        return stream.stream, stream.log
+    return stream, None
+
+
+#: the live display's colour of a finished run's line by its outcome
+#: (:attr:`pdverify.results.RunResult.outcome`): a documented failure is shown as
+#: expected, in pytest's colour for an expected failure, never as a failure
+OUTCOME_STYLE = {"ok": None, "expected-failure": "yellow", "failed": "red",
+                 "unexpected-pass": "red"}
+
+
+def counts_text(failed: int, expected: int) -> str:
+    """`` (2 failed, 8 failed as expected)``: the failures that count, then the documented
+    ones; empty when there are none."""
+    parts = ([f"{failed} failed"] if failed else []) + (
+        [f"{expected} failed as expected"] if expected else [])
+    return f" ({', '.join(parts)})" if parts else ""
+
+
 def is_terminal(stream) -> bool:
     """True if ``stream`` is an interactive terminal (False for a pipe, a file, CI's log,
     pytest's capture, or an object without ``isatty``)."""
@@ -61,6 +90,16 @@ def is_terminal(stream) -> bool:
         return bool(isatty())
     except (ValueError, OSError):  # a closed or detached stream
         return False
+
+
+def _outcome(res) -> str:
+    """The run's outcome (``ok``, ``failed``, ``expected-failure``, ``unexpected-pass``);
+    a record without one (a test's stand-in) by its status."""
+    return getattr(res, "outcome", None) or ("ok" if res.status == "ok" else "failed")
+
+
+def _counts_as_failure(res) -> bool:
+    return _outcome(res) in ("failed", "unexpected-pass")
 
 
 def clock(seconds) -> str:
@@ -107,8 +146,8 @@ class RunProgress:
         self.stream = stream
         self.live = stream is not None and is_terminal(stream)
         #: the report's log (a :class:`Tee`'s file): the plain lines, also under the live
-        #: display
-        self.log = getattr(stream, "log", None)
+        #: display, which draws on the terminal only (never screen frames in the log)
+        self.screen, self.log = screen_and_log(stream)
         #: each case's predicted cost (:func:`pdverify.schedule.case_costs`): ("known",
         #: its seconds in the previous report), ("size", the budget's size model in its
         #: own unit) or (None, None)
@@ -120,7 +159,10 @@ class RunProgress:
         self.line = line or (lambda k, res: describe(self.cases[k]))
         self.t0 = time.monotonic()
         self.done = 0
+        #: runs that count as failures (:attr:`~pdverify.results.RunResult.counts_as_failure`)
+        #: and documented failures that happened (``expected-failure``)
         self.failed = 0
+        self.expected = 0
         self.in_flight: dict[int, float | None] = {}  # case index -> start time, if known
         self.durations: list[float] = []
         self._took: dict[int, float] = {}     # case index -> its run time
@@ -135,8 +177,11 @@ class RunProgress:
         """Each case's predicted seconds from its cost (:attr:`costs`), calibrated by the
         finished runs (ratios of sums, so the long runs weigh most):
 
-        - a previous time: times the ratio of this report's to the previous report's
-          times over the finished runs that have one (1 before any finished);
+        - a previous or measured time ("known"): times the ratio of this report's to
+          those times over the finished runs that have one (1 before any finished);
+        - a cold reference's time ("reference": a run that computes its scene's
+          reference, its measured time with a cold cache): times the same ratio, never
+          part of it (on a warm cache the run takes a fraction of that time);
         - a size (the budget's model, in its own unit): times the seconds per unit of
           the finished runs of the same scene (a size is comparable within a scene only:
           across scenes, fixed costs that the model does not see dominate small runs);
@@ -144,8 +189,10 @@ class RunProgress:
           None before any run finished."""
         known = [(self._took[k], c) for k, (kd, c) in enumerate(self.costs)
                  if kd == "known" and k in self._took and c]
-        total = sum(c for _, c in known)
-        speed = sum(t for t, _ in known) / total if total > 0 else 1.0
+        # the ratio starts from SPEED_PRIOR_S seconds at the predicted speed: the first
+        # runs done are short ones, whose ratio alone says little
+        speed = ((sum(t for t, _ in known) + SPEED_PRIOR_S)
+                 / (sum(c for _, c in known) + SPEED_PRIOR_S))
         per_scene: dict[str, list[float]] = {}
         for k, (kind, cost) in enumerate(self.costs):
             if kind == "size" and k in self._took and cost:
@@ -156,7 +203,7 @@ class RunProgress:
         out = []
         for k, (kind, cost) in enumerate(self.costs):
             acc = per_scene.get(self.cases[k][0])
-            if kind == "known" and cost is not None:
+            if kind in ("known", "reference") and cost is not None:
                 out.append(cost * speed)
             elif kind == "size" and cost and acc and acc[1] > 0:
                 out.append(cost * acc[0] / acc[1])
@@ -167,18 +214,22 @@ class RunProgress:
     def eta(self) -> float | None:
         """Seconds left: the predicted times (:meth:`predicted`) of the runs not started
         and what is left of those in flight, over the worker count (so it assumes that
-        every worker stays busy); None while nothing predicts the runs left."""
+        every worker stays busy), and at least what is left of the longest; None while
+        nothing predicts the runs left."""
         pred = self.predicted()
         now = time.monotonic()
-        left = 0.0
+        left = longest = 0.0
         for k in range(self.total):
             if k in self._took:
                 continue
             if pred[k] is None:
                 return None
             start = self.in_flight.get(k)
-            left += max(pred[k] - (now - start if start is not None else 0.0), 0.0)
-        return left / self.workers
+            mine = max(pred[k] - (now - start if start is not None else 0.0), 0.0)
+            left += mine
+            longest = max(longest, mine)
+        # a run is not shared out among workers: the report lasts at least its longest
+        return max(left / self.workers, longest)
 
     # -- events (main process only) -------------------------------------------------------
     def started(self, k: int, timed: bool = True) -> None:
@@ -191,7 +242,8 @@ class RunProgress:
         with self._lock:
             start = self.in_flight.pop(k, None)
             self.done += 1
-            self.failed += res.status != "ok"
+            self.failed += _counts_as_failure(res)
+            self.expected += _outcome(res) == "expected-failure"
             took = (time.monotonic() - start if start is not None
                     else float(res.timings.get("total_s", 0.0) or 0.0))
             self.durations.append(took)
@@ -204,7 +256,7 @@ class RunProgress:
         plain = f"{text.rstrip()} | elapsed {clock(elapsed)}, ETA {clock(eta)}"
         if self._live is not None:
             from rich.text import Text
-            self._live.console.print(Text(text, style=None if res.status == "ok" else "red"),
+            self._live.console.print(Text(text, style=OUTCOME_STYLE.get(_outcome(res), "red")),
                                      soft_wrap=True)
             self._live.refresh()
             if self.log is not None:
@@ -257,13 +309,13 @@ class RunProgress:
         from rich.table import Table
         from rich.text import Text
         with self._lock:
-            done, failed, eta, elapsed = self.done, self.failed, self.eta(), self.elapsed()
+            done, eta, elapsed = self.done, self.eta(), self.elapsed()
+            counts = counts_text(self.failed, self.expected)
             flight = list(self.in_flight.items())
         now = time.monotonic()
         head = Table.grid(padding=(0, 1))
         head.add_row(ProgressBar(total=max(self.total, 1), completed=done, width=30),
-                     Text(f"{done}/{self.total} runs"
-                          + (f" ({failed} failed)" if failed else "")
+                     Text(f"{done}/{self.total} runs{counts}"
                           + f"  elapsed {clock(elapsed)}  ETA {clock(eta)}"))
         rows = [head]
         for k, start in flight[:SHOWN_IN_FLIGHT]:
@@ -282,7 +334,7 @@ class RunProgress:
         if self.live:
             from rich.console import Console
             from rich.live import Live
-            console = Console(file=self.stream, force_terminal=True)
+            console = Console(file=self.screen, force_terminal=True)
             self._live = Live(self, console=console, auto_refresh=self.auto_refresh,
                               refresh_per_second=4, transient=False,
                               redirect_stdout=False, redirect_stderr=False)

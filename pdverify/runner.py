@@ -230,10 +230,15 @@ def _died(case, exitcode) -> RunResult:
 
 def run_line(case, res) -> str:
     """A finished run's progress line (after ``[done/total] ``): ``scene method params ...
-    status (seconds) metrics``."""
+    status (seconds) metrics``; the status by the run's outcome: ``ok``, ``FAILED:
+    message``, ``failed as expected: message`` (a documented finding: not a failure of the
+    report) or ``ok, UNEXPECTED PASS: ...`` (a documented failure that did not happen)."""
     from .progress import format_overrides
     params = format_overrides(case[2])
-    status = res.status if res.status == "ok" else f"FAILED: {res.message}"
+    status = {"ok": "ok", "expected-failure": f"failed as expected: {res.message}",
+              "unexpected-pass": f"ok, UNEXPECTED PASS: documented to fail "
+                                 f"({res.expected_failure})"}.get(res.outcome,
+                                                                  f"FAILED: {res.message}")
     if res.warnings:
         status += f" ({len(res.warnings)} warning)"
     return (f"{res.scene} {res.method} {params} ... {status} "

@@ -50,21 +50,55 @@ def memory_estimates(cases) -> list[float]:
     return out
 
 
-def case_costs(cases, known=None) -> list[tuple]:
+#: The measured run times the ETA starts from (:func:`measured_times`): each run of the
+#: full and the quick plan, its ``total_s`` in a report on 2 cores, and, for a run that
+#: computes its scene's reference (:func:`computes_reference`), the seconds that
+#: computation took (the reference study and its converged solution) when the cache was
+#: cold; written by ``benchmarks/eta_replay.py --write-table``
+MEASURED_TIMES = os.path.join(os.path.dirname(__file__), "data", "run_times.json")
+
+
+def measured_times() -> dict:
+    """``{run key: (seconds, cold reference seconds)}`` of :data:`MEASURED_TIMES`; {}
+    when the file is missing or unreadable (the ETA then starts from the size model)."""
+    import json
+    from .results import run_key
+    try:
+        with open(MEASURED_TIMES) as fh:
+            rows = json.load(fh)["runs"]
+        return {run_key(r["scene"], r["method"], r["params"]): (float(r["s"]),
+                                                               float(r.get("cold_s", 0.0)))
+                for r in rows}
+    except (OSError, ValueError, KeyError, TypeError):
+        return {}
+
+
+def case_costs(cases, known=None, measured=None) -> list[tuple]:
     """Each case's predicted cost for the progress ETA: ("known", its seconds in the
-    previous report) when ``known`` has it, else ("size", the budget's size model: the
-    memory estimate in bytes times the explicit steps or load increments, at least 1),
-    else (None, None). The progress calibrates each kind by the runs done."""
+    previous report) when ``known`` has it, else from the measured times
+    (``measured``, default :func:`measured_times`): ("known", its seconds there), or, for
+    a run that computes its scene's reference, ("reference", those seconds plus the cold
+    reference's: a warm cache makes it a fraction of a second, and such a run starts
+    first and ends at once), else ("size", the budget's size model: the memory estimate in
+    bytes times the explicit steps or load increments, at least 1), else (None, None). The
+    progress calibrates each kind by the runs done."""
     from .scenes import get_scene
     from .results import run_key
     known = known or {}
+    measured = measured_times() if measured is None else measured
     out = []
     for scene_id, method, overrides in cases:
         scene = get_scene(scene_id)
         params = scene.resolve(method, overrides)
-        t = known.get(run_key(scene_id, method, params))
+        key = run_key(scene_id, method, params)
+        t = known.get(key)
         if t is not None:
             out.append(("known", float(t)))
+            continue
+        if key in measured:
+            t, cold = measured[key]
+            reference = computes_reference((scene_id, method, overrides)) and cold > 0
+            out.append(("reference", t + cold) if reference else ("known", t))
             continue
         est = scene.estimate(method, params)
         if est is None or not est.memory > 0:

@@ -134,7 +134,7 @@ def rerun_plan(cases, out: str):
 
 
 #: Bytes a report needs on disk, per run and once (figures of the overview, pages), from
-#: the largest --quick --only SCENE report per run measured: see the README's "Storage".
+#: the largest --quick --only SCENE report per run measured: see "Storage" in docs/command-line.md.
 REPORT_BYTES_PER_RUN = 256_000
 REPORT_BYTES_FIXED = 2_000_000
 
@@ -291,6 +291,27 @@ def _settled(what, status, value, empty, progress):
     return value
 
 
+class FigureProgress:
+    """The figure phase's progress on the report's stream: a line when it starts, then a
+    line as each task is drawn (``figures 3/41: figure for plate-l | elapsed 0:12``), so
+    that a minute of drawing is not a silent one; plain lines on any stream (a few dozen,
+    one per scene and the overview)."""
+
+    def __init__(self, tasks, jobs, stream):
+        self.total, self.count, self.stream = len(tasks), 0, stream
+        self.t0 = time.monotonic()
+        if stream is not None and tasks:
+            print(f"figures: drawing {self.total} figure tasks in {max(1, jobs)} "
+                  f"process{'es' if jobs > 1 else ''}", file=stream, flush=True)
+
+    def done(self, what: str) -> None:
+        from ..progress import clock
+        self.count += 1
+        if self.stream is not None:
+            print(f"figures {self.count}/{self.total}: {what} | elapsed "
+                  f"{clock(time.monotonic() - self.t0)}", file=self.stream, flush=True)
+
+
 #: the figure tasks of :func:`_draw_all`, read by the forked drawing processes
 _TASKS: list = []
 
@@ -305,8 +326,13 @@ def _draw_all(tasks, jobs, progress) -> list:
     from concurrent.futures import ProcessPoolExecutor
     from ..schedule import default_jobs
     jobs = min(default_jobs() if jobs is None else jobs, len(tasks))
+    shown = FigureProgress(tasks, jobs, progress)
     if jobs <= 1 or "fork" not in mp.get_all_start_methods():
-        return [_drawn(what, draw, args, empty, progress) for what, draw, args, empty in tasks]
+        out = []
+        for what, draw, args, empty in tasks:
+            out.append(_drawn(what, draw, args, empty, progress))
+            shown.done(what)
+        return out
     import signal
     global _TASKS
     _TASKS = tasks
@@ -318,8 +344,11 @@ def _draw_all(tasks, jobs, progress) -> list:
     finally:
         signal.pthread_sigmask(signal.SIG_SETMASK, old)
     try:
-        out = []
-        for k, job in enumerate(pending):
+        from concurrent.futures import as_completed
+        index = {job: k for k, job in enumerate(pending)}
+        out = [None] * len(tasks)
+        for job in as_completed(pending):
+            k = index[job]
             what, draw, args, empty = tasks[k]
             try:
                 status, value = job.result()
@@ -327,7 +356,8 @@ def _draw_all(tasks, jobs, progress) -> list:
                 print(f"{what}: its drawing process failed ({type(exc).__name__}); drawn "
                       "in the report process", file=progress)
                 status, value = _attempt(draw, args)
-            out.append(_settled(what, status, value, empty, progress))
+            out[k] = _settled(what, status, value, empty, progress)
+            shown.done(what)
         return out
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
@@ -460,13 +490,16 @@ def _build_logged(cases, out, final, jobs, progress, client=None, quick=False,
     failed = outcomes.count("failed")
     expected = outcomes.count("expected-failure")
     passed = [r for r in results if r.outcome == "unexpected-pass"]
-    from .summary import print_summary
+    from .summary import load_note, print_summary
     print_summary(scenes, results, progress)  # one row per scene, before the last line
     if slots:                                 # the local pool (not a Dask cluster)
         print(critical_path(slots, cases), file=progress)
     heaviest = largest_memory(results)
     if heaviest:
         print(heaviest, file=progress)
+    loads = load_note(results, doc.get("machine", {}).get("cpus"))
+    if loads:
+        print(loads, file=progress)
     for r in passed:   # strict: a documented failure that no longer happens
         print(f"unexpected pass: {r.scene}/{r.method} is ok, but it is documented to fail "
               f"({r.expected_failure}); update the finding", file=progress)

@@ -19,7 +19,8 @@ from ..quotes import resolve
 from ..results import CACHED_SETUP
 from ..results import cost_s as run_cost_s
 from ..results import time_s as run_time_s
-from .summary import default_run, headline, headline_value, summarise
+from .summary import (configurations, default_run, headline, headline_value, load_note,
+                      summarise)
 
 _ENV = jinja2.Environment(
     loader=jinja2.PackageLoader("pdverify.report", "templates"),
@@ -198,9 +199,18 @@ def _row(scene, r, metrics) -> dict:
         "total": _num3(run_time_s({"total_s": 0, **t})),
         "solver": _solver(r.diagnostics),
         "peak": (f", peak memory {r.resources['peak_rss_gb']:.3g} GB"
-                 if r.resources.get("peak_rss_gb") else ""),
+                 if r.resources.get("peak_rss_gb") else "") + _load_text(r.resources),
         "size": ", ".join(f"{k} {v}" for k, v in r.size.items()),
     }
+
+
+def _load_text(resources: dict) -> str:
+    """``, machine load 0.8-3.1``: the 1-minute load average at the run's start and end
+    (:func:`pdverify.budget.load_average`), empty when it was not recorded."""
+    start, end = resources.get("load_start"), resources.get("load_end")
+    if start is None or end is None:
+        return ""
+    return f", machine load {start:.1f}-{end:.1f} (1-minute average)"
 
 
 def _num3(v) -> str:
@@ -407,10 +417,13 @@ def _pct_text(pct: float) -> str:
 
 
 def best_run(scene, method, runs):
-    """The run of ``method`` with the lowest headline error among ``runs`` (ties: the
+    """The best configuration of ``method``: among its runs on the default run's problem
+    and grid (:func:`~pdverify.report.summary.configurations`: jitter, geometry and
+    refinement are not configurations), the one with the lowest headline error (ties: the
     cheaper one), or None when none has a headline error."""
-    mine = [(abs(headline_pct(scene, r)), cost_s(r), k, r) for k, r in enumerate(runs)
-            if r.method == method and headline_pct(scene, r) is not None]
+    mine = [(abs(headline_pct(scene, r)), cost_s(r), k, r)
+            for k, r in enumerate(configurations(scene, method, runs))
+            if headline_pct(scene, r) is not None]
     return min(mine)[3] if mine else None
 
 
@@ -529,6 +542,8 @@ def page(doc: dict, sections: list[tuple], total_time: float, results=None,
         n_failed=sum(1 for r in runs if r["status"] != "ok" and not r.get("expected_failure")),
         n_expected=sum(1 for r in runs if r["status"] != "ok" and r.get("expected_failure")),
         n_warned=sum(1 for r in runs if r.get("warnings")), total_time=total_time,
+        load_note=(load_note(results, doc.get("machine", {}).get("cpus"))
+                   if results is not None else ""),
         overview=overview(scenes, results) if results is not None else "",
         failed=failed_runs(results, tabled),
         front_figures=front_figures, papers=papers(scenes),

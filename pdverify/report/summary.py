@@ -37,6 +37,40 @@ def default_run(scene, method, runs):
     return next((r for r in mine if r.params == defaults), mine[0] if mine else None)
 
 
+#: Scene parameters that are settings of the model or method (a quadrature rule, an
+#: influence function, a micromodulus, a calibration, a solver), not of the problem: the
+#: other scene parameters define the problem (geometry, material, load)
+SETTINGS = frozenset({"quadrature", "influence", "micromodulus", "complete_m",
+                      "end_weight", "calibration", "solver"})
+#: Method parameters that define the problem or its discretisation, not a setting of the
+#: method: the grid and its refinement (spacing, horizon, m_ratio, nodes, levels, mesh
+#: cells and grading, time steps), the lattice's jitter, the kinematics and where the load
+#: acts. A run that changes one is another problem or a finer grid
+PROBLEM = frozenset({"spacing", "horizon", "horizon_ratio", "m_ratio", "nodes", "levels",
+                     "cells", "arc_cells", "radial_cells", "elements", "fine_depth",
+                     "fine_half_width", "grading_power", "grading_ratio", "sample_spacing",
+                     "dt", "dt_factor", "n_steps", "substeps", "uniform_study", "jitter",
+                     "jitter_seed", "kinematics", "load_point", "symmetry"})
+
+
+def problem_params(scene) -> set:
+    """The names of the parameters that define ``scene``'s problem and discretisation
+    (every parameter of the scene but :data:`SETTINGS`, and :data:`PROBLEM`)."""
+    return {p.name for p in scene.params if p.name not in SETTINGS} | PROBLEM
+
+
+def configurations(scene, method, runs) -> list:
+    """The runs of ``method`` that are configurations of its default run
+    (:func:`default_run`): the same problem on the same grid, other settings of the
+    method only (:func:`problem_params` equal); the default run among them."""
+    default = default_run(scene, method, runs)
+    if default is None:
+        return []
+    fixed = problem_params(scene)
+    return [r for r in runs if r.method == method
+            and all(r.params.get(k) == default.params.get(k) for k in fixed)]
+
+
 @dataclass
 class SceneSummary:
     scene: str
@@ -45,7 +79,8 @@ class SceneSummary:
     best_error: float | None  # its headline error as a fraction
     best_time_s: float | None
     runs: int
-    failed: list            # (method, message) of the failed runs
+    failed: list            # (method, message) of the runs that count as failures
+    expected: int = 0       # documented failures that happened (not failures of the report)
 
 
 def summarise(scene, runs) -> SceneSummary:
@@ -59,13 +94,15 @@ def summarise(scene, runs) -> SceneSummary:
         scene=scene.id, metric=headline(scene), best=best,
         best_error=values.get(best), runs=len(runs),
         best_time_s=time_s(picked[best].timings) if best else None,
-        failed=[(r.method, r.message) for r in runs if r.counts_as_failure])
+        failed=[(r.method, r.message) for r in runs if r.counts_as_failure],
+        expected=sum(r.outcome == "expected-failure" for r in runs))
 
 
 # -- the end-of-report summary (one row per scene) -----------------------------------------
-SUMMARY_COLUMNS = ("scene", "best method", "error", "time", "runs", "failed", "first failure")
-#: right-aligned columns: error, time, runs, failed
-_NUMERIC = (2, 3, 4, 5)
+SUMMARY_COLUMNS = ("scene", "best method", "error", "time", "runs", "failed",
+                   "failed as expected", "first failure")
+#: right-aligned columns: error, time, runs, failed, failed as expected
+_NUMERIC = (2, 3, 4, 5, 6)
 #: a failure message is cut to this many characters in the summary
 FAILURE_WIDTH = 60
 
@@ -88,27 +125,34 @@ def summary_row(s: SceneSummary) -> list[str]:
     first = _shorten(f"{s.failed[0][0]}: {s.failed[0][1]}") if s.failed else ""
     return [s.scene, s.best or "-", error,
             "-" if s.best_time_s is None else f"{s.best_time_s:.2f} s",
-            str(s.runs), str(len(s.failed)), first]
+            str(s.runs), str(len(s.failed)), str(s.expected), first]
 
 
-def _columns(summaries) -> int:
-    """How many of :data:`SUMMARY_COLUMNS` to show: 'first failure' only if a run failed."""
-    n = len(SUMMARY_COLUMNS)
-    return n if any(s.failed for s in summaries) else n - 1
+def _columns(summaries) -> list[int]:
+    """Which of :data:`SUMMARY_COLUMNS` to show: 'failed as expected' only if a documented
+    failure happened, 'first failure' only if a run failed."""
+    shown = list(range(len(SUMMARY_COLUMNS)))
+    if not any(s.failed for s in summaries):
+        shown.remove(SUMMARY_COLUMNS.index("first failure"))
+    if not any(s.expected for s in summaries):
+        shown.remove(SUMMARY_COLUMNS.index("failed as expected"))
+    return shown
 
 
 def format_summary(summaries) -> str:
     """The summary as fixed-width plain text: a header, then one row per scene: the best
     method at default parameters, its headline error (in %, the metric named unless it is
-    ``rel_l2_error``) and total time, the number of runs and of failed runs, and (if any
-    run failed) the first failure's message, shortened."""
-    n = _columns(summaries)
-    rows = [list(SUMMARY_COLUMNS[:n])] + [summary_row(s)[:n] for s in summaries]
-    widths = [max(len(r[i]) for r in rows) for i in range(n)]
+    ``rel_l2_error``) and total time, the number of runs and of failed runs (those that
+    count: documented failures are apart, in 'failed as expected', shown when one
+    happened), and (if any run failed) the first failure's message, shortened."""
+    shown = _columns(summaries)
+    rows = [[SUMMARY_COLUMNS[i] for i in shown]] + [[summary_row(s)[i] for i in shown]
+                                                     for s in summaries]
+    widths = [max(len(r[j]) for r in rows) for j in range(len(shown))]
     lines = []
     for r in rows:
         cells = [c.rjust(w) if i in _NUMERIC else c.ljust(w)
-                 for i, (c, w) in enumerate(zip(r, widths))]
+                 for i, c, w in zip(shown, r, widths)]
         lines.append("  ".join(cells).rstrip())
     return "\n".join(lines)
 
@@ -125,11 +169,15 @@ def summary_table(summaries):
                   header_style="bold underline", box=None, padding=(0, 1), pad_edge=False)
     rows = [summary_row(s) for s in summaries]
     value = max([len(r[2].split(" %")[0]) + 2 for r in rows] + [5])  # '1.2e-13 %'
-    for i, name in enumerate(SUMMARY_COLUMNS[:-1]):
+    shown = [i for i in _columns(summaries) if SUMMARY_COLUMNS[i] != "first failure"]
+    for i in shown:
+        name = SUMMARY_COLUMNS[i]
         table.add_column(name, justify="right" if i in _NUMERIC else "left",
                          no_wrap=name != "error", min_width=value if name == "error" else None)
     for s, row in zip(summaries, rows):
-        table.add_row(*row[:-1], style="red" if s.failed else None)
+        # red for failures that count; a documented failure is expected (pytest's yellow)
+        table.add_row(*[row[i] for i in shown],
+                      style="red" if s.failed else "yellow" if s.expected else None)
     failures = [Text(f"  {s.scene}: {row[-1]}", style="red")
                 for s, row in zip(summaries, rows) if s.failed]
     if not failures:
@@ -139,16 +187,53 @@ def summary_table(summaries):
 
 def print_summary(scenes, results, stream) -> None:
     """Print the end-of-report summary of ``scenes`` (Scene objects) from ``results`` to
-    ``stream``: a rich table on a terminal, :func:`format_summary` text otherwise. A
+    ``stream``: a rich table on a terminal, :func:`format_summary` text otherwise (and
+    always in the report's log, when ``stream`` is a :class:`~pdverify.progress.Tee`). A
     summary that cannot be made costs only itself (a note), never the report."""
-    from ..progress import is_terminal
+    from ..progress import is_terminal, screen_and_log
     try:
         summaries = [summarise(scene, [r for r in results if r.scene == scene.id])
                      for scene in scenes]
-        if is_terminal(stream):
+        screen, log = screen_and_log(stream)
+        if is_terminal(screen):
             from rich.console import Console
-            Console(file=stream, force_terminal=True).print(summary_table(summaries))
+            Console(file=screen, force_terminal=True).print(summary_table(summaries))
+            if log is not None:
+                print(format_summary(summaries), file=log)
         else:
             print(format_summary(summaries), file=stream)
     except Exception as exc:  # a display problem must not lose the report
         print(f"summary failed: {type(exc).__name__}: {exc}", file=stream)
+
+
+# -- the machine's load over the runs ------------------------------------------------------
+#: A report notes the machine's load when the runs' shares of a core differ by more than
+#: this factor: each run records the 1-minute load average at its start and end
+#: (``resources.load_start``, ``load_end``: :func:`pdverify.budget.load_average`), and
+#: above the CPU count the runnable processes share the cores, so a run can take up to
+#: max(1, load / CPUs) times its time on an idle machine. 1.5: a run time half again as long
+#: is more than the run-to-run spread of a run at one load (a few %, the quick report's
+#: repeats in benchmarks/report_cost.py)
+LOAD_FACTOR = 1.5
+
+
+def load_note(results, cpus) -> str:
+    """A sentence saying how the machine's load varied over the runs of ``results`` on
+    ``cpus`` CPUs, when it varied by more than :data:`LOAD_FACTOR` in shares of a core;
+    empty otherwise, or when no run recorded its load."""
+    loads = [v for r in results for v in (r.resources.get("load_start"),
+                                            r.resources.get("load_end"))
+             if isinstance(v, (int, float)) and not isinstance(v, bool)]
+    if not loads or not cpus or cpus < 1:
+        return ""
+    low, high = min(loads), max(loads)
+    factor = max(1.0, high / cpus) / max(1.0, low / cpus)
+    if factor <= LOAD_FACTOR:
+        return ""
+    return (f"The machine's load varied while the runs ran: the 1-minute load average was "
+            f"{low:.1f} to {high:.1f} on {cpus} CPUs. Above the CPU count the runs share "
+            f"the cores, so a run's time may be up to {factor:.1f} times what it would be "
+            f"at the lowest load: compare run times at similar loads (each run's load is "
+            f"in its time's hover text and in results.json, resources.load_start and "
+            f"load_end).")
+

@@ -493,6 +493,7 @@ class Scene:
         timer = Timer()
         budget.release_freed_memory()        # what earlier runs left is not this run's
         measured = budget.reset_peak_rss()   # the run's own peak memory, beside its time
+        load_start = budget.load_average()   # the machine's load, beside its time
         broken = self._broken_plugin(method)
         if broken:
             result.status = "failed"
@@ -542,6 +543,9 @@ class Scene:
         peak = budget.peak_rss() if measured else None
         if peak is not None:
             result.resources = {"peak_rss_gb": peak / 1e9}
+        load_end = budget.load_average()
+        if load_start is not None and load_end is not None:
+            result.resources.update(load_start=load_start, load_end=load_end)
         return result
 
     def published_for(self, method: str, params: dict) -> dict:

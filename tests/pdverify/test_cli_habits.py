@@ -407,11 +407,49 @@ def test_eta_follows_each_cases_cost_not_the_mean(monkeypatch):
     shown = progress.RunProgress(cases, 1, None, costs=costs)
     assert shown.eta() is None               # d has no calibration and no mean yet
     shown.started(0)
-    clock["t"] = 2.0                          # a took 2 s: this machine is twice as slow
+    clock["t"] = 2.0                          # a took 2 s: this machine may be slower
     shown.finished(0, _Res())
-    # b 2 s, c 200 s, d: no size run finished yet, so the mean, 2 s
-    assert shown.eta() == pytest.approx(2.0 + 200.0 + 2.0)
+    # the speed: a's 2 s against its 1 s, from SPEED_PRIOR_S seconds at speed 1
+    speed = (2.0 + progress.SPEED_PRIOR_S) / (1.0 + progress.SPEED_PRIOR_S)
+    # b 1 s and c 100 s at that speed, d: no size run finished yet, so the mean, 2 s
+    assert shown.eta() == pytest.approx(101.0 * speed + 2.0)
     # the mean would have said 3 runs x 2 s = 6 s
+    shown.started(1)
+    clock["t"] = 2.0 + 2 * (1.0 + progress.SPEED_PRIOR_S)   # b: far slower, for long
+    shown.finished(1, _Res())
+    # (2 + 2 (1 + prior) + prior) / (2 + prior): the ratio tends to the runs' own
+    speed = (2.0 + 2 * (1.0 + progress.SPEED_PRIOR_S) + progress.SPEED_PRIOR_S) / (
+        2.0 + progress.SPEED_PRIOR_S)
+    assert shown.eta() == pytest.approx(100.0 * speed + (clock["t"] / 2))
+
+
+def test_eta_starts_from_the_measured_times_cold_references_included(monkeypatch):
+    """Without a previous report, the ETA has a prediction before any run ends: the
+    measured run times (schedule.MEASURED_TIMES), a reference run's with its cold cost;
+    a reference run that ends at once (a warm cache) does not change the speed."""
+    from pdverify import progress
+    from pdverify.results import run_key
+    from pdverify.scenes import get_scene
+    from pdverify.schedule import case_costs
+    cases = [("sheet2d-clamped", "fem", {}), ("sheet2d-clamped", "none", {})]
+    keys = [run_key(s, m, get_scene(s).resolve(m, o)) for s, m, o in cases]
+    costs = case_costs(cases, measured={keys[0]: (0.05, 3.0), keys[1]: (2.0, 0.0)})
+    assert costs == [("reference", 3.05), ("known", 2.0)]
+    clock = {"t": 0.0}
+    monkeypatch.setattr(progress.time, "monotonic", lambda: clock["t"])
+    shown = progress.RunProgress(cases, 1, None, costs=costs)
+    assert shown.eta() == pytest.approx(5.05)        # from the start
+    shown.started(0)
+    clock["t"] = 0.05                                # warm: the reference was cached
+    shown.finished(0, _Res())
+    assert shown.eta() == pytest.approx(2.0)         # the speed is still 1
+    # the shipped table covers the report's plans (every case but a new one)
+    from pdverify.runner import plan
+    from pdverify.schedule import measured_times
+    quick = plan(quick=True)
+    known = [c for c, (kind, _) in zip(quick, case_costs(quick, measured=measured_times()))
+             if kind in ("known", "reference")]
+    assert len(known) >= 0.9 * len(quick)
 
 
 def test_case_costs_use_the_previous_times_then_the_size_model():
@@ -420,7 +458,7 @@ def test_case_costs_use_the_previous_times_then_the_size_model():
     from pdverify.schedule import case_costs
     cases = [("bar1d-traction", "none", {}), ("bar1d-traction", "pddo", {})]
     key = run_key("bar1d-traction", "none", get_scene("bar1d-traction").resolve("none", {}))
-    costs = case_costs(cases, {key: 3.5})
+    costs = case_costs(cases, {key: 3.5}, measured={})
     assert costs[0] == ("known", 3.5)
     assert costs[1][0] in ("size", None)
 

@@ -16,7 +16,8 @@ from pdverify.runner import plan, run_cases
 from pdverify.scenes import get_scene
 
 #: today's line, then the elapsed time and the ETA
-LINE = re.compile(r"^\[(\d+)/(\d+)\] (\S+) (\S+) .*\.\.\. (ok|FAILED: .*) \(\d+\.\d\d s\).*"
+LINE = re.compile(r"^\[(\d+)/(\d+)\] (\S+) (\S+) .*\.\.\. (ok|FAILED: .*|failed as expected: .*) "
+                  r"\(\d+\.\d\d s\).*"
                   r" \| elapsed (\d+:\d\d), ETA (\d+:\d\d|\?)$")
 ANSI = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]")
 
@@ -169,6 +170,8 @@ def test_format_summary_shortens_the_first_failure():
 def test_report_prints_the_summary_before_its_last_line(quick_report):
     lines = quick_report[0].splitlines()
     assert lines[-1].startswith("report: ")
+    # the machine's load, when it varied (summary.load_note: a loaded machine), before it
+    lines = [line for line in lines if not line.startswith("The machine's load varied")]
     # the heaviest run by its measured peak memory (Linux: each run records it)
     memory = [k for k, line in enumerate(lines)
               if line.startswith("largest peak memory of a run: ")]
@@ -184,7 +187,15 @@ def test_report_prints_the_summary_before_its_last_line(quick_report):
     assert [r.split()[0] for r in rows] == ["bar1d-traction", "sheet2d-clamped"]
     assert rows[0].split()[1] in {"taylor-fictitious", "surface-nodes", "mirror-nodes", "pddo"}
     assert rows[1].split()[1] == "energy-directional"
-    assert all(LINE.match(line) for line in lines[:head])
+    # each finished run's line; a heartbeat (progress.HEARTBEAT_S) when a minute passed
+    # without one, as on a loaded machine; then the figure phase's lines
+    figures = [k for k, line in enumerate(lines[:head]) if line.startswith("figures")]
+    assert figures and figures == list(range(figures[0], head))
+    assert lines[figures[0]].startswith("figures: drawing ")
+    tasks = int(lines[figures[0]].split()[2])
+    assert len(figures) == tasks + 1 and lines[head - 1].startswith(f"figures {tasks}/{tasks}: ")
+    assert all(LINE.match(line) or line.startswith("... running: ")
+               for line in lines[:figures[0]])
 
 
 def test_list_shows_the_choices_of_a_choice_param(capsys):

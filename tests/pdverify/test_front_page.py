@@ -49,6 +49,26 @@ def test_best_configuration_beside_the_default_in_per_cent():
     assert 'class="best"' not in _cells(html.overview([bar], runs), bar.id)["none"]
 
 
+def test_best_configuration_is_a_setting_on_the_same_problem():
+    """A finer grid, a jittered lattice or another geometry is more accurate, but it is
+    another problem or grid, not a configuration of the method (issue 52): the best line
+    shows the more accurate setting on the default run's problem, and the page says the
+    rule."""
+    sheet = get_scene("plate-hole")
+    runs = [_run(sheet, "taylor-fictitious", rel_l2_error=0.05),
+            _run(sheet, "taylor-fictitious", {"order": 3}, rel_l2_error=0.02),
+            _run(sheet, "energy", rel_l2_error=0.1),
+            _run(sheet, "energy", {"jitter": 0.4, "jitter_seed": 1}, rel_l2_error=0.001),
+            _run(sheet, "taylor-fictitious", {"spacing": sheet.resolve(
+                "taylor-fictitious", {})["spacing"] / 2}, rel_l2_error=1e-4)]
+    text = html.overview([sheet], runs)
+    cells = _cells(text, sheet.id)
+    best = cells["taylor-fictitious"].split('class="best"')[1]
+    assert "2 %" in best and "order=<wbr>3" in best and "spacing" not in best
+    assert 'class="best"' not in cells["energy"]            # the jittered lattice is not
+    assert "never a best configuration" in text and "lattice jitter" in text
+
+
 def test_colour_scale_is_fitted_to_the_errors_present():
     """The scale runs from the smallest error that is not round-off to the largest (per
     cent); the ends get the scale's two extreme colours."""

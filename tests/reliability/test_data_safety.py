@@ -374,7 +374,7 @@ def test_a_fifo_or_device_is_never_an_output(tmp_path, env, capsys, special):
 
 def test_a_cache_that_cannot_take_files_is_refused_before_work(tmp_path, monkeypatch,
                                                               capsys):
-    """The choice documented in the README: a cache folder that is a file, cannot be
+    """The choice documented in docs/command-line.md: a cache folder that is a file, cannot be
     written or is full is exit 2 naming it (a FEM reference would be computed and lost)."""
     monkeypatch.chdir(tmp_path)
     (tmp_path / "cachefile").write_text("x")
