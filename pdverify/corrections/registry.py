@@ -36,10 +36,11 @@ from __future__ import annotations
 
 import difflib
 import functools
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, field, fields, replace
 from typing import Any, Callable, Mapping
 
 from ..errors import InputError, NumericalError
+from . import containment
 from ..params import Param
 from ..pd.closure import Closure
 from .treatment import ENTRY_POINT_GROUP, THEORIES, Treatment  # noqa: F401  (re-exported)
@@ -166,6 +167,7 @@ def _guard(fn, who: str, what: str, error=PluginError):
     ``who`` (the plugin) and ``what`` (which of its functions)."""
     @functools.wraps(fn)
     def guarded(*args, **kwargs):
+        mark = containment.watching(f"{who}: {what}")
         try:
             return fn(*args, **kwargs)
         except KeyboardInterrupt:
@@ -174,7 +176,46 @@ def _guard(fn, who: str, what: str, error=PluginError):
             raise
         except BaseException as exc:  # SystemExit included: a plugin never ends pdverify
             raise error(f"{who}: {what} raised {what_it_did(exc)}") from None
+        finally:
+            containment.unwatch(mark)
     return guarded
+
+
+class PluginCheckError(InputError):
+    """A plugin's check (of its treatment or of a parameter) raised something other than
+    a refusal, ended its process or did not return: the plugin's failure, not the user's
+    input. ``run`` records it as a failed run naming the plugin; a report's case of that
+    plugin fails, the other cases go on."""
+
+
+#: outcomes of contained checks by (who, what, arguments): a check is a function of its
+#: arguments, and one that hung is not waited for twice
+_CHECKED: dict[tuple, tuple] = {}
+
+
+def contained_check(fn, who: str, what: str, *args):
+    """``fn(*args)``, a plugin's check, run in a child process under the plugin time limit
+    (:mod:`~pdverify.corrections.containment`): its refusal (``InputError``) is bad input
+    as it wrote it; anything else it does is a :class:`PluginCheckError` naming ``who``."""
+    try:
+        key = (who, what, repr(args))
+    except Exception:  # an argument whose repr fails: not cached
+        key = None
+    outcome = _CHECKED.get(key) if key is not None else None
+    if outcome is None:
+        outcome = containment.in_child(fn, args)
+        if key is not None:
+            _CHECKED[key] = outcome
+    if outcome[0] == "ok":
+        return outcome[1]
+    if outcome[0] == "raised":
+        if outcome[1]:
+            raise InputError(outcome[3])
+        raise PluginCheckError(f"{who}: {what} raised {outcome[2]}")
+    if outcome[0] == "ended":
+        raise PluginCheckError(f"{who}: {what} ended its process ({outcome[1]})")
+    raise PluginCheckError(f"{who}: {what} did not return within {outcome[1]:g} s (the "
+                           f"plugin time limit, ${containment.ENV}); its process was killed")
 
 
 class _GuardedConstitutive:
@@ -221,30 +262,34 @@ def _checked_param(p: Param, who: str) -> Param:
         raise TypeError(f"parameter name {p.name!r} is not an identifier")
     if p.check is None:
         return p
-    guarded = _guard(p.check, who, f"the check of its parameter {p.name}", error=InputError)
-    problem = guarded(p.default)
+    problem = _guard(p.check, who, f"the check of its parameter {p.name}")(p.default)
+    guarded = functools.partial(contained_check, p.check, who,
+                                f"the check of its parameter {p.name}")
     if problem:
         raise ValueError(f"the default {p.name}={p.default!r} fails its own check ({problem})")
     return replace(p, check=guarded)
 
 
 def _as_builtin_type(item, origin: str) -> Treatment:
-    """The plugin's treatment with its origin set and its fields checked: a
-    :class:`BondMethod` is rebuilt as a plain one with the plugin's data (so that only
-    pdverify's own methods run on it, its closure guarded); any other
-    :class:`~pdverify.corrections.treatment.Treatment` keeps its class (its ``assemble``
-    and ``check`` are the plugin's, called through :func:`plugin_call`)."""
+    """The plugin's treatment with its origin set and its fields checked, rebuilt as one
+    of pdverify's own classes so that only pdverify's methods run on it: a
+    :class:`BondMethod` as a plain one with the plugin's data (its closure guarded); any
+    other :class:`~pdverify.corrections.treatment.Treatment` as a :class:`PluginTreatment`
+    that holds what the plugin's own methods answered once, at load, for every scene
+    (``params_for``, ``why_not``, ``kind``), and calls the plugin only for ``check`` and
+    ``assemble`` (through :func:`plugin_call`)."""
     if not isinstance(item, Treatment):
         raise TypeError(f"{type(item).__name__} is not a pdverify Treatment")
-    base = BondMethod if isinstance(item, BondMethod) else type(item)
+    bond = isinstance(item, BondMethod)
+    base = BondMethod if bond else Treatment
     data = {f.name: getattr(item, f.name) for f in fields(base)}
     if not (isinstance(data["name"], str) and data["name"] and data["name"].isprintable()
             and " " not in data["name"]):
         raise TypeError(f"method name {data['name']!r} must be a non-empty word")
-    for key in ("description", "source"):
+    for key in ("description", "source", "scope", "box_only"):
         if not isinstance(data[key], str):
             raise TypeError(f"{key} must be a string")
-    if base is BondMethod and not callable(data["closure"]):
+    if bond and not callable(data["closure"]):
         raise TypeError("closure is not callable")
     who = f"plugin method {data['name']} ({origin})"
     data.update(origin=f"plugin {origin}", params=tuple(_checked_param(p, who)
@@ -252,23 +297,105 @@ def _as_builtin_type(item, origin: str) -> Treatment:
                 theories=tuple(data["theories"]), dims=tuple(int(d) for d in data["dims"]),
                 families=tuple(map(str, data["families"])),
                 scenes=None if data["scenes"] is None else tuple(map(str, data["scenes"])),
-                unavailable=None if data["unavailable"] is None else str(data["unavailable"]))
-    return base(**data)
+                unavailable=None if data["unavailable"] is None else str(data["unavailable"]),
+                roles=tuple((str(f), r) for f, r in data["roles"]))
+    if bond:
+        return BondMethod(**data)
+    kind = item.kind
+    if kind not in ("family", "hand-wired"):
+        raise TypeError(f"kind {kind!r} is not family or hand-wired")
+    answers = {}
+    for scene in (SCENES() if SCENES is not None else ()):
+        why = item.why_not(scene)
+        if why is not None and not isinstance(why, str):
+            raise TypeError(f"why_not({scene.id}) returned {type(why).__name__}, not a "
+                            "string or None")
+        params = tuple(_checked_param(p, who) for p in tuple(item.params_for(scene)))
+        answers[scene.id] = (why, params)
+    return PluginTreatment(**data, plugin=item, plugin_kind=kind, answers=answers)
+
+
+@dataclass(frozen=True)
+class PluginTreatment(Treatment):
+    """A plugin's treatment of its own class, as pdverify holds it (:func:`_as_builtin_type`):
+    where it applies and its parameters as the plugin answered at load; its ``check``,
+    ``assemble`` and roles call the plugin's object, guarded."""
+
+    plugin: Any = field(default=None, compare=False)
+    plugin_kind: str = "hand-wired"
+    #: scene id -> (why_not, params_for) as the plugin answered at load
+    answers: Mapping[str, tuple] = field(default=None, compare=False)
+
+    @property
+    def kind(self) -> str:
+        return self.plugin_kind
+
+    def why_not(self, scene) -> str | None:
+        answer = self.answers.get(scene.id)
+        return ("not offered (the plugin was loaded before this scene)" if answer is None
+                else answer[0])
+
+    def params_for(self, scene) -> tuple[Param, ...]:
+        answer = self.answers.get(scene.id)
+        return self.params if answer is None else answer[1]
+
+    def check(self, cells, params, where):
+        return self.plugin.check(cells, params, where)
+
+    def assemble(self, problem, params):
+        return self.plugin.assemble(problem, params)
+
+    def build_for(self, family, problem, params):
+        return plugin_call(self, f"role in {family}",
+                           lambda *a: self.plugin.build_for(*a), family, problem, params)
+
+    def check_for(self, family, context, params, where):
+        return plugin_call(self, "check", lambda *a: self.plugin.check_for(*a), family,
+                           context, params, where)
 
 
 def plugin_call(treatment: Treatment, what: str, fn, *args):
-    """``fn(*args)`` of ``treatment``; guarded when the treatment is a plugin's (a raise
-    or exit becomes a failed run naming it; bad input stays bad input)."""
+    """``fn(*args)`` of ``treatment``; guarded when the treatment is a plugin's: its
+    ``check`` runs in a child process under the plugin time limit (a refusal stays bad
+    input; anything else is a :class:`PluginCheckError` naming it); its other calls run
+    guarded in the run's worker process, whose supervisor enforces the limit and names
+    the plugin if the process ends inside it (:mod:`pdverify.runner`)."""
     if treatment.origin == "built-in":
         return fn(*args)
     who = f"plugin method {treatment.name} ({treatment.origin.removeprefix('plugin ')})"
-    error = InputError if what == "check" else PluginError
-    return _guard(fn, who, f"its {what}", error=error)(*args)
+    if what == "check":
+        return contained_check(fn, who, f"its {what}", *args)
+    return _guard(fn, who, f"its {what}")(*args)
+
+
+def _load(ep) -> tuple[list, str | None]:
+    """The treatments of entry point ``ep`` and, when it is broken, why (one phrase)."""
+    try:
+        obj = ep.load()
+    except KeyboardInterrupt:
+        raise
+    except BaseException as exc:  # a broken plugin never stops pdverify
+        return [], f"{ep.value}: {what_it_did(exc)} at import"
+    try:
+        items = obj if isinstance(obj, (list, tuple)) else [obj]
+        methods = [_as_builtin_type(item, ep.value) for item in items]
+        for m in methods:
+            clash = _scene_param_clash(m)
+            if clash:
+                return [], f"{m.origin}: {clash}"
+    except KeyboardInterrupt:
+        raise
+    except BaseException as exc:
+        return [], f"{ep.value}: {what_it_did(exc)}"
+    return methods, None
 
 
 def _plugins():
-    """Every plugin's treatments; a load that raises anything but KeyboardInterrupt,
-    ``SystemExit`` at import included, is listed in :data:`BROKEN`."""
+    """Every plugin's treatments. The entry points are first tried in a child process
+    (:func:`~pdverify.corrections.containment.probe`: import, conversion, the answers of
+    its methods, under the plugin time limit); one that raises, ends that process or
+    does not return is listed in :data:`BROKEN` with its entry point and never imported
+    here; the others are then loaded in this process."""
     from importlib.metadata import entry_points
     try:
         eps = list(entry_points(group=ENTRY_POINT_GROUP))
@@ -277,21 +404,19 @@ def _plugins():
     except BaseException as exc:  # broken metadata of some installed distribution
         BROKEN["(entry points)"] = f"{what_it_did(exc)} while listing the entry points"
         return
-    for ep in eps:
-        try:
-            obj = ep.load()
-        except KeyboardInterrupt:
-            raise
-        except BaseException as exc:  # a broken plugin never stops pdverify
-            BROKEN[ep.name] = f"{ep.value}: {what_it_did(exc)} at import"
+    if not eps:
+        return
+    problems, failures = containment.probe(len(eps), lambda k: _load(eps[k])[1])
+    for k, ep in enumerate(eps):
+        if k in failures:
+            BROKEN[ep.name] = f"{ep.value}: {failures[k]} while loading"
             continue
-        try:
-            items = obj if isinstance(obj, (list, tuple)) else [obj]
-            methods = [_as_builtin_type(item, ep.value) for item in items]
-        except KeyboardInterrupt:
-            raise
-        except BaseException as exc:
-            BROKEN[ep.name] = f"{ep.value}: {what_it_did(exc)}"
+        if k in problems:
+            BROKEN[ep.name] = problems[k]
+            continue
+        methods, problem = _load(ep)
+        if problem is not None:
+            BROKEN[ep.name] = problem
             continue
         yield from methods
 
@@ -327,15 +452,13 @@ def treatments() -> dict[str, Treatment]:
     built-in name, nor a scene's parameter: it is listed as broken instead)."""
     global _METHODS
     if _METHODS is None:
+        if SCENES is None:       # the plugins' answers are taken for every scene
+            from .. import scenes  # noqa: F401
         methods = {m.name: m for m in _builtin()}
         _METHODS = dict(methods)  # the scenes, loaded to check the plugins, see these
         for m in _plugins():
             if m.name in methods:
                 BROKEN[m.name] = f"{m.origin}: the name {m.name!r} is taken"
-                continue
-            clash = _scene_param_clash(m)
-            if clash:
-                BROKEN[m.name] = f"{m.origin}: {clash}"
                 continue
             methods[m.name] = m
         _METHODS = methods
@@ -358,6 +481,7 @@ def reload() -> None:
     global _METHODS
     _METHODS = None
     BROKEN.clear()
+    _CHECKED.clear()
 
 
 def from_name(name: str) -> Treatment:
