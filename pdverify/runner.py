@@ -141,11 +141,9 @@ def plan(only=None, quick=False, methods=None) -> list[tuple[str, str, dict]]:
 def _params(scene, method, overrides) -> dict:
     """The resolved params of a report case; a plugin whose check fails (not a refusal)
     keeps its case, which then fails naming the plugin, and the report goes on."""
-    from .corrections.registry import PluginCheckError
-    try:
-        return scene.resolve(method, overrides)
-    except PluginCheckError:
-        return dict(overrides)
+    from .schedule import case_params
+    params = case_params(scene, method, overrides)
+    return dict(overrides) if params is None else params
 
 
 #: A worker process is replaced by a fresh one after this many runs, and after any run

@@ -30,6 +30,8 @@ def headline_value(scene, result):
 def default_run(scene, method, runs):
     """The run of ``method`` at its default params, else its first run."""
     mine = [r for r in runs if r.method == method]
+    if not mine:          # (nothing to resolve: a method that did not run is not called)
+        return None
     try:
         defaults = scene.resolve(method, {})
     except InputError:
