@@ -43,6 +43,14 @@ def limit_s() -> float:
     return DEFAULT_LIMIT_S
 
 
+def what_it_did(exc: BaseException) -> str:
+    """``SystemExit(3)``, ``ValueError: bad factor``: the exception in one short phrase."""
+    if isinstance(exc, SystemExit):
+        return f"SystemExit({exc.code!r})"
+    text = " ".join(str(exc).split())
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+
+
 def how_it_ended(status: int) -> str:
     """``exit code 3``, ``signal SIGTERM``: a ``waitpid`` status as a phrase."""
     if os.WIFSIGNALED(status):
@@ -139,7 +147,6 @@ def _end(pid: int, kill: bool) -> int:
 
 def _outcome(fn, args):
     from ..errors import InputError
-    from .registry import what_it_did
     try:
         return ("ok", fn(*args))
     except BaseException as exc:  # anything the call does is reported, never raised here

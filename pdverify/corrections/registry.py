@@ -41,6 +41,7 @@ from typing import Any, Callable, Mapping
 
 from ..errors import InputError, NumericalError
 from . import containment
+from .containment import what_it_did  # noqa: F401  (re-exported)
 from ..params import Param
 from ..pd.closure import Closure
 from .treatment import ENTRY_POINT_GROUP, THEORIES, Treatment  # noqa: F401  (re-exported)
@@ -151,14 +152,6 @@ BROKEN: dict[str, str] = {}
 
 class PluginError(NumericalError):
     """A plugin's code raised (or exited) during a run: the run fails, naming the plugin."""
-
-
-def what_it_did(exc: BaseException) -> str:
-    """``SystemExit(3)``, ``ValueError: bad factor``: the exception in one short phrase."""
-    if isinstance(exc, SystemExit):
-        return f"SystemExit({exc.code!r})"
-    text = " ".join(str(exc).split())
-    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
 
 
 def _guard(fn, who: str, what: str, error=PluginError):
@@ -452,8 +445,6 @@ def treatments() -> dict[str, Treatment]:
     built-in name, nor a scene's parameter: it is listed as broken instead)."""
     global _METHODS
     if _METHODS is None:
-        if SCENES is None:       # the plugins' answers are taken for every scene
-            from .. import scenes  # noqa: F401
         methods = {m.name: m for m in _builtin()}
         _METHODS = dict(methods)  # the scenes, loaded to check the plugins, see these
         for m in _plugins():
