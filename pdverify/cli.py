@@ -39,7 +39,9 @@ from .terminal import printable
 
 
 RUN_TIMEOUT_HELP = ("kill a run that takes longer than SECONDS and record it as failed "
-                    "('timed out after N s'); the report goes on (default: no limit)")
+                    "('timed out after N s'); the report goes on (default: no limit; a "
+                    "call into a plugin's code is limited to 60 s in any case, "
+                    "$PDVERIFY_PLUGIN_TIMEOUT)")
 MAX_MEMORY_HELP = ("refuse (exit 2) any run whose memory estimate exceeds SIZE, e.g. 4G, "
                    "512M (default: $PDVERIFY_MAX_MEMORY, else half of the smallest of total "
                    "memory, the cgroup limit and RLIMIT_AS)")
