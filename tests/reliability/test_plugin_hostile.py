@@ -19,7 +19,7 @@ import pytest
 PLUGINS = Path(__file__).resolve().parents[1] / "plugins" / "broken_plugins"
 ENTRY_POINTS = {
     "pdverify_hostile": [f"{name} = pdverify_hostile:{attr}" for name, attr in (
-        ("check-sys-exit", "CHECK_SYS_EXIT"), ("check-hang", "CHECK_HANG"),
+        ("role-check-exit", "ROLE_CHECK_EXIT"), ("check-hang", "CHECK_HANG"),
         ("closure-os-exit", "CLOSURE_OS_EXIT"), ("closure-signal", "CLOSURE_SIGNAL"),
         ("closure-hang", "CLOSURE_HANG"), ("called", "CALLED"),
         ("params-for-raises", "PARAMS_FOR_RAISES"), ("escapes", "ESCAPES"),
@@ -59,8 +59,8 @@ def cli(env, *args, cwd=None):
 
 
 RUNS = {
-    "check-sys-exit": (2, "plugin method check-sys-exit (pdverify_hostile:CHECK_SYS_EXIT): "
-                          "its check raised SystemExit(3)"),
+    "role-check-exit": (2, "plugin method role-check-exit (pdverify_hostile:ROLE_CHECK_EXIT): "
+                           "its check raised SystemExit(3)"),
     "check-hang": (2, "plugin method check-hang (pdverify_hostile:CHECK_HANG): its check did "
                       f"not return within {LIMIT} s"),
     "closure-os-exit": (1, "plugin method closure-os-exit (pdverify_hostile:CLOSURE_OS_EXIT): "
@@ -78,11 +78,15 @@ RUNS = {
 }
 
 
+#: the scene of a method's run where not bar1d-traction
+SCENE = {"role-check-exit": "wave1d-surface-nodes"}
+
+
 @pytest.fixture(scope="module")
 def runs(plugin_env):
     with ThreadPoolExecutor(2) as pool:
-        done = pool.map(lambda m: cli(plugin_env, "run", "bar1d-traction", "--method", m),
-                        RUNS)
+        done = pool.map(lambda m: cli(plugin_env, "run", SCENE.get(m, "bar1d-traction"),
+                                      "--method", m), RUNS)
         return dict(zip(RUNS, done))
 
 

@@ -9,7 +9,7 @@ import time
 import numpy as np
 
 from pdverify.corrections.registry import BondMethod
-from pdverify.corrections.treatment import Treatment
+from pdverify.corrections.treatment import Role, Treatment
 from pdverify.pd.closure import Closure
 
 
@@ -53,7 +53,14 @@ class HangingParamsFor(Treatment):
         _forever()
 
 
+def _role_check_exit(n, params, where):
+    sys.exit(3)
+
+
 COMMON = dict(description="hostile test plugin", source="tests/plugins/broken_plugins")
+#: a role in the wave bars' family whose check exits (called unguarded before issue 50)
+ROLE_CHECK_EXIT = Treatment(name="role-check-exit", roles=(
+    ("wave-bar", Role(lambda problem, params: None, (), _role_check_exit)),), **COMMON)
 CHECK_SYS_EXIT = BondMethod(name="check-sys-exit", closure=_uniform, checker=_sys_exit_check,
                             **COMMON)
 CHECK_HANG = BondMethod(name="check-hang", closure=_uniform, checker=_forever, **COMMON)
