@@ -14,20 +14,28 @@ them, e.g. in the plugin's ``pyproject.toml``::
     [project.entry-points."pdverify.methods"]
     my-method = "my_package.pdverify_plugin:METHOD"
 
-A plugin never stops pdverify. Every call into plugin code (its import, its closure, the
-functions that closure hands the model, its ``assemble`` and ``check``, its parameters'
-checks) catches any exception, ``SystemExit`` included (only ``KeyboardInterrupt``, the
-user's own stop, passes):
+A plugin never stops or stalls pdverify (issue 31, issue 50; the mechanics are in
+:mod:`~pdverify.corrections.containment`). Every call into plugin code is contained and
+under the plugin time limit (``$PDVERIFY_PLUGIN_TIMEOUT``, default 60 s):
 
-- a plugin that fails to load, whose entry point is not a well-formed
-  :class:`~pdverify.corrections.treatment.Treatment`, whose parameter's default fails its
-  own check, or whose parameter shares a name with a parameter of a scene it serves (it
-  would replace that scene's default), is listed as broken with its error (``list``:
-  ``plugin NAME: failed to load (SystemExit(3) at import)``) and left out of reports;
-  the built-in methods run as before, and ``run --method NAME`` on a scene that takes
-  bond methods is a failed run giving that error;
-- a plugin whose code raises during a run (``SystemExit(0)`` in its closure included)
-  makes that run a failed run whose message names the plugin and what it did.
+- the entry points are loaded first in a child process (import, conversion, the answers
+  of a plugin class's ``why_not``/``params_for``/``kind`` for every scene, its parameters'
+  defaults checked); one that raises, exits, signals itself or does not return there is
+  listed as broken (``list``: ``plugin NAME: failed to load (ENTRY POINT: ...)``), never
+  imported here, and left out of reports; so is one whose entry point is not a
+  well-formed :class:`~pdverify.corrections.treatment.Treatment` or whose parameter
+  shares a name with a parameter of a scene it serves (it would replace that scene's
+  default). ``run --method NAME`` of it gives that error;
+- a plugin's own class is held as a :class:`PluginTreatment` (its answers from the
+  load), so pdverify calls no plugin code but its checks, closure and assembly;
+- its checks (treatment, role, parameters) run in a child process
+  (:func:`contained_check`): a refusal is bad input; anything else is a
+  :class:`PluginCheckError` naming the plugin (``run``: exit 2; a report fails that case);
+- its closure, the functions that closure hands the model, its ``assemble`` and roles run
+  in a run's worker process (``run`` of a plugin method goes to one too): a raise or
+  ``SystemExit`` is a failed run naming the plugin and what it did; an exit, a signal or
+  a call past the limit ends the worker, and the supervisor records a failed run naming
+  the plugin call (:mod:`pdverify.runner`).
 
 A method whose optional dependency is missing says so in ``unavailable`` (the install
 command), and a run of it is refused as bad input.

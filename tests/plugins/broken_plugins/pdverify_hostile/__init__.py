@@ -31,6 +31,11 @@ def _self_signal(params):
     time.sleep(5)
 
 
+def _segfault(params):
+    os.kill(os.getpid(), signal.SIGSEGV)
+    time.sleep(5)
+
+
 def _sys_exit_check(cells, params, where):
     sys.exit(3)
 
@@ -66,6 +71,7 @@ CHECK_SYS_EXIT = BondMethod(name="check-sys-exit", closure=_uniform, checker=_sy
 CHECK_HANG = BondMethod(name="check-hang", closure=_uniform, checker=_forever, **COMMON)
 CLOSURE_OS_EXIT = BondMethod(name="closure-os-exit", closure=_os_exit, **COMMON)
 CLOSURE_SIGNAL = BondMethod(name="closure-signal", closure=_self_signal, **COMMON)
+CLOSURE_SEGV = BondMethod(name="closure-segv", closure=_segfault, **COMMON)
 CLOSURE_HANG = BondMethod(name="closure-hang", closure=_forever, **COMMON)
 CALLED = BondMethod(name="called", closure=_uniform, checker=_called_check, **COMMON)
 PARAMS_FOR_RAISES = RaisingParamsFor(name="params-for-raises", families=("static-state",),
