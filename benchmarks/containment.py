@@ -78,6 +78,41 @@ def plugin_cases(site: Path, argv_only=None) -> tuple[int, int]:
     return int(a), int(b)
 
 
+def mechanism_costs(site: Path, repeats: int) -> str:
+    """The containment's own costs, timed inside one process (little disturbed by the
+    other load): the load's child process for the example plugins' entry points (the
+    probe alone, then the whole load of the plugins: probe and import), and one contained
+    check (a child process for a call that returns at once)."""
+    code = f"""
+import statistics, time
+from pdverify.scenes import all_scenes
+from pdverify.corrections import containment, registry
+all_scenes()
+def med(fn, n={repeats * 4}):
+    out = []
+    for _ in range(n):
+        t0 = time.perf_counter(); fn(); out.append(time.perf_counter() - t0)
+    return statistics.median(out)
+from importlib.metadata import entry_points
+eps = list(entry_points(group="pdverify.methods"))
+probe = med(lambda: containment.probe(len(eps), lambda k: registry._load(eps[k])[1]))
+def load():
+    registry.reload(); registry.treatments()
+whole = med(load)
+check = med(lambda: containment.in_child(lambda: None))
+print(f"{{len(eps)}} {{probe:.4f}} {{whole:.4f}} {{check:.4f}}")
+"""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(site), str(AFTER)]))
+    r = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    if r.returncode:
+        return f"(mechanism timing failed: {r.stderr[-300:]})"
+    n, probe, whole, check = r.stdout.split()
+    return (f"inside one process, medians: the load's child process for {n} entry points "
+            f"{1e3 * float(probe):.1f} ms (the whole load of the plugins, probe and "
+            f"import: {1e3 * float(whole):.1f} ms); one contained check "
+            f"{1e3 * float(check):.1f} ms")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=5)
@@ -123,6 +158,7 @@ def main():
     print(f"extrapolated extra of a full report with the example plugins: {full_extra:.2f} s "
           f"= {100 * full_extra / FULL_REPORT_S:.2f} % of {FULL_REPORT_S:g} s "
           f"(no plugin installed: {rows[2][2] - rows[2][1]:+.3f} s on the small report)")
+    print(mechanism_costs(site, args.repeats))
     shutil.rmtree(work, ignore_errors=True)
 
 

@@ -192,10 +192,10 @@ def in_child(fn, args=(), limit: float | None = None):
 def probe(count: int, try_one, limit: float | None = None):
     """Try ``try_one(i)`` for ``i`` in ``range(count)`` in forked children (one for all,
     a new one after a death or a hang), each within ``limit`` seconds. Returns
-    ``(problems, failures)`` by index: what ``try_one`` answered when not ``None`` (its
-    phrase), and how an entry ended or stalled its child."""
+    ``(answers, failures)`` by index: what ``try_one`` returned (it must pickle; a raise
+    is ``("problem", phrase)``), and how an entry ended or stalled its child."""
     limit = limit_s() if limit is None else limit
-    problems: dict[int, str] = {}
+    problems: dict[int, object] = {}
     failures: dict[int, str] = {}
     i = 0
     while i < count:
@@ -209,8 +209,13 @@ def probe(count: int, try_one, limit: float | None = None):
                 for k in range(i, count):
                     _send(fd, ("start", k))
                     item = _outcome(try_one, (k,))
-                    problem = item[1] if item[0] == "ok" else f"{item[2]}"
-                    _send(fd, ("done", k, problem))
+                    answer = item[1] if item[0] == "ok" else ("problem", item[2])
+                    try:
+                        pickle.dumps(answer)
+                    except Exception as exc:  # noqa: BLE001  (a value that does not pickle)
+                        answer = ("problem", "its answers cannot be passed between "
+                                             f"processes ({what_it_did(exc)})")
+                    _send(fd, ("done", k, answer))
             except BaseException:
                 code = 70
             os._exit(code)
@@ -239,8 +244,7 @@ def probe(count: int, try_one, limit: float | None = None):
                 if item[0] == "start":
                     current, start = item[1], time.monotonic()
                 else:
-                    if item[2]:
-                        problems[item[1]] = item[2]
+                    problems[item[1]] = item[2]
                     current = None
                     if item[1] == count - 1:
                         _end(pid, kill=False)

@@ -254,16 +254,19 @@ def _plugin_closure(method: "BondMethod", params: Mapping) -> Closure:
     return replace(closure, **changes)
 
 
-def _checked_param(p: Param, who: str) -> Param:
-    """A plugin's parameter whose check is guarded: raising in it is refused as bad input
-    naming the plugin; its default must pass it (else the plugin is broken)."""
+def _checked_param(p: Param, who: str, check_default: bool = True) -> Param:
+    """A plugin's parameter whose check is contained (:func:`contained_check`); its
+    default must pass it (else the plugin is broken; checked in the load's child process,
+    ``check_default`` False in pdverify's own)."""
     if not isinstance(p, Param):
         raise TypeError(f"params holds {type(p).__name__}, not a pdverify Param")
     if not isinstance(p.name, str) or not p.name.isidentifier():
         raise TypeError(f"parameter name {p.name!r} is not an identifier")
-    if p.check is None:
+    if p.check is None or isinstance(p.check, functools.partial) and \
+            p.check.func is contained_check:
         return p
-    problem = _guard(p.check, who, f"the check of its parameter {p.name}")(p.default)
+    problem = (_guard(p.check, who, f"the check of its parameter {p.name}")(p.default)
+               if check_default else None)
     guarded = functools.partial(contained_check, p.check, who,
                                 f"the check of its parameter {p.name}")
     if problem:
@@ -271,14 +274,18 @@ def _checked_param(p: Param, who: str) -> Param:
     return replace(p, check=guarded)
 
 
-def _as_builtin_type(item, origin: str) -> Treatment:
+def _as_builtin_type(item, origin: str, probed=None) -> Treatment:
     """The plugin's treatment with its origin set and its fields checked, rebuilt as one
     of pdverify's own classes so that only pdverify's methods run on it: a
     :class:`BondMethod` as a plain one with the plugin's data (its closure guarded); any
     other :class:`~pdverify.corrections.treatment.Treatment` as a :class:`PluginTreatment`
     that holds what the plugin's own methods answered once, at load, for every scene
     (``params_for``, ``why_not``, ``kind``), and calls the plugin only for ``check`` and
-    ``assemble`` (through :func:`plugin_call`)."""
+    ``assemble`` (through :func:`plugin_call`).
+
+    ``probed``: None in the load's child process (the plugin's methods are asked and its
+    parameters' defaults checked there); in pdverify's own process, what the child
+    answered (:func:`_answers`), so that no plugin method is called here."""
     if not isinstance(item, Treatment):
         raise TypeError(f"{type(item).__name__} is not a pdverify Treatment")
     bond = isinstance(item, BondMethod)
@@ -293,27 +300,52 @@ def _as_builtin_type(item, origin: str) -> Treatment:
     if bond and not callable(data["closure"]):
         raise TypeError("closure is not callable")
     who = f"plugin method {data['name']} ({origin})"
-    data.update(origin=f"plugin {origin}", params=tuple(_checked_param(p, who)
-                                                        for p in tuple(data["params"])),
+    fresh = probed is None
+    roles = tuple((str(f), r) for f, r in data["roles"])
+    data.update(origin=f"plugin {origin}",
+                params=tuple(_checked_param(p, who, fresh) for p in tuple(data["params"])),
                 theories=tuple(data["theories"]), dims=tuple(int(d) for d in data["dims"]),
                 families=tuple(map(str, data["families"])),
                 scenes=None if data["scenes"] is None else tuple(map(str, data["scenes"])),
                 unavailable=None if data["unavailable"] is None else str(data["unavailable"]),
-                roles=tuple((str(f), r) for f, r in data["roles"]))
+                roles=roles)
     if bond:
         return BondMethod(**data)
+    if not fresh:
+        kind, coded = probed
+        role_params = {f: tuple(_checked_param(p, who, False) for p in tuple(r.params))
+                       for f, r in roles}
+        answers = {sid: (why, data["params"] if code == "own" else
+                         role_params[code[1]] if isinstance(code, tuple) and code
+                         and code[0] == "role" else code)
+                   for sid, (why, code) in coded.items()}
+        return PluginTreatment(**data, plugin=item, plugin_kind=kind, answers=answers,
+                               coded=coded)
     kind = item.kind
     if kind not in ("family", "hand-wired"):
         raise TypeError(f"kind {kind!r} is not family or hand-wired")
-    answers = {}
+    own = tuple(item.params)
+    answers, coded = {}, {}
     for scene in (SCENES() if SCENES is not None else ()):
         why = item.why_not(scene)
         if why is not None and not isinstance(why, str):
             raise TypeError(f"why_not({scene.id}) returned {type(why).__name__}, not a "
                             "string or None")
-        params = tuple(_checked_param(p, who) for p in tuple(item.params_for(scene)))
+        raw = tuple(item.params_for(scene))
+        params = tuple(_checked_param(p, who) for p in raw)
         answers[scene.id] = (why, params)
-    return PluginTreatment(**data, plugin=item, plugin_kind=kind, answers=answers)
+        # how the parent finds the same parameters without calling the plugin
+        code = ("own" if raw == own else
+                next((("role", f) for f, r in roles if raw == tuple(r.params)), params))
+        coded[scene.id] = (why, code)
+    return PluginTreatment(**data, plugin=item, plugin_kind=kind, answers=answers,
+                           coded=coded)
+
+
+def _answers(methods) -> list:
+    """What the load's child hands back of an entry point's treatments: for each, None
+    (a bond method: nothing to ask) or its kind and coded answers."""
+    return [None if isinstance(m, BondMethod) else (m.plugin_kind, m.coded) for m in methods]
 
 
 @dataclass(frozen=True)
@@ -326,6 +358,9 @@ class PluginTreatment(Treatment):
     plugin_kind: str = "hand-wired"
     #: scene id -> (why_not, params_for) as the plugin answered at load
     answers: Mapping[str, tuple] = field(default=None, compare=False)
+    #: the same, as the load's child process hands it back (params_for: ``"own"``,
+    #: ``("role", family)`` or the parameters)
+    coded: Mapping[str, tuple] = field(default=None, compare=False, repr=False)
 
     @property
     def kind(self) -> str:
@@ -369,8 +404,10 @@ def plugin_call(treatment: Treatment, what: str, fn, *args):
     return _guard(fn, who, f"its {what}")(*args)
 
 
-def _load(ep) -> tuple[list, str | None]:
-    """The treatments of entry point ``ep`` and, when it is broken, why (one phrase)."""
+def _load(ep, probed=None) -> tuple[list, str | None]:
+    """The treatments of entry point ``ep`` and, when it is broken, why (one phrase).
+    ``probed``: what the load's child answered for its treatments (:func:`_answers`);
+    None in that child."""
     try:
         obj = ep.load()
     except KeyboardInterrupt:
@@ -379,7 +416,10 @@ def _load(ep) -> tuple[list, str | None]:
         return [], f"{ep.value}: {what_it_did(exc)} at import"
     try:
         items = obj if isinstance(obj, (list, tuple)) else [obj]
-        methods = [_as_builtin_type(item, ep.value) for item in items]
+        if probed is not None and len(probed) != len(items):
+            return [], f"{ep.value}: loads differently in another process"
+        methods = [_as_builtin_type(item, ep.value, None if probed is None else probed[i])
+                   for i, item in enumerate(items)]
         for m in methods:
             clash = _scene_param_clash(m)
             if clash:
@@ -391,12 +431,18 @@ def _load(ep) -> tuple[list, str | None]:
     return methods, None
 
 
+def _probe_one(ep):
+    """In the load's child process: ``("problem", phrase)`` or ``("ok", answers)``."""
+    methods, problem = _load(ep)
+    return ("problem", problem) if problem is not None else ("ok", _answers(methods))
+
+
 def _plugins():
-    """Every plugin's treatments. The entry points are first tried in a child process
+    """Every plugin's treatments. The entry points are first loaded in a child process
     (:func:`~pdverify.corrections.containment.probe`: import, conversion, the answers of
     its methods, under the plugin time limit); one that raises, ends that process or
     does not return is listed in :data:`BROKEN` with its entry point and never imported
-    here; the others are then loaded in this process."""
+    here; the others are then imported here and take the child's answers."""
     from importlib.metadata import entry_points
     try:
         eps = list(entry_points(group=ENTRY_POINT_GROUP))
@@ -407,15 +453,21 @@ def _plugins():
         return
     if not eps:
         return
-    problems, failures = containment.probe(len(eps), lambda k: _load(eps[k])[1])
+    # what the child's answers read of every scene, its own methods (the FEM-referenced
+    # scenes import their reference modules), loaded here first: the child inherits it
+    # and this process keeps it (else both would import them)
+    for scene in (SCENES() if SCENES is not None else ()):
+        scene.methods
+    answers, failures = containment.probe(len(eps), lambda k: _probe_one(eps[k]))
     for k, ep in enumerate(eps):
         if k in failures:
             BROKEN[ep.name] = f"{ep.value}: {failures[k]} while loading"
             continue
-        if k in problems:
-            BROKEN[ep.name] = problems[k]
+        status, payload = answers.get(k, ("problem", f"{ep.value}: no answer"))
+        if status != "ok":
+            BROKEN[ep.name] = payload if ep.value in payload else f"{ep.value}: {payload}"
             continue
-        methods, problem = _load(ep)
+        methods, problem = _load(ep, payload)
         if problem is not None:
             BROKEN[ep.name] = problem
             continue
