@@ -386,8 +386,12 @@ class PluginTreatment(Treatment):
                            lambda *a: self.plugin.build_for(*a), family, problem, params)
 
     def check_for(self, family, context, params, where):
-        return plugin_call(self, "check", lambda *a: self.plugin.check_for(*a), family,
-                           context, params, where)
+        role = self.role(family)
+        if role is None or role.checker is None:
+            return None
+        who = f"plugin method {self.name} ({self.origin.removeprefix('plugin ')})"
+        return contained_check(lambda *a: self.plugin.check_for(*a), who, "its check",
+                               family, context, params, where)
 
 
 def plugin_call(treatment: Treatment, what: str, fn, *args):
@@ -400,8 +404,19 @@ def plugin_call(treatment: Treatment, what: str, fn, *args):
         return fn(*args)
     who = f"plugin method {treatment.name} ({treatment.origin.removeprefix('plugin ')})"
     if what == "check":
+        if not _has_check(treatment):   # pdverify's own no-op: no child process
+            return None
         return contained_check(fn, who, f"its {what}", *args)
     return _guard(fn, who, f"its {what}")(*args)
+
+
+def _has_check(t: Treatment) -> bool:
+    """Whether the ``check`` of the plugin treatment ``t`` runs plugin code."""
+    if isinstance(t, BondMethod):
+        return t.checker is not None
+    if isinstance(t, PluginTreatment):
+        return type(t.plugin).check is not Treatment.check
+    return True
 
 
 def _load(ep, probed=None) -> tuple[list, str | None]:
