@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 from ..errors import InputError
 from ..results import time_s
+from ..terminal import printable
 
 #: The error each scene is ranked by (a scene may set ``headline``).
 HEADLINE_DEFAULT = "rel_l2_error"
@@ -61,7 +62,9 @@ def summarise(scene, runs) -> SceneSummary:
         scene=scene.id, metric=headline(scene), best=best,
         best_error=values.get(best), runs=len(runs),
         best_time_s=time_s(picked[best].timings) if best else None,
-        failed=[(r.method, r.message) for r in runs if r.counts_as_failure])
+        # (shown on the terminal: the names and messages of included records escaped)
+        failed=[(printable(r.method), printable(r.message)) for r in runs
+                if r.counts_as_failure])
 
 
 # -- the end-of-report summary (one row per scene) -----------------------------------------
