@@ -168,8 +168,9 @@ def test_sigterm_ends_run_with_143(tmp_path):
         seen.append((delay, p.returncode, err[-200:]))
         if p.returncode == 0:      # it finished first
             continue
-        if p.returncode == -signal.SIGTERM and not err:
-            continue               # before the interpreter ran pdverify (the default action)
+        if p.returncode == -signal.SIGTERM:
+            continue               # the default action: before the interpreter ran pdverify,
+            # or while it exited after the output (a shell shows both as 143)
         assert p.returncode == 143, seen
         assert err.rstrip().endswith("pdverify: stopped by SIGTERM"), seen
         assert "Traceback" not in err
