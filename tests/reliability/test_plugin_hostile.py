@@ -159,7 +159,7 @@ def test_sigterm_ends_run_with_143(tmp_path):
     left armed after main returned)."""
     env = dict(os.environ, PDVERIFY_CACHE_DIR=str(tmp_path / "cache"))
     seen = []
-    for delay in (0.5, 0.8, 1.0, 1.2, 1.5):
+    for delay in (0.3, 0.5, 0.8, 1.0, 1.2, 1.5):
         p = subprocess.Popen([sys.executable, "-m", "pdverify", "run", "stiffness2d-sheet"],
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
         time.sleep(delay)
