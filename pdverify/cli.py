@@ -19,7 +19,13 @@ Exit codes: 0 success; 1 a run failed numerically, a regression was found, or an
 could not be written after the work (one line naming it; a report stays in its staging
 folder), or report --scheduler lost its Dask scheduler (one line); 2 bad input (one line naming the input and what is allowed), a run above the
 memory budget (its estimate and the limit), an output pdverify may not replace and a
-cache or disk that cannot take the output included, all before any work; 130 interrupted.
+cache or disk that cannot take the output included, all before any work; stopped by a
+signal: 130 SIGINT (Ctrl-C), 143 SIGTERM, 129 SIGHUP (128 + the signal's number).
+
+Plugins: every call into a plugin's code (its import, its checks, its closure and
+assembly) runs contained and within 60 s ($PDVERIFY_PLUGIN_TIMEOUT seconds); a plugin
+that raises, exits, signals itself or hangs is listed as broken, refused (exit 2) or a
+failed run, each naming the plugin and its entry point.
 """
 from __future__ import annotations
 
@@ -29,10 +35,13 @@ import sys
 
 from . import __version__, budget
 from .errors import STOP_REQUESTED, ClusterError, InputError, OutputError
+from .terminal import printable
 
 
 RUN_TIMEOUT_HELP = ("kill a run that takes longer than SECONDS and record it as failed "
-                    "('timed out after N s'); the report goes on (default: no limit)")
+                    "('timed out after N s'); the report goes on (default: no limit; a "
+                    "call into a plugin's code is limited to 60 s in any case, "
+                    "$PDVERIFY_PLUGIN_TIMEOUT)")
 MAX_MEMORY_HELP = ("refuse (exit 2) any run whose memory estimate exceeds SIZE, e.g. 4G, "
                    "512M (default: $PDVERIFY_MAX_MEMORY, else half of the smallest of total "
                    "memory, the cgroup limit and RLIMIT_AS)")
@@ -202,10 +211,23 @@ def _inside_import_or_exec(frame) -> bool:
     return any(inside)
 
 
+def _cancel_retry() -> None:
+    """Stop the re-check timer of :func:`_terminate`: armed when main returns, it would
+    fire after the interpreter has put back SIGALRM's default action and end the process
+    by SIGALRM (status -14) after its output."""
+    try:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+    except ValueError:
+        pass
+
+
 def _terminate(signum, frame):
-    """SIGTERM: unwind like Ctrl-C, so cleanups run. Inside an import or ``exec`` the
-    interrupt waits (SIGALRM re-checks every 20 ms) until that code has returned."""
+    """SIGTERM, SIGHUP: unwind like Ctrl-C, so cleanups run (the exit status is the
+    signal's, :data:`STOP_STATUS`). Inside an import or ``exec`` the interrupt waits
+    (SIGALRM re-checks every 20 ms) until that code has returned."""
     STOP_REQUESTED["flag"] = True
+    if signum in STOP_STATUS:
+        STOP_REQUESTED["signal"] = signum
     if _inside_import_or_exec(frame):
         signal.setitimer(signal.ITIMER_REAL, _RETRY_S)
         return
@@ -214,40 +236,56 @@ def _terminate(signum, frame):
 
 def _retry(signum, frame):
     if STOP_REQUESTED["flag"]:
-        _terminate(signum, frame)
+        _terminate(STOP_REQUESTED.get("signal", signal.SIGTERM), frame)
 
 
 def _install_stop_handlers() -> None:
     try:
         signal.signal(signal.SIGTERM, _terminate)
+        signal.signal(signal.SIGHUP, _terminate)
         signal.signal(signal.SIGALRM, _retry)
     except ValueError:  # not in the main thread (e.g. called from a test's worker thread)
         pass
 
 
+#: the exit status of a stop by each signal pdverify handles: 128 + its number, as a
+#: shell reports a process the signal killed (README, "Exit codes")
+STOP_STATUS = {signal.SIGINT: 130, signal.SIGTERM: 143, signal.SIGHUP: 129}
+
+
 def main(argv=None) -> int:
     _install_stop_handlers()
+    STOP_REQUESTED.pop("signal", None)
+    out, err = sys.stdout, sys.stderr
     try:
         args = build_parser().parse_args(argv)
         if args.command is None:
             print(__doc__)
             return 2
+        if args.command != "report":   # the report escapes its lines itself (live display)
+            from .terminal import EscapingStream
+            sys.stdout, sys.stderr = EscapingStream(out), EscapingStream(err)
         return _dispatch(args)
     except InputError as exc:
-        print(f"pdverify: error: {exc}", file=sys.stderr)
+        print(f"pdverify: error: {printable(exc)}", file=sys.stderr)
         return 2
     except (OutputError, ClusterError) as exc:
-        print(f"pdverify: error: {exc}", file=sys.stderr)
+        print(f"pdverify: error: {printable(exc)}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
-        print("pdverify: interrupted", file=sys.stderr)
-        return 130
+        _cancel_retry()
+        signum = STOP_REQUESTED.get("signal") or signal.SIGINT
+        print("pdverify: " + ("interrupted" if signum == signal.SIGINT else
+                              f"stopped by {signal.Signals(signum).name}"), file=sys.stderr)
+        return STOP_STATUS.get(signum, 130)
     except BrokenPipeError:  # the reader of stdout went away (| head): stop quietly, and
         # point stdout at /dev/null so that the interpreter's final flush cannot fail too
         import os
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 141  # 128 + SIGPIPE, as a shell reports a pipe's writer
     finally:
+        _cancel_retry()
+        sys.stdout, sys.stderr = out, err
         budget.set_limit(None)  # --max-memory holds for this command only
 
 

@@ -27,7 +27,7 @@ def run_one(scene_id: str, *, method=None, overrides=None, json_path=None, vtu_p
     scene = get_scene(scene_id)
     method = method or scene.default_method
     scene.resolve(method, overrides)  # bad input fails here, before any work
-    if run_timeout is None:
+    if run_timeout is None and not is_plugin(scene, method):
         result = scene.run(method, overrides)
     else:
         result = run_cases([(scene_id, method, dict(overrides or {}))], jobs=1,
@@ -63,6 +63,13 @@ def run_one(scene_id: str, *, method=None, overrides=None, json_path=None, vtu_p
         print(f"unexpected pass: documented to fail ({result.expected_failure}); the finding "
               "is out of date")
     return 1 if result.counts_as_failure else 0
+
+
+def is_plugin(scene, method: str) -> bool:
+    """Whether ``method`` on ``scene`` runs a plugin's code (its run then goes to a
+    supervised worker process, where the plugin time limit holds)."""
+    t = scene.offered().get(method)
+    return t is not None and t.origin != "built-in"
 
 
 def run_case(case) -> RunResult:
@@ -109,23 +116,34 @@ def plan(only=None, quick=False, methods=None) -> list[tuple[str, str, dict]]:
                 raise InputError(f"--method {name!r}{did_you_mean(name, offered)} is not a "
                                  "method of the " + ("scenes of --only" if only else "scenes")
                                  + f"; allowed: {', '.join(offered)}")
-        cases = [c for c in plan(only, quick) if c[1] in methods]
-        if not cases:
-            raise InputError(f"--method {' '.join(methods)}: no run of the report uses "
-                             "these methods (an unavailable one is not run)")
-        return cases
+    keep = (lambda m: m in methods) if methods else (lambda m: True)
     cases, seen = [], set()
+    # only the selected methods' cases are resolved: an unselected plugin is never called
     for scene in scenes:
         for method, overrides in scene.report_cases(quick=quick):
-            seen.add(run_key(scene.id, method, scene.resolve(method, overrides)))
-            cases.append((scene.id, method, overrides))
+            if keep(method):
+                seen.add(run_key(scene.id, method, _params(scene, method, overrides)))
+                cases.append((scene.id, method, overrides))
     # the convergence studies' levels, unless a scene case already runs them
     for scene_id, method, overrides in convergence.cases([s.id for s in scenes], quick):
-        key = run_key(scene_id, method, get_scene(scene_id).resolve(method, overrides))
+        if not keep(method):
+            continue
+        key = run_key(scene_id, method, _params(get_scene(scene_id), method, overrides))
         if key not in seen:
             seen.add(key)
             cases.append((scene_id, method, overrides))
+    if methods and not cases:
+        raise InputError(f"--method {' '.join(methods)}: no run of the report uses "
+                         "these methods (an unavailable one is not run)")
     return cases
+
+
+def _params(scene, method, overrides) -> dict:
+    """The resolved params of a report case; a plugin whose check fails (not a refusal)
+    keeps its case, which then fails naming the plugin, and the report goes on."""
+    from .schedule import case_params
+    params = case_params(scene, method, overrides)
+    return dict(overrides) if params is None else params
 
 
 #: A worker process is replaced by a fresh one after this many runs, and after any run
@@ -166,7 +184,7 @@ def _die_with_parent(parent_pid: int) -> None:
         os._exit(1)
 
 
-def _worker(conn, inherited, parent_pid) -> None:
+def _worker(conn, inherited, parent_pid, watch=None) -> None:
     """Worker process: run the cases it receives, send back each result; None ends it.
 
     ``inherited``: the supervisor's ends of the pipes, copied by fork; closed at once so
@@ -176,6 +194,9 @@ def _worker(conn, inherited, parent_pid) -> None:
     _die_with_parent(parent_pid)
     for c in inherited:
         c.close()
+    if watch is not None:
+        from .corrections import containment
+        containment.WATCH = watch
     while True:
         try:
             case = conn.recv()
@@ -214,8 +235,10 @@ def _forked(proc) -> None:
         signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
-def _died(case, exitcode) -> RunResult:
-    """The failed record of a case whose worker process died in native code."""
+def _died(case, exitcode, plugin_call=None) -> RunResult:
+    """The failed record of a case whose worker process died in native code, or inside
+    the plugin call ``plugin_call`` (``"plugin method NAME (ENTRY POINT): its closure"``,
+    :mod:`~pdverify.corrections.containment`)."""
     import signal
     if exitcode is not None and exitcode < 0:
         try:
@@ -224,8 +247,21 @@ def _died(case, exitcode) -> RunResult:
             how = f"signal {-exitcode}"
     else:
         how = f"exit code {exitcode}"
+    if plugin_call:
+        return _failed(case, f"{case[0]}/{case[1]}: {plugin_call} ended the run's process "
+                             f"({how})")
     return _failed(case, f"the run's process died ({how}) in native code (e.g. a crash in "
                          "a linear-algebra library, or killed for lack of memory)")
+
+
+def _plugin_hung(case, plugin_call, seconds) -> RunResult:
+    """The failed record of a case whose plugin call outlasted the plugin time limit."""
+    from .corrections.containment import ENV
+    res = _failed(case, f"{case[0]}/{case[1]}: {plugin_call} did not return within "
+                        f"{seconds:g} s (the plugin time limit, ${ENV}); the supervisor "
+                        "killed the run's process")
+    res.timings = {"setup_s": 0.0, "solve_s": float(seconds), "total_s": float(seconds)}
+    return res
 
 
 def run_line(case, res) -> str:
@@ -241,8 +277,10 @@ def run_line(case, res) -> str:
                                                                   f"FAILED: {res.message}")
     if res.warnings:
         status += f" ({len(res.warnings)} warning)"
-    return (f"{res.scene} {res.method} {params} ... {status} "
-            f"({res.timings.get('total_s', 0):.2f} s) {format_metrics(res.metrics, 2)}")
+    from .terminal import printable
+    return printable(f"{res.scene} {res.method} {params} ... {status} "
+                     f"({res.timings.get('total_s', 0):.2f} s) "
+                     f"{format_metrics(res.metrics, 2)}")
 
 
 def run_cases(cases, *, jobs: int | None = None, progress=None, client=None,
@@ -313,6 +351,7 @@ def _run_local(cases, jobs, shown, run_timeout=None, known=None, slots=None):
     from multiprocessing.connection import wait
 
     from .budget import memory_limit
+    from .corrections import containment
     from .schedule import Slot, longest_first, memory_estimates, next_case
 
     total = len(cases)
@@ -326,13 +365,22 @@ def _run_local(cases, jobs, shown, run_timeout=None, known=None, slots=None):
     slots = slots if slots is not None else []
     slots.extend(Slot() for _ in range(min(jobs, total)))
     t0 = time.monotonic()
+    plugin_limit = containment.limit_s()
+    watches = {}          # connection -> the worker's plugin-call buffers
+    #: a plugin call starts unseen by the supervisor: it looks this often while a worker
+    #: runs a plugin's case (a small fraction of the limit)
+    look_s = min(1.0, plugin_limit / 10)
+    plugin_cases = {k for k, (scene_id, method, _) in enumerate(cases)
+                    if is_plugin(get_scene(scene_id), method)}
 
     def start(slot):
         parent, child = ctx.Pipe()
-        proc = ctx.Process(target=_worker, args=(child, [parent, *workers], os.getpid()),
-                           daemon=True)
+        watch = containment.watch_buffers(ctx)
+        proc = ctx.Process(target=_worker, args=(child, [parent, *workers], os.getpid(),
+                                                  watch), daemon=True)
         _forked(proc)
         child.close()
+        watches[parent] = watch
         workers[parent] = [proc, None, slot, None, 0]
         slots[slot].processes += 1
         return parent
@@ -368,6 +416,7 @@ def _run_local(cases, jobs, shown, run_timeout=None, known=None, slots=None):
     def replace(conn):
         """The worker of ``conn`` is dead or killed: a new one takes its slot."""
         proc, _, slot, _, _ = workers.pop(conn)
+        watches.pop(conn, None)
         conn.close()
         start(slot)
 
@@ -398,6 +447,8 @@ def _run_local(cases, jobs, shown, run_timeout=None, known=None, slots=None):
             if run_timeout is not None:
                 left = min(w[3] + run_timeout for w in busy.values()) - time.monotonic()
                 timeout = max(0.0, left) if timeout is None else min(timeout, max(0.0, left))
+            if any(w[1] in plugin_cases for w in busy.values()):
+                timeout = look_s if timeout is None else min(timeout, look_s)
             ready = wait(list(busy) + [w[0].sentinel for w in busy.values()],
                          timeout=timeout)
             for conn, (proc, k, slot, began, _) in list(busy.items()):
@@ -410,12 +461,20 @@ def _run_local(cases, jobs, shown, run_timeout=None, known=None, slots=None):
                         res = None
                     if res is None and not proc.is_alive():   # died: record, replace
                         proc.join()
-                        finish(conn, k, _died(cases[k], proc.exitcode))
+                        inside = containment.watched(watches[conn])
+                        finish(conn, k, _died(cases[k], proc.exitcode,
+                                              inside[1] if inside else None))
                         replace(conn)
                         continue
+                inside = containment.watched(watches[conn]) if res is None else None
                 if res is not None:
                     finish(conn, k, res)
                     recycle(conn, k)
+                elif inside and time.monotonic() - inside[0] > plugin_limit:
+                    proc.kill()
+                    proc.join()
+                    finish(conn, k, _plugin_hung(cases[k], inside[1], plugin_limit))
+                    replace(conn)
                 elif run_timeout is not None and time.monotonic() - began > run_timeout:
                     proc.kill()
                     proc.join()

@@ -39,13 +39,25 @@ def default_jobs() -> int:
         return max(1, os.cpu_count() or 1)
 
 
+def case_params(scene, method, overrides) -> dict | None:
+    """The resolved params of a case; None when a plugin's check failed (not a refusal:
+    :class:`~pdverify.corrections.registry.PluginCheckError`), a case that then fails in
+    its run naming the plugin, while the report goes on."""
+    from .corrections.registry import PluginCheckError
+    try:
+        return scene.resolve(method, overrides)
+    except PluginCheckError:
+        return None
+
+
 def memory_estimates(cases) -> list[float]:
     """Each case's memory estimate in bytes (:meth:`Scene.estimate`; 0 when it has none)."""
     from .scenes import get_scene
     out = []
     for scene_id, method, overrides in cases:
         scene = get_scene(scene_id)
-        est = scene.estimate(method, scene.resolve(method, overrides))
+        params = case_params(scene, method, overrides)
+        est = None if params is None else scene.estimate(method, params)
         out.append(float(est.memory) if est is not None else 0.0)
     return out
 
@@ -89,7 +101,10 @@ def case_costs(cases, known=None, measured=None) -> list[tuple]:
     out = []
     for scene_id, method, overrides in cases:
         scene = get_scene(scene_id)
-        params = scene.resolve(method, overrides)
+        params = case_params(scene, method, overrides)
+        if params is None:
+            out.append((None, None))
+            continue
         key = run_key(scene_id, method, params)
         t = known.get(key)
         if t is not None:
@@ -143,7 +158,8 @@ def longest_first(cases, known=None) -> list[int]:
     keys = []
     for case in cases:
         scene_id, method, overrides = case
-        t = known.get(run_key(scene_id, method, get_scene(scene_id).resolve(method, overrides)))
+        params = case_params(get_scene(scene_id), method, overrides)
+        t = None if params is None else known.get(run_key(scene_id, method, params))
         keys.append((-1, 0.0) if computes_reference(case) else
                     (0, 0.0) if t is None else (1, -t))
     return sorted(range(len(cases)), key=lambda k: keys[k])

@@ -14,20 +14,28 @@ them, e.g. in the plugin's ``pyproject.toml``::
     [project.entry-points."pdverify.methods"]
     my-method = "my_package.pdverify_plugin:METHOD"
 
-A plugin never stops pdverify. Every call into plugin code (its import, its closure, the
-functions that closure hands the model, its ``assemble`` and ``check``, its parameters'
-checks) catches any exception, ``SystemExit`` included (only ``KeyboardInterrupt``, the
-user's own stop, passes):
+A plugin never stops or stalls pdverify (issue 31, issue 50; the mechanics are in
+:mod:`~pdverify.corrections.containment`). Every call into plugin code is contained and
+under the plugin time limit (``$PDVERIFY_PLUGIN_TIMEOUT``, default 60 s):
 
-- a plugin that fails to load, whose entry point is not a well-formed
-  :class:`~pdverify.corrections.treatment.Treatment`, whose parameter's default fails its
-  own check, or whose parameter shares a name with a parameter of a scene it serves (it
-  would replace that scene's default), is listed as broken with its error (``list``:
-  ``plugin NAME: failed to load (SystemExit(3) at import)``) and left out of reports;
-  the built-in methods run as before, and ``run --method NAME`` on a scene that takes
-  bond methods is a failed run giving that error;
-- a plugin whose code raises during a run (``SystemExit(0)`` in its closure included)
-  makes that run a failed run whose message names the plugin and what it did.
+- the entry points are loaded first in a child process (import, conversion, the answers
+  of a plugin class's ``why_not``/``params_for``/``kind`` for every scene, its parameters'
+  defaults checked); one that raises, exits, signals itself or does not return there is
+  listed as broken (``list``: ``plugin NAME: failed to load (ENTRY POINT: ...)``), never
+  imported here, and left out of reports; so is one whose entry point is not a
+  well-formed :class:`~pdverify.corrections.treatment.Treatment` or whose parameter
+  shares a name with a parameter of a scene it serves (it would replace that scene's
+  default). ``run --method NAME`` of it gives that error;
+- a plugin's own class is held as a :class:`PluginTreatment` (its answers from the
+  load), so pdverify calls no plugin code but its checks, closure and assembly;
+- its checks (treatment, role, parameters) run in a child process
+  (:func:`contained_check`): a refusal is bad input; anything else is a
+  :class:`PluginCheckError` naming the plugin (``run``: exit 2; a report fails that case);
+- its closure, the functions that closure hands the model, its ``assemble`` and roles run
+  in a run's worker process (``run`` of a plugin method goes to one too): a raise or
+  ``SystemExit`` is a failed run naming the plugin and what it did; an exit, a signal or
+  a call past the limit ends the worker, and the supervisor records a failed run naming
+  the plugin call (:mod:`pdverify.runner`).
 
 A method whose optional dependency is missing says so in ``unavailable`` (the install
 command), and a run of it is refused as bad input.
@@ -36,10 +44,12 @@ from __future__ import annotations
 
 import difflib
 import functools
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, field, fields, replace
 from typing import Any, Callable, Mapping
 
 from ..errors import InputError, NumericalError
+from . import containment
+from .containment import what_it_did  # noqa: F401  (re-exported)
 from ..params import Param
 from ..pd.closure import Closure
 from .protocols import BondClosure, ParamCheck
@@ -153,20 +163,13 @@ class PluginError(NumericalError):
     """A plugin's code raised (or exited) during a run: the run fails, naming the plugin."""
 
 
-def what_it_did(exc: BaseException) -> str:
-    """``SystemExit(3)``, ``ValueError: bad factor``: the exception in one short phrase."""
-    if isinstance(exc, SystemExit):
-        return f"SystemExit({exc.code!r})"
-    text = " ".join(str(exc).split())
-    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
-
-
 def _guard(fn, who: str, what: str, error=PluginError):
     """``fn`` wrapped so that anything it raises except ``KeyboardInterrupt`` (and the
     engine's own :class:`NumericalError` raised through it) becomes ``error`` naming
     ``who`` (the plugin) and ``what`` (which of its functions)."""
     @functools.wraps(fn)
     def guarded(*args, **kwargs):
+        mark = containment.watching(f"{who}: {what}")
         try:
             return fn(*args, **kwargs)
         except KeyboardInterrupt:
@@ -175,7 +178,46 @@ def _guard(fn, who: str, what: str, error=PluginError):
             raise
         except BaseException as exc:  # SystemExit included: a plugin never ends pdverify
             raise error(f"{who}: {what} raised {what_it_did(exc)}") from None
+        finally:
+            containment.unwatch(mark)
     return guarded
+
+
+class PluginCheckError(InputError):
+    """A plugin's check (of its treatment or of a parameter) raised something other than
+    a refusal, ended its process or did not return: the plugin's failure, not the user's
+    input. ``run`` records it as a failed run naming the plugin; a report's case of that
+    plugin fails, the other cases go on."""
+
+
+#: outcomes of contained checks by (who, what, arguments): a check is a function of its
+#: arguments, and one that hung is not waited for twice
+_CHECKED: dict[tuple, tuple] = {}
+
+
+def contained_check(fn, who: str, what: str, *args):
+    """``fn(*args)``, a plugin's check, run in a child process under the plugin time limit
+    (:mod:`~pdverify.corrections.containment`): its refusal (``InputError``) is bad input
+    as it wrote it; anything else it does is a :class:`PluginCheckError` naming ``who``."""
+    try:
+        key = (who, what, repr(args))
+    except Exception:  # an argument whose repr fails: not cached
+        key = None
+    outcome = _CHECKED.get(key) if key is not None else None
+    if outcome is None:
+        outcome = containment.in_child(fn, args)
+        if key is not None:
+            _CHECKED[key] = outcome
+    if outcome[0] == "ok":
+        return outcome[1]
+    if outcome[0] == "raised":
+        if outcome[1]:
+            raise InputError(outcome[3])
+        raise PluginCheckError(f"{who}: {what} raised {outcome[2]}")
+    if outcome[0] == "ended":
+        raise PluginCheckError(f"{who}: {what} ended its process ({outcome[1]})")
+    raise PluginCheckError(f"{who}: {what} did not return within {outcome[1]:g} s (the "
+                           f"plugin time limit, ${containment.ENV}); its process was killed")
 
 
 class _GuardedConstitutive:
@@ -213,63 +255,210 @@ def _plugin_closure(method: "BondMethod", params: Mapping) -> Closure:
     return replace(closure, **changes)
 
 
-def _checked_param(p: Param, who: str) -> Param:
-    """A plugin's parameter whose check is guarded: raising in it is refused as bad input
-    naming the plugin; its default must pass it (else the plugin is broken)."""
+def _checked_param(p: Param, who: str, check_default: bool = True) -> Param:
+    """A plugin's parameter whose check is contained (:func:`contained_check`); its
+    default must pass it (else the plugin is broken; checked in the load's child process,
+    ``check_default`` False in pdverify's own)."""
     if not isinstance(p, Param):
         raise TypeError(f"params holds {type(p).__name__}, not a pdverify Param")
     if not isinstance(p.name, str) or not p.name.isidentifier():
         raise TypeError(f"parameter name {p.name!r} is not an identifier")
-    if p.check is None:
+    if p.check is None or isinstance(p.check, functools.partial) and \
+            p.check.func is contained_check:
         return p
-    guarded = _guard(p.check, who, f"the check of its parameter {p.name}", error=InputError)
-    problem = guarded(p.default)
+    problem = (_guard(p.check, who, f"the check of its parameter {p.name}")(p.default)
+               if check_default else None)
+    guarded = functools.partial(contained_check, p.check, who,
+                                f"the check of its parameter {p.name}")
     if problem:
         raise ValueError(f"the default {p.name}={p.default!r} fails its own check ({problem})")
     return replace(p, check=guarded)
 
 
-def _as_builtin_type(item, origin: str) -> Treatment:
-    """The plugin's treatment with its origin set and its fields checked: a
-    :class:`BondMethod` is rebuilt as a plain one with the plugin's data (so that only
-    pdverify's own methods run on it, its closure guarded); any other
-    :class:`~pdverify.corrections.treatment.Treatment` keeps its class (its ``assemble``
-    and ``check`` are the plugin's, called through :func:`plugin_call`)."""
+def _as_builtin_type(item, origin: str, probed=None) -> Treatment:
+    """The plugin's treatment with its origin set and its fields checked, rebuilt as one
+    of pdverify's own classes so that only pdverify's methods run on it: a
+    :class:`BondMethod` as a plain one with the plugin's data (its closure guarded); any
+    other :class:`~pdverify.corrections.treatment.Treatment` as a :class:`PluginTreatment`
+    that holds what the plugin's own methods answered once, at load, for every scene
+    (``params_for``, ``why_not``, ``kind``), and calls the plugin only for ``check`` and
+    ``assemble`` (through :func:`plugin_call`).
+
+    ``probed``: None in the load's child process (the plugin's methods are asked and its
+    parameters' defaults checked there); in pdverify's own process, what the child
+    answered (:func:`_answers`), so that no plugin method is called here."""
     if not isinstance(item, Treatment):
         raise TypeError(f"{type(item).__name__} is not a pdverify Treatment")
-    base = BondMethod if isinstance(item, BondMethod) else type(item)
+    bond = isinstance(item, BondMethod)
+    base = BondMethod if bond else Treatment
     data = {f.name: getattr(item, f.name) for f in fields(base)}
     if not (isinstance(data["name"], str) and data["name"] and data["name"].isprintable()
             and " " not in data["name"]):
         raise TypeError(f"method name {data['name']!r} must be a non-empty word")
-    for key in ("description", "source"):
+    for key in ("description", "source", "scope", "box_only"):
         if not isinstance(data[key], str):
             raise TypeError(f"{key} must be a string")
-    if base is BondMethod and not callable(data["closure"]):
+    if bond and not callable(data["closure"]):
         raise TypeError("closure is not callable")
     who = f"plugin method {data['name']} ({origin})"
-    data.update(origin=f"plugin {origin}", params=tuple(_checked_param(p, who)
-                                                        for p in tuple(data["params"])),
+    fresh = probed is None
+    roles = tuple((str(f), r) for f, r in data["roles"])
+    data.update(origin=f"plugin {origin}",
+                params=tuple(_checked_param(p, who, fresh) for p in tuple(data["params"])),
                 theories=tuple(data["theories"]), dims=tuple(int(d) for d in data["dims"]),
                 families=tuple(map(str, data["families"])),
                 scenes=None if data["scenes"] is None else tuple(map(str, data["scenes"])),
-                unavailable=None if data["unavailable"] is None else str(data["unavailable"]))
-    return base(**data)
+                unavailable=None if data["unavailable"] is None else str(data["unavailable"]),
+                roles=roles)
+    if bond:
+        return BondMethod(**data)
+    if not fresh:
+        kind, coded = probed
+        role_params = {f: tuple(_checked_param(p, who, False) for p in tuple(r.params))
+                       for f, r in roles}
+        answers = {sid: (why, data["params"] if code == "own" else
+                         role_params[code[1]] if isinstance(code, tuple) and code
+                         and code[0] == "role" else code)
+                   for sid, (why, code) in coded.items()}
+        return PluginTreatment(**data, plugin=item, plugin_kind=kind, answers=answers,
+                               coded=coded)
+    kind = item.kind
+    if kind not in ("family", "hand-wired"):
+        raise TypeError(f"kind {kind!r} is not family or hand-wired")
+    own = tuple(item.params)
+    answers, coded = {}, {}
+    for scene in (SCENES() if SCENES is not None else ()):
+        why = item.why_not(scene)
+        if why is not None and not isinstance(why, str):
+            raise TypeError(f"why_not({scene.id}) returned {type(why).__name__}, not a "
+                            "string or None")
+        raw = tuple(item.params_for(scene))
+        params = tuple(_checked_param(p, who) for p in raw)
+        answers[scene.id] = (why, params)
+        # how the parent finds the same parameters without calling the plugin
+        code = ("own" if raw == own else
+                next((("role", f) for f, r in roles if raw == tuple(r.params)), params))
+        coded[scene.id] = (why, code)
+    return PluginTreatment(**data, plugin=item, plugin_kind=kind, answers=answers,
+                           coded=coded)
+
+
+def _answers(methods) -> list:
+    """What the load's child hands back of an entry point's treatments: for each, None
+    (a bond method: nothing to ask) or its kind and coded answers."""
+    return [None if isinstance(m, BondMethod) else (m.plugin_kind, m.coded) for m in methods]
+
+
+@dataclass(frozen=True)
+class PluginTreatment(Treatment):
+    """A plugin's treatment of its own class, as pdverify holds it (:func:`_as_builtin_type`):
+    where it applies and its parameters as the plugin answered at load; its ``check``,
+    ``assemble`` and roles call the plugin's object, guarded."""
+
+    plugin: Any = field(default=None, compare=False)
+    plugin_kind: str = "hand-wired"
+    #: scene id -> (why_not, params_for) as the plugin answered at load
+    answers: Mapping[str, tuple] = field(default=None, compare=False)
+    #: the same, as the load's child process hands it back (params_for: ``"own"``,
+    #: ``("role", family)`` or the parameters)
+    coded: Mapping[str, tuple] = field(default=None, compare=False, repr=False)
+
+    @property
+    def kind(self) -> str:
+        return self.plugin_kind
+
+    def why_not(self, scene) -> str | None:
+        answer = self.answers.get(scene.id)
+        return ("not offered (the plugin was loaded before this scene)" if answer is None
+                else answer[0])
+
+    def params_for(self, scene) -> tuple[Param, ...]:
+        answer = self.answers.get(scene.id)
+        return self.params if answer is None else answer[1]
+
+    def check(self, cells, params, where):
+        return self.plugin.check(cells, params, where)
+
+    def assemble(self, problem, params):
+        return self.plugin.assemble(problem, params)
+
+    def build_for(self, family, problem, params):
+        return plugin_call(self, f"role in {family}",
+                           lambda *a: self.plugin.build_for(*a), family, problem, params)
+
+    def check_for(self, family, context, params, where):
+        role = self.role(family)
+        if role is None or role.checker is None:
+            return None
+        who = f"plugin method {self.name} ({self.origin.removeprefix('plugin ')})"
+        return contained_check(lambda *a: self.plugin.check_for(*a), who, "its check",
+                               family, context, params, where)
 
 
 def plugin_call(treatment: Treatment, what: str, fn, *args):
-    """``fn(*args)`` of ``treatment``; guarded when the treatment is a plugin's (a raise
-    or exit becomes a failed run naming it; bad input stays bad input)."""
+    """``fn(*args)`` of ``treatment``; guarded when the treatment is a plugin's: its
+    ``check`` runs in a child process under the plugin time limit (a refusal stays bad
+    input; anything else is a :class:`PluginCheckError` naming it); its other calls run
+    guarded in the run's worker process, whose supervisor enforces the limit and names
+    the plugin if the process ends inside it (:mod:`pdverify.runner`)."""
     if treatment.origin == "built-in":
         return fn(*args)
     who = f"plugin method {treatment.name} ({treatment.origin.removeprefix('plugin ')})"
-    error = InputError if what == "check" else PluginError
-    return _guard(fn, who, f"its {what}", error=error)(*args)
+    if what == "check":
+        if not _has_check(treatment):   # pdverify's own no-op: no child process
+            return None
+        return contained_check(fn, who, f"its {what}", *args)
+    return _guard(fn, who, f"its {what}")(*args)
+
+
+def _has_check(t: Treatment) -> bool:
+    """Whether the ``check`` of the plugin treatment ``t`` runs plugin code."""
+    if isinstance(t, BondMethod):
+        return t.checker is not None
+    if isinstance(t, PluginTreatment):
+        return type(t.plugin).check is not Treatment.check
+    return True
+
+
+def _load(ep, probed=None) -> tuple[list, str | None]:
+    """The treatments of entry point ``ep`` and, when it is broken, why (one phrase).
+    ``probed``: what the load's child answered for its treatments (:func:`_answers`);
+    None in that child."""
+    try:
+        obj = ep.load()
+    except KeyboardInterrupt:
+        raise
+    except BaseException as exc:  # a broken plugin never stops pdverify
+        return [], f"{ep.value}: {what_it_did(exc)} at import"
+    try:
+        items = obj if isinstance(obj, (list, tuple)) else [obj]
+        if probed is not None and len(probed) != len(items):
+            return [], f"{ep.value}: loads differently in another process"
+        methods = [_as_builtin_type(item, ep.value, None if probed is None else probed[i])
+                   for i, item in enumerate(items)]
+        for m in methods:
+            clash = _scene_param_clash(m)
+            if clash:
+                return [], f"{m.origin}: {clash}"
+    except KeyboardInterrupt:
+        raise
+    except BaseException as exc:
+        return [], f"{ep.value}: {what_it_did(exc)}"
+    return methods, None
+
+
+def _probe_one(ep):
+    """In the load's child process: ``("problem", phrase)`` or ``("ok", answers)``."""
+    methods, problem = _load(ep)
+    return ("problem", problem) if problem is not None else ("ok", _answers(methods))
 
 
 def _plugins():
-    """Every plugin's treatments; a load that raises anything but KeyboardInterrupt,
-    ``SystemExit`` at import included, is listed in :data:`BROKEN`."""
+    """Every plugin's treatments. The entry points are first loaded in a child process
+    (:func:`~pdverify.corrections.containment.probe`: import, conversion, the answers of
+    its methods, under the plugin time limit); one that raises, ends that process or
+    does not return is listed in :data:`BROKEN` with its entry point and never imported
+    here; the others are then imported here and take the child's answers."""
     from importlib.metadata import entry_points
     try:
         eps = list(entry_points(group=ENTRY_POINT_GROUP))
@@ -278,21 +467,25 @@ def _plugins():
     except BaseException as exc:  # broken metadata of some installed distribution
         BROKEN["(entry points)"] = f"{what_it_did(exc)} while listing the entry points"
         return
-    for ep in eps:
-        try:
-            obj = ep.load()
-        except KeyboardInterrupt:
-            raise
-        except BaseException as exc:  # a broken plugin never stops pdverify
-            BROKEN[ep.name] = f"{ep.value}: {what_it_did(exc)} at import"
+    if not eps:
+        return
+    # what the child's answers read of every scene, its own methods (the FEM-referenced
+    # scenes import their reference modules), loaded here first: the child inherits it
+    # and this process keeps it (else both would import them)
+    for scene in (SCENES() if SCENES is not None else ()):
+        scene.methods
+    answers, failures = containment.probe(len(eps), lambda k: _probe_one(eps[k]))
+    for k, ep in enumerate(eps):
+        if k in failures:
+            BROKEN[ep.name] = f"{ep.value}: {failures[k]} while loading"
             continue
-        try:
-            items = obj if isinstance(obj, (list, tuple)) else [obj]
-            methods = [_as_builtin_type(item, ep.value) for item in items]
-        except KeyboardInterrupt:
-            raise
-        except BaseException as exc:
-            BROKEN[ep.name] = f"{ep.value}: {what_it_did(exc)}"
+        status, payload = answers.get(k, ("problem", f"{ep.value}: no answer"))
+        if status != "ok":
+            BROKEN[ep.name] = payload if ep.value in payload else f"{ep.value}: {payload}"
+            continue
+        methods, problem = _load(ep, payload)
+        if problem is not None:
+            BROKEN[ep.name] = problem
             continue
         yield from methods
 
@@ -340,10 +533,6 @@ def treatments() -> dict[str, Treatment]:
             if m.name in methods:
                 BROKEN[m.name] = f"{m.origin}: the name {m.name!r} is taken"
                 continue
-            clash = _scene_param_clash(m)
-            if clash:
-                BROKEN[m.name] = f"{m.origin}: {clash}"
-                continue
             methods[m.name] = m
         _METHODS = methods
     return _METHODS
@@ -365,6 +554,7 @@ def reload() -> None:
     global _METHODS
     _METHODS = None
     BROKEN.clear()
+    _CHECKED.clear()
 
 
 def from_name(name: str) -> Treatment:

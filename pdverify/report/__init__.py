@@ -125,7 +125,8 @@ def rerun_plan(cases, out: str):
     again = []
     for case in cases:
         scene_id, method, overrides = case
-        key = run_key(scene_id, method, get_scene(scene_id).resolve(method, overrides))
+        from ..runner import _params
+        key = run_key(scene_id, method, _params(get_scene(scene_id), method, overrides))
         prev = previous.get(key)
         if prev is None or prev.outcome == "failed":
             again.append(case)
@@ -445,6 +446,7 @@ def _build_logged(cases, out, final, jobs, progress, client=None, quick=False,
     with phase("figures_s"):
         os.makedirs(figdir, exist_ok=True)
     from . import figures, html
+    from ..runner import _params
     sections = []
     tabled = set()   # the runs in the scenes' tables (the failure list links to their rows)
     order = []
@@ -455,7 +457,10 @@ def _build_logged(cases, out, final, jobs, progress, client=None, quick=False,
     for scene_id in order:
         scene = get_scene(scene_id)
         # the scene's own cases; the convergence studies' extra levels have their section
-        own = {run_key(scene_id, m, scene.resolve(m, o)) for m, o in scene.report_cases(quick)}
+        # (of the methods that ran: an unselected plugin's check is never called)
+        ran = {r.method for r in results if r.scene == scene_id}
+        own = {run_key(scene_id, m, _params(scene, m, o))
+               for m, o in scene.report_cases(quick) if m in ran}
         mine = [r for r in results if r.scene == scene_id
                 and (r.key in own or is_external(r.method))]
         tabled.update(r.key for r in mine)

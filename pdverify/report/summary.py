@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 from ..errors import InputError
 from ..results import time_s
+from ..terminal import printable
 
 #: The error each scene is ranked by (a scene may set ``headline``).
 HEADLINE_DEFAULT = "rel_l2_error"
@@ -30,6 +31,8 @@ def headline_value(scene, result):
 def default_run(scene, method, runs):
     """The run of ``method`` at its default params, else its first run."""
     mine = [r for r in runs if r.method == method]
+    if not mine:          # (nothing to resolve: a method that did not run is not called)
+        return None
     try:
         defaults = scene.resolve(method, {})
     except InputError:
@@ -94,7 +97,9 @@ def summarise(scene, runs) -> SceneSummary:
         scene=scene.id, metric=headline(scene), best=best,
         best_error=values.get(best), runs=len(runs),
         best_time_s=time_s(picked[best].timings) if best else None,
-        failed=[(r.method, r.message) for r in runs if r.counts_as_failure],
+        # (shown on the terminal: the names and messages of included records escaped)
+        failed=[(printable(r.method), printable(r.message)) for r in runs
+                if r.counts_as_failure],
         expected=sum(r.outcome == "expected-failure" for r in runs))
 
 

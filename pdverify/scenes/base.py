@@ -381,6 +381,11 @@ class Scene:
             # accepted as a bond method (the params of ``none``): its run is a failed run
             # naming the plugin and what it did (see :meth:`run`)
             return MethodSpec(name, self.baseline_spec().params)
+        from ..corrections.registry import broken_method
+        why = broken_method(name)
+        if why:
+            raise InputError(f"{self.id}: method {name!r} is a plugin that failed to load: "
+                             f"{why}")
         allowed = [m.name for m in self.all_methods]
         raise InputError(f"{self.id}: method {name!r}{did_you_mean(name, allowed)} is not "
                          f"supported by this scene; allowed: {', '.join(allowed)}")
@@ -484,7 +489,14 @@ class Scene:
 
         Bad input raises :class:`InputError` before any work starts.
         """
-        params = self.resolve(method, overrides)
+        from ..corrections.registry import PluginCheckError
+        try:
+            params = self.resolve(method, overrides)
+        except PluginCheckError as exc:   # the plugin's check failed, not the user's input
+            return RunResult(scene=self.id, method=method, params=dict(overrides or {}),
+                             reference=self.reference, status="failed",
+                             message=f"{self.id}/{method}: {exc}",
+                             timings={"setup_s": 0.0, "solve_s": 0.0, "total_s": 0.0})
         result = RunResult(scene=self.id, method=method, params=params, reference=self.reference,
                            expected_failure=next((e.reason for e in self.expected_failures
                                                   if e.applies(method, params)), ""),

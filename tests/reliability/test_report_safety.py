@@ -101,9 +101,9 @@ def test_killed_reports_leave_the_previous_one_intact(tmp_path, env):
             before = {n: (out / n).read_bytes() for n in ("results.json", "index.html")}
             assert sorted(os.listdir(out / "figures")) == figures
             continue
-        # 130: SIGTERM unwound the report; -15: it arrived while the interpreter was
+        # 143: SIGTERM unwound the report; -15: it arrived while the interpreter was
         # exiting after a finished report (handlers are reset then); -9: SIGKILL
-        assert p.returncode in (130, -signal.SIGTERM, -signal.SIGKILL), (p.returncode,
+        assert p.returncode in (143, -signal.SIGTERM, -signal.SIGKILL), (p.returncode,
                                                                        err[-300:])
         now = {n: (out / n).read_bytes() for n in before}
         assert sorted(os.listdir(out / "figures")) == figures
@@ -121,7 +121,7 @@ def test_killed_reports_leave_the_previous_one_intact(tmp_path, env):
     # timing (the fractions above land there only when the machine's load holds still)
     for sig in (signal.SIGTERM, signal.SIGKILL):
         p, err = _kill_after_last_run(out, sig, env)
-        assert p.returncode in (130, -signal.SIGTERM, -signal.SIGKILL), (p.returncode,
+        assert p.returncode in (143, -signal.SIGTERM, -signal.SIGKILL), (p.returncode,
                                                                        err[-300:])
         now = {n: (out / n).read_bytes() for n in before}
         assert sorted(os.listdir(out / "figures")) == figures
