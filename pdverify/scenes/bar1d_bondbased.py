@@ -26,7 +26,7 @@ from ..solvers.modal import exact_stability_limit, min_angular_frequency
 from ..solvers.front import solve_constrained
 from ..quotes import Quote as Q
 from . import Outcome, Published, Scene, register
-from .base import truncation_problem
+from .base import Discretisation, truncation_problem
 
 
 #: Cross-section A [m^2]. It cancels in every metric (c1 ~ 1/A, forces ~ A); kept so that
@@ -134,6 +134,12 @@ class BondBarScene(Scene):
     seed = "004"
     dim = 1
     closure_theory = "bond-based"
+
+    def discretisation(self, p):
+        """``nodes`` points over ``length`` (Delta = length / (nodes - 1)), delta =
+        horizon_ratio x Delta (as horizon_ratio x length / (nodes - 1))."""
+        return Discretisation(p["length"] / (p["nodes"] - 1),
+                              p["horizon_ratio"] * p["length"] / (p["nodes"] - 1))
 
     def min_nodes(self, m: int) -> int:
         """Smallest allowed ``nodes``: every bar needs 2m + 1 points, one horizon family."""

@@ -12,6 +12,7 @@ from ..pd.build import Body, BondMaterial
 from ..pd.influence import bond_based_nu
 from ..pd.problem import BondProblem, PartCondition
 from . import Outcome, Published, register
+from .base import Discretisation
 from .bondfamily import PAPER, PD_COMMON, BondStaticScene, check_horizon_grid
 from ..quotes import Quote as Q
 
@@ -339,6 +340,13 @@ class ClampedSheet(SheetScene):
                   deviation="003-table2-quadrature",
                   reproduced=_table2("8.73")),
     )
+
+    def discretisation(self, p):
+        """Delta = horizon / m_ratio, delta = horizon, on a side L = side_factor x delta:
+        relative to L, delta / L = 1 / side_factor and Delta / L = 1 / (side_factor m)."""
+        return Discretisation(p["horizon"] / p["m_ratio"], p["horizon"],
+                              relative=(1.0 / (p["side_factor"] * p["m_ratio"]),
+                                        1.0 / p["side_factor"]))
 
     def estimate_pd(self, method, p):
         m = p["m_ratio"]
