@@ -59,3 +59,14 @@ def test_parameter_surface_unchanged():
     assert sorted(after) == sorted(before)
     for sid in before:
         assert after[sid] == before[sid], sid
+
+
+def test_shared_quantities_declared_once():
+    """E, nu, spacing, m_ratio and horizon are declared by the shared parameter sets of
+    pdverify/params.py only, never by a scene module (a scene passes its defaults)."""
+    import re
+    pattern = re.compile(r"""Param\(\s*["'](E|nu|spacing|m_ratio|horizon|thickness)["']""")
+    scenes = Path(__file__).parents[1] / "pdverify" / "scenes"
+    found = [f"{path.name}: {m.group(0)}" for path in sorted(scenes.glob("*.py"))
+             for m in pattern.finditer(path.read_text())]
+    assert not found, found

@@ -16,7 +16,7 @@ from .. import budget
 from ..errors import InputError, NumericalError
 from ..metrics import fitted_frequency, max_error_of_peak_pct, rel_l2_error
 from ..papers_data import Formula, load_tables
-from ..params import Param, at_least, positive
+from ..params import Param, at_least, positive, youngs_modulus
 from ..pd import build_stencil, get_influence
 from ..pd.bar1d import bar_micromodulus, micromodulus_factor, split_horizon_ratio
 from ..pd.build import Body, BondMaterial
@@ -59,7 +59,7 @@ def bar_params(horizon_ratio=4.0, E=1.0):
         Param("calibration", "discrete", "c1 from the discrete horizon, Eqs. (14)/(22), or the "
               "continuum c_inf (6E/(A delta^2), constant 2E/(A delta^2))",
               choices=("discrete", "continuum")),
-        Param("E", E, "Young's modulus [Pa]", positive),
+        youngs_modulus(E),
     )
 
 
