@@ -35,7 +35,6 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 
@@ -46,16 +45,16 @@ EXACT = 1e-10
 
 @dataclass(frozen=True)
 class Study:
-    """One refinement of one scene: ``levels`` are parameter overrides, coarsest first;
-    ``h_of`` maps a level to the refined length h (the horizon for a delta-refinement,
-    the spacing for an m-refinement, or those over the body's size where the scene is
-    given in relative terms); ``fixed`` says what stays fixed, ``h_label`` names h."""
+    """One refinement of one scene: ``levels`` are overrides of the scene's own
+    parameters, coarsest first. A level's refined length h is the horizon delta (a
+    delta-refinement) or the grid spacing Delta (an m-refinement) as the scene states them
+    in its one vocabulary, :meth:`~pdverify.scenes.base.Scene.discretisation`; or those
+    over the body's size where the scene's size is itself a multiple of delta
+    (``Discretisation.relative``). :meth:`fixed_in` says what stays fixed,
+    :attr:`h_label` names h."""
     scene: str
     kind: str                  # "delta" (fixed m) or "m" (fixed delta)
     levels: tuple              # overrides per level, coarsest first
-    h_of: Callable[[dict], float]
-    fixed: str
-    h_label: str
     metric: str = "rel_l2_error"
     #: methods the study leaves out, each for a stated cost (the scene's own cases run them)
     skip: tuple = ()
@@ -63,11 +62,33 @@ class Study:
     #: report (None: those two; (): the study is left out of ``--quick``); the full
     #: report always runs :attr:`levels`
     quick_levels: tuple | None = None
-    #: what stays fixed in :attr:`quick_levels` where it differs from :attr:`fixed`
-    quick_fixed: str | None = None
+    #: how the fixed m-ratio is written where the scene's paper writes it otherwise
+    m_name: str = "m"
+
+    def grid(self, level: dict):
+        """The level's :class:`~pdverify.scenes.base.Discretisation`: the scene's
+        parameters with the level's overrides, those of its uncorrected model where its
+        methods differ in them (plate2d-clamped's FEM reference has a spacing of its own)."""
+        from .scenes import get_scene
+        scene = get_scene(self.scene)
+        method = scene.baseline_spec().name or scene.all_methods[0].name
+        return scene.discretisation(scene.resolve(method, level))
+
+    @property
+    def relative(self) -> bool:
+        return self.grid(self.levels[0]).relative is not None
+
+    @property
+    def h_label(self) -> str:
+        if self.relative:
+            return "delta / L (side L)" if self.kind == "delta" else "Delta / L (side L)"
+        return "horizon delta [m]" if self.kind == "delta" else "grid spacing Delta [m]"
 
     def h(self, level: dict) -> float:
-        return float(self.h_of(level))
+        d = self.grid(level)
+        if d.relative is not None:
+            return float(d.relative[1] if self.kind == "delta" else d.relative[0])
+        return float(d.delta if self.kind == "delta" else d.h)
 
     def used_levels(self, quick: bool) -> tuple:
         if not quick:
@@ -75,29 +96,29 @@ class Study:
         return self.levels[:2] if self.quick_levels is None else self.quick_levels
 
     def fixed_in(self, quick: bool) -> str:
-        """What stays fixed in the levels of :meth:`used_levels`."""
-        return self.quick_fixed if quick and self.quick_fixed is not None else self.fixed
+        """What stays fixed in the levels of :meth:`used_levels`: the m-ratio of a
+        delta-refinement, the horizon (or its ratio to the body's size) of an
+        m-refinement; a ValueError where the levels do not keep it fixed."""
+        grids = [self.grid(level) for level in self.used_levels(quick) or self.levels]
+        if self.kind == "delta":
+            held = {round(g.m, 9) for g in grids}
+            text = f"{self.m_name} = {grids[0].m:g}"
+        elif grids[0].relative is not None:
+            held = {round(g.relative[1], 12) for g in grids}
+            text = f"delta / L = 1/{1.0 / grids[0].relative[1]:g}"
+        else:
+            held = {round(g.delta, 12) for g in grids}
+            text = f"delta = {grids[0].delta:g}"
+        if len(held) > 1:
+            raise ValueError(f"{self.scene}: the levels of a {self.kind}-refinement"
+                             f"{' (--quick)' if quick else ''} do not keep "
+                             f"{'m' if self.kind == 'delta' else 'delta'} fixed")
+        return text
 
 
-def _mratio(scene, kind, levels, skip=(), quick=None):
-    """Levels given as spacing and m_ratio (delta = m_ratio x spacing); ``quick``: the
-    levels of ``--quick`` likewise (:attr:`Study.quick_levels`)."""
-    lv = tuple({"spacing": h, "m_ratio": float(m)} for h, m in levels)
-    ql = None if quick is None else tuple({"spacing": h, "m_ratio": float(m)}
-                                          for h, m in quick)
-    if kind == "delta":
-        if ql is not None and len({q["m_ratio"] for q in ql}) > 1:
-            raise ValueError(f"{scene}: a delta-refinement's quick levels share one m_ratio")
-        return Study(scene, kind, lv, lambda p: p["spacing"] * p["m_ratio"],
-                     f"m = {lv[0]['m_ratio']:g}", "horizon delta [m]", skip=skip,
-                     quick_levels=ql,
-                     quick_fixed=f"m = {ql[0]['m_ratio']:g}" if ql else None)
-    if ql is not None and len({round(q["spacing"] * q["m_ratio"], 12) for q in ql}) > 1:
-        raise ValueError(f"{scene}: an m-refinement's quick levels share one delta")
-    return Study(scene, kind, lv, lambda p: p["spacing"],
-                 f"delta = {lv[0]['spacing'] * lv[0]['m_ratio']:g}", "grid spacing Delta [m]",
-                 skip=skip, quick_levels=ql,
-                 quick_fixed=f"delta = {ql[0]['spacing'] * ql[0]['m_ratio']:g}" if ql else None)
+def _levels(names, values) -> tuple:
+    """Levels as dicts of the scene's own parameters ``names`` (the papers' spelling)."""
+    return tuple(dict(zip(names, v)) for v in values)
 
 
 #: seed 000's fictitious nodes in 3D: 35-40 s and 2 GB a run at h = 0.05, near-singular on
@@ -106,79 +127,60 @@ def _mratio(scene, kind, levels, skip=(), quick=None):
 COSTLY_3D = ("taylor-fictitious",)
 
 
-def _sheet(kind, levels):
-    """sheet2d-tension: the spacing and the horizon are parameters, the sheet is fixed."""
-    lv = tuple({"spacing": h, "horizon": d} for h, d in levels)
-    if kind == "delta":
-        return Study("sheet2d-tension", kind, lv, lambda p: p["horizon"],
-                     f"m = {lv[0]['horizon'] / lv[0]['spacing']:g}", "horizon delta [m]")
-    return Study("sheet2d-tension", kind, lv, lambda p: p["spacing"],
-                 f"delta = {lv[0]['horizon']:g}", "grid spacing Delta [m]")
-
-
-def _clamped(kind, levels, quick=None):
-    """sheet2d-clamped: the side is side_factor x delta and the load a strain, so the
-    relative errors depend only on delta / L = 1 / side_factor and m; a delta-refinement
-    at a fixed sheet is a growing side_factor. ``quick``: the levels of ``--quick``
-    (:attr:`Study.quick_levels`), a delta-refinement at the same m."""
-    lv = tuple({"side_factor": float(s), "m_ratio": float(m)} for s, m in levels)
-    if kind == "delta":
-        ql = None if quick is None else tuple({"side_factor": float(s), "m_ratio": float(m)}
-                                              for s, m in quick)
-        if ql is not None and len({q["m_ratio"] for q in ql}) > 1:
-            raise ValueError("sheet2d-clamped: a delta-refinement's quick levels share one "
-                             "m_ratio")
-        return Study("sheet2d-clamped", kind, lv, lambda p: 1.0 / p["side_factor"],
-                     f"m = {lv[0]['m_ratio']:g}", "delta / L (side L)", quick_levels=ql,
-                     quick_fixed=None if ql is None else f"m = {ql[0]['m_ratio']:g}")
-    return Study("sheet2d-clamped", kind, lv,
-                 lambda p: 1.0 / (p["side_factor"] * p["m_ratio"]),
-                 f"delta / L = 1/{lv[0]['side_factor']:g}", "Delta / L (side L)")
-
-
-def _vibration(kind, levels):
-    """bar1d-vibration: N points on L = 1 (spacing 1 / (N - 1)), delta = ratio x spacing."""
-    lv = tuple({"nodes": int(n), "horizon_ratio": float(r)} for n, r in levels)
-    if kind == "delta":
-        return Study("bar1d-vibration", kind, lv,
-                     lambda p: p["horizon_ratio"] / (p["nodes"] - 1),
-                     f"delta / Delta = {lv[0]['horizon_ratio']:g}", "horizon delta [m]")
-    return Study("bar1d-vibration", kind, lv, lambda p: 1.0 / (p["nodes"] - 1),
-                 f"delta = {lv[0]['horizon_ratio'] / (lv[0]['nodes'] - 1):g}",
-                 "grid spacing Delta [m]")
+def _m(scene, kind, levels, skip=(), quick=None):
+    """A study of a scene whose grid is its ``spacing`` and ``m_ratio``; ``levels`` and
+    ``quick`` are (spacing, m_ratio) pairs."""
+    names = ("spacing", "m_ratio")
+    as_float = [(h, float(m)) for h, m in levels]
+    return Study(scene, kind, _levels(names, as_float), skip=skip,
+                 quick_levels=None if quick is None else _levels(
+                     names, [(h, float(m)) for h, m in quick]))
 
 
 STUDIES = (
-    _mratio("bar1d-sine-load", "delta", [(h, 3) for h in (0.1, 0.05, 0.025, 0.0125)]),
-    _mratio("bar1d-sine-load", "m", [(0.15 / m, m) for m in (3, 6, 12, 24)]),
-    # seed 004: the homogenised bond bar; free-end history against Rao's series
-    _vibration("delta", [(n, 4) for n in (26, 51, 101, 201)]),
-    _vibration("m", [(int(12.5 * r) + 1, r) for r in (2, 4, 8, 16)]),   # delta = 0.08
+    _m("bar1d-sine-load", "delta", [(h, 3) for h in (0.1, 0.05, 0.025, 0.0125)]),
+    _m("bar1d-sine-load", "m", [(0.15 / m, m) for m in (3, 6, 12, 24)]),
+    # seed 004: the homogenised bond bar (N points on L = 1, delta = horizon_ratio x
+    # Delta); free-end history against Rao's series
+    Study("bar1d-vibration", "delta", _levels(("nodes", "horizon_ratio"),
+                                              [(n, 4.0) for n in (26, 51, 101, 201)]),
+          m_name="delta / Delta"),
+    Study("bar1d-vibration", "m", _levels(("nodes", "horizon_ratio"),   # delta = 0.08
+                                          [(int(12.5 * r) + 1, float(r))
+                                           for r in (2, 4, 8, 16)])),
     # seed 003: bond-based sheets (the directional, energy, volume, perifit corrections)
-    _sheet("delta", [(d / 4, d) for d in (0.01, 0.005, 0.0025)]),   # even spacings a side
-    _sheet("m", [(0.005 / m, 0.005) for m in (2, 4, 8)]),
+    Study("sheet2d-tension", "delta", _levels(("spacing", "horizon"),   # even spacings a side
+                                              [(d / 4, d) for d in (0.01, 0.005, 0.0025)])),
+    Study("sheet2d-tension", "m", _levels(("spacing", "horizon"),
+                                          [(0.005 / m, 0.005) for m in (2, 4, 8)])),
+    # sheet2d-clamped: the side is side_factor x delta and the load a strain, so the
+    # relative errors depend only on delta / L = 1 / side_factor and m; a delta-refinement
+    # at a fixed sheet is a growing side_factor.
     # 16: 10 s a run; --quick at m = 3 (side 8: 0.5 s for its six methods, 6.9 s at m = 6;
     # issue 32), its side 4 the m-refinement's first level
-    _clamped("delta", [(s, 6) for s in (4, 8, 12)], quick=[(4, 3), (8, 3)]),
-    _clamped("m", [(4, m) for m in (3, 6, 12)]),
+    Study("sheet2d-clamped", "delta", _levels(("side_factor", "m_ratio"),
+                                              [(float(s), 6.0) for s in (4, 8, 12)]),
+          quick_levels=_levels(("side_factor", "m_ratio"), [(4.0, 3.0), (8.0, 3.0)])),
+    Study("sheet2d-clamped", "m", _levels(("side_factor", "m_ratio"),
+                                          [(4.0, float(m)) for m in (3, 6, 12)])),
     # seed 000 §6: the scene's own sweeps (same levels, so no extra runs in a full report)
-    _mratio("plate2d-clamped", "delta", [(h, 3) for h in (0.2, 0.1, 0.05)]),
+    _m("plate2d-clamped", "delta", [(h, 3) for h in (0.2, 0.1, 0.05)]),
     # --quick at delta = 0.4 (h = 0.2 at m = 2, 0.1 at m = 4: 1.5 s for the eight methods;
     # 3.5 s at delta = 0.2, whose h = 1/15 level took 3.1 s; issue 32)
-    _mratio("plate2d-clamped", "m", [(0.2 / m, m) for m in (2, 3, 4)],
-            quick=[(0.2, 2), (0.1, 4)]),
-    _mratio("plate2d-plane-strain", "delta", [(h, 3) for h in (0.1, 0.05, 0.025, 0.0125)]),
-    _mratio("plate2d-plane-strain", "m", [(0.2 / m, m) for m in (2, 4, 8)]),
+    _m("plate2d-clamped", "m", [(0.2 / m, m) for m in (2, 3, 4)],
+       quick=[(0.2, 2), (0.1, 4)]),
+    _m("plate2d-plane-strain", "delta", [(h, 3) for h in (0.1, 0.05, 0.025, 0.0125)]),
+    _m("plate2d-plane-strain", "m", [(0.2 / m, m) for m in (2, 4, 8)]),
     # --quick (issue 32: the quick report in 30 s on 2 cores): the delta-refinement at
     # h = 0.1 (the scene's own quick runs) and 1/12 (6 cells a side, 0.5-4 s a run),
     # not 0.0625 (1-6.5 s a run, 16 s in all); the m-refinement is left out: its finer
     # level, h = 1/18 at m = 3, took 30 s of the quick report's 111 s of runs (surface
     # nodes alone 12 s), and no cheaper pair of whole m-ratios at one delta exists on the
     # 1 x 0.5 x 0.5 box (order-3 surface nodes need 5 cells a side, whole m-ratios)
-    _mratio("body3d-manufactured", "delta", [(h, 3) for h in (0.1, 0.0625, 0.05)],
-            skip=COSTLY_3D, quick=[(0.1, 3), (1 / 12, 3)]),
-    _mratio("body3d-manufactured", "m", [(1 / (6 * m), m) for m in (2, 3)], skip=COSTLY_3D,
-            quick=[]),
+    _m("body3d-manufactured", "delta", [(h, 3) for h in (0.1, 0.0625, 0.05)],
+       skip=COSTLY_3D, quick=[(0.1, 3), (1 / 12, 3)]),
+    _m("body3d-manufactured", "m", [(1 / (6 * m), m) for m in (2, 3)], skip=COSTLY_3D,
+       quick=[]),
 )
 
 

@@ -142,6 +142,53 @@ def open_interval(lo, hi) -> Check:
     return check
 
 
+# -- the shared parameter sets: each name declared once, with the scene's defaults -----
+# Every scene states its material and its grid with these (issue 51): one name, one unit,
+# one check per quantity; a scene passes its paper's defaults and, where its paper says
+# more (a table, a node count), a ``note`` appended to the shared help text. The grid's
+# names are the papers' and the command line's; the scenes translate them to one
+# (h, delta) in metres in ``Scene.discretisation``.
+
+def _doc(text: str, note: str) -> str:
+    return f"{text} ({note})" if note else text
+
+
+def youngs_modulus(default: float, note: str = "") -> Param:
+    return Param("E", default, _doc("Young's modulus [Pa]", note), positive)
+
+
+def poisson_ratio(default: float = 0.3, note: str = "") -> Param:
+    return Param("nu", default, _doc("Poisson's ratio", note), open_interval(-1.0, 0.5))
+
+
+def material_params(E: float, nu: float | None = None, note: str = "") -> tuple[Param, ...]:
+    """``E`` [Pa] and, where the scene's model has one, Poisson's ratio ``nu``."""
+    return (youngs_modulus(E, note),) + (() if nu is None else (poisson_ratio(nu),))
+
+
+def spacing_param(default: float, note: str = "") -> Param:
+    return Param("spacing", default, _doc("grid spacing Delta [m]", note), positive)
+
+
+def horizon_param(default: float, note: str = "") -> Param:
+    return Param("horizon", default, _doc("horizon delta [m]", note), positive)
+
+
+def m_ratio_param(default: float, least: float = 1.0, note: str = "") -> Param:
+    """The m-ratio delta / Delta; ``least``: the smallest the scene's grid takes (its
+    type as the scene's check reports it: ``>= 1`` for an integer ratio)."""
+    return Param("m_ratio", default, _doc("m-ratio delta / Delta (horizon / spacing)", note),
+                 at_least(least))
+
+
+def grid_params(spacing: float, m_ratio: float, least_m: float = 1.0,
+                note: str = "") -> tuple[Param, ...]:
+    """A grid stated as ``spacing`` and ``m_ratio`` (delta = m_ratio x spacing), the most
+    common spelling; the others combine :func:`spacing_param`, :func:`horizon_param` and
+    :func:`m_ratio_param`."""
+    return spacing_param(spacing, note), m_ratio_param(m_ratio, least_m)
+
+
 def resolve(specs: tuple[Param, ...], overrides: Mapping[str, Any], where: str) -> dict:
     """Defaults of ``specs`` updated with converted, checked ``overrides``.
 

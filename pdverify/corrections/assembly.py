@@ -26,7 +26,7 @@ from scipy.spatial import cKDTree
 
 from ..pd import StateBasedModel
 from ..pd.build import build_model
-from ..pd.problem import FACES, LinearSystem
+from ..pd.problem import FACES, LinearSystem, face_number
 
 
 def model_of(problem, grid, closure) -> StateBasedModel:
@@ -128,7 +128,8 @@ def eliminated(model, K, rhs, fixed, values, solver, nodes, by_face, **extra):
     react = residual_reaction(K, rhs)
     return LinearSystem(model, K, rhs, fixed, values, model.n_unknown_nodes, solver=solver,
                         coords=None if solver == "direct" else unknown_coords(model, nodes),
-                        reaction=lambda x, face: react(x, face, by_face.__getitem__), **extra)
+                        reaction=lambda x, face: react(x, face_number(face), by_face.__getitem__),
+                        **extra)
 
 
 def _sorted(fixed, values):

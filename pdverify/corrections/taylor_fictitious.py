@@ -27,7 +27,7 @@ import scipy.sparse as sp
 
 from ..pd.bonds import unique_ids
 from ..pd.closure import Closure, real_identity, with_rows
-from ..pd.problem import FACES, LinearSystem
+from ..pd.problem import FACES, LinearSystem, face_number
 from ..solvers.policy import static_solver
 from .assembly import boundary_nodes, model_of, shape_counts, side_sign, unknown_coords
 from .shape_fictitious import condition_rows, normal_closure
@@ -91,21 +91,23 @@ def fictitious_closure(grid, order: int) -> Closure:
                    dilatation_map=extrapolation_map(grid, order - 1))
 
 
-def boundary_lines(grid, face: int) -> np.ndarray:
-    """Integer indices (n_lines, dim) of the real nodes nearest ``face`` (= 2 axis + side):
-    the anchor of each line perpendicular to that face."""
+def boundary_lines(grid, face: str) -> np.ndarray:
+    """Integer indices (n_lines, dim) of the real nodes nearest ``face`` (its name,
+    :data:`~pdverify.pd.problem.FACES`): the anchor of each line perpendicular to it."""
+    face = face_number(face)
     real = grid.index[grid.interior_ids]
     return real[real[:, face // 2] == grid.boundary_layer(face)]
 
 
-def boundary_value_rows(grid, order: int, face: int) -> tuple[sp.csr_matrix, np.ndarray]:
+def boundary_value_rows(grid, order: int, face: str) -> tuple[sp.csr_matrix, np.ndarray]:
     """Rows R (one per line perpendicular to ``face``) with R @ u_real = u at the boundary
     point of the line, by the 1D Taylor extrapolation of Eq. (58) from the ``order + 1``
     real nodes of the line nearest the face (the same rows serve every component,
     Remark 4). Returns ``(R, anchors)``, ``anchors`` the lines' boundary-node indices."""
     _check_size(grid, order)
-    axis, side = divmod(face, 2)
     anchors = boundary_lines(grid, face)
+    face = face_number(face)
+    axis, side = divmod(face, 2)
     inward = 1 if side == 0 else -1
     x_anchor = grid.x[grid.ext_id(anchors[:1]), axis][0]
     target = (grid.face_coordinate(face) - x_anchor) / grid.spacing   # in spacings
@@ -140,7 +142,7 @@ def yields_component(axis: int, other_axis: int, k: int) -> bool:
 
 
 def clamped_rows(grid, order: int, faces, corners: str = "normal-only"):
-    """Constraint rows of clamped ``faces``: the displacement at the boundary point of every
+    """Constraint rows of clamped ``faces`` (their names): the displacement at the boundary point of every
     line perpendicular to a face, by the Taylor extrapolation of Eq. (58), for every
     component (Remark 4), the corner lines by the rule ``corners`` (:data:`CORNER_RULES`).
 
@@ -149,12 +151,12 @@ def clamped_rows(grid, order: int, faces, corners: str = "normal-only"):
     """
     if corners not in CORNER_RULES:
         raise ValueError(f"corners={corners!r}; allowed: {', '.join(CORNER_RULES)}")
-    faces = sorted(set(faces))
+    faces = sorted({face_number(name) for name in faces})
     n, d = grid.n_interior, grid.dim
     blocks, points, comps = [], [], []
     for face in faces:
         axis = face // 2
-        R, anchors = boundary_value_rows(grid, order, face)
+        R, anchors = boundary_value_rows(grid, order, FACES[face])
         x = grid.x[grid.ext_id(anchors)]
         x[:, axis] = grid.face_coordinate(face)
         for k in range(d):
@@ -242,7 +244,7 @@ def assemble_taylor(problem, order: int, corners: str = "normal-only") -> Linear
     for face in range(2 * d):
         axis, side = divmod(face, 2)
         cond = problem.conditions.get(FACES[face])
-        R, anchors = boundary_value_rows(g, order, face)
+        R, anchors = boundary_value_rows(g, order, FACES[face])
         xb = g.x[g.ext_id(anchors)]
         xb[:, axis] = g.face_coordinate(face)
         exact = problem.exact(xb)
@@ -290,7 +292,7 @@ def assemble_taylor(problem, order: int, corners: str = "normal-only") -> Linear
     def reaction(x, face):
         if d != 1:
             raise ValueError("the Taylor reaction is defined for 1D bars only")
-        return float((model.crossing_selector([g.face_coordinate(face)]) @ K_b @ x[:ni])[0])
+        return float((model.crossing_selector([g.face_coordinate(face_number(face))]) @ K_b @ x[:ni])[0])
     counts = {"fictitious_nodes": int(g.n_ext - g.n_interior), "constraints": int(B.shape[0])}
     none = np.zeros(0, dtype=int), np.zeros(0)
     if solver == "direct":

@@ -223,8 +223,9 @@ class LinearSystem(_Unknowns):
     unknowns' coordinates (nested dissection). ``model``: the PD model (its grid's real
     nodes are the measured ones); ``extra_x``: positions of the extra unknown nodes
     (surface nodes), measured too when the scene asks. ``reaction(x, face)``: the normal
-    force the face transmits, tension positive, as the treatment defines it (the force
-    flux through the face, or the reactions of its prescribed unknowns). ``counts``:
+    force the face (its name, :data:`FACES`) transmits, tension positive, as the
+    treatment defines it (the force flux through the face, or the reactions of its
+    prescribed unknowns). ``counts``:
     node counts the treatment reports beside the size. ``offset``: the displacement
     ``(n_ext, d)`` of the grid's nodes that the unknowns do not carry (the mirror nodes'
     affine part); every grid node's displacement is the model's ``A_U_full`` applied to
@@ -243,7 +244,7 @@ class LinearSystem(_Unknowns):
     B: object | None = None
     c: np.ndarray | None = None
     extra_x: np.ndarray | None = None
-    reaction: Callable[[np.ndarray, int], float] | None = None
+    reaction: Callable[[np.ndarray, str], float] | None = None
     counts: dict = field(default_factory=dict)
     offset: np.ndarray | None = None
     #: SuperLU's column ordering when the treatment's system wants another than the

@@ -132,7 +132,7 @@ class StaticBar(StaticStateScene):
                    "rel_l2_error": rel_l2_error(u, u_ref)}
         if system.reaction is not None:
             total = self.total_load(p)
-            reaction = system.reaction(x, 0)
+            reaction = system.reaction(x, "x-")
             metrics["reaction_force"] = reaction
             metrics["reaction_error_pct"] = abs(reaction - total) / abs(total) * 100.0
         metrics["gap_nonlinearity"] = float(np.max(np.abs(d - fit)) / np.max(np.abs(u_ref)))

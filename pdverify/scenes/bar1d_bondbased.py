@@ -16,7 +16,7 @@ from .. import budget
 from ..errors import InputError, NumericalError
 from ..metrics import fitted_frequency, max_error_of_peak_pct, rel_l2_error
 from ..papers_data import Formula, load_tables
-from ..params import Param, at_least, positive
+from ..params import Param, at_least, positive, youngs_modulus
 from ..pd import build_stencil, get_influence
 from ..pd.bar1d import bar_micromodulus, micromodulus_factor, split_horizon_ratio
 from ..pd.build import Body, BondMaterial
@@ -26,7 +26,7 @@ from ..solvers.modal import exact_stability_limit, min_angular_frequency
 from ..solvers.front import solve_constrained
 from ..quotes import Quote as Q
 from . import Outcome, Published, Scene, register
-from .base import truncation_problem
+from .base import Discretisation, truncation_problem
 
 
 #: Cross-section A [m^2]. It cancels in every metric (c1 ~ 1/A, forces ~ A); kept so that
@@ -59,7 +59,7 @@ def bar_params(horizon_ratio=4.0, E=1.0):
         Param("calibration", "discrete", "c1 from the discrete horizon, Eqs. (14)/(22), or the "
               "continuum c_inf (6E/(A delta^2), constant 2E/(A delta^2))",
               choices=("discrete", "continuum")),
-        Param("E", E, "Young's modulus [Pa]", positive),
+        youngs_modulus(E),
     )
 
 
@@ -134,6 +134,12 @@ class BondBarScene(Scene):
     seed = "004"
     dim = 1
     closure_theory = "bond-based"
+
+    def discretisation(self, p):
+        """``nodes`` points over ``length`` (Delta = length / (nodes - 1)), delta =
+        horizon_ratio x Delta (as horizon_ratio x length / (nodes - 1))."""
+        return Discretisation(p["length"] / (p["nodes"] - 1),
+                              p["horizon_ratio"] * p["length"] / (p["nodes"] - 1))
 
     def min_nodes(self, m: int) -> int:
         """Smallest allowed ``nodes``: every bar needs 2m + 1 points, one horizon family."""

@@ -43,6 +43,27 @@ def conditioning_warnings(diagnostics: Mapping) -> list[str]:
 
 
 @dataclass(frozen=True)
+class Discretisation:
+    """A run's grid as every scene states it: the grid spacing ``h`` (Delta) and the
+    horizon ``delta``, both in metres (:meth:`Scene.discretisation`), whatever the
+    scene's own parameters are called (spacing, horizon, m_ratio, side_factor, nodes,
+    horizon_ratio: the papers' and the command line's names).
+
+    ``relative``: (Delta / L, delta / L) for a scene whose size L is itself stated as a
+    multiple of delta (sheet2d-clamped: L = side_factor x delta), computed from its
+    relative parameters as the scene states them; None for a body of fixed size."""
+
+    h: float
+    delta: float
+    relative: tuple[float, float] | None = None
+
+    @property
+    def m(self) -> float:
+        """The m-ratio delta / Delta."""
+        return self.delta / self.h
+
+
+@dataclass(frozen=True)
 class MethodSpec:
     """A method as a scene offers it: its name and the parameters it takes there."""
 
@@ -454,6 +475,21 @@ class Scene:
                              f"({estimate.detail}); no run of this size fits any memory")
         budget.check(where, estimate)
         return values
+
+    def discretisation(self, p: Mapping[str, Any]) -> Discretisation:
+        """The grid spacing and the horizon of the run of resolved params ``p``, in metres.
+
+        The default reads the spellings most scenes use: ``spacing`` with ``m_ratio``
+        (delta = m_ratio x spacing) or with ``horizon``, or ``horizon`` with ``m_ratio``
+        (Delta = horizon / m_ratio); a scene that states its grid otherwise overrides it."""
+        if "spacing" in p and "m_ratio" in p:
+            return Discretisation(p["spacing"], p["spacing"] * p["m_ratio"])
+        if "spacing" in p and "horizon" in p:
+            return Discretisation(p["spacing"], p["horizon"])
+        if "horizon" in p and "m_ratio" in p:
+            return Discretisation(p["horizon"] / p["m_ratio"], p["horizon"])
+        raise NotImplementedError(f"{self.id}: no grid spacing and horizon among its params "
+                                  f"({', '.join(p)}); the scene states its discretisation")
 
     def check(self, method: str, params: dict) -> None:
         """Cross-parameter checks; raise :class:`InputError` with a one-line message."""

@@ -8,7 +8,7 @@ import numpy as np
 
 from .. import budget
 from ..errors import InputError, NumericalError
-from ..params import Param, at_least, open_interval, positive
+from ..params import Param, at_least, horizon_param, open_interval, spacing_param
 from ..pd import get_influence
 from ..pd.build import Body, BondMaterial
 from ..pd.influence import bond_based_nu
@@ -194,8 +194,8 @@ class Indentation(BondStaticScene):
     params_class, function = "IndentationParams", "indentation"
     shared = ("width", "height", "radius", "depth", "n_steps", "E", "nu", "thickness")
     pd_params = (
-        Param("spacing", 0.00025, "node spacing Delta [m] (161 x 161 nodes)", positive),
-        Param("horizon", 0.0015, "horizon delta [m] (m = 6)", positive),
+        spacing_param(0.00025, "161 x 161 nodes"),
+        horizon_param(0.0015, "m = 6"),
         *(q for q in PD_COMMON if q.name != "solver"),
         Param("solver", "auto", "linear solver of each Newton step: direct (sparse LU), cg "
               "(conjugate gradients, two-level smoothed aggregation one horizon wide, built "

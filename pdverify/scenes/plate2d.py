@@ -6,7 +6,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..metrics import plate_errors
-from ..params import Param, at_least, positive
+from ..params import Param, grid_params
 from ..pd import QUADRATURES, StateBasedConstants, get_influence, state_based_stencil
 from ..pd.problem import FACES, FaceCondition, StaticProblem
 from ..quotes import Quote as Q
@@ -120,8 +120,7 @@ class ClampedPlate(FemStaticStateScene):
     params_class, function = "PlateParams", "clamped_plate"
     shared = ("length", "width", "thickness", "E", "nu", "body_force")
     pd_params = (
-        Param("spacing", 0.1, "PD grid spacing Delta [m] (Table 4; 30 x 20 nodes)", positive),
-        Param("m_ratio", 3.0, "horizon / spacing (Table 4)", at_least(1.0)),
+        *grid_params(0.1, 3.0, note="Table 4; 30 x 20 nodes"),
         influence_param("hyperbolic", "seed 000, Eq. 23: delta / |xi|"),
         Param("quadrature", "partial-volume", "weights beta: exact cell fractions inside the "
               "horizon, or those adjusted to an isotropic fourth moment (our addition)",

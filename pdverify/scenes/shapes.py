@@ -14,7 +14,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..metrics import region_errors, rel_l2_error
-from ..params import Param, at_least, positive
+from ..params import Param, at_least, grid_params
 from ..pd import QUADRATURES, StateBasedConstants, get_influence, state_based_stencil
 from ..pd.problem import FaceCondition, StaticProblem
 from ..pd.shapes import l_shape, quarter_hole
@@ -65,8 +65,7 @@ class ShapeScene(FemStaticStateScene):
     #: the boundary parts whose own error is reported (``shape_errors``)
     regions: tuple = ()
     pd_params = (
-        Param("spacing", 0.025, "PD grid spacing Delta [m]", positive),
-        Param("m_ratio", 3.0, "horizon / spacing", at_least(1.0)),
+        *grid_params(0.025, 3.0),
         influence_param("hyperbolic", "seed 000, Eq. 23: delta / |xi|"),
         Param("quadrature", "partial-volume", "weights beta: exact cell fractions inside the "
               "horizon, or those adjusted to an isotropic fourth moment",

@@ -6,12 +6,13 @@ import numpy as np
 from .. import budget
 from ..errors import InputError
 from ..metrics import rel_l2_error
-from ..params import Param, at_least, positive
+from ..params import Param, horizon_param, m_ratio_param, spacing_param
 from ..pd import get_influence
 from ..pd.build import Body, BondMaterial
 from ..pd.influence import bond_based_nu
 from ..pd.problem import BondProblem, PartCondition
 from . import Outcome, Published, register
+from .base import Discretisation
 from .bondfamily import PAPER, PD_COMMON, BondStaticScene, check_horizon_grid
 from ..quotes import Quote as Q
 
@@ -126,8 +127,8 @@ class TensionSheet(SheetScene):
     params_class, function = "TensionSheetParams", "tension_sheet"
     shared = ("width", "length", "traction", "E", "nu", "thickness")
     pd_params = (
-        Param("spacing", 0.001, "node spacing Delta [m] (51 x 101 nodes)", positive),
-        Param("horizon", 0.005, "horizon delta [m]", positive),
+        spacing_param(0.001, "51 x 101 nodes"),
+        horizon_param(0.005),
         *PD_COMMON,
         Param("load_sharing", "tributary", "end force per end node: by tributary length "
               "(corners half) or equal", choices=("tributary", "equal")),
@@ -310,8 +311,8 @@ class ClampedSheet(SheetScene):
     reference = "fem"
     params_class, function = "ClampedSheetParams", "clamped_sheet"
     shared = ("horizon", "side_factor", "strain", "E", "nu", "thickness")
-    pd_params = (Param("m_ratio", 6.0, "delta / Delta (the paper's m = 1/6 is Delta / delta)",
-                       at_least(0.0)), *PD_COMMON)
+    pd_params = (m_ratio_param(6.0, least=0.0,
+                                 note="the paper's m = 1/6 is Delta / delta"), *PD_COMMON)
     NODE_VOLUMES = Param("node_volumes", "partial", "volume of the nodes on the surface: half "
                          "on edges, a quarter at corners (ERRATA), or a full cell",
                          choices=("partial", "full"))
@@ -339,6 +340,13 @@ class ClampedSheet(SheetScene):
                   deviation="003-table2-quadrature",
                   reproduced=_table2("8.73")),
     )
+
+    def discretisation(self, p):
+        """Delta = horizon / m_ratio, delta = horizon, on a side L = side_factor x delta:
+        relative to L, delta / L = 1 / side_factor and Delta / L = 1 / (side_factor m)."""
+        return Discretisation(p["horizon"] / p["m_ratio"], p["horizon"],
+                              relative=(1.0 / (p["side_factor"] * p["m_ratio"]),
+                                        1.0 / p["side_factor"]))
 
     def estimate_pd(self, method, p):
         m = p["m_ratio"]

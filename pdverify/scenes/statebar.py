@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from .. import budget
 from ..errors import InputError
-from ..params import Param, at_least, open_interval, positive
+from ..params import Param, grid_params, material_params, positive
 from ..pd import StateBasedConstants, build_stencil, get_influence
 from ..pd.build import Body, StateMaterial, build_model
 from .base import cell_count, influence_param
@@ -15,10 +15,8 @@ from .base import cell_count, influence_param
 BAR_PARAMS = (
     Param("length", 1.0, "bar length l [m]", positive),
     Param("area", 0.01, "cross-section A [m^2]", positive),
-    Param("E", 1e9, "Young's modulus [Pa]", positive),
-    Param("nu", 0.3, "Poisson's ratio", open_interval(-1.0, 0.5)),
-    Param("spacing", 0.05, "grid spacing Delta [m]", positive),
-    Param("m_ratio", 3.0, "horizon / spacing", at_least(1.0)),
+    *material_params(1e9, 0.3),
+    *grid_params(0.05, 3.0),
     influence_param("hyperbolic", "seed 000, Eq. 23: delta / |xi|"),
     Param("quadrature", "partial-volume", "volume fractions beta: partial-volume (seed 000: "
           "the fraction of each cell inside the horizon, 1/2 for the node at |xi| = delta "

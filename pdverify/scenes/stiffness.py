@@ -32,7 +32,8 @@ import itertools
 import numpy as np
 
 from .. import budget
-from ..params import Param, at_least, open_interval, positive
+from ..params import (Param, grid_params, m_ratio_param, material_params, positive,
+                      spacing_param, youngs_modulus)
 from ..pd import (StateBasedConstants, bond_micromodulus, build_stencil, get_influence,
                   state_based_stencil)
 from ..pd.build import Body, BondMaterial, StateMaterial, build_model
@@ -202,9 +203,8 @@ class SheetStiffness(StiffnessScene):
     params = (
         Param("width", 0.05, "sheet width [m]", positive),
         Param("length", 0.1, "sheet length [m]", positive),
-        Param("spacing", 0.001, "node spacing [m]", positive),
-        Param("m_ratio", 5.0, "horizon / spacing", at_least(2.0)),
-        Param("E", 1e9, "Young's modulus [Pa] (scales W and W_bulk alike)", positive),
+        *grid_params(0.001, 5.0, least_m=2.0),
+        youngs_modulus(1e9, "scales W and W_bulk alike"),
         Param("micromodulus", "constant", "c(xi): constant (seed 003) or conical",
               choices=("constant", "conical")),
         Param("quadrature", "full-cells", "horizon quadrature (see sheet2d-tension)",
@@ -356,9 +356,8 @@ class _StateStiffness(StiffnessScene, StaticStateScene):
 
 
 STATE_PARAMS = (
-    Param("E", 200e9, "Young's modulus [Pa]", positive),
-    Param("nu", 0.3, "Poisson's ratio", open_interval(-1.0, 0.5)),
-    Param("m_ratio", 3.0, "horizon / spacing", at_least(1.0)),
+    *material_params(200e9, 0.3),
+    m_ratio_param(3.0),
     Param("quadrature", "partial-volume", "weights beta (see body3d-traction)",
           choices=("partial-volume", "moment-corrected")),
     Param("influence", "gaussian", "influence function (seed 001, Eq. 7: Gaussian)",
@@ -370,7 +369,7 @@ STATE_PARAMS = (
 BOX_PARAMS = (Param("lx", 1.0, "box length [m]", positive),
               Param("ly", 0.5, "box size l_y [m]", positive),
               Param("lz", 0.5, "box size l_z [m]", positive),
-              Param("spacing", 0.05, "grid spacing h [m]", positive))
+              spacing_param(0.05))
 
 
 def box_lengths(p):
@@ -442,8 +441,8 @@ class BondBoxStiffness(StiffnessScene):
     dim = 3
     quick_overrides = {"spacing": 0.1}
     params = BOX_PARAMS + (
-        Param("m_ratio", 3.0, "horizon / spacing", at_least(1.0)),
-        Param("E", 200e9, "Young's modulus [Pa] (scales W and W_bulk alike)", positive),
+        m_ratio_param(3.0),
+        youngs_modulus(200e9, "scales W and W_bulk alike"),
         Param("micromodulus", "constant", "c(xi): constant or conical",
               choices=("constant", "conical")),
         Param("quadrature", "full-cells", "horizon quadrature: whole cells (perifit's view) "
@@ -484,7 +483,7 @@ class PlateStiffness(_StateStiffness):
     quick_overrides = {"spacing": 0.05}
     params = (Param("lx", 1.0, "plate width [m]", positive),
               Param("ly", 1.0, "plate height [m]", positive),
-              Param("spacing", 0.02, "grid spacing h [m]", positive)) + STATE_PARAMS
+              spacing_param(0.02)) + STATE_PARAMS
 
     def lengths(self, p):
         return (p["lx"], p["ly"])

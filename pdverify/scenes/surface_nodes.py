@@ -8,7 +8,7 @@ import numpy as np
 from manufactured import surface3d as closed
 
 from ..metrics import error_metrics, surface_error_pct
-from ..params import Param, at_least, open_interval, positive
+from ..params import Param, grid_params, material_params, positive
 from ..pd import QUADRATURES, StateBasedConstants, get_influence, state_based_stencil
 from ..pd.problem import FaceCondition, StaticProblem
 from ..solvers.policy import ND3D_FROM_UNKNOWNS, ND_FROM_UNKNOWNS, STATIC_SOLVERS
@@ -199,10 +199,8 @@ BODY_PARAMS = (
     Param("lx", 1.0, "body length l_x along x [m] (ERRATA seed 001: Table 1 missing)", positive),
     Param("ly", 0.5, "body size l_y [m], y centred on 0", positive),
     Param("lz", 0.5, "body size l_z [m], z centred on 0", positive),
-    Param("E", 200e9, "Young's modulus [Pa]", positive),
-    Param("nu", 0.3, "Poisson's ratio", open_interval(-1.0, 0.5)),
-    Param("spacing", 0.05, "grid spacing h [m]", positive),
-    Param("m_ratio", 3.0, "horizon / spacing", at_least(1.0)),
+    *material_params(200e9, 0.3),
+    *grid_params(0.05, 3.0),
     QUADRATURE,
     INFLUENCE,
     GEOMETRY,
@@ -567,10 +565,8 @@ class Plate2DPlaneStrain(SurfaceNodeScene):
     params = (
         Param("lx", 1.0, "plate width [m] (ERRATA seed 001: Table 2 missing)", positive),
         Param("ly", 1.0, "plate height [m]", positive),
-        Param("E", 200e9, "Young's modulus [Pa]", positive),
-        Param("nu", 0.3, "Poisson's ratio", open_interval(-1.0, 0.5)),
-        Param("spacing", 0.02, "grid spacing h [m]", positive),
-        Param("m_ratio", 3.0, "horizon / spacing", at_least(1.0)),
+        *material_params(200e9, 0.3),
+        *grid_params(0.02, 3.0),
         Param("traction", 240e6, "traction p on y = l_y [Pa]", positive),
         Param("plane", "strain", "plane strain (the paper) or plane stress",
               choices=("strain", "stress")),

@@ -20,7 +20,7 @@ import scipy.sparse as sp
 from .. import budget
 from ..errors import InputError, NumericalError
 from ..metrics import max_error_of_peak_pct, rel_l2_error
-from ..params import Param, at_least, positive
+from ..params import Param, at_least, horizon_param, m_ratio_param, positive, youngs_modulus
 from ..pd import bond_micromodulus, build_stencil, get_influence
 from ..pd.build import Body, BondMaterial
 from ..pd.problem import BondProblem, PartCondition, WaveSystem, assemble_wave
@@ -146,10 +146,10 @@ class Wave1DSurfaceNodes(Scene):
     dim = 1
     params = (
         Param("length", 1.0, "bar length l [m]", positive),
-        Param("horizon", 0.1, "horizon delta [m] (0.1 l)", positive),
-        Param("E", 200e9, "Young's modulus [Pa]", positive),
+        horizon_param(0.1, "0.1 l"),
+        youngs_modulus(200e9),
         Param("rho", 8000.0, "density [kg/m^3]", positive),
-        Param("m_ratio", 10, "m-ratio delta / Delta (the paper uses 10, 25, 100)", at_least(1)),
+        m_ratio_param(10, least=1, note="the paper uses 10, 25, 100"),
         Param("dt", 2e-7, "time step [s]", positive),
         Param("n_terms", 40, "modes m = 1..n_terms of the analytic series", at_least(1)),
     )

@@ -152,9 +152,15 @@ def test_the_plates_quick_m_refinement_says_its_delta():
 
 
 def test_quick_levels_must_keep_what_the_study_fixes():
-    with pytest.raises(ValueError, match="share one delta"):
-        convergence._mratio("plate2d-clamped", "m", [(0.1, 2), (0.05, 4)],
-                            quick=[(0.2, 2), (0.1, 3)])
-    with pytest.raises(ValueError, match="share one m_ratio"):
-        convergence._mratio("plate2d-clamped", "delta", [(0.2, 3), (0.1, 3)],
-                            quick=[(0.2, 3), (0.1, 2)])
+    """What a study fixes is read from the scene's Discretisation of its levels: quick
+    levels that do not keep it are refused when the study says what it fixes."""
+    st = convergence._m("plate2d-clamped", "m", [(0.1, 2), (0.05, 4)],
+                        quick=[(0.2, 2), (0.1, 3)])
+    assert st.fixed_in(False) == "delta = 0.2"
+    with pytest.raises(ValueError, match="--quick.*do not keep delta fixed"):
+        st.fixed_in(True)
+    st = convergence._m("plate2d-clamped", "delta", [(0.2, 3), (0.1, 3)],
+                        quick=[(0.2, 3), (0.1, 2)])
+    assert st.fixed_in(False) == "m = 3"
+    with pytest.raises(ValueError, match="--quick.*do not keep m fixed"):
+        st.fixed_in(True)

@@ -4,7 +4,6 @@ import pytest
 
 from pdverify.corrections.taylor import taylor_extrapolation_weights
 from pdverify.corrections.taylor_fictitious import boundary_value_rows
-from pdverify.pd.problem import face_number
 from descriptions import bar_system
 
 EPS = np.finfo(float).eps
@@ -47,7 +46,7 @@ def test_boundary_value_row_is_exact(order, rng):
     g = bar_system("taylor-fictitious", order=order).model.grid
     coef = rng.normal(size=order + 1)
     for face, point in (("x-", 0.0), ("x+", 1.0)):
-        row = boundary_value_rows(g, order, face_number(face))[0].toarray()[0]
+        row = boundary_value_rows(g, order, face)[0].toarray()[0]
         got = row @ np.polyval(coef, g.x[g.interior_ids, 0])
         assert got == pytest.approx(np.polyval(coef, point),
                                     abs=50 * EPS * np.abs(row).sum() * np.abs(coef).sum())

@@ -124,7 +124,7 @@ def test_clamped_box_imposes_each_component_once_at_every_boundary_node(order):
     never leaves it to the node's equilibrium), edge and corner nodes included: the
     component along an edge goes to the face of the lower axis."""
     g = BoxGrid((0.6, 0.5, 0.4), (0.0,) * 3, 0.1, layers=3)
-    B, points, comps = clamped_rows(g, order, range(6))
+    B, points, comps = clamped_rows(g, order, FACES)
     n = np.asarray(g.nodes_per_axis)
     node = np.clip(np.floor(points / g.spacing).astype(int), 0, n - 1)   # cell of the point
     count = np.zeros((*n, 3), dtype=int)

@@ -1,0 +1,72 @@
+"""One vocabulary for the scenes' grids and parameters (issue 51): every scene states its
+discretisation as (h, delta) in metres, the convergence studies read it there, and the
+shared parameter sets leave every scene's parameter surface as it was at a694eb9."""
+import json
+import math
+from pathlib import Path
+
+import pytest
+
+from pdverify.scenes import all_scenes
+from pdverify.scenes.base import Discretisation
+
+from param_surface import surface
+from studies_snapshot import studies
+
+DATA = Path(__file__).parent / "data"
+
+
+def test_every_scene_states_its_discretisation_in_metres():
+    for scene in all_scenes():
+        method = scene.baseline_spec().name or scene.all_methods[0].name
+        d = scene.discretisation(scene.resolve(method, {}))
+        assert isinstance(d, Discretisation), scene.id
+        assert math.isfinite(d.h) and math.isfinite(d.delta), scene.id
+        # a horizon spans at least one spacing on every scene (m >= 1; the checks of
+        # m_ratio, horizon_ratio and horizon/spacing say so)
+        assert 0 < d.h <= d.delta, (scene.id, d)
+
+
+def test_discretisation_follows_each_spelling():
+    """Each scene's own names map to one (h, delta): a level changed in the scene's
+    spelling moves h and delta as the scene's grid does."""
+    from pdverify.scenes import get_scene
+    cases = {"bar1d-sine-load": ({"spacing": 0.1, "m_ratio": 4.0}, 0.1, 0.4),
+             "sheet2d-tension": ({"spacing": 0.0025, "horizon": 0.01}, 0.0025, 0.01),
+             "sheet2d-clamped": ({"side_factor": 8.0, "m_ratio": 4.0}, 0.005 / 4, 0.005),
+             "bar1d-vibration": ({"nodes": 51, "horizon_ratio": 4.0}, 1 / 50, 4 / 50),
+             "wave1d-surface-nodes": ({"horizon": 0.1, "m_ratio": 10}, 0.01, 0.1)}
+    for sid, (level, h, delta) in cases.items():
+        scene = get_scene(sid)
+        d = scene.discretisation(scene.resolve(scene.baseline_spec().name
+                                               or scene.all_methods[0].name, level))
+        assert d.h == pytest.approx(h, rel=1e-15) and d.delta == pytest.approx(delta, rel=1e-15), sid
+
+
+def test_studies_unchanged_bit_for_bit():
+    """Every study's levels, labels and refined lengths h (as float.hex) as at a694eb9,
+    when convergence.py had four adapters of its own."""
+    before = json.loads((DATA / "studies_a694eb9.json").read_text())
+    assert json.loads(json.dumps(studies())) == before
+
+
+def test_parameter_surface_unchanged():
+    """Every scene's and method's parameters (name, default, type, unit, choices,
+    scene_default, the check's verdict on probe values) and resolved defaults as at
+    a694eb9; only the help texts were unified."""
+    before = json.loads((DATA / "param_surface_a694eb9.json").read_text())
+    after = json.loads(json.dumps(surface()))
+    assert sorted(after) == sorted(before)
+    for sid in before:
+        assert after[sid] == before[sid], sid
+
+
+def test_shared_quantities_declared_once():
+    """E, nu, spacing, m_ratio and horizon are declared by the shared parameter sets of
+    pdverify/params.py only, never by a scene module (a scene passes its defaults)."""
+    import re
+    pattern = re.compile(r"""Param\(\s*["'](E|nu|spacing|m_ratio|horizon|thickness)["']""")
+    scenes = Path(__file__).parents[1] / "pdverify" / "scenes"
+    found = [f"{path.name}: {m.group(0)}" for path in sorted(scenes.glob("*.py"))
+             for m in pattern.finditer(path.read_text())]
+    assert not found, found
