@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import re
 
+import pytest
+
 import numpy as np
 from matplotlib.colors import LogNorm, to_hex
 
@@ -208,3 +210,59 @@ def test_bar_errors_exact_to_round_off_sit_on_a_floor(monkeypatch):
     assert ax2.get_ylim()[0] > 1e-2
     labels = [line.get_label() for line in kept[0].axes[0].get_lines()]
     assert sum("exact to round-off" in lab for lab in labels) == 2
+
+
+def _full_records(scene_id):
+    """The full report's records of ``scene_id`` (params, metrics, status): what the
+    convergence figures draw (tests/data/full_report_records.json.gz)."""
+    import gzip
+    import json
+    import os
+    path = os.path.join(os.path.dirname(__file__), "..", "data",
+                        "full_report_records.json.gz")
+    scene = get_scene(scene_id)
+    with gzip.open(path, "rt") as fh:
+        return [RunResult(scene=scene_id, method=r["method"], params=r["params"],
+                          reference=scene.reference, status=r["status"], message="",
+                          metrics=r["metrics"], fields={}, timings={"total_s": 1.0})
+                for r in json.load(fh)["runs"]
+                if r["scene"] == scene_id and r["method"] != "fem"]
+
+
+def _legends_off_the_data(fig):
+    """(legend, axes) pairs where a legend of ``fig`` (an axes' or the figure's) overlaps
+    an axes' data area, after drawing."""
+    fig.canvas.draw()
+    legends = [a.get_legend() for a in fig.axes if a.get_legend()] + list(fig.legends)
+    assert legends, "no legend drawn"
+    return [(i, j) for i, leg in enumerate(legends) for j, ax in enumerate(fig.axes)
+            if leg.get_window_extent().overlaps(ax.get_window_extent())]
+
+
+@pytest.mark.parametrize("scene_id", ["plate-hole", "plate-l",
+                                      "plate2d-clamped", "plate2d-plane-strain"])
+def test_convergence_legends_sit_outside_the_data(monkeypatch, scene_id):
+    """The shape scenes' and the plates' refinement figures, and their convergence
+    studies' figure, put each legend beside or below its panel, not over its lines
+    (before: the refinement figures' legends sat inside, over the coarse levels)."""
+    import matplotlib.pyplot as plt
+    from pdverify.convergence import collect
+    from pdverify.report.figures import plate2d, shapes
+    records = _full_records(scene_id)
+    figs = []
+    if scene_id != "plate2d-plane-strain":      # its refinement is the studies' figure
+        module = plate2d if scene_id.startswith("plate2d") else shapes
+        kept = _keep(monkeypatch, module)
+        assert module._convergence(get_scene(scene_id), records, "unused")
+        figs += kept
+    studies = collect(records)
+    if scene_id.startswith("plate2d"):          # the shape scenes have none
+        kept = _keep(monkeypatch, convergence)
+        assert studies and convergence.draw(studies, "unused")
+        figs += kept
+    try:
+        for fig in figs:
+            assert _legends_off_the_data(fig) == [], fig.axes[0].get_title()
+    finally:
+        for fig in figs:
+            plt.close(fig)

@@ -124,6 +124,18 @@ def round_off(values, scale=None) -> bool:
     return float(v.max() - v.min()) <= ROUND_OFF * ref
 
 
+def legend_outside(ax, where="right", **kw):
+    """``ax``'s legend outside its data: right of the panel (``where="right"``) or below
+    it (``"below"``, two columns); constrained layout makes room for it. Inside, a legend
+    covers lines or markers wherever they happen to run (issue 52)."""
+    style = {"fontsize": 7, "frameon": False, **kw}
+    if where == "below":
+        return ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16),
+                         ncol=style.pop("ncol", 2), **style)
+    return ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0,
+                     **style)
+
+
 def number_panel(ax, text, title=None):
     """An axes showing ``text`` instead of a map (round-off, a single value)."""
     ax.set_axis_off()

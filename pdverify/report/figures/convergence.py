@@ -7,7 +7,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.ticker import NullFormatter
 
-from . import palette, save
+from . import legend_outside, palette, save
 
 
 def _legend(entry) -> str:
@@ -130,8 +130,7 @@ def draw(studies, folder) -> dict:
                          fontsize=10)
             ax.grid(True, which="both", alpha=0.3)
             # below the panel, outside the data
-            ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2,
-                      frameon=False)
+            legend_outside(ax, "below")
         fig.suptitle(f"{scene}: convergence of every method", fontsize=11)
         name = save(fig, folder, f"{scene}-convergence-studies.png")
         out[scene] = [(name, f"{scene}: error against the refined length, one line per "

@@ -5,7 +5,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from ...scenes.plate2d import TABLE4 as PAPER
-from . import family, fem_then_pd, node_image, palette, save
+from . import family, fem_then_pd, legend_outside, node_image, palette, save
 from .shapes import taylor_style
 
 #: the params of Table 4's runs (the maps); the sweeps vary spacing, m_ratio, quadrature
@@ -70,7 +70,7 @@ def _error_maps(scene, runs, folder):
 def _sweep(ax, runs, x_of, xlabel, title):
     styles = {("none", None): (palette.colour("none"), palette.marker("none")),
               **{n: taylor_style(n) for n in (1, 2, 3)}}
-    drawn = False
+    slopes = {}
     for quad, ls in (("partial-volume", "-"), ("moment-corrected", "--")):
         for key, (colour, marker) in styles.items():
             method = "none" if key == ("none", None) else "taylor-fictitious"
@@ -87,14 +87,14 @@ def _sweep(ax, runs, x_of, xlabel, title):
             q = "" if quad == "partial-volume" else ", moment-corr."
             ax.loglog(xs, e * 100, ls, color=colour, marker=marker, ms=4,
                       label=f"{name}{q} (slope {slope:.2f})")
-            drawn = True
+            slopes[(method, key if method != "none" else None, quad)] = slope
     ax.set_xlabel(xlabel)
     ax.set_ylabel("rel. L2 error vs FEM [%]")
     ax.set_title(title, fontsize=10)
     ax.grid(True, which="both", alpha=0.3)
-    if drawn:
-        ax.legend(fontsize=7)
-    return drawn
+    if slopes:
+        legend_outside(ax)
+    return slopes
 
 
 def _convergence(scene, runs, folder):
@@ -104,18 +104,25 @@ def _convergence(scene, runs, folder):
                and abs(r.params["spacing"] * r.params["m_ratio"] - delta) < 1e-9]
     m = TABLE4["m_ratio"]
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 4.4), layout="constrained")
-    ok1 = _sweep(a1, fixed_m, lambda r: r.params["spacing"] * r.params["m_ratio"],
-                 f"horizon delta [m] (m = {m:g} fixed)", f"delta-refinement at fixed m = {m:g}")
-    ok2 = _sweep(a2, fixed_d, lambda r: r.params["m_ratio"],
-                 f"m = delta / Delta (delta = {delta:g} m fixed)", "m-refinement at fixed delta")
-    if not (ok1 or ok2):
+    s1 = _sweep(a1, fixed_m, lambda r: r.params["spacing"] * r.params["m_ratio"],
+                f"horizon delta [m] (m = {m:g} fixed)", f"delta-refinement at fixed m = {m:g}")
+    s2 = _sweep(a2, fixed_d, lambda r: r.params["m_ratio"],
+                f"m = delta / Delta (delta = {delta:g} m fixed)", "m-refinement at fixed delta")
+    if not (s1 or s2):
         plt.close(fig)
         return []
+    # the rates the caption quotes: the fitted slopes of the corrected, moment-corrected
+    # lines of the left panel (those in its legend), never a typed number
+    mc = [v for (method, _, quad), v in s1.items()
+          if method != "none" and quad == "moment-corrected"]
+    rates = ("converge at the rates in the legend" if not mc else
+             f"converge at rate {mc[0]:.2f}" if len(mc) == 1 else
+             f"converge at rates {min(mc):.2f} to {max(mc):.2f}")
     return [(save(fig, folder, f"{scene.id}-convergence.png"),
              "Refinement toward the FEM reference, fitted log-log slopes in the legends. Left: "
-             "delta -> 0 at m = 3; with exact partial volumes (solid) the corrected errors stop "
-             "at the fixed-m quadrature error, with moment-corrected weights (dashed) they "
-             "converge at rate ~2. Right: m -> infinity at delta = 0.2 m; the corrected errors "
+             f"delta -> 0 at m = {m:g}; with exact partial volumes (solid) the corrected errors "
+             f"stop at the fixed-m quadrature error, with moment-corrected weights (dashed) they "
+             f"{rates}. Right: m -> infinity at delta = {delta:g} m; the corrected errors "
              "fall, the uncorrected ones grow (one ring of fixed nodes clamps an ever thinner "
              "layer).")]
 

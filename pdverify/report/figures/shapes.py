@@ -5,7 +5,7 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 
-from . import family, fem_then_pd, node_image, palette, save
+from . import family, fem_then_pd, legend_outside, node_image, palette, save
 
 def taylor_style(order: int) -> tuple[str, str]:
     """The Taylor method's colour in a shade per order 1, 2, 3 (dark to light) and its
@@ -88,7 +88,7 @@ def _lines(ax, runs, x_of, metric, xlabel, spread=False):
     ax.set_xlabel(xlabel)
     ax.grid(True, which="both", alpha=0.3)
     if drawn:
-        ax.legend(fontsize=7)
+        legend_outside(ax)
     return drawn
 
 
