@@ -179,7 +179,6 @@ def write_export(ns: NodeSet, fmt: str, out: str) -> list[str]:
     it was and the staging folder is removed. A format the node set does not take
     (:func:`check_format`) is InputError before any file."""
     import shutil
-    import tempfile
     from . import outputs
     check_format(ns.scene, ns.params, fmt)
     files = {"problem.json": dumps(describe_json(ns))}
@@ -198,12 +197,7 @@ def write_export(ns: NodeSet, fmt: str, out: str) -> list[str]:
     # under the caller's lock on ``out`` (export_command's)
     _check_state(out, out)                     # what changed while the node set was built
     outputs.check_free(parent, need, f"--out {out!r} (an export of {len(ns.x)} nodes)")
-    outputs.clean_stale(parent, name, _own_leftover)
-    try:
-        staging = tempfile.mkdtemp(prefix=f".{name}.staging-", dir=parent)
-    except OSError as exc:
-        raise OutputError(f"export: cannot create its staging folder in {parent!r} "
-                          f"({exc.strerror or exc}); nothing was written") from None
+    staging = outputs.new_staging(parent, name, _own_leftover, "export", "nothing was written")
     path = staging
     try:
         from .results import umask_mode

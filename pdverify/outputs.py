@@ -523,6 +523,20 @@ def clean_stale(parent: str, name: str, own) -> None:
                 shutil.rmtree(path, ignore_errors=True)
 
 
+def new_staging(parent: str, name: str, own, who: str, nothing: str) -> str:
+    """A fresh staging folder for ``name`` in ``parent`` (the stale ones of killed writers
+    removed first, :func:`clean_stale`); one that cannot be made is an OutputError naming
+    ``who`` (``report``, ``export``) and what that means (``nothing``: "nothing was
+    run")."""
+    from .errors import OutputError
+    clean_stale(parent, name, own)
+    try:
+        return tempfile.mkdtemp(prefix=f".{name}.staging-", dir=parent)
+    except OSError as exc:
+        raise OutputError(f"{who}: cannot create its staging folder in {parent!r} "
+                          f"({exc.strerror or exc}); {nothing}") from None
+
+
 def swap_in(staging: str, out: str) -> None:
     """Replace ``out`` by ``staging`` as a whole: the old folder is renamed aside, the new
     one renamed in, the old one deleted. A reader sees the old folder or the new one."""

@@ -6,7 +6,6 @@ import hashlib
 import os
 import shutil
 import sys
-import tempfile
 import time
 from contextlib import contextmanager
 
@@ -161,12 +160,8 @@ def _locked(cases, out, parent, name, jobs, progress, client, quick=False,
     A report that could not be written whole (:class:`OutputError`: a figure, a VTU file,
     a page or results.json failed to write) is not swapped in: the previous report stays,
     the partial one stays in its staging folder, and OutputError names both."""
-    outputs.clean_stale(parent, name, outputs.is_own_leftover)
-    try:
-        staging = tempfile.mkdtemp(prefix=f".{name}.staging-", dir=parent)
-    except OSError as exc:
-        raise OutputError(f"report: cannot create its staging folder in {parent!r} "
-                          f"({exc.strerror or exc}); nothing was run") from None
+    staging = outputs.new_staging(parent, name, outputs.is_own_leftover, "report",
+                                  "nothing was run")
     keep = False
     try:
         try:

@@ -3,15 +3,13 @@ function its closure hands the model or in a parameter check, or whose parameter
 like a scene's, is listed as broken or makes its own run fail naming it; pdverify, its
 built-in methods and the other runs of a report go on."""
 import json
-import os
-import shutil
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 
-PLUGINS = Path(__file__).resolve().parents[1] / "plugins" / "broken_plugins"
+import plugin_site
+
 ENTRY_POINTS = {
     "pdverify_exit_at_import": ["exit-at-import = pdverify_exit_at_import:METHOD"],
     "pdverify_misbehaving": [f"{name} = pdverify_misbehaving:{attr}" for name, attr in (
@@ -24,18 +22,7 @@ ENTRY_POINTS = {
 @pytest.fixture(scope="module")
 def plugin_env(tmp_path_factory):
     """The two packages and their dist-info, as ``pip install --target`` lays them out."""
-    target = tmp_path_factory.mktemp("site")
-    for package, eps in ENTRY_POINTS.items():
-        shutil.copytree(PLUGINS / package, target / package)
-        info = target / f"{package}-0.1.0.dist-info"
-        info.mkdir()
-        (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {package}\n"
-                                       "Version: 0.1.0\n")
-        (info / "entry_points.txt").write_text("[pdverify.methods]\n" + "\n".join(eps) + "\n")
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join([str(target), env.get("PYTHONPATH", "")])
-    env["PDVERIFY_CACHE_DIR"] = str(target / "cache")
-    return env
+    return plugin_site.install(tmp_path_factory.mktemp("site"), ENTRY_POINTS)
 
 
 def cli(env, *args, cwd=None):

@@ -6,17 +6,16 @@ never calls it; a SIGTERM ends pdverify with 143; control characters read from f
 the terminal escaped."""
 import json
 import os
-import shutil
 import signal
 import subprocess
 import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
-from pathlib import Path
 
 import pytest
 
-PLUGINS = Path(__file__).resolve().parents[1] / "plugins" / "broken_plugins"
+import plugin_site
+
 ENTRY_POINTS = {
     "pdverify_hostile": [f"{name} = pdverify_hostile:{attr}" for name, attr in (
         ("role-check-exit", "ROLE_CHECK_EXIT"), ("check-hang", "CHECK_HANG"),
@@ -35,19 +34,7 @@ ENTRY = "pdverify_hostile"
 @pytest.fixture(scope="module")
 def plugin_env(tmp_path_factory):
     """The packages and their dist-info, as ``pip install --target`` lays them out."""
-    target = tmp_path_factory.mktemp("site")
-    for package, eps in ENTRY_POINTS.items():
-        shutil.copytree(PLUGINS / package, target / package)
-        info = target / f"{package}-0.1.0.dist-info"
-        info.mkdir()
-        (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {package}\n"
-                                       "Version: 0.1.0\n")
-        (info / "entry_points.txt").write_text("[pdverify.methods]\n" + "\n".join(eps) + "\n")
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join([str(target), env.get("PYTHONPATH", "")])
-    env["PDVERIFY_CACHE_DIR"] = str(target / "cache")
-    env["PDVERIFY_PLUGIN_TIMEOUT"] = str(LIMIT)
-    return env
+    return plugin_site.install(tmp_path_factory.mktemp("site"), ENTRY_POINTS, PDVERIFY_PLUGIN_TIMEOUT=LIMIT)
 
 
 def cli(env, *args, cwd=None):
