@@ -14,7 +14,9 @@ Plain script (no test runner):
    solves is timed as pdverify solves it (wall and CPU seconds, so a piece's threads are
    counted) and then, on the same matrix and right-hand side, by each library
    (factor + solve, in rotated order, median of ``--repeat``), with the relative residual
-   of each answer. Which piece solved it is read from the leaf's own ``info["solver"]``.
+   of each answer. A run that solves many systems of one piece (a Newton sequence's
+   tangents) has the libraries time its first ``--per-case`` (2) and the mean of those
+   stand for the rest (rows marked ``extrapolated``). Which piece solved it is read from the leaf's own ``info["solver"]``.
 2. **Memory** (``--memory``): the largest system of each piece is saved (``--keep``) and
    factored by each library and by pdverify's leaf in a fresh process each, whose peak
    resident memory above the loaded matrix is recorded.
@@ -133,9 +135,10 @@ class Capture:
     """Wraps the solver layer's leaves; every call is timed as pdverify does it and then
     by each library on the same system."""
 
-    def __init__(self, libs, repeat, keep):
-        self.libs, self.repeat, self.keep = libs, repeat, keep
+    def __init__(self, libs, repeat, keep, per_case=2):
+        self.libs, self.repeat, self.keep, self.per_case = libs, repeat, keep, per_case
         self.rows = []
+        self.sampled = collections.Counter()
         self.case = None
         self.largest = {}
 
@@ -146,6 +149,20 @@ class Capture:
                "ours": {"wall_s": ours_wall, "cpu_s": ours_cpu,
                         "residual": rel_res(A, ours_x, b) if ours_x is not None else None}}
         names = list(self.libs)
+        self.sampled[(self.case, piece_of)] += 1
+        if self.sampled[(self.case, piece_of)] > self.per_case:
+            # a Newton sequence's later tangents: ours timed, the libraries' time taken
+            # as the mean of this case's sampled systems (marked ``extrapolated``)
+            done = [r for r in self.rows if r["case"] == self.case and r["piece"] == piece_of
+                    and not r.get("extrapolated")]
+            for name in names:
+                ok = [r[name]["wall_s"] for r in done if "wall_s" in r[name]]
+                okc = [r[name]["cpu_s"] for r in done if "cpu_s" in r[name]]
+                row[name] = ({"wall_s": float(np.mean(ok)), "cpu_s": float(np.mean(okc))}
+                             if ok else {"failed": "not sampled"})
+            row["extrapolated"] = True
+            self.rows.append(row)
+            return
         walls = collections.defaultdict(list)
         cpus = collections.defaultdict(list)
         res = {}
@@ -218,7 +235,7 @@ def _slug(text: str) -> str:
 def capture(args, libs) -> list:
     from pdverify.runner import plan
     from pdverify.scenes import get_scene
-    cap = Capture(libs, args.repeat, args.keep)
+    cap = Capture(libs, args.repeat, args.keep, args.per_case)
     cap.install()
     cases = plan(args.only or None, args.quick)
     for k, (scene_id, method, overrides) in enumerate(cases):
@@ -284,6 +301,8 @@ def main(argv=None):
     ap.add_argument("--only", action="append", default=[])
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--per-case", type=int, default=2, help="systems of one piece in one run "
+                    "that the libraries solve (a Newton run's later tangents: their mean)")
     ap.add_argument("--json", default=None)
     ap.add_argument("--keep", default=None, help="folder for the largest system of each piece")
     ap.add_argument("--memory", action="store_true")
