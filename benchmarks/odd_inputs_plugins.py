@@ -109,13 +109,11 @@ def cases(work: Path):
 
 
 def lay_out(site: Path) -> None:
-    for package, eps in ENTRY_POINTS.items():
-        shutil.copytree(PLUGINS / package, site / package)
-        info = site / f"{package}-0.1.0.dist-info"
-        info.mkdir()
-        (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {package}\n"
-                                       "Version: 0.1.0\n")
-        (info / "entry_points.txt").write_text("[pdverify.methods]\n" + "\n".join(eps) + "\n")
+    """The broken plugins laid out in ``site`` as ``pip install --target`` does (the
+    tests' own helper, tests/reliability/plugin_site.py)."""
+    sys.path.insert(0, str(HERE.parent / "tests" / "reliability"))
+    import plugin_site
+    plugin_site.install(site, ENTRY_POINTS)
 
 
 def results_files(work: Path, env) -> None:
