@@ -8,6 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import entry_points
+
 from pdverify.corrections import registry
 from pdverify.corrections.volume import volume_factors
 
@@ -21,18 +23,12 @@ EPS = 1e-12
 def plugin(monkeypatch):
     """The plugin's entry point, as ``importlib.metadata`` lists an installed one; the
     registry loaded afresh with it, and without it after the test."""
-    import importlib.metadata as md
     monkeypatch.syspath_prepend(str(PLUGIN))
 
-    class EP:
-        name, value, group = NAME, "pdverify_mean_ratio:METHOD", registry.ENTRY_POINT_GROUP
-
-        def load(self):
-            import pdverify_mean_ratio
-            return pdverify_mean_ratio.METHOD
-
-    monkeypatch.setattr(md, "entry_points", lambda group=None: [EP()])
-    registry.reload()
+    def load():
+        import pdverify_mean_ratio
+        return pdverify_mean_ratio.METHOD
+    entry_points.register(monkeypatch, NAME, "pdverify_mean_ratio:METHOD", load)
     yield sys.modules.get("pdverify_mean_ratio") or __import__("pdverify_mean_ratio")
     monkeypatch.undo()
     registry.reload()

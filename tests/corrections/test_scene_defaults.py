@@ -4,6 +4,8 @@ given value is; a plugin's parameter of the same name keeps its own default."""
 import numpy as np
 import pytest
 
+import entry_points
+
 from pdverify.corrections import registry
 from pdverify.corrections.registry import BondMethod
 from pdverify.errors import InputError
@@ -22,16 +24,8 @@ def _method(name, **param):
 
 @pytest.fixture
 def register(monkeypatch):
-    import importlib.metadata as md
-
     def install(*methods):
-        class EP:
-            name, value, group = "orders", "test:METHODS", registry.ENTRY_POINT_GROUP
-
-            def load(self):
-                return list(methods)
-        monkeypatch.setattr(md, "entry_points", lambda group=None: [EP()])
-        registry.reload()
+        entry_points.register(monkeypatch, "orders", "test:METHODS", lambda: list(methods))
     yield install
     monkeypatch.undo()
     registry.reload()

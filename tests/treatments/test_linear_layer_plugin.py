@@ -9,6 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import entry_points
+
 from pdverify.corrections import registry
 from pdverify.corrections.protocols import ParamCheck, StaticAssembly, conformance
 from pdverify.solvers.front import solve
@@ -25,16 +27,8 @@ NAME = "linear-layer"
 @pytest.fixture
 def registered(monkeypatch):
     """The plugin as pdverify finds an installed one: through its entry point."""
-    import importlib.metadata as md
-
-    class EP:
-        name, value, group = NAME, "pdverify_linear_layer:METHOD", registry.ENTRY_POINT_GROUP
-
-        def load(self):
-            return layer.METHOD
-
-    monkeypatch.setattr(md, "entry_points", lambda group=None: [EP()])
-    registry.reload()
+    entry_points.register(monkeypatch, NAME, "pdverify_linear_layer:METHOD",
+                          lambda: layer.METHOD)
     try:
         assert NAME in registry.treatments(), registry.BROKEN
         yield registry.treatments()[NAME]
