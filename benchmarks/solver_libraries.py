@@ -232,7 +232,7 @@ def _slug(text: str) -> str:
     return "".join(ch if ch.isalnum() else "-" for ch in text)[:60].strip("-")
 
 
-def capture(args, libs) -> list:
+def capture(args, libs, partial=None) -> list:
     from pdverify.runner import plan
     from pdverify.scenes import get_scene
     cap = Capture(libs, args.repeat, args.keep, args.per_case)
@@ -244,6 +244,8 @@ def capture(args, libs) -> list:
         result = get_scene(scene_id).run(method, overrides)
         print(f"[{k + 1}/{len(cases)}] {cap.case}: {result.status} "
               f"({time.perf_counter() - t0:.1f} s)", file=sys.stderr, flush=True)
+        if partial:                        # the record so far, after every case
+            partial(cap.rows, k + 1, len(cases))
     return cap.rows, cap.largest
 
 
@@ -318,7 +320,13 @@ def main(argv=None):
         os.makedirs(args.keep, exist_ok=True)
     record = {"machine": machine(), "libraries": libs_info}
     t0 = time.perf_counter()
-    rows, largest = capture(args, libs)
+    def partial(rows, done, total):
+        if args.json:
+            with open(args.json, "w") as fh:
+                json.dump({**record, "cases_done": f"{done} of {total}",
+                           "pieces": summarize(rows, libs), "systems": rows}, fh,
+                          indent=1, default=str)
+    rows, largest = capture(args, libs, partial)
     record["capture_wall_s"] = time.perf_counter() - t0
     record["machine"]["load_1min_after"] = os.getloadavg()[0]
     record["pieces"] = summarize(rows, libs)
