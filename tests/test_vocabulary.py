@@ -40,6 +40,7 @@ def test_discretisation_follows_each_spelling():
         scene = get_scene(sid)
         d = scene.discretisation(scene.resolve(scene.baseline_spec().name
                                                or scene.all_methods[0].name, level))
+        # a few roundings of the same products in metres: a few ulp (eps 2.2e-16)
         assert d.h == pytest.approx(h, rel=1e-15) and d.delta == pytest.approx(delta, rel=1e-15), sid
 
 

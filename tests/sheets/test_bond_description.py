@@ -56,4 +56,5 @@ def test_virtual_nodes_bring_their_own_clamp_nodes_for_the_clamped_faces():
     assert np.all(y[own.parts["y+"]] > L / 2) and np.all(y[own.parts["y-"]] < -L / 2)
     _, base = scene.bond_system("none", scene.resolve("none"), "test")
     yb = base.model.grid.x[:, 1]
+    # cell centres at L/2 ~ 1e-2 m, one rounding of a sum: a few ulp of it (eps 2.2e-16)
     np.testing.assert_allclose(yb[base.parts["y+"]], L / 2, rtol=0, atol=1e-15)
