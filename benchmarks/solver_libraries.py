@@ -9,8 +9,8 @@ Plain script (no test runner):
 
 1. **Capture**: the report's cases (``pdverify.runner.plan``; ``--only``/``--quick`` as
    the report takes them) run in this process, one BLAS thread each as in the report,
-   with the solver layer's leaves wrapped (``solve_constrained``, ``solve_dense``,
-   ``solve_nested``, ``solve_spd`` and the Newton tangents' CG): every system a run
+   with the solver layer's leaves wrapped (``solve_constrained``, the front door's
+   ``factor`` solves, ``solve_spd`` and the Newton tangents' CG): every system a run
    solves is timed as pdverify solves it (wall and CPU seconds, so a piece's threads are
    counted) and then, on the same matrix and right-hand side, by each library
    (factor + solve, in rotated order, median of ``--repeat``), with the relative residual
@@ -142,7 +142,7 @@ class Capture:
         self.case = None
         self.largest = {}
 
-    def record(self, piece_of, A, b, ours_wall, ours_cpu, ours_x):
+    def record(self, piece_of, A, b, ours_wall, ours_cpu, ours_x, how=None):
         A = sp.csr_matrix(A)
         b = np.asarray(b, dtype=float).ravel()
         row = {"case": self.case, "piece": piece_of, "n": int(A.shape[0]), "nnz": int(A.nnz),
@@ -185,6 +185,14 @@ class Capture:
             path = os.path.join(self.keep, f"{_slug(piece_of)}.npz")
             sp.save_npz(path, A)
             np.save(path[:-4] + "-rhs.npy", b)
+            # how pdverify's front door factored it (its coordinates, symmetric mode,
+            # ordering), so that the memory child runs the same piece; None: not a factor
+            # of the front door (the Newton tangents' CG), whose memory is not measured
+            how = dict(how) if how is not None else None
+            if how is not None and how.get("coords") is not None:
+                np.save(path[:-4] + "-coords.npy", np.asarray(how.pop("coords")))
+            with open(path[:-4] + "-how.json", "w") as fh:
+                json.dump(how, fh)
             self.largest[piece_of] = (A.nnz, path)
 
     def install(self):
@@ -202,8 +210,17 @@ class Capture:
                     x = np.concatenate([u, lam])
                 else:
                     A, rhs, x = K, f, u
-                cap.record(info.get("solver", "superlu"), A, rhs, w, cp, x)
+                cap.record(info.get("solver", "superlu"), A, rhs, w, cp, x,
+                           {"ordering": kw.get("ordering", "COLAMD"),
+                            "spd": bool(kw.get("spd", False)) and A is K})
                 return u, lam, info
+            return leaf
+
+        def wrap_factored(orig):
+            def leaf(A, b, where, **how):
+                (u, info), w, cp = timed(lambda: orig(A, b, where, **how))
+                cap.record(info.get("solver", "factor"), A, b, w, cp, u, how)
+                return u, info
             return leaf
 
         def wrap_plain(orig, argc):
@@ -215,8 +232,7 @@ class Capture:
 
         front.solve_constrained = wrap_constrained(front.solve_constrained)
         bb.solve_constrained = front.solve_constrained
-        front.solve_dense = wrap_plain(front.solve_dense, 2)
-        front.solve_nested = wrap_plain(front.solve_nested, 3)
+        front._solved = wrap_factored(front._solved)      # every factor(A, precision)
         front.solve_spd = wrap_plain(front.solve_spd, 4)
         orig_cg = newton.cg_solve
 
@@ -257,9 +273,15 @@ def _memory_child(path, who):
     b = np.load(path[:-4] + "-rhs.npy")
     base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     if who == "ours":
-        from pdverify.solvers.front import solve_with_dirichlet
-        _, w, _ = timed(lambda: solve_with_dirichlet(A, b, np.array([], int), np.array([]),
-                                                     where="benchmark", solver="direct"))
+        from pdverify.solvers.front import factor
+        with open(path[:-4] + "-how.json") as fh:
+            how = json.load(fh)
+        if how is None:
+            print(json.dumps({"skipped": "not a factor of the front door (CG)"}))
+            return
+        if os.path.exists(path[:-4] + "-coords.npy"):
+            how["coords"] = np.load(path[:-4] + "-coords.npy")
+        _, w, _ = timed(lambda: factor(A, "auto", where="benchmark", **how).solve(b))
     else:
         _, w, _ = timed(LIBRARIES[who][1], A, b)
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss

@@ -12,30 +12,57 @@ from ..errors import NumericalError
 from .checks import equilibrate, refuse_near_singular, relative_residual, rounded_estimate
 
 
+class DenseFactor:
+    """LAPACK's LU (dgetrf) of the equilibrated square ``K`` (row then column
+    max-scaling, :func:`~pdverify.solvers.checks.equilibrate`), refused at once when it is
+    singular or near-singular (a 1-norm condition estimate of the equilibrated matrix,
+    LAPACK gecon; :class:`NumericalError` naming ``where``). :meth:`solve` checks each
+    solution and leaves its diagnostics in :attr:`info`."""
+
+    kind = "dense LU (LAPACK)"
+
+    def __init__(self, K, *, where: str = "static solve"):
+        K = sp.csr_matrix(K)
+        self.K, self.where = K, where
+        n = K.shape[0]
+        if not np.all(np.isfinite(K.data)):
+            raise NumericalError(f"{where}: the system has non-finite entries")
+        A_s, self.row_max, self.col_max = equilibrate(K, where)
+        A = A_s.toarray()
+        anorm = float(np.abs(A).sum(axis=0).max())
+        self.lu, self.piv, info_ = lapack.dgetrf(A, overwrite_a=True)
+        if info_ > 0:
+            raise NumericalError(f"{where}: singular system of size {n} (zero pivot {info_})")
+        rcond, _ = lapack.dgecon(self.lu, anorm, norm="1")
+        self.cond = np.inf if rcond == 0 else rounded_estimate(1.0 / rcond)
+        refuse_near_singular(self.cond, where)
+        self.info: dict = {}
+
+    def solve(self, f) -> np.ndarray:
+        f = np.asarray(f, dtype=float)
+        if not np.all(np.isfinite(f)):
+            raise NumericalError(f"{self.where}: the system has non-finite entries")
+        u = sl.lu_solve((self.lu, self.piv), f / self.row_max, check_finite=False) / self.col_max
+        if not np.all(np.isfinite(u)):
+            raise NumericalError(f"{self.where}: solution has non-finite values (singular "
+                                 "system)")
+        self.info = {"unknowns": int(self.K.shape[0]),
+                     "relative_residual": relative_residual(self.K, u, f),
+                     "condition_estimate": float(self.cond), "solver": self.kind}
+        return u
+
+
 def solve_dense(K, f, *, where: str = "static solve"):
-    """Solve the square system K u = f by a dense LAPACK LU (dgetrf).
+    """Solve the square system K u = f by a dense LAPACK LU (:class:`DenseFactor`).
 
     Same contract as :func:`pdverify.solvers.lu.solve_constrained` without constraints:
     row then column equilibration, a 1-norm condition estimate of the equilibrated
     matrix (LAPACK gecon), :class:`NumericalError` on singular or near-singular systems.
     Returns ``(u, info)``.
     """
-    K = sp.csr_matrix(K)
-    n = K.shape[0]
     f = np.asarray(f, dtype=float)
-    if not np.all(np.isfinite(K.data)) or not np.all(np.isfinite(f)):
+    if not np.all(np.isfinite(sp.csr_matrix(K).data)) or not np.all(np.isfinite(f)):
         raise NumericalError(f"{where}: the system has non-finite entries")
-    A_s, row_max, col_max = equilibrate(K, where)
-    A = A_s.toarray()
-    anorm = float(np.abs(A).sum(axis=0).max())
-    lu, piv, info_ = lapack.dgetrf(A, overwrite_a=True)
-    if info_ > 0:
-        raise NumericalError(f"{where}: singular system of size {n} (zero pivot {info_})")
-    rcond, _ = lapack.dgecon(lu, anorm, norm="1")
-    cond = np.inf if rcond == 0 else rounded_estimate(1.0 / rcond)
-    refuse_near_singular(cond, where)
-    u = sl.lu_solve((lu, piv), f / row_max, check_finite=False) / col_max
-    if not np.all(np.isfinite(u)):
-        raise NumericalError(f"{where}: solution has non-finite values (singular system)")
-    return u, {"unknowns": int(n), "relative_residual": relative_residual(K, u, f),
-               "condition_estimate": float(cond), "solver": "dense LU (LAPACK)"}
+    lu = DenseFactor(K, where=where)
+    u = lu.solve(f)
+    return u, lu.info

@@ -4,20 +4,74 @@ solver's diagnostics out. Three things are kept apart: the elimination of prescr
 unknowns (:mod:`~pdverify.solvers.condense`), the choice of solver and every threshold
 of it (:mod:`~pdverify.solvers.policy`), and the implementations (``lu``, ``dense``,
 ``nested``, ``mixed``, ``iterative``). This module only dispatches: which
-implementation for which solver name."""
+implementation for which solver name.
+
+Every direct solve goes through one door, :func:`factor`: ``factor(A, precision) ->
+Factor``, whose ``solve(b)`` returns the solution and leaves the checks' diagnostics in
+``Factor.info`` (the same for every implementation: unknowns, relative residual,
+condition estimate of the equilibrated matrix, which solver)."""
 from __future__ import annotations
+
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 import scipy.sparse as sp
 
+from ..errors import NumericalError
 from . import policy
 from .condense import condense
-from .dense import solve_dense
+from .dense import DenseFactor, solve_dense
 from .iterative import solve_spd
-from .lu import solve_constrained
-from .nested import solve_nested
+from .lu import SuperLUFactor, solve_constrained
+from .nested import NestedFactor, solve_nested
 
-__all__ = ["solve", "solve_with_dirichlet", "solve_square", "solve_constrained"]
+__all__ = ["factor", "Factor", "PRECISIONS", "solve", "solve_with_dirichlet", "solve_square",
+           "solve_constrained", "solve_dense", "solve_nested"]
+
+#: ``factor``'s precisions: ``double`` (an LU in float64), ``mixed`` (a float32 LU whose
+#: solves are refined in float64, :mod:`~pdverify.solvers.mixed`; needs the unknowns'
+#: coordinates), ``auto`` (``mixed`` from
+#: :data:`~pdverify.solvers.policy.MIXED_FROM_UNKNOWNS` unknowns when coordinates are
+#: given, else ``double``)
+PRECISIONS = ("auto", "double", "mixed")
+
+
+@runtime_checkable
+class Factor(Protocol):
+    """What :func:`factor` returns: ``solve(b)`` solves A x = b (and checks x), and
+    ``info`` holds the last solve's diagnostics."""
+
+    info: dict
+
+    def solve(self, b) -> np.ndarray: ...
+
+
+def factor(A, precision: str = "auto", *, where: str, coords=None, spd: bool = False,
+           ordering: str = "COLAMD") -> Factor:
+    """The factor of the square matrix ``A`` that the solve needs:
+
+    - with the unknowns' ``coords``: sparse LU under their geometric nested-dissection
+      ordering (:class:`~pdverify.solvers.nested.NestedFactor`), in ``precision``;
+    - without: LAPACK's dense LU when ``A`` is full enough
+      (:func:`~pdverify.solvers.policy.dense_lu`;
+      :class:`~pdverify.solvers.dense.DenseFactor`), else SuperLU
+      (:class:`~pdverify.solvers.lu.SuperLUFactor`; ``spd``: its symmetric mode,
+      ``ordering``: its column ordering), both in double.
+
+    Every factor equilibrates ``A`` first and refuses a singular or near-singular one
+    (:class:`~pdverify.errors.NumericalError` naming ``where``)."""
+    if precision not in PRECISIONS:
+        raise ValueError(f"precision={precision!r}: allowed {PRECISIONS}")
+    if coords is not None:
+        mixed = None if precision == "auto" else precision == "mixed"
+        return NestedFactor(A, coords, where=where, mixed=mixed)
+    if precision == "mixed":
+        raise ValueError(f"{where}: precision='mixed' needs the unknowns' coordinates "
+                         "(a nested-dissection ordering)")
+    K = sp.csr_matrix(A)
+    if policy.dense_lu(K.shape[0], K.nnz):
+        return DenseFactor(K, where=where)
+    return SuperLUFactor(K, where=where, spd=spd, ordering=ordering)
 
 
 def solve(system, *, where: str, ordering: str = "COLAMD"):
@@ -43,17 +97,10 @@ def solve(system, *, where: str, ordering: str = "COLAMD"):
 
 def solve_square(K, f, *, where: str = "static solve", spd: bool = False,
                  ordering: str = "COLAMD"):
-    """The ``direct`` solver: K u = f by the dense LAPACK LU
-    (:func:`~pdverify.solvers.dense.solve_dense`) when K is full enough
-    (:func:`~pdverify.solvers.policy.dense_lu`), else by SuperLU
-    (:func:`~pdverify.solvers.lu.solve_constrained` without constraints; ``spd``: its
-    symmetric mode, ``ordering``: its column ordering). Returns ``(u, info)``."""
-    K = sp.csr_matrix(K)
-    n = K.shape[0]
-    if not policy.dense_lu(n, K.nnz):
-        u, _, info = solve_constrained(K, f, where=where, spd=spd, ordering=ordering)
-        return u, info
-    return solve_dense(K, f, where=where)
+    """The ``direct`` solver: K u = f by :func:`factor` in double without coordinates (the
+    dense LAPACK LU when K is full enough, else SuperLU; ``spd``: its symmetric mode,
+    ``ordering``: its column ordering). Returns ``(u, info)``."""
+    return _solved(K, f, where, spd=spd, ordering=ordering)
 
 
 def solve_with_dirichlet(K, rhs, fixed, values, where, spd: bool = False,
@@ -71,7 +118,7 @@ def solve_with_dirichlet(K, rhs, fixed, values, where, spd: bool = False,
     applies; else on a 2D lattice nested dissection from
     :data:`~pdverify.solvers.policy.ND_FROM_UNKNOWNS` unless the LU is dense,
     :func:`~pdverify.solvers.policy.lattice_uses_nd`; else ``direct``), or ``nested-dissection`` (sparse LU under a geometric
-    ordering, :func:`~pdverify.solvers.nested.solve_nested`; needs the unknowns'
+    ordering, :class:`~pdverify.solvers.nested.NestedFactor`; needs the unknowns'
     ``coords``). Returns the full solution and the solver's diagnostics, which say what
     was chosen and why.
     """
@@ -86,16 +133,28 @@ def solve_with_dirichlet(K, rhs, fixed, values, where, spd: bool = False,
     use_cg = policy.lattice_uses_cg(solver, iterative_ok, free.size)
     use_nd = lattice is not None and policy.lattice_uses_nd(
         solver, use_cg, lattice.dim, free.size, K_free.nnz)
-    if use_nd:
-        u_free, info = solve_nested(K_free, r, lattice.take(free).x, where=where)
-    elif solver == "nested-dissection":
-        if coords is None:
+    if use_nd or solver == "nested-dissection":
+        if use_nd:
+            at = lattice.take(free).x
+        elif coords is None:
             raise ValueError(f"{where}: solver=nested-dissection needs the unknowns' coordinates")
-        u_free, info = solve_nested(K_free, r, np.asarray(coords)[free], where=where)
+        else:
+            at = np.asarray(coords)[free]
+        u_free, info = _solved(K_free, r, where, coords=at)
     elif use_cg:
         u_free, info = solve_spd(K_free, r, lattice.take(free), aggregate_width, where=where)
     else:
-        u_free, info = solve_square(K_free, r, where=where, spd=spd, ordering=ordering)
+        u_free, info = _solved(K_free, r, where, spd=spd, ordering=ordering)
     if solver == "auto":
         info["solver_choice"] = policy.lattice_note(use_cg, free.size, use_nd)
     return expand(u_free), info
+
+
+def _solved(A, b, where: str, **how):
+    """``(x, info)`` of A x = b by :func:`factor` (``how``: its keywords)."""
+    b = np.asarray(b, dtype=float)
+    if not np.all(np.isfinite(sp.csr_matrix(A).data)) or not np.all(np.isfinite(b)):
+        raise NumericalError(f"{where}: the system has non-finite entries")
+    lu = factor(A, "auto", where=where, **how)
+    x = lu.solve(b)
+    return x, lu.info

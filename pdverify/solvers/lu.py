@@ -23,13 +23,48 @@ SPD_OPTIONS = dict(permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
 # but ~1.6x slower on the seed-001 surface-node plate, so each scene states its choice.
 
 
+class SuperLUFactor:
+    """SuperLU's factor of the equilibrated square ``A`` (:func:`~pdverify.solvers.checks.
+    equilibrate`): ``spd=True`` declares A symmetric positive definite and factors it in
+    SuperLU's symmetric mode (:data:`SPD_OPTIONS`), otherwise ``ordering`` is SuperLU's
+    column ordering (``permc_spec``) with partial pivoting. :meth:`solve` checks each
+    solution (non-finite values, the condition estimate; :class:`NumericalError` naming
+    ``where``) and leaves its diagnostics in :attr:`info`."""
+
+    def __init__(self, A, *, where: str = "static solve", spd: bool = False,
+                 ordering: str = "COLAMD"):
+        A = sp.csc_matrix(A)
+        if not np.all(np.isfinite(A.data)):
+            raise NumericalError(f"{where}: the system has non-finite entries")
+        self.A, self.where = A, where
+        A_s, self.row_max, self.col_max = equilibrate(A, where)
+        self.A_s = A_s.tocsc()
+        self.lu = factor(self.A_s, where, **(SPD_OPTIONS if spd else {"permc_spec": ordering}))
+        self.kind = ("sparse LU (SuperLU, " + ("symmetric mode)" if spd
+                                               else f"{ordering} ordering)"))
+        self.info: dict = {}
+
+    def solve(self, b) -> np.ndarray:
+        b = np.asarray(b, dtype=float)
+        if not np.all(np.isfinite(b)):
+            raise NumericalError(f"{self.where}: the system has non-finite entries")
+        sol = self.lu.solve(b / self.row_max) / self.col_max
+        cond = checked_condition(sol, self.A_s, self.lu, self.where)
+        self.info = {"unknowns": int(self.A.shape[0]),
+                     "relative_residual": relative_residual(self.A, sol, b),
+                     "condition_estimate": float(cond),  # of the equilibrated system
+                     "solver": self.kind}
+        return sol
+
+
 def solve_constrained(K, f, B=None, c=None, *, where: str = "static solve", spd: bool = False,
                       ordering: str = "COLAMD"):
-    """Solve [[K, B^T], [B, 0]] [u; lam] = [f; c] with a sparse LU factorisation.
+    """Solve [[K, B^T], [B, 0]] [u; lam] = [f; c] with a sparse LU factorisation
+    (:class:`SuperLUFactor`).
 
     ``spd=True`` (only without constraints) declares K symmetric positive definite and
     factors it in SuperLU's symmetric mode (:data:`SPD_OPTIONS`); the residual and
-    condition checks below guard the claim. Otherwise ``ordering`` is SuperLU's column
+    condition checks guard the claim. Otherwise ``ordering`` is SuperLU's column
     ordering (``permc_spec``), with partial pivoting.
 
     Returns ``(u, lam, info)``; ``info`` holds the system size, the relative residual
@@ -43,21 +78,15 @@ def solve_constrained(K, f, B=None, c=None, *, where: str = "static solve", spd:
         c = np.atleast_1d(np.asarray(c, dtype=float))
         A = sp.bmat([[K, B.T], [B, None]], format="csc")
         rhs = np.concatenate([np.asarray(f, dtype=float), c])
+        spd = False
     else:
         A = K.tocsc()
         rhs = np.asarray(f, dtype=float)
     if not np.all(np.isfinite(A.data)) or not np.all(np.isfinite(rhs)):
         raise NumericalError(f"{where}: the system has non-finite entries")
-    A_s, row_max, col_max = equilibrate(A, where)
-    A_s = A_s.tocsc()
-    lu = factor(A_s, where, **(SPD_OPTIONS if spd and B is None else {"permc_spec": ordering}))
-    sol = lu.solve(rhs / row_max) / col_max
-    cond = checked_condition(sol, A_s, lu, where)
-    info = {"unknowns": int(A.shape[0]), "relative_residual": relative_residual(A, sol, rhs),
-            "condition_estimate": float(cond),  # of the equilibrated system
-            "solver": "sparse LU (SuperLU, " + ("symmetric mode)" if spd and B is None
-                                                else f"{ordering} ordering)")}
-    return sol[:n], sol[n:], info
+    lu = SuperLUFactor(A, where=where, spd=spd, ordering=ordering)
+    sol = lu.solve(rhs)
+    return sol[:n], sol[n:], lu.info
 
 
 def factor(A, where: str, **options):

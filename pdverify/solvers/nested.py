@@ -92,67 +92,112 @@ MAX_CROSSED_PIVOTS = 32
 FRONTAL_FACTOR = True
 
 
-def solve_nested(A, rhs, coords, *, where: str = "static solve", mixed: bool | None = None):
-    """Solve the square system A x = rhs by sparse LU under a geometric nested-dissection
-    ordering (:func:`pdverify.solvers.ordering.nested_dissection`; ``coords``: one row
-    per unknown). Same checks and diagnostics as
-    :func:`~pdverify.solvers.lu.solve_constrained`: equilibration,
-    a 1-norm condition estimate, :class:`NumericalError` on (near-)singular systems.
+class NestedFactor:
+    """Sparse LU of the square ``A`` under a geometric nested-dissection ordering
+    (:func:`pdverify.solvers.ordering.nested_dissection`; ``coords``: one row per
+    unknown), after the equilibration of :func:`~pdverify.solvers.checks.equilibrate`.
 
     ``mixed`` (default: :func:`~pdverify.solvers.policy.mixed_precision`): factor in single
-    precision (:class:`SplitLU`) and refine in double as LAPACK's dsgesv does, or, when
-    that stalls (condition ~1/eps_single = 1.7e7), by GMRES preconditioned with the same
-    factor (:mod:`~pdverify.solvers.mixed`); a system whose single-precision factor fails
-    or that neither refinement solves is solved by the double LU instead, with the reason
-    in the diagnostics (``mixed_precision``). A random right-hand side is refined alongside
-    (a near-singular system cannot converge on it) and gives the condition estimate
-    (:func:`~pdverify.solvers.mixed.probe_condition_estimate`). The diagnostics record
-    the refinement's steps and relative residuals (``refinement_steps``,
-    ``refinement_residuals``, the probe's final residual ``refinement_probe_residual``),
-    the top separator's size and the separator rows pivoted into a half.
-    """
-    A = sp.csr_matrix(A)
+    precision (:class:`SplitLU`, or :class:`~pdverify.solvers.frontal.FrontalLU` when the
+    separator is too large to split at) and refine each solve in double as LAPACK's dsgesv
+    does, or, when that stalls (condition ~1/eps_single = 1.7e7), by GMRES preconditioned
+    with the same factor (:mod:`~pdverify.solvers.mixed`); a system whose single-precision
+    factor fails or that neither refinement solves is factored in double instead (once),
+    with the reason in the diagnostics (``mixed_precision``). A random right-hand side is
+    refined alongside (a near-singular system cannot converge on it) and gives the
+    condition estimate (:func:`~pdverify.solvers.mixed.probe_condition_estimate`).
+    :meth:`solve` checks each solution (:class:`NumericalError` naming ``where``) and
+    leaves its diagnostics in :attr:`info`: the refinement's steps and relative residuals
+    (``refinement_steps``, ``refinement_residuals``, the probe's final residual
+    ``refinement_probe_residual``), the top separator's size and the separator rows
+    pivoted into a half."""
+
+    def __init__(self, A, coords, *, where: str = "static solve", mixed: bool | None = None):
+        A = sp.csr_matrix(A)
+        if not np.all(np.isfinite(A.data)):
+            raise NumericalError(f"{where}: the system has non-finite entries")
+        self.A, self.where = A, where
+        n = A.shape[0]
+        self.A_p, self.row_max, self.perm, (n1, n2), self.col_max, tree = ordered_matrix(
+            A, coords, where)
+        self.mixed = policy.mixed_precision(n) if mixed is None else mixed
+        self.single = self.single_note = self.single_failed = None
+        if self.mixed:
+            try:
+                self.single, self.single_note = single_precision_factor(self.A_p, n1, n2, tree)
+            except RuntimeError as exc:  # "Factor is exactly singular" in single precision
+                self.single_failed = (f"not used: single-precision factor failed ({exc}); "
+                                      "double LU")
+        self.double = None
+        self.info: dict = {}
+
+    def _double(self):
+        """SuperLU's double factor (made once, when first needed)."""
+        if self.double is None:
+            # SuperLU takes CSC: the CSR copy goes before the factor is made (memory)
+            self.A_p = self.A_p.tocsc()
+            self.double = factor(self.A_p, self.where, **ND_OPTIONS)
+        return self.double
+
+    def solve(self, rhs) -> np.ndarray:
+        rhs = np.asarray(rhs, dtype=float)
+        if not np.all(np.isfinite(rhs)):
+            raise NumericalError(f"{self.where}: the system has non-finite entries")
+        b_p = (rhs / self.row_max)[self.perm]
+        info: dict = {"unknowns": int(self.A.shape[0])}
+        y = None
+        if self.single is not None:
+            y, cond, diag = _refined(self.A_p, b_p, self.single, self.single_note)
+            info.update(diag)
+        elif self.single_failed is not None:
+            info["mixed_precision"] = self.single_failed
+        if y is None:
+            lu = self._double()
+            y = lu.solve(b_p)
+            cond = checked_condition(y, self.A_p, lu, self.where)
+            info["factor_entries"] = int(lu.nnz)
+            info["solver"] = "sparse LU (SuperLU, nested-dissection ordering)"
+        else:
+            refuse_near_singular(cond, self.where)
+        sol = np.empty_like(y)
+        sol[self.perm] = y
+        sol /= self.col_max
+        info["relative_residual"] = relative_residual(self.A, sol, rhs)
+        info["condition_estimate"] = float(cond)   # of the equilibrated system
+        self.info = info
+        return sol
+
+
+def solve_nested(A, rhs, coords, *, where: str = "static solve", mixed: bool | None = None):
+    """Solve the square system A x = rhs by :class:`NestedFactor` (its docstring: the
+    ordering, ``mixed``, the checks and the diagnostics). Returns ``(x, info)``."""
     rhs = np.asarray(rhs, dtype=float)
-    if not np.all(np.isfinite(A.data)) or not np.all(np.isfinite(rhs)):
+    if not np.all(np.isfinite(sp.csr_matrix(A).data)) or not np.all(np.isfinite(rhs)):
         raise NumericalError(f"{where}: the system has non-finite entries")
-    n = A.shape[0]
-    A_p, b_p, perm, (n1, n2), col_max, tree = ordered_system(A, rhs, coords, where,
-                                                             tree=True)
-    use_mixed = policy.mixed_precision(n) if mixed is None else mixed
-    info: dict = {"unknowns": int(n)}
-    y = None
-    if use_mixed:
-        y, cond, diag = _solve_mixed(A_p, b_p, n1, n2, tree)
-        info.update(diag)
-    if y is None:
-        # SuperLU takes CSC: the CSR copy goes before the factor is made (memory)
-        A_p = A_p.tocsc()
-        lu = factor(A_p, where, **ND_OPTIONS)
-        y = lu.solve(b_p)
-        cond = checked_condition(y, A_p, lu, where)
-        info["factor_entries"] = int(lu.nnz)
-        info["solver"] = "sparse LU (SuperLU, nested-dissection ordering)"
-    else:
-        refuse_near_singular(cond, where)
-    sol = np.empty_like(y)
-    sol[perm] = y
-    sol /= col_max
-    info["relative_residual"] = relative_residual(A, sol, rhs)
-    info["condition_estimate"] = float(cond)   # of the equilibrated system
-    return sol, info
+    lu = NestedFactor(A, coords, where=where, mixed=mixed)
+    x = lu.solve(rhs)
+    return x, lu.info
+
+
+def ordered_matrix(A, coords, where: str):
+    """``(A_p, row_max, perm, (n1, n2), col_max, tree)``: ``A`` equilibrated
+    (:func:`~pdverify.solvers.checks.equilibrate`) and permuted to the geometric
+    nested-dissection order (``perm``; the top split's halves ``n1``, ``n2``; the
+    ordering's separator tree); the solution of ``A x = rhs`` is ``x[perm] = y / col_max``
+    for ``A_p y = (rhs / row_max)[perm]``."""
+    A_s, row_max, col_max = equilibrate(A, where)
+    perm, halves, tree = nested_dissection(A_s, coords, top_split=True, tree=True)
+    A_p = A_s[perm][:, perm].tocsr()
+    del A_s     # memory: one copy of the system fewer while it is factored (issue 32)
+    return A_p, row_max, perm, halves, col_max, tree
 
 
 def ordered_system(A, rhs, coords, where: str, *, tree: bool = False):
-    """``(A_p, b_p, perm, (n1, n2), col_max)``: ``A x = rhs`` equilibrated
-    (:func:`~pdverify.solvers.checks.equilibrate`) and permuted to the geometric
-    nested-dissection order (``perm``; the top split's halves ``n1``, ``n2``); the
-    solution is ``x[perm] = y / col_max`` for ``A_p y = b_p``. ``tree=True`` appends the
-    ordering's separator tree."""
-    A_s, row_max, col_max = equilibrate(A, where)
-    perm, halves, *fronts = nested_dissection(A_s, coords, top_split=True, tree=tree)
-    A_p = A_s[perm][:, perm].tocsr()
-    del A_s     # memory: one copy of the system fewer while it is factored (issue 32)
-    return (A_p, (rhs / row_max)[perm], perm, halves, col_max, *fronts)
+    """:func:`ordered_matrix` with the right-hand side permuted alongside:
+    ``(A_p, b_p, perm, (n1, n2), col_max)`` (``tree=True``: and the separator tree)."""
+    A_p, row_max, perm, halves, col_max, sep_tree = ordered_matrix(A, coords, where)
+    out = (A_p, (np.asarray(rhs, dtype=float) / row_max)[perm], perm, halves, col_max)
+    return out + ((sep_tree,) if tree else ())
 
 
 def single_precision_factor(A_p, n1: int, n2: int, tree=None):
@@ -178,20 +223,12 @@ def single_precision_factor(A_p, n1: int, n2: int, tree=None):
         return SplitLU(A_p, 0, 0), f" (whole matrix: {exc})"
 
 
-def _solve_mixed(A_p, b_p, n1: int, n2: int, tree=None):
-    """Single-precision LU of the equilibrated, permuted ``A_p`` (:class:`SplitLU`: the
-    two halves of the top split in parallel, or, when SuperLU's pivoting crosses between
-    the blocks or the separator is too large to split at
-    (:func:`~pdverify.solvers.policy.split_too_large`), the whole matrix in one piece)
-    and refinement in double
-    (:func:`~pdverify.solvers.mixed.refine_with_probe`): ``(y, condition estimate,
-    diagnostics)``, or ``(None, None, diagnostics)`` with the reason in
-    ``diagnostics['mixed_precision']`` when the double LU must take over."""
-    try:
-        lu, note = single_precision_factor(A_p, n1, n2, tree)
-    except RuntimeError as exc:  # "Factor is exactly singular" in single precision
-        return None, None, {"mixed_precision": f"not used: single-precision factor "
-                                               f"failed ({exc}); double LU"}
+def _refined(A_p, b_p, lu, note: str):
+    """Refinement in double (:func:`~pdverify.solvers.mixed.refine_with_probe`) of the
+    equilibrated, permuted ``A_p y = b_p`` with the single-precision factor ``lu``
+    (:func:`single_precision_factor`, whose ``note`` says how it was made):
+    ``(y, condition estimate, diagnostics)``, or ``(None, None, diagnostics)`` with the
+    reason in ``diagnostics['mixed_precision']`` when the double LU must take over."""
     y, cond, diag = refine_with_probe(A_p, b_p, lu)
     if y is None:
         return None, None, diag
