@@ -330,6 +330,8 @@ def main(argv=None):
     ap.add_argument("--json", default=None)
     ap.add_argument("--keep", default=None, help="folder for the largest system of each piece")
     ap.add_argument("--memory", action="store_true")
+    ap.add_argument("--no-timing", action="store_true", help="time only pdverify's solves "
+                    "(with --memory: the libraries' memory of the largest systems only)")
     ap.add_argument("--_child", nargs=2, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args._child:
@@ -348,16 +350,18 @@ def main(argv=None):
                 json.dump({**record, "cases_done": f"{done} of {total}",
                            "pieces": summarize(rows, libs), "systems": rows}, fh,
                           indent=1, default=str)
-    rows, largest = capture(args, libs, partial)
+    rows, largest = capture(args, [] if args.no_timing else libs, partial)
     record["capture_wall_s"] = time.perf_counter() - t0
     record["machine"]["load_1min_after"] = os.getloadavg()[0]
-    record["pieces"] = summarize(rows, libs)
+    record["pieces"] = summarize(rows, [] if args.no_timing else libs)
     record["systems"] = rows
     if args.memory:
         record["memory"] = memory(largest, ["ours", *libs])
     print(f"machine: {record['machine']}")
     print("libraries: " + ", ".join(f"{n} {v.get('version') or 'missing'}"
                                      for n, v in libs_info.items()))
+    if args.no_timing:
+        libs = []
     head = f"{'piece':70s} {'runs':>5s} {'max n':>7s} {'ours':>8s}" + "".join(
         f" {n:>9s}" for n in libs)
     print(head)

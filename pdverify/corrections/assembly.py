@@ -37,13 +37,6 @@ def side_sign(face: int) -> float:
     return -1.0 if face % 2 == 0 else 1.0
 
 
-def system_matrix(model, P, solver, map_last: bool = False):
-    """K (direct) or the augmented system with the nodal scalars as unknowns (``map_last``:
-    ``StateBasedModel.unknown_rows``)."""
-    return (model.stiffness(P, map_last=map_last) if solver == "direct"
-            else model.augmented_stiffness(P, map_last=map_last))
-
-
 def unknown_coords(model, nodes):
     """Coordinates of the unknowns: d displacement components of ``nodes``, then the
     closure's nodal scalars (dilatations; PALS: two per node) of the real nodes."""
@@ -115,19 +108,22 @@ def shape_counts(g, **counts) -> dict:
     return counts
 
 
-def eliminated(model, K, rhs, fixed, values, solver, nodes, by_face, **extra):
-    """The system of prescribed unknowns ``fixed`` (lists per condition) eliminated:
-    the right-hand side (n_unknown_nodes, d) flattened component-major and padded for the
-    augmented system's nodal scalars, the unknowns' coordinates (``nodes``: the unknown
-    nodes' positions) for nested dissection, and the reaction of each face's prescribed
-    normal components (``by_face``: face -> their unknowns)."""
+def eliminated(problem, model, K, rhs, fixed, values, nodes, by_face, **extra):
+    """The augmented system ``K`` (``StateBasedModel.augmented_stiffness``; the solver
+    layer forms what its solver needs, ``LinearSystem.scalars``) with the prescribed
+    unknowns ``fixed`` (lists per condition) eliminated: the right-hand side
+    (n_unknown_nodes, d) flattened component-major and padded for the nodal scalars, the
+    unknowns' coordinates (``nodes``: the unknown nodes' positions) for nested
+    dissection, and the reaction of each face's prescribed normal components
+    (``by_face``: face -> their unknowns), solved by ``problem.solver``."""
     fixed, values = _sorted(fixed, values)
     rhs = rhs.T.ravel()
-    if solver != "direct":
-        rhs = padded(rhs, K)
+    scalars = K.shape[0] - rhs.size
+    rhs = padded(rhs, K)
     react = residual_reaction(K, rhs)
-    return LinearSystem(model, K, rhs, fixed, values, model.n_unknown_nodes, solver=solver,
-                        coords=None if solver == "direct" else unknown_coords(model, nodes),
+    return LinearSystem(model, K, rhs, fixed, values, model.n_unknown_nodes,
+                        solver=problem.solver, coords=unknown_coords(model, nodes),
+                        scalars=scalars,
                         reaction=lambda x, face: react(x, face_number(face), by_face.__getitem__),
                         **extra)
 

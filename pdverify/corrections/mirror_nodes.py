@@ -69,8 +69,7 @@ import scipy.sparse as sp
 
 from ..pd.closure import Closure, real_identity
 from ..pd.problem import LinearSystem
-from ..solvers.policy import static_solver
-from .assembly import model_of, padded, system_matrix, traction_of, unknown_coords
+from .assembly import model_of, padded, traction_of, unknown_coords
 
 
 def peridynamic_gradient(grid, stencil) -> np.ndarray:
@@ -302,9 +301,8 @@ def assemble_mirror(problem, neumann: str, mirror_point: str,
                          mirror_point=mirror_point, gradient_at=gradient_at)
     model = model_of(problem, g, mirror.closure())
     d, ni, nu_ = g.dim, g.n_interior, model.n_unknown_nodes
-    solver = static_solver(problem.solver, d, d * nu_)
     P = model.equilibrium_rows()
-    K = system_matrix(model, P, solver)
+    K = model.augmented_stiffness(P)      # the solver layer forms what it needs
     x_int = g.x[g.interior_ids]
     rhs = np.zeros((nu_, d))
     rhs[:ni] = problem.body_load(x_int, model.node_volume[g.interior_ids][:, None])
@@ -313,9 +311,9 @@ def assemble_mirror(problem, neumann: str, mirror_point: str,
     rhs[:ni] -= model.rows_of_state(U_c, model.A_Theta @ (model.A_theta @ e_c),
                                     P).reshape(d, nu_).T
     rhs = rhs.T.ravel()
-    if solver != "direct":
-        rhs = padded(rhs, K)
+    scalars = K.shape[0] - rhs.size
+    rhs = padded(rhs, K)
     return LinearSystem(model, K, rhs, np.zeros(0, dtype=int), np.zeros(0), nu_,
-                        solver=solver,
-                        coords=None if solver == "direct" else unknown_coords(model, x_int),
+                        solver=problem.solver, coords=unknown_coords(model, x_int),
+                        scalars=scalars,
                         counts={"fictitious_nodes": int(g.n_ext - g.n_interior)}, offset=U_c)

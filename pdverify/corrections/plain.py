@@ -12,8 +12,7 @@ import numpy as np
 
 from ..pd.closure import Closure
 from ..pd.problem import LinearSystem
-from ..solvers.policy import static_solver
-from .assembly import boundary_nodes, eliminated, model_of, shape_counts, side_sign, system_matrix
+from .assembly import boundary_nodes, eliminated, model_of, shape_counts, side_sign
 
 
 def assemble_plain(problem, closure: Closure | None = None) -> LinearSystem:
@@ -23,9 +22,7 @@ def assemble_plain(problem, closure: Closure | None = None) -> LinearSystem:
     if problem.shape is not None:
         return _plain_on_shape(problem, g, model)
     d, ni, nu_ = g.dim, g.n_interior, model.n_unknown_nodes
-    solver = static_solver(problem.solver, d, d * nu_)
-    P = model.equilibrium_rows()
-    K = system_matrix(model, P, solver)
+    K = model.augmented_stiffness(model.equilibrium_rows())
     x_int = g.x[g.interior_ids]
     cells = g.index[g.interior_ids]
     rhs = np.zeros((nu_, d))
@@ -50,7 +47,7 @@ def assemble_plain(problem, closure: Closure | None = None) -> LinearSystem:
         values.append(u_ref[nodes, k])
         if k == face // 2:
             by_face[face] = k * nu_ + nodes
-    return eliminated(model, K, rhs, fixed, values, solver, x_int, by_face)
+    return eliminated(problem, model, K, rhs, fixed, values, x_int, by_face)
 
 
 def _plain_on_shape(problem, g, model) -> LinearSystem:
@@ -60,8 +57,7 @@ def _plain_on_shape(problem, g, model) -> LinearSystem:
     t(x, n) w thickness on the node each belongs to, x the sample (``load_point=surface``)
     or the node (``node``)."""
     d, ni, nu_ = g.dim, g.n_interior, model.n_unknown_nodes
-    solver = static_solver(problem.solver, d, d * nu_)
-    K = system_matrix(model, model.equilibrium_rows(), solver)
+    K = model.augmented_stiffness(model.equilibrium_rows())
     x_int = g.x[g.interior_ids]
     rhs = np.zeros((nu_, d))
     rhs[:ni] = problem.body_load(x_int, model.node_volume[g.interior_ids][:, None])
@@ -81,4 +77,4 @@ def _plain_on_shape(problem, g, model) -> LinearSystem:
             fixed.append(k * nu_ + nodes)
             values.append(u_ref[nodes, k])
     counts = shape_counts(g, boundary_nodes=int(np.unique(node).size))
-    return eliminated(model, K, rhs, fixed, values, solver, x_int, {}, counts=counts)
+    return eliminated(problem, model, K, rhs, fixed, values, x_int, {}, counts=counts)

@@ -11,8 +11,7 @@ from ..errors import InputError
 from ..pd.bonds import bond_pairs
 from ..pd.closure import Closure, real_identity, with_rows
 from ..pd.problem import LinearSystem
-from ..solvers.policy import static_solver
-from .assembly import eliminated, model_of, system_matrix
+from .assembly import eliminated, model_of
 from .protocols import GridMap, Params
 from .taylor import extrapolation_rows, taylor_weights, window_start
 
@@ -298,11 +297,10 @@ def impose_on_surface_nodes(problem, g, closure, flux) -> LinearSystem:
     surface nodes (a plugin's, e.g.)."""
     model, P = surface_node_rows(problem, g, closure, flux)
     d, ni, nu_ = g.dim, g.n_interior, model.n_unknown_nodes
-    solver = static_solver(problem.solver, d, d * nu_)
     # in 3D the extrapolation rows are wide (order N: (N + 1)(2 ceil(N/2) + 1)^2 sources),
     # so the displacement map is multiplied in last; in 1D and 2D the products keep the
     # order the runs' numbers were made with (the gain there is small)
-    K = system_matrix(model, P, solver, map_last=d == 3)
+    K = model.augmented_stiffness(P, map_last=d == 3)
     x_int = g.x[g.interior_ids]
     rhs = np.zeros((nu_, d))
     rhs[:ni] = problem.body_load(x_int, model.node_volume[g.interior_ids][:, None])
@@ -321,6 +319,6 @@ def impose_on_surface_nodes(problem, g, closure, flux) -> LinearSystem:
         values.append(us_ref[nodes, k])
     for face in range(2 * d):
         by_face[face] = (face // 2) * nu_ + ni + np.flatnonzero(g.surface_face == face)
-    return eliminated(model, K, rhs, fixed, values, solver, np.r_[x_int, xs], by_face,
+    return eliminated(problem, model, K, rhs, fixed, values, np.r_[x_int, xs], by_face,
                        extra_x=xs, counts={"surface_nodes": int(g.n_surface),
                                            "fictitious_nodes": int(g.n_ext - g.n_interior)})

@@ -28,7 +28,6 @@ import scipy.sparse as sp
 from ..pd.bonds import unique_ids
 from ..pd.closure import Closure, real_identity, with_rows
 from ..pd.problem import FACES, LinearSystem, face_number
-from ..solvers.policy import static_solver
 from .assembly import boundary_nodes, model_of, shape_counts, side_sign, unknown_coords
 from .shape_fictitious import condition_rows, normal_closure
 from .surface_nodes import crossing_bonds
@@ -231,16 +230,15 @@ def assemble_taylor(problem, order: int, corners: str = "normal-only") -> Linear
     model = model_of(problem, g, closure)
     ni = g.n_interior
     P = model.equilibrium_rows()
-    solver = static_solver(problem.solver, d, d * ni)
     x_int = g.x[g.interior_ids]
     rhs = problem.body_load(x_int, model.node_volume[g.interior_ids][:, None]).T.ravel()
     K_b = model.bond_force_matrix() if d == 1 else None
-    # the constraint rows act on the solver's unknowns: the real displacements (direct),
-    # or those and the real dilatations (the augmented system of nested dissection)
-    width = d * ni if solver == "direct" else (d + 1) * ni
+    # the constraint rows act on the augmented system's unknowns: the real displacements
+    # and the real dilatations (the solver layer eliminates the latter for a direct LU)
+    width = (d + 1) * ni
     rows, vals = [], []
     if flux is not None:   # force of each boundary cell face from the unknowns
-        Fs = _flux_of_unknowns(model, flux, g.n_surface, solver)
+        Fs = _flux_of_unknowns(model, flux, g.n_surface)
     for face in range(2 * d):
         axis, side = divmod(face, 2)
         cond = problem.conditions.get(FACES[face])
@@ -277,7 +275,8 @@ def assemble_taylor(problem, order: int, corners: str = "normal-only") -> Linear
                 sec = model.crossing_selector([g.face_coordinate(face)]) @ K_b
                 # tension positive through the plane; the force on the body at the
                 # face is the outward traction: + at x+, - at x-
-                rows.append(sp.csr_matrix(sec))
+                rows.append(sp.hstack([sp.csr_matrix(sec), sp.csr_matrix((1, width - sec.shape[1]))],
+                                      format="csr"))
                 t = (cond.traction(xb, np.array([[side_sign(face)]]))[0, 0]
                      if cond is not None and cond.traction is not None else 0.0)
                 vals.append(np.array([side_sign(face) * t * g.face_area
@@ -295,39 +294,15 @@ def assemble_taylor(problem, order: int, corners: str = "normal-only") -> Linear
         return float((model.crossing_selector([g.face_coordinate(face_number(face))]) @ K_b @ x[:ni])[0])
     counts = {"fictitious_nodes": int(g.n_ext - g.n_interior), "constraints": int(B.shape[0])}
     none = np.zeros(0, dtype=int), np.zeros(0)
-    if solver == "direct":
-        return LinearSystem(model, model.stiffness(P), rhs, *none, ni, B=B, c=c,
-                            reaction=reaction, counts=counts)
-    # the bordered augmented system [[A, B^T], [B, 0]] (dilatations and multipliers as
-    # unknowns) under nested dissection: each block couples within one horizon, so its
-    # separators are half as thick as K's (on the seed-001 plate at h = 0.0125: 6.7 s
-    # against 19.6 s for the Lagrange system of K, same machine, solutions equal to
-    # 5e-13); in 3D the flux rows too act on the dilatations as unknowns (_bond_forces);
-    # a multiplier sits at the mean position of the nodes its row involves
+    # the augmented system, the constraint rows beside it: the solver layer forms what
+    # its solver needs (pdverify.solvers.front.solve_augmented: for nested dissection the
+    # bordered system, whose separators are half as thick as those of K's Lagrange system
+    # (on the seed-001 plate at h = 0.0125: 6.7 s against 19.6 s, solutions equal to
+    # 5e-13), with the multipliers of rows on the dilatations (3D) kept sparse)
     A = model.augmented_stiffness(P)
-    absB = abs(B).tocsr()
-    at = (absB @ np.tile(x_int, (d + 1, 1))) / np.asarray(absB.sum(axis=1))
-    B_theta = B[:, d * ni:]
-    if B_theta.nnz == 0:
-        M = sp.bmat([[A, B.T], [B, None]], format="csr")
-        return LinearSystem(model, M, np.r_[rhs, np.zeros(A.shape[0] - rhs.size), c], *none,
-                            ni, solver=solver, coords=np.r_[unknown_coords(model, x_int), at],
-                            reaction=reaction, counts=counts)
-    # rows on the dilatations (3D): the multipliers' forces on the displacements must be
-    # those of the direct system, (B_u + B_theta G)^T lambda with G = A_theta A_e A_U
-    # (theta = G u); B^T alone would put B_theta^T lambda into the dilatation rows and
-    # solve another problem (7 % apart on body3d-manufactured, order 2, h = 0.0625).
-    # Kept sparse by mu = B_theta^T lambda as ni more unknowns at the nodes:
-    # [[A, [G^T; 0], [B_u^T; 0]], [0, I, -B_theta^T], [B, 0, 0]]
-    G = (model.A_theta @ (model.A_e @ model.A_U_full)).tocsr()
-    zero_theta = sp.csr_matrix((ni, ni))
-    M = sp.bmat([[A, sp.vstack([G.T, zero_theta]), sp.vstack([B[:, :d * ni].T,
-                                                                sp.csr_matrix((ni, B.shape[0]))])],
-                 [None, sp.identity(ni, format="csr"), -B_theta.T],
-                 [B, None, None]], format="csr")
-    return LinearSystem(model, M, np.r_[rhs, np.zeros(A.shape[0] - rhs.size + ni), c], *none,
-                        ni, solver=solver, coords=np.r_[unknown_coords(model, x_int), x_int, at],
-                        reaction=reaction, counts=counts)
+    return LinearSystem(model, A, np.r_[rhs, np.zeros(A.shape[0] - rhs.size)], *none, ni,
+                        B=B, c=c, solver=problem.solver, coords=unknown_coords(model, x_int),
+                        scalars=A.shape[0] - rhs.size, reaction=reaction, counts=counts)
 
 
 def _taylor_on_shape(problem, order: int) -> LinearSystem:
@@ -354,11 +329,10 @@ def _taylor_on_shape(problem, order: int) -> LinearSystem:
                         B=B, c=c, counts=counts, ordering="COLAMD")
 
 
-def _bond_forces(model, solver, bonds=None):
-    """Scalar bond forces (times beta V_a V_b) as a matrix on the solver's unknowns, the
-    flux rows' factor. Direct: of the real displacements (``model.bond_force_matrix``,
-    whose dilatation term couples nodes two horizons apart). Augmented (displacements,
-    then the real dilatations): in 3D [K_e A_e A_U, K_theta A_Theta], each block within
+def _bond_forces(model, bonds=None):
+    """Scalar bond forces (times beta V_a V_b) as a matrix on the augmented system's
+    unknowns (displacements, then the real dilatations), the flux rows' factor: in 3D
+    [K_e A_e A_U, K_theta A_Theta], each block within
     one horizon, which (with the mu unknowns of assemble_taylor) takes body3d-traction at
     h = 0.05 from 11.0 M to 6.2 M non-zeros, 5.3 GB to 2.1 GB and 42 s to 36 s (whole
     runs, /usr/bin/time; benchmarks/taylor3d.py times the parts); in 2D the bond forces of
@@ -366,8 +340,6 @@ def _bond_forces(model, solver, bonds=None):
     form raised the plane-strain plate's condition estimate at h = 0.0125 from 2.1e5 to
     6.8e9 and moved its errors by 3e-7 (relative). ``bonds``: only these rows
     (ascending; the flux rows need the face-crossing bonds only)."""
-    if solver == "direct":
-        return model.bond_force_matrix(bonds)
     ni = model.A_theta.shape[0]
     rows = model.bond_a.size if bonds is None else len(bonds)
     if model.dim != 3:
@@ -416,13 +388,13 @@ def _shear_pair_lines(problem, g, anchors, axis, k):
     return out
 
 
-def _flux_of_unknowns(model, flux, n_surface, solver):
+def _flux_of_unknowns(model, flux, n_surface):
     """The force of each boundary cell face from the unknowns: :func:`_surface_flux`
     times :func:`_bond_forces`, the latter of the face-crossing bonds only (the other
     columns of the flux rows are zero; the same products, row by row)."""
     used = unique_ids(flux[1])
     return (_surface_flux(model, flux, n_surface)[:, used]
-            @ _bond_forces(model, solver, used)).tocsr()
+            @ _bond_forces(model, used)).tocsr()
 
 
 def _surface_flux(model, flux, n_surface):

@@ -250,6 +250,14 @@ class LinearSystem(_Unknowns):
     #: SuperLU's column ordering when the treatment's system wants another than the
     #: scene's ``StaticProblem.ordering`` (None: the scene's)
     ordering: str | None = None
+    #: the augmented form's nodal scalars (dilatations; PALS: two per node): the last
+    #: ``scalars`` unknowns, whose rows say ``theta = G u`` (``[[A_uu, A_ut], [G, -I]]``,
+    #: ``StateBasedModel.augmented_stiffness``) and whose ``rhs`` is zero; constraint rows
+    #: ``B`` may act on them too. The solver layer's front door
+    #: (:func:`pdverify.solvers.front.solve`) forms what its solver needs from it: the
+    #: condensed ``K = A_uu + A_ut G`` (and ``B_u + B_t G``) for a direct LU, the
+    #: augmented system as it is for nested dissection. 0: ``K`` is solved as it is.
+    scalars: int = 0
 
 
     def displacements(self, x: np.ndarray) -> np.ndarray:

@@ -14,7 +14,6 @@ import math
 from .. import budget
 from ..errors import InputError
 from ..solvers.front import solve as solve_system
-from ..solvers.policy import auto_note
 from .base import MethodSpec, Outcome, Scene, whole_cells
 from .fem_references import FEM, FemAndPD, FemReference
 
@@ -121,9 +120,12 @@ class StaticStateScene(Scene):
             return t.finish(self.measure(p, problem, system, x, info), metrics, trouble, where)
         with timer.phase("solve"):
             x, info = solve_system(system, where=where, ordering=problem.ordering)
-            if self.declared(p, "solver") == "auto":     # the user's auto: say what it chose
-                info["solver_choice"] = auto_note(system.solver, system.dofs)
-        return self.measure(p, problem, system, x, info)
+            if self.declared(p, "solver") != "auto":     # only the user's auto says what
+                info.pop("solver_choice", None)          # it chose
+        out = self.measure(p, problem, system, x, info)
+        for key in ("matrix_nnz", "static_solver"):      # the front door's, for sizes
+            out.diagnostics.pop(key, None)
+        return out
 
     @staticmethod
     def size(system) -> dict:
@@ -217,7 +219,8 @@ class FemStaticStateScene(StaticStateScene, FemAndPD):
         fields = {"x": x_int, "u": u, "u_ref": u_ref, "error": err, "spacing": p["spacing"],
                   "horizon": system.model.horizon, "lengths": lengths}
         size = self.size(system)
-        size["stiffness_nnz"] = int(system.K.nnz)
+        size["stiffness_nnz"] = info.pop("matrix_nnz", int(system.K.nnz))
+        info.pop("static_solver", None)
         if system.B is not None:
             info["constraints"] = int(system.B.shape[0])
         return Outcome(metrics=metrics, size=size, fields=fields, diagnostics=info)

@@ -190,7 +190,9 @@ class SurfaceNodeScene(StaticStateScene):
                   "lengths": np.asarray(lengths), "origin": np.asarray(origin),
                   "spacing": p["spacing"], "horizon": horizon}
         size = self.size(system)
-        size["stiffness_nnz" if system.solver == "direct" else "augmented_nnz"] = int(system.K.nnz)
+        nnz = info.pop("matrix_nnz", int(system.K.nnz))
+        solver = info.pop("static_solver", system.solver)
+        size["stiffness_nnz" if solver == "direct" else "augmented_nnz"] = nnz
         return Outcome(metrics=metrics, size=size, fields=fields, diagnostics=info)
 
 

@@ -80,12 +80,15 @@ def solve(system, *, where: str, ordering: str = "COLAMD"):
     solved by ``system.solver``; ``ordering``: SuperLU's column ordering of a direct
     solve. Returns ``(x, info)``; ``x`` holds every unknown of the system (multipliers
     dropped). A system that names its own ``ordering`` (``LinearSystem.ordering``) is
-    solved with that one."""
+    solved with that one. An augmented system (``LinearSystem.scalars``) is solved in the
+    form its solver needs (:func:`solve_augmented`)."""
     ordering = getattr(system, "ordering", None) or ordering
+    if system.B is not None and np.size(system.fixed):
+        raise ValueError(f"{where}: a system with constraint rows has no eliminated "
+                         "unknowns")
+    if getattr(system, "scalars", 0):
+        return solve_augmented(system, where=where, ordering=ordering)
     if system.B is not None:
-        if np.size(system.fixed):
-            raise ValueError(f"{where}: a system with constraint rows has no eliminated "
-                             "unknowns")
         x, _lam, info = solve_constrained(system.K, system.rhs, system.B, system.c,
                                           where=where, ordering=ordering)
         return x, info
@@ -93,6 +96,106 @@ def solve(system, *, where: str, ordering: str = "COLAMD"):
     return solve_with_dirichlet(system.K, system.rhs, system.fixed, system.values,
                                 where=where, solver=system.solver, coords=coords,
                                 ordering=ordering)
+
+
+def condensed(A, scalars: int):
+    """``(K, G)``: the augmented ``A = [[A_uu, A_ut], [G, -I]]`` with its last ``scalars``
+    unknowns (theta = G u) eliminated, ``K = A_uu + A_ut G``: the products of
+    ``StateBasedModel.stiffness`` in its order, so K is that matrix to the last bit."""
+    A = sp.csr_matrix(A)
+    n = A.shape[0] - int(scalars)
+    G = A[n:, :n]
+    return (A[:n, :n] + A[:n, n:] @ G).tocsr(), G
+
+
+def displacement_form(system):
+    """``(K, rhs)`` of ``system`` on its displacement unknowns alone: an augmented system
+    (``LinearSystem.scalars``) condensed (:func:`condensed`; its scalars' right-hand side
+    is zero), any other as it is. For checks that apply K to a displacement field."""
+    s = int(getattr(system, "scalars", 0))
+    if not s:
+        return sp.csr_matrix(system.K), np.asarray(system.rhs, dtype=float)
+    K, _ = condensed(system.K, s)
+    return K, np.asarray(system.rhs, dtype=float)[:K.shape[0]]
+
+
+def solve_augmented(system, *, where: str, ordering: str = "COLAMD"):
+    """Solve a state-based system given in its augmented form ``A = [[A_uu, A_ut], [G, -I]]``
+    (the last ``system.scalars`` unknowns are nodal scalars theta = G u, with zero
+    right-hand side; constraint rows ``B = [B_u, B_t]`` may act on them), in the form the
+    solver that :func:`~pdverify.solvers.policy.static_solver` chooses for
+    ``system.solver`` needs:
+
+    - ``direct``: theta eliminated, ``K = A_uu + A_ut G`` (the same products as
+      ``StateBasedModel.stiffness``, so the same matrix to the last bit) and
+      ``B_u + B_t G``, solved by :func:`solve_with_dirichlet` (or, with constraint rows,
+      :func:`~pdverify.solvers.lu.solve_constrained`); theta = G u appended;
+    - ``nested-dissection``: ``A`` as it is under the unknowns' ``system.coords``; with
+      constraint rows, bordered ``[[A, B^T], [B, 0]]``, a multiplier placed at the mean
+      position of the unknowns its row involves. Rows on theta (``B_t`` not empty) would
+      put ``B_t^T lambda`` into theta's rows and solve another problem; the multipliers'
+      forces on the displacements must be ``(B_u + B_t G)^T lambda``, kept sparse by
+      ``mu = B_t^T lambda`` as more unknowns at the scalars' nodes:
+      ``[[A, [G^T; 0], [B_u^T; 0]], [0, I, -B_t^T], [B, 0, 0]]``.
+
+    Returns ``(x, info)``: ``x`` the augmented unknowns (displacements, then theta; the
+    multipliers dropped); ``info`` the solver's diagnostics, with ``matrix_nnz`` (the
+    non-zeros of the matrix factored, before eliminating prescribed unknowns),
+    ``static_solver`` (the solver used) and, when ``system.solver`` is ``auto``,
+    ``solver_choice``."""
+    A = sp.csr_matrix(system.K)
+    s = int(system.scalars)
+    n = A.shape[0] - s
+    rhs = np.asarray(system.rhs, dtype=float)
+    solver = policy.static_solver(system.solver, system.dim, system.dofs)
+    B = None if system.B is None else sp.csr_matrix(system.B)
+    if solver == "direct":
+        K, G = condensed(A, s)
+        r = rhs[:n]
+        if np.any(rhs[n:]):
+            r = r - A[:n, n:] @ rhs[n:]
+        if B is not None:
+            B_t = B[:, n:]
+            B_c = B[:, :n] if B_t.nnz == 0 else (B[:, :n] + B_t @ G).tocsr()
+            u, _lam, info = solve_constrained(K, r, B_c, system.c, where=where,
+                                              ordering=ordering)
+        else:
+            u, info = solve_with_dirichlet(K, r, system.fixed, system.values, where=where,
+                                           solver="direct", ordering=ordering)
+        x = np.r_[u, G @ u - rhs[n:]]
+        nnz = K.nnz
+    else:
+        coords = np.asarray(system.coords)
+        if B is None:
+            x, info = solve_with_dirichlet(A, rhs, system.fixed, system.values, where=where,
+                                           solver=solver, coords=coords, ordering=ordering)
+            nnz = A.nnz
+        else:
+            absB = abs(B).tocsr()
+            at = (absB @ coords) / np.asarray(absB.sum(axis=1))
+            B_t = B[:, n:]
+            c = np.asarray(system.c, dtype=float)
+            if B_t.nnz == 0:
+                M = sp.bmat([[A, B.T], [B, None]], format="csr")
+                rhs_m, coords_m = np.r_[rhs, c], np.r_[coords, at]
+            else:
+                G = A[n:, :n]
+                M = sp.bmat([[A, sp.vstack([G.T, sp.csr_matrix((s, s))]),
+                              sp.vstack([B[:, :n].T, sp.csr_matrix((s, B.shape[0]))])],
+                             [None, sp.identity(s, format="csr"), -B_t.T],
+                             [B, None, None]], format="csr")
+                rhs_m = np.r_[rhs, np.zeros(s), c]
+                coords_m = np.r_[coords, coords[n:], at]
+            none = np.zeros(0, dtype=int), np.zeros(0)
+            x, info = solve_with_dirichlet(M, rhs_m, *none, where=where, solver=solver,
+                                           coords=coords_m, ordering=ordering)
+            x = x[:A.shape[0]]
+            nnz = M.nnz
+    info["matrix_nnz"] = int(nnz)
+    info["static_solver"] = solver
+    if system.solver == "auto":
+        info["solver_choice"] = policy.auto_note(solver, system.dofs)
+    return x, info
 
 
 def solve_square(K, f, *, where: str = "static solve", spd: bool = False,

@@ -91,8 +91,9 @@ def rows_of_state(system, field):
 
 def solved(system, f):
     """The real nodes' displacements (n, 2) with K u = f and the constraint rows."""
+    f = np.r_[f, np.zeros(system.K.shape[0] - np.size(f))]    # the scalars' rows: zero
     x, info = solve(replace(system, rhs=f), where="plate", ordering=ORDERING)
-    return x.reshape(2, -1).T, info
+    return x[:system.dofs].reshape(2, -1).T, info
 
 
 def real_x(system):
