@@ -45,7 +45,7 @@ def main(argv=None) -> int:
     here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     sys.path.insert(0, here)
     from pdverify import outputs, validate
-    from pdverify.report import estimate_bytes
+    from pdverify.report.folder import estimate_bytes
 
     with tempfile.TemporaryDirectory() as tmp:
         os.environ["PDVERIFY_CACHE_DIR"] = os.path.join(tmp, "cache")

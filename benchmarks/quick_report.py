@@ -174,10 +174,11 @@ def _summary(a, name, rounds) -> None:
 
 
 def _tasks(cases, results, figdir):
-    """The figure tasks of the report, as ``pdverify.report._build_logged`` makes them
-    (``pdverify.report.figure_tasks``; a source tree from before it: the same list,
+    """The figure tasks of the report, as ``pdverify.report.build`` makes them
+    (``pdverify.report.drawing.figure_tasks``; in a source tree from before the report
+    package's split, ``pdverify.report.figure_tasks``; from before that: the same list,
     scenes first, the overview and all convergence figures last)."""
-    from pdverify import report
+    drawing = _drawing()
     from pdverify.convergence import collect
     from pdverify.results import run_key
     from pdverify.scenes import get_scene
@@ -188,15 +189,30 @@ def _tasks(cases, results, figdir):
         own = {run_key(scene_id, m, scene.resolve(m, o)) for m, o in scene.report_cases(True)}
         owned.append((scene, [r for r in results if r.scene == scene_id and r.key in own]))
     studies = collect(results, True)
-    if hasattr(report, "figure_tasks"):
+    if hasattr(drawing, "figure_tasks"):
         return [(_short_name(what), draw, args, empty) for what, draw, args, empty
-                in report.figure_tasks(owned, results, studies, figdir)]
+                in drawing.figure_tasks(owned, results, studies, figdir)]
     from pdverify.report import figures
     from pdverify.report.figures import convergence, overview
     scenes = [s for s, _ in owned]
     return ([(scene.id, figures.draw, (scene, mine, figdir), []) for scene, mine in owned]
             + [("error-against-cost", overview.pareto, (scenes, results, figdir), []),
                ("convergence", convergence.draw, (studies, figdir), {})])
+
+
+def _drawing():
+    """The module that holds ``figure_tasks`` and ``draw_all``: ``pdverify.report.drawing``,
+    or in a source tree from before the report package's split (``--against``) the
+    package itself, whose ``_draw_all`` it names ``draw_all`` here."""
+    try:
+        from pdverify.report import drawing
+        return drawing
+    except ImportError:
+        from types import SimpleNamespace
+        from pdverify import report
+        return SimpleNamespace(draw_all=report._draw_all,
+                               **({"figure_tasks": report.figure_tasks}
+                                  if hasattr(report, "figure_tasks") else {}))
 
 
 def _short_name(what):
@@ -216,7 +232,7 @@ def _count(value) -> int:
 
 
 def inprocess(a) -> None:
-    from pdverify.report import _draw_all
+    draw_all = _drawing().draw_all
     from pdverify.runner import plan, run_cases
     print(f"load before: {_load()}")
     cases = plan(only=a.only, quick=True)
@@ -263,7 +279,7 @@ def inprocess(a) -> None:
             prof.dump_stats(a.profile)
             pstats.Stats(a.profile).sort_stats("cumulative").print_stats(25)
         t = time.perf_counter()
-        _draw_all(tasks, a.jobs, sys.stderr)
+        draw_all(tasks, a.jobs, sys.stderr)
         parallel = time.perf_counter() - t
     med = {w: statistics.median(v) for w, v in times.items()}
     mcpu = {w: statistics.median(v) for w, v in cpu.items()}
@@ -283,7 +299,8 @@ def figures_child(runs_file, out, jobs) -> None:
     drawn once serially into ``out/serial`` (wall and CPU time of each) and once as the
     report draws them, by ``jobs`` forked processes, into ``out/parallel`` (wall, and the
     CPU time of this process and of the drawing processes); one JSON line on stdout."""
-    from pdverify.report import _draw_all, figures
+    from pdverify.report import figures
+    draw_all = _drawing().draw_all
     from pdverify.runner import plan
     with open(runs_file, "rb") as fh:
         results = pickle.load(fh)
@@ -302,7 +319,7 @@ def figures_child(runs_file, out, jobs) -> None:
         tasks = _tasks(cases, results, os.path.join(out, "parallel"))
         r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
         t0, c0 = time.perf_counter(), time.process_time()
-        _draw_all(tasks, jobs, sys.stderr)
+        draw_all(tasks, jobs, sys.stderr)
         r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
         row["parallel_wall_s"] = time.perf_counter() - t0
         row["parallel_cpu_s"] = (time.process_time() - c0 + r1.ru_utime - r0.ru_utime

@@ -1,5 +1,5 @@
-"""What the report's front page and the end-of-run summary say about each scene: its
-headline error, the run of each method at its default parameters, the best method."""
+"""What the report's front page and the end-of-run summary say: each scene's headline error,
+the run of each method at its default parameters, the best method; the heaviest run; load."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -209,6 +209,17 @@ def print_summary(scenes, results, stream) -> None:
             print(format_summary(summaries), file=stream)
     except Exception as exc:  # a display problem must not lose the report
         print(f"summary failed: {type(exc).__name__}: {exc}", file=stream)
+
+
+def largest_memory(results) -> str:
+    """The run with the largest peak memory (``resources.peak_rss_gb``), as a line; empty
+    where no run measured one."""
+    measured = [r for r in results if r.resources.get("peak_rss_gb")]
+    if not measured:
+        return ""
+    r = max(measured, key=lambda r: r.resources["peak_rss_gb"])
+    return (f"largest peak memory of a run: {r.resources['peak_rss_gb']:.3g} GB "
+            f"({r.scene} {r.method}, {r.timings.get('total_s', 0.0):.3g} s)")
 
 
 # -- the machine's load over the runs ------------------------------------------------------

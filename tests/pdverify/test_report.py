@@ -150,7 +150,7 @@ def test_figure_tasks_start_with_the_overview_and_end_with_the_convergence_piece
     scene its own figures back, whatever the order drawn."""
     from types import SimpleNamespace
 
-    from pdverify.report import figure_tasks, figures_drawn
+    from pdverify.report.drawing import figure_tasks, figures_drawn
     owned = [(SimpleNamespace(id=name), []) for name in ("a", "b", "c")]
     studies = [{"scene": "c", "study": "delta"}, {"scene": "a", "study": "delta"},
                {"scene": "c", "study": "m"}]

@@ -194,7 +194,7 @@ def test_a_previous_report_is_replaced_but_not_with_a_file_the_user_added(
     rep = tmp_path / "rep"
     _previous(made_report, rep)
     capsys.readouterr()
-    from pdverify.report import estimate_bytes
+    from pdverify.report.folder import estimate_bytes
     size = sum(os.path.getsize(os.path.join(d, f)) for d, _, fs in os.walk(rep) for f in fs)
     assert size < estimate_bytes(range(4))       # the free-space estimate covers it
     marker = json.loads((rep / outputs.MARKER).read_text())
@@ -508,7 +508,8 @@ def test_a_broken_figure_that_is_no_storage_failure_stays_a_note(tmp_path, env, 
     """The rule: an exception of the plotting code is a note (the figure is missing, the
     numbers are kept); only a storage failure (ENOSPC, EDQUOT, EFBIG, EROFS, EIO in the
     exception or what it was raised from) makes the report incomplete."""
-    from pdverify.report import figures, storage_failure
+    from pdverify.report import figures
+    from pdverify.report.folder import storage_failure
 
     def broken(*args):
         raise ValueError("no ink")

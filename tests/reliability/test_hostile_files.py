@@ -74,7 +74,7 @@ def test_an_included_record_whose_files_point_outside_is_refused(tmp_path):
 
 
 def test_report_failed_refuses_a_previous_results_file_with_files_outside(tmp_path):
-    from pdverify.report import rerun_plan
+    from pdverify.report.rerun import rerun_plan
     from pdverify.runner import plan
     out = tmp_path / "rep"
     out.mkdir()
@@ -85,7 +85,7 @@ def test_report_failed_refuses_a_previous_results_file_with_files_outside(tmp_pa
 
 
 def test_kept_fields_are_never_read_or_written_outside_the_reports(tmp_path):
-    from pdverify.report import _keep_fields
+    from pdverify.report.files import keep_fields
     from pdverify.results import RunResult
     final, staging = tmp_path / "final", tmp_path / "staging"
     final.mkdir()
@@ -93,14 +93,14 @@ def test_kept_fields_are_never_read_or_written_outside_the_reports(tmp_path):
     (tmp_path / "victim-x.vtu").write_text("mine")
     r = RunResult(scene=SCENE, method="none", params={}, reference="analytic",
                   files=["../victim-x.vtu"])
-    _keep_fields([r], str(final), str(staging))
+    keep_fields([r], str(final), str(staging))
     assert r.files == [] and sorted(os.listdir(tmp_path)) == ["final", "staging",
                                                               "victim-x.vtu"]
 
 
 # ------------------------------------------------------------------------------ export
 def test_a_second_export_into_a_locked_folder_exits_2(tmp_path, capsys):
-    from pdverify.report import output_lock       # report's lock is export's
+    from pdverify.outputs import output_lock      # report's lock is export's
     out = tmp_path / "ex"
     with output_lock(str(out)):
         assert _export(out) == 2

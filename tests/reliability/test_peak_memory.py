@@ -41,7 +41,7 @@ def test_a_run_records_its_peak_and_results_json_keeps_it(tmp_path):
 
 
 def test_the_report_names_the_heaviest_run():
-    from pdverify.report import largest_memory
+    from pdverify.report.summary import largest_memory
     light = RunResult("a", "none", {}, "analytic", resources={"peak_rss_gb": 0.1},
                       timings={"total_s": 1.0})
     heavy = RunResult("b", "pddo", {}, "analytic", resources={"peak_rss_gb": 2.5},
