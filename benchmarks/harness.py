@@ -346,8 +346,8 @@ def _slug(text: str, limit: int = 60) -> str:
 
 
 class Record:
-    """One benchmark run's record; ``rec[key] = value`` adds a result, ``save()`` writes
-    the file (again after every case), leaving the ``with`` block writes it with the
+    """One benchmark run's record; ``rec[key] = value`` adds a result and writes the file
+    again (so after every case; ``save()`` writes it explicitly), leaving the ``with`` block writes it with the
     load at the end (and the error, if the script failed)."""
 
     def __init__(self, script: str, args: argparse.Namespace | None = None, *,
@@ -370,13 +370,20 @@ class Record:
                     **header(self._load), "results": {}}
 
     def __setitem__(self, key, value):
+        """A result; the record is written again at once (an interrupted run keeps it)."""
         self.doc["results"][key] = value
+        self.save()
 
     def __getitem__(self, key):
         return self.doc["results"][key]
 
     def update(self, values: dict) -> None:
         self.doc["results"].update(values)
+        self.save()
+
+    @property
+    def results(self) -> dict:
+        return self.doc["results"]
 
     def save(self, final: bool = False) -> Path | None:
         if final:
