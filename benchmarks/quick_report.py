@@ -94,11 +94,12 @@ import json
 import os
 import pickle
 import resource
-import statistics
 import subprocess
 import sys
 import tempfile
 import time
+
+import harness
 
 HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PHASES = ("runs_s", "figures_s", "fields_s", "pages_s", "total_s")
@@ -140,21 +141,19 @@ def fresh_report(jobs=None, cold=False, only=None, src=HERE) -> dict:
             "critical_path": path[-1] if path else ""}
 
 
-def fresh(a) -> None:
+def fresh(a) -> dict:
     trees = {"this tree": HERE}
     if a.against:
         trees[f"against {a.against}"] = os.path.abspath(a.against)
-    rounds = {name: [] for name in trees}
     print(f"load before: {_load()}")
-    for _ in range(a.repeat):        # alternating, so that the machine's load weighs alike
-        for name, src in trees.items():
-            rounds[name].append(fresh_report(a.jobs, a.cold, a.only, src))
+    timed = harness.alternate(       # alternating, so that the machine's load weighs alike
+        {name: (lambda src=src: fresh_report(a.jobs, a.cold, a.only, src))
+         for name, src in trees.items()}, a.repeat, rotate=False)
     print(f"load after:  {_load()}")
-    for name, rs in rounds.items():
-        _summary(a, name, rs)
+    return {name: _summary(a, name, t.results) for name, t in timed.items()}
 
 
-def _summary(a, name, rounds) -> None:
+def _summary(a, name, rounds) -> dict:
     kind = "cold (empty FEM cache)" if a.cold else "warm"
     r0 = rounds[0]
     print(f"{name}: report --quick, {kind}, fresh processes, median of {a.repeat}: "
@@ -163,7 +162,7 @@ def _summary(a, name, rounds) -> None:
     print(f"  {r0['last']}")
     for k in PHASES + ("wall_s", "cpu_s"):
         vals = [r.get(k, 0.0) for r in rounds]
-        print(f"  {k[:-2]:8s} {statistics.median(vals):7.2f} s   "
+        print(f"  {k[:-2]:8s} {harness.median(vals):7.2f} s   "
               f"(rounds: {', '.join(f'{v:.1f}' for v in vals)})")
     for r in rounds:
         print(f"  {r['critical_path']}")
@@ -171,6 +170,8 @@ def _summary(a, name, rounds) -> None:
         print("  FEM runs of the first round (their references computed):")
         for t, what in r0["fem"]:
             print(f"    {t:7.2f} s  {what}")
+    return {"median_s": {k: harness.median(r.get(k, 0.0) for r in rounds)
+                         for k in PHASES + ("wall_s", "cpu_s")}, "rounds": rounds}
 
 
 def _tasks(cases, results, figdir):
@@ -215,7 +216,7 @@ def _count(value) -> int:
     return len(value)
 
 
-def inprocess(a) -> None:
+def inprocess(a) -> dict:
     from pdverify.report import _draw_all
     from pdverify.runner import plan, run_cases
     print(f"load before: {_load()}")
@@ -265,8 +266,8 @@ def inprocess(a) -> None:
         t = time.perf_counter()
         _draw_all(tasks, a.jobs, sys.stderr)
         parallel = time.perf_counter() - t
-    med = {w: statistics.median(v) for w, v in times.items()}
-    mcpu = {w: statistics.median(v) for w, v in cpu.items()}
+    med = {w: harness.median(v) for w, v in times.items()}
+    mcpu = {w: harness.median(v) for w, v in cpu.items()}
     print(f"figure tasks, serial, median of {a.repeat} (wall s, CPU s of this process, "
           "figures, wall s per figure):")
     for w, t in sorted(med.items(), key=lambda x: -x[1]):
@@ -276,6 +277,10 @@ def inprocess(a) -> None:
           f"{sum(counts.values()):4d}")
     print(f"the report's drawing (--jobs {a.jobs or 'default'} processes): {parallel:.2f} s")
     print(f"load after:  {_load()}")
+    return {"runs": len(results), "failed": failed, "runs_wall_s": runs_s,
+            "runs_summed_s": total, "per_scene_s": per_scene,
+            "figure_tasks_median_s": med, "figure_tasks_cpu_median_s": mcpu,
+            "figures_per_task": counts, "parallel_drawing_s": parallel}
 
 
 def figures_child(runs_file, out, jobs) -> None:
@@ -310,7 +315,7 @@ def figures_child(runs_file, out, jobs) -> None:
     print(json.dumps(row))
 
 
-def figures_side_by_side(a) -> None:
+def figures_side_by_side(a) -> dict:
     """``--mode figures``: :func:`figures_child` of this tree and of ``--against``,
     alternating, ``--repeat`` rounds; medians side by side, and whether the two trees
     drew the same pixels (each figure file of the last round's serial drawing)."""
@@ -320,20 +325,22 @@ def figures_side_by_side(a) -> None:
     trees = {"this tree": HERE}
     if a.against:
         trees["against"] = os.path.abspath(a.against)
-    rows = {name: [] for name in trees}
     keep = a.keep or tempfile.mkdtemp(prefix="figures-")
+    rounds = {name: 0 for name in trees}
+
+    def one(name, src):
+        out = os.path.join(keep, f"{'this' if name == 'this tree' else 'against'}-"
+                                 f"{rounds[name]}")
+        rounds[name] += 1
+        env = {**os.environ, "PYTHONPATH": src + os.pathsep + os.environ.get("PYTHONPATH", "")}
+        return harness.fresh([sys.executable, os.path.abspath(__file__), "--figures-child",
+                              a.runs_file, out, str(a.jobs or 2)], env=env)
     print(f"load before: {_load()}")
-    for k in range(a.repeat):
-        for name, src in trees.items():
-            out = os.path.join(keep, f"{'this' if name == 'this tree' else 'against'}-{k}")
-            env = {**os.environ,
-                   "PYTHONPATH": src + os.pathsep + os.environ.get("PYTHONPATH", "")}
-            done = subprocess.run(
-                [sys.executable, os.path.abspath(__file__), "--figures-child", a.runs_file,
-                 out, str(a.jobs or 2)], env=env, capture_output=True, text=True, check=True)
-            rows[name].append(json.loads(done.stdout.strip().splitlines()[-1]))
+    timed = harness.alternate({name: (lambda name=name, src=src: one(name, src))
+                               for name, src in trees.items()}, a.repeat, rotate=False)
+    rows = {name: t.results for name, t in timed.items()}
     print(f"load after:  {_load()}")
-    med = {name: {key: statistics.median(r[key] for r in rs) for key in
+    med = {name: {key: harness.median(r[key] for r in rs) for key in
                   ("serial_wall_s", "serial_cpu_s", "parallel_wall_s", "parallel_cpu_s")}
            for name, rs in rows.items()}
     names = list(trees)
@@ -348,7 +355,7 @@ def figures_side_by_side(a) -> None:
             print(f"    {n} rounds: {', '.join(f'{r[key]:.1f}' for r in rows[n])}")
     print("  CPU s per task (serial, median):")
     tasks = list(dict.fromkeys(t for n in names for t in rows[n][0]["tasks"]))
-    cpu = {n: {t: statistics.median(r["tasks"][t][1] for r in rows[n])
+    cpu = {n: {t: harness.median(r["tasks"][t][1] for r in rows[n])
                for t in rows[n][0]["tasks"]} for n in names}
     for t in sorted(tasks, key=lambda t: -max(cpu[n].get(t, 0.0) for n in names)):
         print(f"    {t:34s}" + "".join(f"{cpu[n][t]:10.2f}" if t in cpu[n] else f"{'-':>10s}"
@@ -357,6 +364,7 @@ def figures_side_by_side(a) -> None:
         _same_pixels(os.path.join(keep, f"this-{a.repeat - 1}", "serial"),
                      os.path.join(keep, f"against-{a.repeat - 1}", "serial"))
     print(f"  figure files kept in {keep}")
+    return {"median_s": med, "rounds": rows, "cpu_per_task_median_s": cpu}
 
 
 def _same_pixels(one, two) -> None:
@@ -395,18 +403,20 @@ def main(argv=None) -> int:
                     help="inprocess: the runs' results pickled here on the first call and "
                          "read back on later ones (to time the figures alone; delete the "
                          "file after a change to the runs)")
+    harness.add_arguments(ap)
     a = ap.parse_args(argv)
     if a.figures_child:
         runs_file, out, jobs = a.figures_child
         figures_child(runs_file, out, int(jobs))
         return 0
-    if a.mode == "figures":
-        figures_side_by_side(a)
-        return 0
-    if a.mode in ("fresh", "both"):
-        fresh(a)
-    if a.mode in ("inprocess", "both"):
-        inprocess(a)
+    with harness.Record(__file__, a, argv=argv) as rec:
+        if a.mode == "figures":
+            rec["figures"] = figures_side_by_side(a)
+            return 0
+        if a.mode in ("fresh", "both"):
+            rec["fresh"] = fresh(a)
+        if a.mode in ("inprocess", "both"):
+            rec["inprocess"] = inprocess(a)
     return 0
 
 

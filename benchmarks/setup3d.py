@@ -62,12 +62,12 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import statistics
 import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
+import harness
 from _trees import extract
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -153,9 +153,11 @@ def label(case) -> str:
 def run_once(path: Path, case, mode: str) -> dict | str:
     scene, method, over = case
     env = {**os.environ, "PYTHONPATH": str(path)}
-    out = subprocess.run([sys.executable, "-c", RUNNER, scene, method, json.dumps(over), mode],
-                         env=env, cwd=path, check=True, capture_output=True, text=True).stdout
-    return out if mode == "profile" else json.loads(out.strip().splitlines()[-1])
+    cmd = [sys.executable, "-c", RUNNER, scene, method, json.dumps(over), mode]
+    if mode == "profile":
+        return subprocess.run(cmd, env=env, cwd=path, check=True, capture_output=True,
+                              text=True).stdout
+    return harness.fresh(cmd, env=env, cwd=path)
 
 
 def metric_check(a: dict, b: dict) -> str:
@@ -175,7 +177,7 @@ def metric_check(a: dict, b: dict) -> str:
     return "same" if worst == 0.0 else f"rel diff {worst:.1e}{name}"
 
 
-def main():
+def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--before", default="main", metavar="REV",
                     help="git revision (or folder) to time as 'before' (default main)")
@@ -184,7 +186,13 @@ def main():
     ap.add_argument("--profile", choices=("after", "before"),
                     help="cProfile the setups of this tree (after) or of --before")
     ap.add_argument("--only", nargs="*", default=[], metavar="TEXT")
-    args = ap.parse_args()
+    harness.add_arguments(ap)
+    args = ap.parse_args(argv)
+    with harness.Record(__file__, args, argv=argv, enabled=args.record and not args.profile) as rec:
+        _measure(args, rec)
+
+
+def _measure(args, rec):
     todo = cases(args.only)
     mode = "run" if args.runs else "setup"
     with tempfile.TemporaryDirectory() as tmp:
@@ -207,11 +215,11 @@ def main():
         print(head)
         sums = {k: [0.0, 0.0, 0.0] for k in trees}
         for case in todo:
-            got = {k: [] for k in trees}
-            for _ in range(args.repeat):
-                for name, path in trees.items():
-                    got[name].append(run_once(path, case, mode))
-            med = {k: {q: statistics.median(r[q] for r in v)
+            timed = harness.alternate({name: (lambda path=path: run_once(path, case, mode))
+                                       for name, path in trees.items()}, args.repeat,
+                                      rotate=False)
+            got = {k: t.results for k, t in timed.items()}
+            med = {k: {q: harness.median(r[q] for r in v)
                        for q in ("setup_s", "cpu_s") + (("total_s",) if mode == "run" else ())}
                    for k, v in got.items()}
             for k in trees:
@@ -222,10 +230,12 @@ def main():
             if mode == "setup":
                 dig = {r["digest"] for v in got.values() for r in v}
                 check = "same" if len(dig) == 1 else "DIFFERENT"
+                rec[label(case)] = {"median": med, "system": check}
                 print(f"{label(case):52s} {b['setup_s']:12.2f} {a['setup_s']:7.2f} "
                       f"{b['cpu_s']:10.2f} {a['cpu_s']:7.2f}  {check}", flush=True)
             else:
                 check = metric_check(got["before"][0]["metrics"], got["after"][0]["metrics"])
+                rec[label(case)] = {"median": med, "metrics": check}
                 print(f"{label(case):52s} {b['setup_s']:12.2f} {a['setup_s']:7.2f} "
                       f"{b['total_s']:12.2f} {a['total_s']:7.2f} {b['cpu_s']:10.2f} "
                       f"{a['cpu_s']:7.2f}  {check}", flush=True)
