@@ -45,6 +45,7 @@ import json
 import statistics
 import types
 
+import harness
 from pdverify import progress as progress_module
 from pdverify.results import run_key
 from pdverify.runner import plan
@@ -71,6 +72,9 @@ def write_table(full: str, quick: str) -> None:
     doc = {"about": "measured run times the progress ETA starts from (pdverify.schedule."
                     "MEASURED_TIMES); written by benchmarks/eta_replay.py --write-table "
                     f"from {full} and {quick}",
+           # who wrote it: the commit, machine and libraries (harness.header); the run
+           # times themselves are the two reports' (their results.json name their machine)
+           "header": harness.header(),
            "runs": list(rows.values())}
     with open(MEASURED_TIMES, "w") as fh:
         json.dump(doc, fh, separators=(",", ":"))

@@ -42,17 +42,16 @@ for _var in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS"):
 import argparse
 import collections
 import json
-import platform
 import resource
 import statistics
-import subprocess
 import sys
 import time
 
 import numpy as np
-import scipy
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+
+import harness
 
 
 # ------------------------------------------------------------------------ the libraries
@@ -105,18 +104,6 @@ def available() -> dict:
                 version = "?"
         out[name] = {"available": True, "version": version}
     return out
-
-
-def machine() -> dict:
-    cpu = ""
-    try:
-        with open("/proc/cpuinfo") as fh:
-            cpu = next(line.split(":", 1)[1].strip() for line in fh if line.startswith("model name"))
-    except (OSError, StopIteration):
-        pass
-    return {"cpu": cpu, "cores": os.cpu_count(), "python": platform.python_version(),
-            "numpy": np.__version__, "scipy": scipy.__version__,
-            "load_1min": os.getloadavg()[0], "threads_per_run": os.environ["OMP_NUM_THREADS"]}
 
 
 def timed(fn, *args):
@@ -271,11 +258,11 @@ def memory(largest, libs) -> dict:
     for piece, (_nnz, path) in largest.items():
         out[piece] = {}
         for who in libs:
-            proc = subprocess.run([sys.executable, __file__, "--_child", path, who],
-                                  capture_output=True, text=True, timeout=1800)
-            out[piece][who] = (json.loads(proc.stdout.strip().splitlines()[-1])
-                               if proc.returncode == 0 else
-                               {"failed": proc.stderr.strip().splitlines()[-1:]})
+            try:
+                out[piece][who] = harness.fresh([sys.executable, __file__, "--_child", path, who],
+                                                timeout=1800)
+            except (RuntimeError, OSError) as exc:   # a library's failure is a row
+                out[piece][who] = {"failed": str(exc).strip().splitlines()[-1:]}
     return out
 
 
@@ -309,6 +296,7 @@ def main(argv=None):
     ap.add_argument("--keep", default=None, help="folder for the largest system of each piece")
     ap.add_argument("--memory", action="store_true")
     ap.add_argument("--_child", nargs=2, help=argparse.SUPPRESS)
+    harness.add_arguments(ap)
     args = ap.parse_args(argv)
     if args._child:
         return _memory_child(*args._child)
@@ -318,22 +306,29 @@ def main(argv=None):
         ap.error("--memory needs --keep DIR")
     if args.keep:
         os.makedirs(args.keep, exist_ok=True)
-    record = {"machine": machine(), "libraries": libs_info}
+    with harness.Record(__file__, args, argv=argv) as rec:
+        _measure(args, rec, libs_info, libs)
+    return 0
+
+
+def _measure(args, rec, libs_info, libs):
+    rec.update({"libraries_timed": libs_info,
+                "threads_per_run": os.environ["OMP_NUM_THREADS"]})
+    record = rec.results
     t0 = time.perf_counter()
-    def partial(rows, done, total):
+
+    def partial(rows, done, total):      # the record after every case
+        rec.update({"cases_done": f"{done} of {total}", "pieces": summarize(rows, libs),
+                    "systems": rows})
         if args.json:
-            with open(args.json, "w") as fh:
-                json.dump({**record, "cases_done": f"{done} of {total}",
-                           "pieces": summarize(rows, libs), "systems": rows}, fh,
-                          indent=1, default=str)
+            harness.write_json(args.json, {**rec.doc, "results": record})
     rows, largest = capture(args, libs, partial)
     record["capture_wall_s"] = time.perf_counter() - t0
-    record["machine"]["load_1min_after"] = os.getloadavg()[0]
     record["pieces"] = summarize(rows, libs)
     record["systems"] = rows
     if args.memory:
         record["memory"] = memory(largest, ["ours", *libs])
-    print(f"machine: {record['machine']}")
+    print(f"machine: {rec.doc['machine']}")
     print("libraries: " + ", ".join(f"{n} {v.get('version') or 'missing'}"
                                      for n, v in libs_info.items()))
     head = f"{'piece':70s} {'runs':>5s} {'max n':>7s} {'ours':>8s}" + "".join(
@@ -349,9 +344,7 @@ def main(argv=None):
             print(f"peak MB above the matrix, {piece[:60]}: " + ", ".join(
                 f"{w} {v.get('peak_mb', float('nan')):.0f}" for w, v in by.items()))
     if args.json:
-        with open(args.json, "w") as fh:
-            json.dump(record, fh, indent=1, default=str)
-    return 0
+        harness.write_json(args.json, {**rec.doc, "results": record})
 
 
 if __name__ == "__main__":
