@@ -30,9 +30,8 @@ vector) one by one: iterations and true relative residual with the corrections' 
 (``GMRES_MAX_ITERATIONS``, the estimator before issue 32) and with
 ``ESTIMATOR_MAX_ITERATIONS``; and the float32 factor's own solves with A and A^T of a random
 vector: their relative residuals against A and A^T, and against the factor's own M =
-Pr^T L U Pc^T and M^T (its factors in double). On manufactured-taylor2: 21 and 505 against
-A, 20 and 502 against M: M is close to A, the float32 solves' own rounding (element growth
-under the 1e-3 pivot threshold, times eps_single) is what is off, and more so transposed.
+Pr^T L U Pc^T and M^T (its factors in double). Measured on manufactured-taylor2:
+benchmarks/records/mixed_precision-2026-11-26-estimator.json.
 
 ``--threshold T ...``: per threshold, in a fresh process, the float32 factor with SuperLU's
 diagonal pivot threshold T (``nested.FLOAT32_PIVOT_THRESHOLD``) and the refinement on it
@@ -60,19 +59,8 @@ difference to the default's, relative to the largest entry of its displacement p
 unknowns whose equation has a diagonal entry: an augmented system's multipliers have
 none) and, apart, of its multiplier part. ``--system DIR`` takes a saved system
 (``A.npz``, ``b.npy``, ``c.npy`` as ``_capture`` writes them) instead of assembling a
-case's. Measured on traction-taylor1, manufactured-taylor2 and manufactured-snm3 (12,840,
-12,880 and 10,700 unknowns; medians of 3, the machine shared): the float32 factor is
-82-89 % of the solve (e.g. manufactured-taylor2: 17.9 s, of which ordering 0.5, factor
-15.9, refinement 1.2, estimate 0.2), all three factored whole (separator too large to
-split at). No knob gains 15 %: panel_size 15 -2 to -6 % (17.5 against 17.9 s, 13.4
-against 14.2 s; on traction-taylor1 20.7 against 26.5 s in medians, but the load fell
-during that table, its last and quietest round 17.7 against 19.0 s), relax 20 -5 % on
-manufactured-snm3 and +16 % on manufactured-taylor2, relax 5 and panel_size 10 slower;
-COLAMD in place of the nested dissection has 30 % fewer entries on the Taylor systems
-at the same factor time, and 46 % more on manufactured-snm3 (3.4x slower). Any of them
-changes the float32 factor's rounding, and traction-taylor1's refined solution moves by
-2.2e-4 of its largest displacement (its multipliers by their own size): the report's
-metrics would not stay within 1e-9. The others' move by 1e-12 to 2e-9.
+case's. Measured: no knob gains 15 %, and every one moves traction-taylor1's metrics
+beyond 1e-9 (benchmarks/records/mixed_precision-2026-11-27-knobs.json).
 """
 from __future__ import annotations
 

@@ -44,48 +44,8 @@ the same results.
 The machine is shared: run the alternatives back to back, quote medians and the load
 (the script prints ``os.getloadavg()`` before and after).
 
-Findings (issue 32, 2 cores; the CPU time is the steadier measure on a loaded machine):
-
-- Before (47198fc), warm, quiet (load 0.1-1.6): 319 runs, 79.8 s wall (runs 56.9 s,
-  figures 19.1 s, VTU 1.0 s, pages 0.1 s), 146 CPU-s. The runs summed 111 s, 60 s of
-  them body3d-manufactured, 50 s of that its convergence levels h = 0.0625 and 1/18
-  (surface nodes at 1/18 alone 12.2 s); sheet2d-tension 16 s (its quick cases at Table
-  1's 1 mm grid, 11 s); sheet2d-clamped 8 s (the delta-refinement's side 8 at m = 6,
-  6.7 s). Figures: 55 files, about 30 CPU-s drawn serially, three quarters of it in
-  ``savefig`` (matplotlib's layout and tick passes: a layout engine or a tight bbox
-  lays a figure out once more before the real draw), the pyvista renders 1.5-2 s with
-  the import; no figure was drawn twice, and the report process had already imported
-  every module the runs use (the forked workers import nothing).
-- After: 298 runs (every scene and every method kept), back to back with the old tree
-  at load 4-6, medians of 2: 78.4 s wall (runs 48.9, figures 26.4), 75.7 CPU-s, against
-  157.9 s (runs 119.6, figures 34.1) and 156.0 CPU-s: half the CPU time; runs 0.41,
-  figures 0.78 of before. At load 2-3: 48.8 s wall (runs 30.5, figures 14.8), 71 CPU-s.
-  One more round each, load falling from 5.1 to 2.4: 37.8 s wall (runs 21.9, figures
-  13.4), 72 CPU-s, against 72.1 s (runs 53.9, figures 14.9), 139 CPU-s: the figures'
-  wall time barely moved (fewer, lighter files, but the same matplotlib passes).
-  The figures are now about a third: 51 files, 25 CPU-s, 0.3-1.5 s each (the 3D error
-  maps, 40 panels, 1-1.5 s; the convergence figures 3 s for 7; the error-against-cost
-  overview 2.8 s).
-- Figures laid out once (``pdverify.report.figures.save``), PNG at zlib level 3, the
-  overview first and the convergence figures one task per scene, last: the same pixels
-  in all 55 files (``--mode figures``). Where the time went before (cProfile, 55
-  files, 2 draws each): the draw without output that ``savefig`` makes to lay a figure
-  out was about half of ``savefig``'s draw time, the constrained layout over a quarter, PNG
-  encoding at level 6 2.9 s. The serial drawing of the same runs (one process,
-  alternating, load 1.4-3.8): 24.1 s CPU against 19.3 s (medians of 3; 0.80), the
-  saves 20.8 s against 16.2 s. What is left is mostly the first measurement of every
-  text (tick labels, titles; each renderer measures its texts anew, mathtext parsed
-  again): a second pass over a measured figure is cheap, so placing the titles once
-  (the y axis measured once for each) saved nothing. One quick report each, load
-  about 3: figures_s 19.2 s against 10.1 s, 71.5 against 65.6 CPU-s for the whole
-  report. At load 5-6 ``--mode figures`` rounds of one tree varied from 22 to 39 CPU-s:
-  too noisy to show a 20 % change.
-- Cold (an empty FEM cache), load about 5: 110.7 s wall, 109 CPU-s (warm: 75.7): the
-  FEM references add about 34 CPU-s, two thirds of it the finite-strain indentation
-  references (Saint Venant-Kirchhoff 17.8 s, neo-Hookean 17.5 s; then the clamped
-  plate 6.2 s, the clamped sheet 5.1 s, the small-strain indentation 3.7 s), and PD
-  runs that start while their scene's reference is computed wait on its cache lock
-  (3.8 s for runs of 0.05 s).
+Findings of issue 32 (the quick report before and after, warm and cold, where the
+figures' time goes): benchmarks/records/quick_report-2026-11-27-issue32-findings.json.
 """
 from __future__ import annotations
 

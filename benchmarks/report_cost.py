@@ -21,9 +21,8 @@ proportional set size (``Pss`` of /proc/PID/smaps_rollup: pages shared by the fo
 workers counted once), sampled every 0.1 s; next to it, the largest single process's
 peak resident size (``ru_maxrss``), and the report process's own peak resident size
 (``VmHWM`` of /proc/PID/status, sampled likewise), so that the report process's share
-and its workers' are told apart (measured at stop 40: the report process peaks at
-0.13-0.15 GB on the quick report; the largest process is a worker running one heavy
-case). ``--against SRC``: also run the report of another
+and its workers' are told apart (benchmarks/records/report_cost-2026-11-26-stop40.json).
+``--against SRC``: also run the report of another
 source tree (e.g. ``git archive`` of an earlier commit unpacked, put first on
 PYTHONPATH; ``--against-args``: its report arguments), alternating with this one, and
 print both and the ratios.

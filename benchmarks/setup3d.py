@@ -27,35 +27,9 @@ repeat, and the table shows medians of ``--repeat`` (default 3). Two modes:
 ``--profile after`` (this tree) or ``before``: cProfile of that tree's setup of each case:
 the functions with the most own time, which is where the setup's time goes.
 
-Measured (issue 32; a 2-core machine shared with two other jobs, so the CPU times are the
-steadier figures). Where the setup went before: in the surface-node runs the sparse
-products of the stiffness, above all the extensions of the unknowns B = A_e A_U (48 M
-entries at order 3, h = 0.05) and (P K_e) B: at order 3, csr_matmat + its symbolic pass
-took ~2.5-4 s of the ~4.5 s of setup CPU; then the closure's Taylor fits
-(``taylor_monomials``, the SVDs; ~0.4 s at order 3), ``face_crossings`` (~0.2 s) and the
-model's operators (~0.15 s). The other methods' setups are 0.1-2 s, spread over many
-small steps. After the displacement map is multiplied in last in 3D
-(``StateBasedModel.unknown_rows``), ``--only surface-nodes``, medians of 3 (setup CPU, s):
-
-    manuf surface-nodes order=1                 1.69 -> 1.14
-    manuf surface-nodes order=2                 1.86 -> 1.25
-    manuf surface-nodes order=3                 4.44 -> 2.38
-    manuf surface-nodes order=3, moment         4.62 -> 2.82
-    manuf surface-nodes order=3, centre         4.80 -> 2.52
-    tract surface-nodes order=1                 1.36 -> 1.02
-    tract surface-nodes order=1, moment         1.30 -> 0.94
-    manuf surface-nodes h=0.1                   1.17 -> 0.72
-    manuf surface-nodes h=0.0625                2.30 -> 1.19
-    manuf surface-nodes h=1/12, m=2             0.60 -> 0.48
-    manuf surface-nodes h=1/18                  2.98 -> 1.55
-    sum                                        27.11 -> 16.00
-
-The systems of every other case are the same bit for bit; those of the surface-node runs
-differ at round-off, and their metrics by at most 7e-10 relative (round-off-level ones
-aside: moment-corrected traction 1.3e-11 -> 3.1e-11 %); ``compare --rtol 1e-9`` against
-the saved full report finds no change. Whole runs (``--runs``), medians of 3: order 3
-with ``surface_load=centre`` setup 8.7 -> 4.1 s wall, total 35.2 -> 32.0 s, CPU 23.8 ->
-21.7 s.
+Measured for issue 32 (the surface-node setups' CPU time, 27.1 s -> 16.0 s summed, once
+the displacement map is multiplied in last):
+benchmarks/records/setup3d-2026-11-27-issue32-surface-nodes.json.
 """
 from __future__ import annotations
 
