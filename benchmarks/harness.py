@@ -406,7 +406,8 @@ class Record:
             self.doc["interrupted"] = f"{kind.__name__}: {exc}"[:500]
         path = self.save(final=True)
         if path is not None and kind is None:
-            print(f"record: {path.relative_to(ROOT)}", file=sys.stderr)
+            shown = path.relative_to(ROOT) if path.is_relative_to(ROOT) else path
+            print(f"record: {shown}", file=sys.stderr)
         return False
 
 
