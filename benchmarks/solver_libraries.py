@@ -311,6 +311,16 @@ def main(argv=None):
     return 0
 
 
+def _flat(rec) -> dict:
+    """``--json FILE`` as before the harness: the results at the top level (``pieces``,
+    ``systems``, ...), ``libraries`` the timed ones; the record's header beside them
+    (its libraries as ``environment``)."""
+    head = {k: v for k, v in rec.doc.items() if k != "results"}
+    head["environment"] = head.pop("libraries")
+    results = dict(rec.results)
+    return {**head, "libraries": results.pop("libraries_timed"), **results}
+
+
 def _measure(args, rec, libs_info, libs):
     rec.update({"libraries_timed": libs_info,
                 "threads_per_run": os.environ["OMP_NUM_THREADS"]})
@@ -321,7 +331,7 @@ def _measure(args, rec, libs_info, libs):
         rec.update({"cases_done": f"{done} of {total}", "pieces": summarize(rows, libs),
                     "systems": rows})
         if args.json:
-            harness.write_json(args.json, {**rec.doc, "results": record})
+            harness.write_json(args.json, _flat(rec))
     rows, largest = capture(args, libs, partial)
     record["capture_wall_s"] = time.perf_counter() - t0
     record["pieces"] = summarize(rows, libs)
@@ -344,7 +354,7 @@ def _measure(args, rec, libs_info, libs):
             print(f"peak MB above the matrix, {piece[:60]}: " + ", ".join(
                 f"{w} {v.get('peak_mb', float('nan')):.0f}" for w, v in by.items()))
     if args.json:
-        harness.write_json(args.json, {**rec.doc, "results": record})
+        harness.write_json(args.json, _flat(rec))
 
 
 if __name__ == "__main__":
