@@ -24,9 +24,8 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import statistics
-import time
 
+import harness
 from pdverify import blas, runner
 
 SCENES = ("body3d-manufactured", "plate2d-plane-strain", "sheet2d-tension")
@@ -51,36 +50,43 @@ class _Silent:
         pass
 
 
-def main():
+def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--jobs", type=int, nargs="+", default=[1, 2])
     ap.add_argument("--only", nargs="+", default=list(SCENES))
     ap.add_argument("--full", action="store_true", help="the full report's cases")
-    args = ap.parse_args()
+    harness.add_arguments(ap)
+    args = ap.parse_args(argv)
+    with harness.Record(__file__, args, argv=argv) as rec:
+        _measure(args, rec)
+
+
+def _measure(args, rec):
     cases = runner.plan(only=args.only, quick=not args.full)
     one = blas.one_thread
     settings = {f"default ({blas.threads()} threads)": contextlib.nullcontext,
                 "one thread per run": one}
-    times, seen = {}, {}
-    for _ in range(args.repeat):
-        for jobs in args.jobs:
-            for name, ctx in settings.items():
-                blas.one_thread = ctx           # forked workers inherit the setting
-                try:
-                    t = time.perf_counter()
-                    res = runner._run_local(cases, jobs, _Silent())
-                    times.setdefault((jobs, name), []).append(time.perf_counter() - t)
-                finally:
-                    blas.one_thread = one
-                seen.setdefault((jobs, name), _metrics(res))
+    seen = {}
+
+    def one_setting(jobs, name):
+        blas.one_thread = settings[name]        # forked workers inherit the setting
+        try:
+            res = runner._run_local(cases, jobs, _Silent())
+        finally:
+            blas.one_thread = one
+        seen.setdefault((jobs, name), _metrics(res))
+    timed = harness.alternate({(jobs, name): (lambda jobs=jobs, name=name: one_setting(jobs, name))
+                               for jobs in args.jobs for name in settings}, args.repeat,
+                              rotate=False)
+    times = {k: t.times for k, t in timed.items()}
     print(f"{len(cases)} cases of {', '.join(args.only)} "
           f"({'full' if args.full else 'quick'} sizes), medians of {args.repeat}")
     for jobs in args.jobs:
         meds = []
         for name in settings:
             ts = times[(jobs, name)]
-            meds.append(statistics.median(ts))
+            meds.append(timed[(jobs, name)].median)
             print(f"  --jobs {jobs}  BLAS {name:22s} {meds[-1]:8.2f} s "
                   f"(min {min(ts):.2f}, max {max(ts):.2f})")
         print(f"  --jobs {jobs}  default / one thread: {meds[0] / meds[1]:.2f}x")
@@ -90,6 +96,10 @@ def main():
     j = args.jobs[0]
     a, b = (seen[(j, name)] for name in settings)
     print(f"  --jobs {j}: metrics bitwise identical between the settings: {a == b}")
+    rec.update({"cases": len(cases), "scenes": args.only, "full": args.full,
+                "median_s": {f"--jobs {j} {n}": t.median for (j, n), t in timed.items()},
+                "times_s": {f"--jobs {j} {n}": t.times for (j, n), t in timed.items()},
+                "metrics_identical_between_settings": a == b})
 
 
 if __name__ == "__main__":

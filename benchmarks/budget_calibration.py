@@ -16,6 +16,7 @@ import os
 import sys
 import tempfile
 
+import harness
 from pdverify.budget import measured_peak
 from pdverify.params import parse_assignments
 from pdverify.scenes import get_scene
@@ -47,29 +48,29 @@ QUICK = [c for c in CASES if c[0] in ("bar1d-traction", "plate2d-clamped", "shee
 def resolve_times():
     """Validation and budget (Scene.resolve) of every report case, after the imports a run
     needs anyway: (median, max) in seconds over 5 repeats of each case."""
-    import statistics
-    import time
-
     from pdverify.scenes import all_scenes
     times = []
     for scene in all_scenes():
         for method, over in scene.cases(quick=False):
             scene.resolve(method, over)  # warm: imports (scikit-fem for the FEM scenes)
-            rep = []
-            for _ in range(5):
-                t0 = time.perf_counter()
-                scene.resolve(method, over)
-                rep.append(time.perf_counter() - t0)
-            times.append(statistics.median(rep))
-    return statistics.median(times), max(times), len(times)
+            times.append(harness.alternate({"x": lambda: scene.resolve(method, over)}, 5,
+                                           collect=False)["x"].median)
+    return harness.median(times), max(times), len(times)
 
 
-def main():
+def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--timing-only", action="store_true")
-    args = ap.parse_args()
+    harness.add_arguments(ap)
+    args = ap.parse_args(argv)
+    with harness.Record(__file__, args, argv=argv) as rec:
+        _measure(args, rec)
+
+
+def _measure(args, rec):
     med, worst, n = resolve_times()
+    rec["resolve_s"] = {"median": med, "max": worst, "cases": n}
     print(f"validation + budget per run (Scene.resolve, {n} report cases): median "
           f"{med * 1e3:.2f} ms, max {worst * 1e3:.2f} ms")
     if args.timing_only:
@@ -79,6 +80,8 @@ def main():
         env = dict(os.environ, PDVERIFY_CACHE_DIR=tmp)
         run = [sys.executable, "-m", "pdverify", "run"]
         base = measured_peak(run + ["bar1d-traction"], env)
+        rec["baseline_bytes"] = base
+        rows = rec["cases"] = []
         print(f"interpreter and imports: {base / 1e6:.0f} MB (subtracted)")
         print(f"{'scene':22s} {'method':18s} {'set':16s} {'measured':>9s} {'estimate':>9s} "
               f"{'ratio':>6s}")
@@ -91,6 +94,10 @@ def main():
             used = max(measured_peak(args, env) - base, 1e6)
             print(f"{scene_id:22s} {method:18s} {' '.join(sets):16s} {used / 1e6:7.0f} MB "
                   f"{est.memory / 1e6:7.0f} MB {est.memory / used:6.2f}", flush=True)
+            rows.append({"scene": scene_id, "method": method, "set": sets,
+                         "measured_bytes": used, "estimate_bytes": est.memory,
+                         "ratio": est.memory / used})
+            rec.save()
 
 
 if __name__ == "__main__":

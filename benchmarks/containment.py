@@ -25,12 +25,13 @@ from __future__ import annotations
 import argparse
 import os
 import shutil
-import statistics
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
+
+import harness
 
 HERE = Path(__file__).resolve().parent
 AFTER = HERE.parent
@@ -110,18 +111,24 @@ print(t1 - t0, c)
             times[name].append(load)
             if name == "after":
                 times["check"].append(check)
-    mb, ma = statistics.median(times["before"]), statistics.median(times["after"])
-    check = statistics.median(times["check"])
+    mb, ma = harness.median(times["before"]), harness.median(times["after"])
+    check = harness.median(times["check"])
     return (f"first treatments() of a process, 2 example plugins: before {1e3 * mb:.1f} ms, "
             f"after {1e3 * ma:.1f} ms, extra {1e3 * (ma - mb):+.1f} ms; one contained "
             f"check {1e3 * check:.1f} ms"), ma - mb, check
 
 
-def main():
+def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--before", default="/work/base57")
-    args = ap.parse_args()
+    harness.add_arguments(ap)
+    args = ap.parse_args(argv)
+    with harness.Record(__file__, args, argv=argv) as rec:
+        _measure(args, rec)
+
+
+def _measure(args, rec):
     before = Path(args.before)
     work = Path(tempfile.mkdtemp(prefix="containment-"))
     site = work / "site"
@@ -143,17 +150,19 @@ def main():
     for name, argv, s in settings:
         timed(AFTER, argv, s, work)          # warm the caches of both trees once
         timed(before, argv, s, work)
-        b, a = [], []
-        for _ in range(args.repeats):
-            b.append(timed(before, argv, s, work))
-            a.append(timed(AFTER, argv, s, work))
-        mb, ma = statistics.median(b), statistics.median(a)
+        t = harness.alternate({"before": lambda: timed(before, argv, s, work),
+                               "after": lambda: timed(AFTER, argv, s, work)}, args.repeats,
+                              rotate=False)
+        mb, ma = harness.median(t["before"].results), harness.median(t["after"].results)
         rows.append((name, mb, ma))
+        rec[name] = {"before_s": t["before"].results, "after_s": t["after"].results,
+                     "median_before_s": mb, "median_after_s": ma}
         print(f"{name:58s} before {mb:7.3f} s  after {ma:7.3f} s  extra {ma - mb:+.3f} s "
               f"({100 * (ma - mb) / mb:+.1f} %)", flush=True)
     full_plugin, full_all = plugin_cases(site)
     text, load_extra, check = load_costs(before, site, 2 * args.repeats)
     print(text)
+    rec["load_costs"] = {"text": text, "load_extra_s": load_extra, "check_s": check}
     # a full report pays the load once (its workers are forks of the report process) and
     # a child process per distinct check of a plugin's case; the example plugins have no
     # check of their own (no child process); a plugin with a check on every case is the

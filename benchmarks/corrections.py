@@ -15,9 +15,8 @@ own correction ``energy-directional``, which reaches 2 mm.
 from __future__ import annotations
 
 import argparse
-import json
-import statistics
 
+import harness
 from pdverify.corrections.registry import bond_methods
 from pdverify.scenes import get_scene
 
@@ -34,8 +33,15 @@ def main(argv=None):
     ap.add_argument("--json", default=None)
     ap.add_argument("--indentation", action="store_true",
                     help="also block2d-indentation at the paper's grid (slow)")
+    harness.add_arguments(ap)
     args = ap.parse_args(argv)
-    out = {}
+    with harness.Record(__file__, args, argv=argv) as rec:
+        _measure(args, rec)
+        if args.json:
+            harness.write_json(args.json, rec.results)
+
+
+def _measure(args, out):
     for sid in SCENES + (("block2d-indentation",) if args.indentation else ()):
         scene = get_scene(sid)
         methods = ["none"] + [k for k, m in bond_methods().items()
@@ -45,15 +51,13 @@ def main(argv=None):
         solve_base = SOLVE_BASE.get(sid, "none")
         if solve_base not in methods:
             methods.append(solve_base)
-        times = {m: {"setup_s": [], "solve_s": []} for m in methods}
-        for _ in range(args.repeat):
-            for m in methods:
-                r = scene.run(m)
+        runs = harness.alternate({m: (lambda m=m: scene.run(m)) for m in methods}, args.repeat)
+        for m, t in runs.items():
+            for r in t.results:
                 # the indentation's none fails by design (seed 003: the lattice folds)
                 assert r.status == "ok" or (sid in SOLVE_BASE and m == "none"), r.message
-                for k in times[m]:
-                    times[m][k].append(r.timings.get(k, 0.0))
-        med = {m: {k: statistics.median(v) for k, v in t.items()} for m, t in times.items()}
+        med = {m: {k: harness.median(r.timings.get(k, 0.0) for r in t.results)
+                   for k in ("setup_s", "solve_s")} for m, t in runs.items()}
         out[sid] = med
         base, solve = med["none"], med[solve_base]["solve_s"]
         print(f"{sid}: median of {args.repeat}; extra setup against {solve_base}'s solve")
@@ -62,9 +66,6 @@ def main(argv=None):
             ratio = extra / solve if solve > 0 else float("nan")
             print(f"  {m:13s} setup {med[m]['setup_s']:8.4f} s  solve {med[m]['solve_s']:8.4f} s"
                   f"  extra setup {extra:+8.4f} s = {ratio:+6.2f} x {solve_base}'s solve")
-    if args.json:
-        with open(args.json, "w") as fh:
-            json.dump(out, fh, indent=1)
 
 
 if __name__ == "__main__":

@@ -23,19 +23,8 @@ report's results.json (each run's ``total_s``, the full report's where both have
 reference, the seconds its reference study and converged solution took when computed:
 ``reference_study_s`` + ``reference_converged_setup_s`` + ``reference_converged_solve_s``).
 
-Measured (issue 52; the table from the full report of 7c77775, alone on the machine, and a
-quick report of the same code under load 15-20; median |error| per quarter, the worst
-in brackets):
-
-- full, warm, three reports of other commits (``final``, ``new``, ``base`` of that day):
-  measured 1 / 7 / 4 / 9 %, 5 / 12 / 9 / 11 %, 14 / 28 / 28 / 17 % (worst -34 %); size
-  model 73 / 42 / 2 / 12 %, 77 / 44 / 5 / 10 %, 136 / 35 / 22 / 10 % (worst +622 %, and
-  no ETA before the first run ends);
-- quick, warm, under load: measured 32 / 23 / 38 / 48 % (the runs 1.6 times slower than
-  the table: the ETA too low until the calibration catches up); size model 72 / 40 / 16 /
-  52 %;
-- quick, cold (an empty FEM cache), under load: measured 62 / 37 / 29 / 54 %; size model
-  518 / 437 / 38 / 175 %.
+Measured for issue 52 (median |ETA error| per quarter of a report, the measured times
+against the size model): benchmarks/records/eta_replay-2026-11-28-issue52.json.
 """
 from __future__ import annotations
 
@@ -45,6 +34,7 @@ import json
 import statistics
 import types
 
+import harness
 from pdverify import progress as progress_module
 from pdverify.results import run_key
 from pdverify.runner import plan
@@ -71,6 +61,9 @@ def write_table(full: str, quick: str) -> None:
     doc = {"about": "measured run times the progress ETA starts from (pdverify.schedule."
                     "MEASURED_TIMES); written by benchmarks/eta_replay.py --write-table "
                     f"from {full} and {quick}",
+           # who wrote it: the commit, machine and libraries (harness.header); the run
+           # times themselves are the two reports' (their results.json name their machine)
+           "header": harness.header(),
            "runs": list(rows.values())}
     with open(MEASURED_TIMES, "w") as fh:
         json.dump(doc, fh, separators=(",", ":"))

@@ -31,10 +31,10 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import statistics
-import subprocess
 import sys
 from pathlib import Path
+
+import harness
 
 ROOT = Path(__file__).resolve().parents[1]
 STUDIES = {"finite": {"kinematics": "finite", "levels": 2, "substeps": 4}, "small": {}}
@@ -60,11 +60,8 @@ print(json.dumps({"study_s": study_s, "forces": np.asarray(r.forces).tolist(),
 def run_case(study: dict, options: dict, path: Path) -> dict:
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(
         [str(path)] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]))
-    out = subprocess.run([sys.executable, "-c", CHILD, json.dumps(study), json.dumps(options)],
-                         env=env, cwd=path, capture_output=True, text=True, check=False)
-    if out.returncode:
-        raise SystemExit(f"case {options} in {path} failed:\n{out.stderr}")
-    return json.loads(out.stdout.strip().splitlines()[-1])
+    return harness.fresh([sys.executable, "-c", CHILD, json.dumps(study), json.dumps(options)],
+                         env=env, cwd=path)
 
 
 def max_rel_change(a, b) -> float:
@@ -72,13 +69,14 @@ def max_rel_change(a, b) -> float:
     return max(abs(x - y) / abs(y) for x, y in zip(a[1:], b[1:]))
 
 
-def main():
+def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--kinematics", choices=sorted(STUDIES), default="finite")
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--all", action="store_true")
     ap.add_argument("--against", type=Path, default=None)
-    args = ap.parse_args()
+    harness.add_arguments(ap)
+    args = ap.parse_args(argv)
     if args.repeat < 1:
         raise SystemExit(f"--repeat must be >= 1, got {args.repeat}")
     if args.against is not None and not (args.against / "reference_fem").is_dir():
@@ -97,21 +95,27 @@ def main():
         cases += [case("half", "plain"), case("full", "reuse")]
     if args.against is not None:
         cases.append((f"{args.against.name} (against)", {}, args.against.resolve()))
-    runs = {name: [] for name, _, _ in cases}
-    for i in range(args.repeat):
-        for name, opts, path in cases:
-            r = run_case(study, opts, path)
-            runs[name].append(r)
-            print(f"  [{i + 1}/{args.repeat}] {name}: study {r['study_s']:.1f} s", flush=True)
+    with harness.Record(__file__, args, argv=argv) as rec:
+        _measure(args, study, cases, rec)
+
+
+def _measure(args, study, cases, rec):
+    def one(name, opts, path):
+        r = run_case(study, opts, path)
+        print(f"  {name}: study {r['study_s']:.1f} s", flush=True)
+        return r
+    timed = harness.alternate({name: (lambda name=name, opts=opts, path=path: one(name, opts, path))
+                               for name, opts, path in cases}, args.repeat, rotate=False)
+    runs = {name: t.results for name, t in timed.items()}
     print(f"\n{args.kinematics}-strain study {study or '(defaults)'}, median of {args.repeat}")
     first = runs[cases[0][0]]
-    base = statistics.median(r["study_s"] for r in first)
+    base = harness.median(r["study_s"] for r in first)
     against = runs[cases[-1][0]] if args.against is not None else None
     print(f"{'case':22s} {'study s':>8s} {'min-max s':>13s} {'conv. s':>8s} {'ratio':>6s} "
           f"{'dF vs 1st':>10s} {'dF vs against':>13s}  levels (dofs, solves, factorisations)")
     for name, rs in runs.items():
-        med = statistics.median(r["study_s"] for r in rs)
-        conv = statistics.median(r["converged_s"] for r in rs)
+        med = harness.median(r["study_s"] for r in rs)
+        conv = harness.median(r["converged_s"] for r in rs)
         spread = f"{min(r['study_s'] for r in rs):.1f}-{max(r['study_s'] for r in rs):.1f}"
         d1 = max_rel_change(rs[0]["forces"], first[0]["forces"])
         da = max_rel_change(rs[0]["forces"], against[0]["forces"]) if against else float("nan")
@@ -119,6 +123,10 @@ def main():
                            f"{lv.get('factorisations', '-')}" for lv in rs[0]["levels"])
         print(f"{name:22s} {med:8.1f} {spread:>13s} {conv:8.1f} {med / base:6.3f} "
               f"{d1:10.2e} {da:13.2e}  {levels}")
+        rec[name] = {"study_median_s": med, "study_s": [r["study_s"] for r in rs],
+                     "converged_median_s": conv, "ratio_to_first": med / base,
+                     "force_change_vs_first": d1, "force_change_vs_against": da,
+                     "levels": rs[0]["levels"]}
 
 
 if __name__ == "__main__":

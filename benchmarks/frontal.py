@@ -28,13 +28,13 @@ import argparse
 import json
 import os
 import resource
-import statistics
-import subprocess
 import sys
 import tempfile
 import time
 
 import numpy as np
+
+import harness
 
 #: per case, how many leading entries of x are the displacements (the Taylor systems'
 #: remaining unknowns are not unique: two exact solvers differ there by up to 2e-2)
@@ -82,23 +82,19 @@ def worker(directory, case, alternative, out, merge):
 
 
 def _run(directory, case, alternative, out, merge):
-    env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
-    res = subprocess.run([sys.executable, __file__, "--worker", directory, case, alternative,
-                          out, str(merge)], capture_output=True, text=True, env=env,
-                         check=True)
-    return json.loads(res.stdout.strip().splitlines()[-1])
+    return harness.fresh([sys.executable, __file__, "--worker", directory, case, alternative,
+                          out, str(merge)], threads=1)
 
 
-def compare(directory, cases, repeat, merge):
+def compare(directory, cases, repeat, merge, rec):
     with tempfile.TemporaryDirectory() as tmp:
         for case in cases:
-            rows = {a: [] for a in ALTERNATIVES}
-            sols = {}
-            for r in range(repeat):
-                for a in (ALTERNATIVES if r % 2 == 0 else ALTERNATIVES[::-1]):
-                    out = os.path.join(tmp, f"{case}-{a}.npy")
-                    rows[a].append(_run(directory, case, a, out, merge))
-                    sols[a] = np.load(out)
+            # alternating, the order swapped every round (harness.alternate rotates it)
+            timed = harness.alternate(
+                {a: (lambda a=a: _run(directory, case, a, os.path.join(tmp, f"{case}-{a}.npy"),
+                                      merge)) for a in ALTERNATIVES}, repeat)
+            rows = {a: t.results for a, t in timed.items()}
+            sols = {a: np.load(os.path.join(tmp, f"{case}-{a}.npy")) for a in ALTERNATIVES}
             unique = CASES.get(case)
             ref = sols["superlu"][:unique]
             print(f"{case} ({sols['superlu'].size} unknowns; compared: "
@@ -107,7 +103,7 @@ def compare(directory, cases, repeat, merge):
                   f"{'GMRES-IR':>8s} {'refine s':>9s} {'peak MB':>8s} {'diff u':>9s} "
                   f"{'diff all':>9s}")
             for a in ALTERNATIVES:
-                med = {k: statistics.median(row[k] for row in rows[a])
+                med = {k: harness.median(row[k] for row in rows[a])
                        for k in ("factor_s", "refine_s", "maxrss_mb")}
                 diff = np.max(np.abs(sols[a][:unique] - ref)) / np.max(np.abs(ref))
                 whole = (np.max(np.abs(sols[a] - sols["superlu"]))
@@ -118,9 +114,11 @@ def compare(directory, cases, repeat, merge):
                       f"{whole:9.1e}")
                 print(f"    factor times {[round(x['factor_s'], 2) for x in rows[a]]}, "
                       f"condition {rows[a][0]['condition']:.2e}")
+                rec[f"{case} {a}"] = {"median": med, "rounds": rows[a], "diff_u": diff,
+                                      "diff_all": whole}
 
 
-def merges(directory, cases, repeat, sizes):
+def merges(directory, cases, repeat, sizes, rec):
     from threadpoolctl import threadpool_limits
 
     from pdverify.solvers.frontal import FrontalLU
@@ -144,24 +142,27 @@ def merges(directory, cases, repeat, sizes):
                   f"{lu.factor_entries / 1e6:.1f} M entries, solve error "
                   f"{accuracy(lu)[0]:.1e} (A), {accuracy(lu)[1]:.1e} (A^T)")
             del lu
-            for r in range(repeat):
-                for m in (sizes if r % 2 == 0 else sizes[::-1]):
-                    t = time.perf_counter()
-                    lu = FrontalLU(A_p, tree, merge=m)
-                    times[m].append(time.perf_counter() - t)
-                    entries[m] = (lu.factor_entries, len(lu.fronts))
-                    errors[m] = accuracy(lu)
-                    del lu
+
+            def one(m):
+                t = time.perf_counter()
+                lu = FrontalLU(A_p, tree, merge=m)
+                times[m].append(time.perf_counter() - t)
+                entries[m] = (lu.factor_entries, len(lu.fronts))
+                errors[m] = accuracy(lu)
+            harness.alternate({m: (lambda m=m: one(m)) for m in sizes}, repeat)
         for m in sizes:
-            print(f"{case} merge {m:5d}: factor {statistics.median(times[m]):6.2f} s "
+            rec[f"{case} merge {m}"] = {"factor_s": times[m], "entries": entries[m][0],
+                                        "fronts": entries[m][1], "solve_errors": errors[m]}
+            print(f"{case} merge {m:5d}: factor {harness.median(times[m]):6.2f} s "
                   f"(median of {repeat}), {entries[m][0] / 1e6:.1f} M entries, "
                   f"{entries[m][1]} fronts, solve error {errors[m][0]:.1e} (A), "
                   f"{errors[m][1]:.1e} (A^T)")
 
 
-def main():
-    if len(sys.argv) > 1 and sys.argv[1] == "--worker":
-        directory, case, alternative, out, merge = sys.argv[2:7]
+def main(argv=None):
+    argv = sys.argv[1:] if argv is None else argv
+    if argv and argv[0] == "--worker":
+        directory, case, alternative, out, merge = argv[1:6]
         worker(directory, case, alternative, out, int(merge))
         return
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -170,12 +171,15 @@ def main():
     p.add_argument("--case", nargs="*", default=list(CASES))
     p.add_argument("--repeat", type=int, default=3)
     p.add_argument("--merge", type=int, nargs="*")
-    args = p.parse_args()
-    if args.merge:
-        merges(args.dir, args.case, args.repeat, args.merge)
-    else:
-        from pdverify.solvers.frontal import MERGE_SIZE
-        compare(args.dir, args.case, args.repeat, MERGE_SIZE)
+    harness.add_arguments(p)
+    args = p.parse_args(argv)
+    with harness.Record(__file__, args, argv=argv) as rec:
+        if args.merge:
+            merges(args.dir, args.case, args.repeat, args.merge, rec)
+        else:
+            from pdverify.solvers.frontal import MERGE_SIZE
+            rec["merge_size"] = MERGE_SIZE
+            compare(args.dir, args.case, args.repeat, MERGE_SIZE, rec)
 
 
 if __name__ == "__main__":

@@ -10,6 +10,7 @@ Reads the source only (``ast``); imports nothing of pdverify.
 """
 from __future__ import annotations
 
+import argparse
 import ast
 import sys
 from pathlib import Path
@@ -97,8 +98,11 @@ def draw(folder: str) -> tuple[list[str], int]:
     return lines, total
 
 
-def main(argv: list[str]) -> int:
-    folders = argv or list(FOLDERS)
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("folders", nargs="*", metavar="FOLDER",
+                    help=f"package folders (default: {' '.join(FOLDERS)})")
+    folders = ap.parse_args(argv).folders or list(FOLDERS)
     totals = {}
     for folder in folders:
         lines, total = draw(folder)

@@ -42,12 +42,11 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import statistics
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
+import harness
 from _trees import extract
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -122,42 +121,43 @@ def phases(args):
         if args.before:
             variants.append((f"before ({args.before})", Path(args.before) if Path(
                 args.before).is_dir() else extract(args.before, Path(tmp))))
-        runs = {name: [] for name, _ in variants}
-        for _ in range(args.repeat):
-            for name, path in variants:
-                env = {**os.environ, "PYTHONPATH": str(path)}
-                out = subprocess.run([sys.executable, "-c", PHASE_RUNNER, args.method,
-                                      json.dumps(over)], env=env, cwd=path, check=True,
-                                     capture_output=True, text=True).stdout
-                runs[name].append(json.loads(out.strip().splitlines()[-1]))
-                print(f"  {name}: {runs[name][-1]['wall_s']:.1f} s", file=sys.stderr,
-                      flush=True)
+        def one(name, path):
+            r = harness.fresh([sys.executable, "-c", PHASE_RUNNER, args.method,
+                               json.dumps(over)], env={**os.environ, "PYTHONPATH": str(path)},
+                              cwd=path)
+            print(f"  {name}: {r['wall_s']:.1f} s", file=sys.stderr, flush=True)
+            return r
+        timed = harness.alternate({name: (lambda name=name, path=path: one(name, path))
+                                   for name, path in variants}, args.repeat, rotate=False)
+        runs = {name: t.results for name, t in timed.items()}
     print(f"{args.method} {over}, medians of {args.repeat} (wall s)")
     cols = ("wall", "cpu", "solve", *PHASES, "rest")
     print(f"{'variant':20s} " + " ".join(f"{c[:12]:>12s}" for c in cols))
+    table = {}
     for name, rs in runs.items():
-        med = {"wall": statistics.median(r["wall_s"] for r in rs),
-               "cpu": statistics.median(r["cpu_s"] for r in rs),
-               "solve": statistics.median(r["solve_s"] for r in rs)}
-        med.update({c: statistics.median(r["phases"].get(c, 0.0) for r in rs) for c in PHASES})
-        med["rest"] = statistics.median(r["solve_s"] - sum(r["phases"].values()) for r in rs)
+        med = {"wall": harness.median(r["wall_s"] for r in rs),
+               "cpu": harness.median(r["cpu_s"] for r in rs),
+               "solve": harness.median(r["solve_s"] for r in rs)}
+        med.update({c: harness.median(r["phases"].get(c, 0.0) for r in rs) for c in PHASES})
+        med["rest"] = harness.median(r["solve_s"] - sum(r["phases"].values()) for r in rs)
         print(f"{name:20s} " + " ".join(f"{med[c]:12.2f}" for c in cols))
+        table[name] = med
     first = next(iter(runs.values()))[0]
     same = all(r["metrics"] == first["metrics"] and r["status"] == first["status"]
                and r["cg_iterations"] == first["cg_iterations"]
                for rs in runs.values() for r in rs)
     print(f"status {first['status']}, CG iterations {first['cg_iterations']}; metrics "
           f"{'bitwise identical' if same else 'DIFFER'} across all runs")
+    return {"phases": {"method": args.method, "overrides": over, "median_s": table,
+                       "metrics_identical": same}}
 
 
 def run_once(path: Path, method: str, over: dict) -> dict:
-    env = {**os.environ, "PYTHONPATH": str(path)}
-    out = subprocess.run([sys.executable, "-c", RUNNER, method, json.dumps(over)], env=env,
-                         cwd=path, check=True, capture_output=True, text=True).stdout
-    return json.loads(out.strip().splitlines()[-1])
+    return harness.fresh([sys.executable, "-c", RUNNER, method, json.dumps(over)],
+                         env={**os.environ, "PYTHONPATH": str(path)}, cwd=path)
 
 
-def main():
+def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--before", metavar="REV", help="git revision to time as 'before'")
@@ -170,9 +170,13 @@ def main():
     ap.add_argument("--method", default="energy-directional", help="the --phases curve")
     ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                     help="a parameter of the --phases curve (repeatable)")
-    args = ap.parse_args()
-    if args.phases:
-        return phases(args)
+    harness.add_arguments(ap)
+    args = ap.parse_args(argv)
+    with harness.Record(__file__, args, argv=argv) as rec:
+        rec.update(phases(args) if args.phases else _measure(args))
+
+
+def _measure(args):
     cases = [("energy-directional", {})]
     if args.scene:
         sys.path.insert(0, str(ROOT))
@@ -186,20 +190,24 @@ def main():
             path = (Path(args.before) if Path(args.before).is_dir()
                     else extract(args.before, Path(tmp)))
             variants.append((f"before ({args.before})", path, {}))
-        results = {}
-        for _ in range(args.repeat):
-            for method, over in cases:
-                for name, path, extra in variants:
-                    r = run_once(path, method, {**over, **extra})
-                    results.setdefault((method, json.dumps(over), name), []).append(r)
-                    print(f"  {name:18s} {method} {over}: {r['status']} "
-                          f"{r['timings']['total_s']:.1f} s", file=sys.stderr, flush=True)
+        def one(method, over, name, path, extra):
+            r = run_once(path, method, {**over, **extra})
+            print(f"  {name:18s} {method} {over}: {r['status']} "
+                  f"{r['timings']['total_s']:.1f} s", file=sys.stderr, flush=True)
+            return r
+        timed = harness.alternate(
+            {(method, json.dumps(over), name): (lambda a=(method, over, name, path, extra): one(*a))
+             for method, over in cases for name, path, extra in variants}, args.repeat,
+            rotate=False)
+        results = {k: t.results for k, t in timed.items()}
     print(f"{'case':44s} {'variant':18s} {'total s':>8s} {'solve s':>8s} {'cpu s':>7s} "
           f"{'solves':>6s} {'CG it':>6s} {'builds':>9s} {'newton':>6s}  status")
-    sums = {}
+    sums, table = {}, {}
     for (method, over, name), rs in results.items():
-        med = {k: statistics.median(r["timings"][k] for r in rs) for k in ("total_s", "solve_s")}
-        cpu = statistics.median(r["cpu_s"] for r in rs)
+        med = {k: harness.median(r["timings"][k] for r in rs) for k in ("total_s", "solve_s")}
+        cpu = harness.median(r["cpu_s"] for r in rs)
+        table[f"{method} {over} {name}"] = {**med, "cpu_s": cpu, "status": rs[0]["status"],
+                                            "diagnostics": rs[0]["diagnostics"]}
         d, m = rs[0]["diagnostics"], rs[0]["metrics"]
         case = f"{method} {over if over != '{}' else ''}"
         print(f"{case:44s} {name:18s} {med['total_s']:8.2f} {med['solve_s']:8.2f} {cpu:7.1f} "
@@ -212,6 +220,7 @@ def main():
     base = sums.get("half")
     print("sum of the medians: " + ", ".join(
         f"{name} {t:.1f} s ({t / base:.2f}x half)" for name, t in sums.items()))
+    return {"runs": table, "sum_of_medians_s": sums}
 
 
 if __name__ == "__main__":

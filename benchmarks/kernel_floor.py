@@ -118,14 +118,21 @@ def by_class(stats: pstats.Stats) -> dict:
     return out
 
 
-def main() -> None:
+def main(argv=None) -> None:
+    import harness                      # beside this script (the tests load it by path)
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="the quick report's cases")
     ap.add_argument("--only", nargs="+", default=None, metavar="SCENE")
     ap.add_argument("--skip", nargs="+", default=(), metavar="SCENE")
     ap.add_argument("--jobs", type=int, default=2, help="workers of the floor (default 2)")
     ap.add_argument("--stats", default=None, metavar="FILE", help="keep the profile here")
-    args = ap.parse_args()
+    harness.add_arguments(ap)
+    args = ap.parse_args(argv)
+    with harness.Record(__file__, args, argv=argv) as rec:
+        _measure(args, rec)
+
+
+def _measure(args, rec) -> None:
     from pdverify.runner import plan
     from pdverify.scenes import get_scene
     cases = [c for c in plan(only=args.only, quick=args.quick) if c[0] not in args.skip]
@@ -159,6 +166,9 @@ def main() -> None:
     print("run time per scene (s):")
     for scene, s in per_scene.most_common():
         print(f"  {scene:28s} {s:8.1f}")
+    rec.update({"runs": len(cases), "wall_s": wall, "profiled_s": total,
+                "by_class_s": dict(classes), "arithmetic_floor_s": floor, "jobs": args.jobs,
+                "floor_on_jobs_s": floor / args.jobs, "per_scene_s": dict(per_scene)})
 
 
 if __name__ == "__main__":

@@ -30,9 +30,8 @@ vector) one by one: iterations and true relative residual with the corrections' 
 (``GMRES_MAX_ITERATIONS``, the estimator before issue 32) and with
 ``ESTIMATOR_MAX_ITERATIONS``; and the float32 factor's own solves with A and A^T of a random
 vector: their relative residuals against A and A^T, and against the factor's own M =
-Pr^T L U Pc^T and M^T (its factors in double). On manufactured-taylor2: 21 and 505 against
-A, 20 and 502 against M: M is close to A, the float32 solves' own rounding (element growth
-under the 1e-3 pivot threshold, times eps_single) is what is off, and more so transposed.
+Pr^T L U Pc^T and M^T (its factors in double). Measured on manufactured-taylor2:
+benchmarks/records/mixed_precision-2026-11-26-estimator.json.
 
 ``--threshold T ...``: per threshold, in a fresh process, the float32 factor with SuperLU's
 diagonal pivot threshold T (``nested.FLOAT32_PIVOT_THRESHOLD``) and the refinement on it
@@ -60,33 +59,20 @@ difference to the default's, relative to the largest entry of its displacement p
 unknowns whose equation has a diagonal entry: an augmented system's multipliers have
 none) and, apart, of its multiplier part. ``--system DIR`` takes a saved system
 (``A.npz``, ``b.npy``, ``c.npy`` as ``_capture`` writes them) instead of assembling a
-case's. Measured on traction-taylor1, manufactured-taylor2 and manufactured-snm3 (12,840,
-12,880 and 10,700 unknowns; medians of 3, the machine shared): the float32 factor is
-82-89 % of the solve (e.g. manufactured-taylor2: 17.9 s, of which ordering 0.5, factor
-15.9, refinement 1.2, estimate 0.2), all three factored whole (separator too large to
-split at). No knob gains 15 %: panel_size 15 -2 to -6 % (17.5 against 17.9 s, 13.4
-against 14.2 s; on traction-taylor1 20.7 against 26.5 s in medians, but the load fell
-during that table, its last and quietest round 17.7 against 19.0 s), relax 20 -5 % on
-manufactured-snm3 and +16 % on manufactured-taylor2, relax 5 and panel_size 10 slower;
-COLAMD in place of the nested dissection has 30 % fewer entries on the Taylor systems
-at the same factor time, and 46 % more on manufactured-snm3 (3.4x slower). Any of them
-changes the float32 factor's rounding, and traction-taylor1's refined solution moves by
-2.2e-4 of its largest displacement (its multipliers by their own size): the report's
-metrics would not stay within 1e-9. The others' move by 1e-12 to 2e-9.
+case's. Measured: no knob gains 15 %, and every one moves traction-taylor1's metrics
+beyond 1e-9 (benchmarks/records/mixed_precision-2026-11-27-knobs.json).
 """
 from __future__ import annotations
 
 import argparse
-import json
-import multiprocessing as mp
 import os
 import resource
-import statistics
 import tempfile
 import time
-from queue import Empty
 
 import numpy as np
+
+import harness
 
 CASES = {
     "manufactured-snm3": ("body3d-manufactured", "surface-nodes", {"order": 3}),
@@ -426,10 +412,9 @@ def _knob_table(name, folder, repeat):
     """``--knobs`` on the system saved in ``folder``: medians, printed and returned."""
     import scipy.sparse as sp
 
-    runs = {k: [] for k in KNOB_GRID}
-    for _ in range(repeat):
-        for knobs in KNOB_GRID:
-            runs[knobs].append(_in_fresh_process(_knobs, folder, *knobs))
+    runs = {k: t.results for k, t in harness.alternate(
+        {knobs: (lambda knobs=knobs: _in_fresh_process(_knobs, folder, *knobs))
+         for knobs in KNOB_GRID}, repeat, rotate=False).items()}
     A = sp.load_npz(os.path.join(folder, "A.npz")).tocsr()
     displacement = A.diagonal() != 0
     xs = {k: np.load(os.path.join(folder, "x-knobs-{}-{}-{}.npy".format(*k)))
@@ -442,7 +427,7 @@ def _knob_table(name, folder, repeat):
           f"(one BLAS thread)")
     for k in KNOB_GRID:
         last = runs[k][-1]
-        row = {key: statistics.median(r[key] for r in runs[k]) for key in keys}
+        row = {key: harness.median(r[key] for r in runs[k]) for key in keys}
         d = np.abs(xs[k] - ref)
         row["solution_difference"] = float(d[displacement].max()
                                            / np.abs(ref[displacement]).max())
@@ -469,10 +454,9 @@ RUN_VARIANTS = ("before", "now", "threshold-0.1", "double-lu", "reference")
 
 def _runs(case, repeat):
     with tempfile.TemporaryDirectory() as folder:
-        runs = {v: [] for v in RUN_VARIANTS}
-        for _ in range(repeat):
-            for v in RUN_VARIANTS:
-                runs[v].append(_in_fresh_process(_whole_run, case, v, folder))
+        runs = {v: t.results for v, t in harness.alternate(
+            {v: (lambda v=v: _in_fresh_process(_whole_run, case, v, folder))
+             for v in RUN_VARIANTS}, repeat, rotate=False).items()}
         xs = {v: np.load(os.path.join(folder, f"x-{v}.npy")) for v in RUN_VARIANTS}
     ref, ref_m = xs["reference"], runs["reference"][-1]["metrics"]
     out = {}
@@ -482,8 +466,8 @@ def _runs(case, repeat):
         m = last["metrics"]
         metric_diff = max((abs(m[k] - ref_m[k]) / abs(ref_m[k]) if ref_m[k] else abs(m[k]))
                           for k in ref_m)
-        row = {"wall_s": statistics.median(r["wall_s"] for r in runs[v]),
-               "peak_gb": statistics.median(r["peak_gb"] for r in runs[v]),
+        row = {"wall_s": harness.median(r["wall_s"] for r in runs[v]),
+               "peak_gb": harness.median(r["peak_gb"] for r in runs[v]),
                "solution_difference": float(np.abs(xs[v] - ref).max() / np.abs(ref).max()),
                "metrics_largest_relative_difference": metric_diff, **last}
         print(f"  {v:14s} run {row['wall_s']:6.1f} s  peak {row['peak_gb']:5.2f} GB  "
@@ -496,21 +480,23 @@ def _runs(case, repeat):
     return out
 
 
+class _Box:
+    """Stands for the queue the targets put their one result on."""
+    value = None
+
+    def put(self, value):
+        self.value = value
+
+
+def _returning(target, *args):
+    box = _Box()
+    target(*args, box)
+    return box.value
+
+
 def _in_fresh_process(target, *args):
-    ctx = mp.get_context("spawn")
-    queue = ctx.Queue()
-    p = ctx.Process(target=target, args=args + (queue,))
-    p.start()
-    while True:     # a child that dies (an exception, memory) would leave get() waiting
-        try:
-            out = queue.get(timeout=5)
-            break
-        except Empty:
-            if not p.is_alive():
-                raise RuntimeError(f"{target.__name__} failed "
-                                   f"in its process (exit code {p.exitcode})") from None
-    p.join()
-    return out
+    """``target(*args, queue)`` in a fresh process (``harness.fresh_call``); what it put."""
+    return harness.fresh_call(_returning, target, *args)
 
 
 def _capture_in_process(case, folder, queue):
@@ -537,27 +523,26 @@ def main(argv=None):
                     help="the float32 factor at SuperLU's relax / panel_size (KNOB_GRID)")
     ap.add_argument("--system", action="append", metavar="DIR",
                     help="a saved system (A.npz, b.npy, c.npy) instead of a case's")
+    harness.add_arguments(ap)
     args = ap.parse_args(argv)
-    out = {}
+    with harness.Record(__file__, args, argv=argv) as rec:
+        _measure(args, rec)
+        if args.json:
+            harness.write_json(args.json, rec.results)
+
+
+def _measure(args, out):
     if args.knobs and args.system:
         for folder in args.system:
             out[os.path.basename(os.path.normpath(folder))] = _knob_table(
                 os.path.basename(os.path.normpath(folder)), folder, args.repeat)
-        if args.json:
-            with open(args.json, "w") as fh:
-                json.dump(out, fh, indent=2)
         return
     for case in args.case or ["manufactured-snm3"]:
         if args.run:
             out[case] = _runs(case, args.repeat)
             continue
         with tempfile.TemporaryDirectory() as folder:
-            ctx = mp.get_context("spawn")
-            q = ctx.Queue()
-            p = ctx.Process(target=_capture_in_process, args=(case, folder, q))
-            p.start()
-            q.get()
-            p.join()
+            _in_fresh_process(_capture_in_process, case, folder)
             if args.stages:
                 st = _in_fresh_process(_stages, folder)
                 print(f"{case}: stages " + ", ".join(
@@ -587,18 +572,17 @@ def main(argv=None):
                     print(f"  {k}: {v}")
                 out[case] = st
                 continue
-            runs = {a: [] for a in ALTERNATIVES}
-            for _ in range(args.repeat):
-                for a in ALTERNATIVES:
-                    runs[a].append(_in_fresh_process(_solve, folder, a))
+            runs = {a: t.results for a, t in harness.alternate(
+                {a: (lambda a=a: _in_fresh_process(_solve, folder, a)) for a in ALTERNATIVES},
+                args.repeat, rotate=False).items()}
             xs = {a: np.load(os.path.join(folder, f"x-{a}.npy")) for a in ALTERNATIVES}
             diff = float(np.abs(xs["gmres-ir"] - xs["double-lu"]).max()
                          / np.abs(xs["double-lu"]).max())
         print(f"{case}: median of {args.repeat}")
         res = {}
         for a in ALTERNATIVES:
-            wall = statistics.median(r["wall_s"] for r in runs[a])
-            peak = statistics.median(r["peak_gb"] for r in runs[a])
+            wall = harness.median(r["wall_s"] for r in runs[a])
+            peak = harness.median(r["peak_gb"] for r in runs[a])
             last = runs[a][-1]
             print(f"  {a:10s} solve {wall:7.1f} s  peak {peak:5.2f} GB  cond "
                   f"{last['condition_estimate']:.3g}  residual {last['relative_residual']:.2g}"
@@ -608,9 +592,6 @@ def main(argv=None):
         ratio = res["double-lu"]["wall_s"] / res["gmres-ir"]["wall_s"]
         print(f"  speed-up {ratio:.2f}x; solutions differ by {diff:.2g} (relative to max |x|)")
         out[case] = {**res, "speedup": ratio, "max_relative_difference": diff}
-    if args.json:
-        with open(args.json, "w") as fh:
-            json.dump(out, fh, indent=2)
 
 
 if __name__ == "__main__":

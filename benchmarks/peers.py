@@ -19,11 +19,12 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import statistics
 import subprocess
 import sys
 import tempfile
 import time
+
+import harness
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
@@ -34,10 +35,8 @@ def _one(scene_id, overrides) -> dict:
             "r = get_scene(sys.argv[1]).run('peer:lammps', json.loads(sys.argv[2])); "
             "print(json.dumps({'status': r.status, 'total_s': r.timings.get('total_s'), "
             "'iterations': r.diagnostics.get('peer', {}).get('iterations')}))")
-    out = subprocess.run([sys.executable, "-c", code, scene_id, json.dumps(overrides)],
-                         capture_output=True, text=True, check=True, cwd=ROOT,
-                         env=dict(os.environ, PYTHONPATH=ROOT))
-    return json.loads(out.stdout.strip().splitlines()[-1])
+    return harness.fresh([sys.executable, "-c", code, scene_id, json.dumps(overrides)],
+                         cwd=ROOT, env=dict(os.environ, PYTHONPATH=ROOT))
 
 
 def runs(repeat: int) -> list[dict]:
@@ -48,9 +47,9 @@ def runs(repeat: int) -> list[dict]:
     rows = []
     for scene_id in sorted(__import__("pdverify.corrections.peer", fromlist=["x"]).REPORT_RUNS):
         for over in peer.report_runs(get_scene(scene_id), False):
-            got = [_one(scene_id, over) for _ in range(repeat)]
+            got = harness.alternate({"run": lambda: _one(scene_id, over)}, repeat)["run"].results
             rows.append({"scene": scene_id, "overrides": over,
-                         "median_s": statistics.median(g["total_s"] for g in got),
+                         "median_s": harness.median(g["total_s"] for g in got),
                          "iterations": got[0]["iterations"], "status": got[0]["status"]})
     return rows
 
@@ -98,15 +97,23 @@ def main(argv=None) -> int:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--minimisers", action="store_true")
     ap.add_argument("--json", metavar="FILE")
+    harness.add_arguments(ap)
     a = ap.parse_args(argv)
+    with harness.Record(__file__, a, argv=argv) as rec:
+        _measure(a, rec)
+    return 0
+
+
+def _measure(a, rec) -> None:
     from pdverify.results import machine_info
-    doc = {"machine": machine_info()}
+    doc = rec.results
+    doc["machine"] = machine_info()     # as the report's results.json names it
     if a.minimisers:
-        doc["minimisers"] = minimisers()
+        rec["minimisers"] = minimisers()
         for r in doc["minimisers"]:
             print(f"{r['minimiser']:32s} {r['stopping']:32s} {r['iterations']:>6} it "
                   f"{r['wall_s']:7.2f} s  diff to none {r['diff_to_none']:.3g}")
-    doc["runs"] = runs(a.repeat)
+    rec["runs"] = runs(a.repeat)
     for r in doc["runs"]:
         print(f"{r['scene']:22s} {r['overrides'].get('setting'):11s} {r['status']:6s} "
               f"median {r['median_s']:7.2f} s  {r['iterations']} FIRE iterations")
@@ -114,9 +121,7 @@ def main(argv=None) -> int:
     print(f"peer runs: {len(doc['runs'])}, summed median run time {total:.1f} s "
           f"(on 2 workers about {total / 2:.1f} s of a report's wall time)")
     if a.json:
-        with open(a.json, "w") as fh:
-            json.dump(doc, fh, indent=1)
-    return 0
+        harness.write_json(a.json, doc)
 
 
 if __name__ == "__main__":

@@ -11,12 +11,10 @@ Plain script (no test runner): python benchmarks/plate_solvers.py [--repeat N] [
 from __future__ import annotations
 
 import argparse
-import json
-import time
 
-import numpy as np
 import scipy.sparse as sp
 
+import harness
 from _splu_timing import time_splu
 from pdverify.corrections.taylor_fictitious import assemble_taylor
 from pdverify.scenes import get_scene
@@ -39,8 +37,17 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--json", default=None, help="write the medians to this file")
+    harness.add_arguments(ap)
     args = ap.parse_args(argv)
-    out = {"orderings": {}, "runs": {}}
+    with harness.Record(__file__, args, argv=argv) as rec:
+        rec.update({"orderings": {}, "runs": {}})
+        _measure(args, rec)
+        if args.json:
+            harness.write_json(args.json, rec.results)
+
+
+def _measure(args, rec):
+    out = rec.results
     for h in (0.05, 0.025):
         A = lagrange_system(h)
         medians = time_splu(A, {name: {"permc_spec": name} for name in ORDERINGS}, args.repeat)
@@ -49,26 +56,22 @@ def main(argv=None):
         for name, med in medians.items():
             print(f"  splu {name:15s} {med:7.2f} s   speed-up vs COLAMD {base / med:5.2f}x")
             out["orderings"][f"{h}/{name}"] = med
+        rec.save()
     scene = get_scene("plate2d-clamped")
     cases = [("Table 4 (600 real nodes)", 0.1, 1.0), ("4x finer (9,600 real nodes)", 0.025, 10.0)]
     for label, h, budget in cases:
         for method, extra in (("none", {}), ("taylor-fictitious", {"order": 1}),
                               ("taylor-fictitious", {"order": 3})):
-            walls = []
-            for _ in range(args.repeat):
-                t0 = time.perf_counter()
-                r = scene.run(method, {"spacing": h, **extra})
-                walls.append(time.perf_counter() - t0)
-                assert r.status == "ok", r.message
-            med = float(np.median(walls))
+            t = harness.alternate({"run": lambda: scene.run(method, {"spacing": h, **extra})},
+                                  args.repeat)["run"]
+            assert all(r.status == "ok" for r in t.results), t.last.message
+            med, r = t.median, t.last
             tag = f"{method} {extra.get('order', '')}".strip()
             print(f"{label:28s} {tag:20s} run {med:6.2f} s (budget {budget:g} s: "
                   f"{'met' if med < budget else 'MISSED'}); setup {r.timings['setup_s']:.2f} s, "
                   f"solve {r.timings['solve_s']:.2f} s")
             out["runs"][f"{h}/{tag}"] = med
-    if args.json:
-        with open(args.json, "w") as fh:
-            json.dump(out, fh, indent=1)
+            rec.save()
 
 
 if __name__ == "__main__":

@@ -44,48 +44,8 @@ the same results.
 The machine is shared: run the alternatives back to back, quote medians and the load
 (the script prints ``os.getloadavg()`` before and after).
 
-Findings (issue 32, 2 cores; the CPU time is the steadier measure on a loaded machine):
-
-- Before (47198fc), warm, quiet (load 0.1-1.6): 319 runs, 79.8 s wall (runs 56.9 s,
-  figures 19.1 s, VTU 1.0 s, pages 0.1 s), 146 CPU-s. The runs summed 111 s, 60 s of
-  them body3d-manufactured, 50 s of that its convergence levels h = 0.0625 and 1/18
-  (surface nodes at 1/18 alone 12.2 s); sheet2d-tension 16 s (its quick cases at Table
-  1's 1 mm grid, 11 s); sheet2d-clamped 8 s (the delta-refinement's side 8 at m = 6,
-  6.7 s). Figures: 55 files, about 30 CPU-s drawn serially, three quarters of it in
-  ``savefig`` (matplotlib's layout and tick passes: a layout engine or a tight bbox
-  lays a figure out once more before the real draw), the pyvista renders 1.5-2 s with
-  the import; no figure was drawn twice, and the report process had already imported
-  every module the runs use (the forked workers import nothing).
-- After: 298 runs (every scene and every method kept), back to back with the old tree
-  at load 4-6, medians of 2: 78.4 s wall (runs 48.9, figures 26.4), 75.7 CPU-s, against
-  157.9 s (runs 119.6, figures 34.1) and 156.0 CPU-s: half the CPU time; runs 0.41,
-  figures 0.78 of before. At load 2-3: 48.8 s wall (runs 30.5, figures 14.8), 71 CPU-s.
-  One more round each, load falling from 5.1 to 2.4: 37.8 s wall (runs 21.9, figures
-  13.4), 72 CPU-s, against 72.1 s (runs 53.9, figures 14.9), 139 CPU-s: the figures'
-  wall time barely moved (fewer, lighter files, but the same matplotlib passes).
-  The figures are now about a third: 51 files, 25 CPU-s, 0.3-1.5 s each (the 3D error
-  maps, 40 panels, 1-1.5 s; the convergence figures 3 s for 7; the error-against-cost
-  overview 2.8 s).
-- Figures laid out once (``pdverify.report.figures.save``), PNG at zlib level 3, the
-  overview first and the convergence figures one task per scene, last: the same pixels
-  in all 55 files (``--mode figures``). Where the time went before (cProfile, 55
-  files, 2 draws each): the draw without output that ``savefig`` makes to lay a figure
-  out was about half of ``savefig``'s draw time, the constrained layout over a quarter, PNG
-  encoding at level 6 2.9 s. The serial drawing of the same runs (one process,
-  alternating, load 1.4-3.8): 24.1 s CPU against 19.3 s (medians of 3; 0.80), the
-  saves 20.8 s against 16.2 s. What is left is mostly the first measurement of every
-  text (tick labels, titles; each renderer measures its texts anew, mathtext parsed
-  again): a second pass over a measured figure is cheap, so placing the titles once
-  (the y axis measured once for each) saved nothing. One quick report each, load
-  about 3: figures_s 19.2 s against 10.1 s, 71.5 against 65.6 CPU-s for the whole
-  report. At load 5-6 ``--mode figures`` rounds of one tree varied from 22 to 39 CPU-s:
-  too noisy to show a 20 % change.
-- Cold (an empty FEM cache), load about 5: 110.7 s wall, 109 CPU-s (warm: 75.7): the
-  FEM references add about 34 CPU-s, two thirds of it the finite-strain indentation
-  references (Saint Venant-Kirchhoff 17.8 s, neo-Hookean 17.5 s; then the clamped
-  plate 6.2 s, the clamped sheet 5.1 s, the small-strain indentation 3.7 s), and PD
-  runs that start while their scene's reference is computed wait on its cache lock
-  (3.8 s for runs of 0.05 s).
+Findings of issue 32 (the quick report before and after, warm and cold, where the
+figures' time goes): benchmarks/records/quick_report-2026-11-27-issue32-findings.json.
 """
 from __future__ import annotations
 
@@ -94,11 +54,12 @@ import json
 import os
 import pickle
 import resource
-import statistics
 import subprocess
 import sys
 import tempfile
 import time
+
+import harness
 
 HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PHASES = ("runs_s", "figures_s", "fields_s", "pages_s", "total_s")
@@ -140,21 +101,19 @@ def fresh_report(jobs=None, cold=False, only=None, src=HERE) -> dict:
             "critical_path": path[-1] if path else ""}
 
 
-def fresh(a) -> None:
+def fresh(a) -> dict:
     trees = {"this tree": HERE}
     if a.against:
         trees[f"against {a.against}"] = os.path.abspath(a.against)
-    rounds = {name: [] for name in trees}
     print(f"load before: {_load()}")
-    for _ in range(a.repeat):        # alternating, so that the machine's load weighs alike
-        for name, src in trees.items():
-            rounds[name].append(fresh_report(a.jobs, a.cold, a.only, src))
+    timed = harness.alternate(       # alternating, so that the machine's load weighs alike
+        {name: (lambda src=src: fresh_report(a.jobs, a.cold, a.only, src))
+         for name, src in trees.items()}, a.repeat, rotate=False)
     print(f"load after:  {_load()}")
-    for name, rs in rounds.items():
-        _summary(a, name, rs)
+    return {name: _summary(a, name, t.results) for name, t in timed.items()}
 
 
-def _summary(a, name, rounds) -> None:
+def _summary(a, name, rounds) -> dict:
     kind = "cold (empty FEM cache)" if a.cold else "warm"
     r0 = rounds[0]
     print(f"{name}: report --quick, {kind}, fresh processes, median of {a.repeat}: "
@@ -163,7 +122,7 @@ def _summary(a, name, rounds) -> None:
     print(f"  {r0['last']}")
     for k in PHASES + ("wall_s", "cpu_s"):
         vals = [r.get(k, 0.0) for r in rounds]
-        print(f"  {k[:-2]:8s} {statistics.median(vals):7.2f} s   "
+        print(f"  {k[:-2]:8s} {harness.median(vals):7.2f} s   "
               f"(rounds: {', '.join(f'{v:.1f}' for v in vals)})")
     for r in rounds:
         print(f"  {r['critical_path']}")
@@ -171,6 +130,8 @@ def _summary(a, name, rounds) -> None:
         print("  FEM runs of the first round (their references computed):")
         for t, what in r0["fem"]:
             print(f"    {t:7.2f} s  {what}")
+    return {"median_s": {k: harness.median(r.get(k, 0.0) for r in rounds)
+                         for k in PHASES + ("wall_s", "cpu_s")}, "rounds": rounds}
 
 
 def _tasks(cases, results, figdir):
@@ -231,7 +192,7 @@ def _count(value) -> int:
     return len(value)
 
 
-def inprocess(a) -> None:
+def inprocess(a) -> dict:
     draw_all = _drawing().draw_all
     from pdverify.runner import plan, run_cases
     print(f"load before: {_load()}")
@@ -281,8 +242,8 @@ def inprocess(a) -> None:
         t = time.perf_counter()
         draw_all(tasks, a.jobs, sys.stderr)
         parallel = time.perf_counter() - t
-    med = {w: statistics.median(v) for w, v in times.items()}
-    mcpu = {w: statistics.median(v) for w, v in cpu.items()}
+    med = {w: harness.median(v) for w, v in times.items()}
+    mcpu = {w: harness.median(v) for w, v in cpu.items()}
     print(f"figure tasks, serial, median of {a.repeat} (wall s, CPU s of this process, "
           "figures, wall s per figure):")
     for w, t in sorted(med.items(), key=lambda x: -x[1]):
@@ -292,6 +253,10 @@ def inprocess(a) -> None:
           f"{sum(counts.values()):4d}")
     print(f"the report's drawing (--jobs {a.jobs or 'default'} processes): {parallel:.2f} s")
     print(f"load after:  {_load()}")
+    return {"runs": len(results), "failed": failed, "runs_wall_s": runs_s,
+            "runs_summed_s": total, "per_scene_s": per_scene,
+            "figure_tasks_median_s": med, "figure_tasks_cpu_median_s": mcpu,
+            "figures_per_task": counts, "parallel_drawing_s": parallel}
 
 
 def figures_child(runs_file, out, jobs) -> None:
@@ -327,7 +292,7 @@ def figures_child(runs_file, out, jobs) -> None:
     print(json.dumps(row))
 
 
-def figures_side_by_side(a) -> None:
+def figures_side_by_side(a) -> dict:
     """``--mode figures``: :func:`figures_child` of this tree and of ``--against``,
     alternating, ``--repeat`` rounds; medians side by side, and whether the two trees
     drew the same pixels (each figure file of the last round's serial drawing)."""
@@ -337,20 +302,22 @@ def figures_side_by_side(a) -> None:
     trees = {"this tree": HERE}
     if a.against:
         trees["against"] = os.path.abspath(a.against)
-    rows = {name: [] for name in trees}
     keep = a.keep or tempfile.mkdtemp(prefix="figures-")
+    rounds = {name: 0 for name in trees}
+
+    def one(name, src):
+        out = os.path.join(keep, f"{'this' if name == 'this tree' else 'against'}-"
+                                 f"{rounds[name]}")
+        rounds[name] += 1
+        env = {**os.environ, "PYTHONPATH": src + os.pathsep + os.environ.get("PYTHONPATH", "")}
+        return harness.fresh([sys.executable, os.path.abspath(__file__), "--figures-child",
+                              a.runs_file, out, str(a.jobs or 2)], env=env)
     print(f"load before: {_load()}")
-    for k in range(a.repeat):
-        for name, src in trees.items():
-            out = os.path.join(keep, f"{'this' if name == 'this tree' else 'against'}-{k}")
-            env = {**os.environ,
-                   "PYTHONPATH": src + os.pathsep + os.environ.get("PYTHONPATH", "")}
-            done = subprocess.run(
-                [sys.executable, os.path.abspath(__file__), "--figures-child", a.runs_file,
-                 out, str(a.jobs or 2)], env=env, capture_output=True, text=True, check=True)
-            rows[name].append(json.loads(done.stdout.strip().splitlines()[-1]))
+    timed = harness.alternate({name: (lambda name=name, src=src: one(name, src))
+                               for name, src in trees.items()}, a.repeat, rotate=False)
+    rows = {name: t.results for name, t in timed.items()}
     print(f"load after:  {_load()}")
-    med = {name: {key: statistics.median(r[key] for r in rs) for key in
+    med = {name: {key: harness.median(r[key] for r in rs) for key in
                   ("serial_wall_s", "serial_cpu_s", "parallel_wall_s", "parallel_cpu_s")}
            for name, rs in rows.items()}
     names = list(trees)
@@ -365,7 +332,7 @@ def figures_side_by_side(a) -> None:
             print(f"    {n} rounds: {', '.join(f'{r[key]:.1f}' for r in rows[n])}")
     print("  CPU s per task (serial, median):")
     tasks = list(dict.fromkeys(t for n in names for t in rows[n][0]["tasks"]))
-    cpu = {n: {t: statistics.median(r["tasks"][t][1] for r in rows[n])
+    cpu = {n: {t: harness.median(r["tasks"][t][1] for r in rows[n])
                for t in rows[n][0]["tasks"]} for n in names}
     for t in sorted(tasks, key=lambda t: -max(cpu[n].get(t, 0.0) for n in names)):
         print(f"    {t:34s}" + "".join(f"{cpu[n][t]:10.2f}" if t in cpu[n] else f"{'-':>10s}"
@@ -374,6 +341,7 @@ def figures_side_by_side(a) -> None:
         _same_pixels(os.path.join(keep, f"this-{a.repeat - 1}", "serial"),
                      os.path.join(keep, f"against-{a.repeat - 1}", "serial"))
     print(f"  figure files kept in {keep}")
+    return {"median_s": med, "rounds": rows, "cpu_per_task_median_s": cpu}
 
 
 def _same_pixels(one, two) -> None:
@@ -412,18 +380,20 @@ def main(argv=None) -> int:
                     help="inprocess: the runs' results pickled here on the first call and "
                          "read back on later ones (to time the figures alone; delete the "
                          "file after a change to the runs)")
+    harness.add_arguments(ap)
     a = ap.parse_args(argv)
     if a.figures_child:
         runs_file, out, jobs = a.figures_child
         figures_child(runs_file, out, int(jobs))
         return 0
-    if a.mode == "figures":
-        figures_side_by_side(a)
-        return 0
-    if a.mode in ("fresh", "both"):
-        fresh(a)
-    if a.mode in ("inprocess", "both"):
-        inprocess(a)
+    with harness.Record(__file__, a, argv=argv) as rec:
+        if a.mode == "figures":
+            rec["figures"] = figures_side_by_side(a)
+            return 0
+        if a.mode in ("fresh", "both"):
+            rec["fresh"] = fresh(a)
+        if a.mode in ("inprocess", "both"):
+            rec["inprocess"] = inprocess(a)
     return 0
 
 

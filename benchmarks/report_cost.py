@@ -21,9 +21,8 @@ proportional set size (``Pss`` of /proc/PID/smaps_rollup: pages shared by the fo
 workers counted once), sampled every 0.1 s; next to it, the largest single process's
 peak resident size (``ru_maxrss``), and the report process's own peak resident size
 (``VmHWM`` of /proc/PID/status, sampled likewise), so that the report process's share
-and its workers' are told apart (measured at stop 40: the report process peaks at
-0.13-0.15 GB on the quick report; the largest process is a worker running one heavy
-case). ``--against SRC``: also run the report of another
+and its workers' are told apart (benchmarks/records/report_cost-2026-11-26-stop40.json).
+``--against SRC``: also run the report of another
 source tree (e.g. ``git archive`` of an earlier commit unpacked, put first on
 PYTHONPATH; ``--against-args``: its report arguments), alternating with this one, and
 print both and the ratios.
@@ -36,12 +35,13 @@ import os
 import resource
 import shlex
 import shutil
-import statistics
 import subprocess
 import sys
 import tempfile
 import threading
 import time
+
+import harness
 
 PHASES = ("runs_s", "figures_s", "fields_s", "pages_s")
 BUDGET = 0.15   # issue 17: figures and VTU export < 15 % of the report's total time
@@ -128,7 +128,7 @@ def one_report(full: bool, only, src=None, args=(), keep=None) -> dict:
 
 
 def summary(name, rounds, repeat) -> dict:
-    med = {k: statistics.median(r.get(k, 0.0) for r in rounds)
+    med = {k: harness.median(r.get(k, 0.0) for r in rounds)
            for k in PHASES + ("total_s", "wall_s", "peak_pss", "report_rss")}
     drawn = (med["figures_s"] + med["fields_s"]) / med["total_s"]
     print(f"{name} ({rounds[0]['runs']} runs), median of {repeat}:")
@@ -142,7 +142,7 @@ def summary(name, rounds, repeat) -> dict:
           f"{med['peak_pss'] / 1e9:.3f} GB")
     print(f"  the report process's own peak resident size (VmHWM): "
           f"{med['report_rss'] / 1e9:.3f} GB")
-    scenes = {s: statistics.median(r["scenes"].get(s, 0.0) for r in rounds)
+    scenes = {s: harness.median(r["scenes"].get(s, 0.0) for r in rounds)
               for s in rounds[0]["scenes"]}
     print("  run time per scene (sum of its runs' total_s):")
     for s, t in sorted(scenes.items(), key=lambda x: -x[1]):
@@ -167,16 +167,23 @@ def main(argv=None) -> int:
                     help="also time the report of this source tree, alternating")
     ap.add_argument("--against-args", default="",
                     help="further arguments of the --against tree's report")
+    harness.add_arguments(ap)
     a = ap.parse_args(argv)
+    with harness.Record(__file__, a, argv=argv) as rec:
+        _measure(a, rec)
+    return 0
+
+
+def _measure(a, rec) -> None:
     kind = "full" if a.full else "quick"
     trees = {f"this tree {a.args}".strip(): (None, shlex.split(a.args)),
              **({f"against {a.against} {a.against_args}".strip():
                  (a.against, shlex.split(a.against_args))} if a.against else {})}
-    rounds = {name: [] for name in trees}
-    for _ in range(a.repeat):
-        for name, (src, args) in trees.items():
-            rounds[name].append(one_report(a.full, a.only, src, args,
-                                           keep=a.keep if src is None else None))
+    timed = harness.alternate(
+        {name: (lambda src=src, args=args: one_report(a.full, a.only, src, args,
+                                                      keep=a.keep if src is None else None))
+         for name, (src, args) in trees.items()}, a.repeat, rotate=False)
+    rounds = {name: t.results for name, t in timed.items()}
     out = {name: summary(f"report ({kind}), {name}", rs, a.repeat) for name, rs in rounds.items()}
     print(f"largest single process's peak resident size, all rounds: "
           f"{max(r['max_child_rss'] for rs in rounds.values() for r in rs) / 1e9:.3f} GB")
@@ -189,10 +196,9 @@ def main(argv=None) -> int:
               f"{other['peak_pss'] / 1e9:.3f} GB")
         print(f"report process's peak resident size, this tree / against: "
               f"{mine['report_rss'] / 1e9:.3f} GB / {other['report_rss'] / 1e9:.3f} GB")
+    rec.update(out)
     if a.json:
-        with open(a.json, "w") as fh:
-            json.dump(out, fh, indent=1)
-    return 0
+        harness.write_json(a.json, out)
 
 
 if __name__ == "__main__":

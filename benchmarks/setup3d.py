@@ -27,47 +27,21 @@ repeat, and the table shows medians of ``--repeat`` (default 3). Two modes:
 ``--profile after`` (this tree) or ``before``: cProfile of that tree's setup of each case:
 the functions with the most own time, which is where the setup's time goes.
 
-Measured (issue 32; a 2-core machine shared with two other jobs, so the CPU times are the
-steadier figures). Where the setup went before: in the surface-node runs the sparse
-products of the stiffness, above all the extensions of the unknowns B = A_e A_U (48 M
-entries at order 3, h = 0.05) and (P K_e) B: at order 3, csr_matmat + its symbolic pass
-took ~2.5-4 s of the ~4.5 s of setup CPU; then the closure's Taylor fits
-(``taylor_monomials``, the SVDs; ~0.4 s at order 3), ``face_crossings`` (~0.2 s) and the
-model's operators (~0.15 s). The other methods' setups are 0.1-2 s, spread over many
-small steps. After the displacement map is multiplied in last in 3D
-(``StateBasedModel.unknown_rows``), ``--only surface-nodes``, medians of 3 (setup CPU, s):
-
-    manuf surface-nodes order=1                 1.69 -> 1.14
-    manuf surface-nodes order=2                 1.86 -> 1.25
-    manuf surface-nodes order=3                 4.44 -> 2.38
-    manuf surface-nodes order=3, moment         4.62 -> 2.82
-    manuf surface-nodes order=3, centre         4.80 -> 2.52
-    tract surface-nodes order=1                 1.36 -> 1.02
-    tract surface-nodes order=1, moment         1.30 -> 0.94
-    manuf surface-nodes h=0.1                   1.17 -> 0.72
-    manuf surface-nodes h=0.0625                2.30 -> 1.19
-    manuf surface-nodes h=1/12, m=2             0.60 -> 0.48
-    manuf surface-nodes h=1/18                  2.98 -> 1.55
-    sum                                        27.11 -> 16.00
-
-The systems of every other case are the same bit for bit; those of the surface-node runs
-differ at round-off, and their metrics by at most 7e-10 relative (round-off-level ones
-aside: moment-corrected traction 1.3e-11 -> 3.1e-11 %); ``compare --rtol 1e-9`` against
-the saved full report finds no change. Whole runs (``--runs``), medians of 3: order 3
-with ``surface_load=centre`` setup 8.7 -> 4.1 s wall, total 35.2 -> 32.0 s, CPU 23.8 ->
-21.7 s.
+Measured for issue 32 (the surface-node setups' CPU time, 27.1 s -> 16.0 s summed, once
+the displacement map is multiplied in last):
+benchmarks/records/setup3d-2026-11-27-issue32-surface-nodes.json.
 """
 from __future__ import annotations
 
 import argparse
 import json
 import os
-import statistics
 import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
+import harness
 from _trees import extract
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -153,9 +127,11 @@ def label(case) -> str:
 def run_once(path: Path, case, mode: str) -> dict | str:
     scene, method, over = case
     env = {**os.environ, "PYTHONPATH": str(path)}
-    out = subprocess.run([sys.executable, "-c", RUNNER, scene, method, json.dumps(over), mode],
-                         env=env, cwd=path, check=True, capture_output=True, text=True).stdout
-    return out if mode == "profile" else json.loads(out.strip().splitlines()[-1])
+    cmd = [sys.executable, "-c", RUNNER, scene, method, json.dumps(over), mode]
+    if mode == "profile":
+        return subprocess.run(cmd, env=env, cwd=path, check=True, capture_output=True,
+                              text=True).stdout
+    return harness.fresh(cmd, env=env, cwd=path)
 
 
 def metric_check(a: dict, b: dict) -> str:
@@ -175,7 +151,7 @@ def metric_check(a: dict, b: dict) -> str:
     return "same" if worst == 0.0 else f"rel diff {worst:.1e}{name}"
 
 
-def main():
+def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--before", default="main", metavar="REV",
                     help="git revision (or folder) to time as 'before' (default main)")
@@ -184,7 +160,13 @@ def main():
     ap.add_argument("--profile", choices=("after", "before"),
                     help="cProfile the setups of this tree (after) or of --before")
     ap.add_argument("--only", nargs="*", default=[], metavar="TEXT")
-    args = ap.parse_args()
+    harness.add_arguments(ap)
+    args = ap.parse_args(argv)
+    with harness.Record(__file__, args, argv=argv, enabled=args.record and not args.profile) as rec:
+        _measure(args, rec)
+
+
+def _measure(args, rec):
     todo = cases(args.only)
     mode = "run" if args.runs else "setup"
     with tempfile.TemporaryDirectory() as tmp:
@@ -207,11 +189,11 @@ def main():
         print(head)
         sums = {k: [0.0, 0.0, 0.0] for k in trees}
         for case in todo:
-            got = {k: [] for k in trees}
-            for _ in range(args.repeat):
-                for name, path in trees.items():
-                    got[name].append(run_once(path, case, mode))
-            med = {k: {q: statistics.median(r[q] for r in v)
+            timed = harness.alternate({name: (lambda path=path: run_once(path, case, mode))
+                                       for name, path in trees.items()}, args.repeat,
+                                      rotate=False)
+            got = {k: t.results for k, t in timed.items()}
+            med = {k: {q: harness.median(r[q] for r in v)
                        for q in ("setup_s", "cpu_s") + (("total_s",) if mode == "run" else ())}
                    for k, v in got.items()}
             for k in trees:
@@ -222,10 +204,12 @@ def main():
             if mode == "setup":
                 dig = {r["digest"] for v in got.values() for r in v}
                 check = "same" if len(dig) == 1 else "DIFFERENT"
+                rec[label(case)] = {"median": med, "system": check}
                 print(f"{label(case):52s} {b['setup_s']:12.2f} {a['setup_s']:7.2f} "
                       f"{b['cpu_s']:10.2f} {a['cpu_s']:7.2f}  {check}", flush=True)
             else:
                 check = metric_check(got["before"][0]["metrics"], got["after"][0]["metrics"])
+                rec[label(case)] = {"median": med, "metrics": check}
                 print(f"{label(case):52s} {b['setup_s']:12.2f} {a['setup_s']:7.2f} "
                       f"{b['total_s']:12.2f} {a['total_s']:7.2f} {b['cpu_s']:10.2f} "
                       f"{a['cpu_s']:7.2f}  {check}", flush=True)

@@ -10,6 +10,7 @@ import argparse
 
 import numpy as np
 
+import harness
 from _splu_timing import time_splu
 from pdverify.scenes import get_scene
 from pdverify.solvers.lu import SPD_OPTIONS
@@ -37,7 +38,13 @@ def sheet_matrix(method="energy-directional"):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--repeat", type=int, default=5)
+    harness.add_arguments(ap)
     args = ap.parse_args(argv)
+    with harness.Record(__file__, args, argv=argv) as rec:
+        _measure(args, rec)
+
+
+def _measure(args, rec):
     K = sheet_matrix()
     alternatives = {
         "splu COLAMD (default)": {},
@@ -49,6 +56,9 @@ def main(argv=None):
     print(f"matrix: {K.shape[0]} unknowns, {K.nnz} non-zeros; median of {args.repeat}")
     for name, med in medians.items():
         print(f"  {name:36s} {med:7.3f} s   ratio to default {med / base:5.2f}")
+    rec.update({"unknowns": K.shape[0], "non_zeros": K.nnz, "repeat": args.repeat,
+                "median_s": medians, "ratio_to_default": harness.ratios(
+                    medians, "splu COLAMD (default)")})
 
 
 if __name__ == "__main__":

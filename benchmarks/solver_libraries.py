@@ -42,17 +42,16 @@ for _var in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS"):
 import argparse
 import collections
 import json
-import platform
 import resource
 import statistics
-import subprocess
 import sys
 import time
 
 import numpy as np
-import scipy
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+
+import harness
 
 
 # ------------------------------------------------------------------------ the libraries
@@ -105,18 +104,6 @@ def available() -> dict:
                 version = "?"
         out[name] = {"available": True, "version": version}
     return out
-
-
-def machine() -> dict:
-    cpu = ""
-    try:
-        with open("/proc/cpuinfo") as fh:
-            cpu = next(line.split(":", 1)[1].strip() for line in fh if line.startswith("model name"))
-    except (OSError, StopIteration):
-        pass
-    return {"cpu": cpu, "cores": os.cpu_count(), "python": platform.python_version(),
-            "numpy": np.__version__, "scipy": scipy.__version__,
-            "load_1min": os.getloadavg()[0], "threads_per_run": os.environ["OMP_NUM_THREADS"]}
 
 
 def timed(fn, *args):
@@ -293,11 +280,11 @@ def memory(largest, libs) -> dict:
     for piece, (_nnz, path) in largest.items():
         out[piece] = {}
         for who in libs:
-            proc = subprocess.run([sys.executable, __file__, "--_child", path, who],
-                                  capture_output=True, text=True, timeout=1800)
-            out[piece][who] = (json.loads(proc.stdout.strip().splitlines()[-1])
-                               if proc.returncode == 0 else
-                               {"failed": proc.stderr.strip().splitlines()[-1:]})
+            try:
+                out[piece][who] = harness.fresh([sys.executable, __file__, "--_child", path, who],
+                                                timeout=1800)
+            except (RuntimeError, OSError) as exc:   # a library's failure is a row
+                out[piece][who] = {"failed": str(exc).strip().splitlines()[-1:]}
     return out
 
 
@@ -333,6 +320,7 @@ def main(argv=None):
     ap.add_argument("--no-timing", action="store_true", help="time only pdverify's solves "
                     "(with --memory: the libraries' memory of the largest systems only)")
     ap.add_argument("--_child", nargs=2, help=argparse.SUPPRESS)
+    harness.add_arguments(ap)
     args = ap.parse_args(argv)
     if args._child:
         return _memory_child(*args._child)
@@ -342,22 +330,39 @@ def main(argv=None):
         ap.error("--memory needs --keep DIR")
     if args.keep:
         os.makedirs(args.keep, exist_ok=True)
-    record = {"machine": machine(), "libraries": libs_info}
+    with harness.Record(__file__, args, argv=argv) as rec:
+        _measure(args, rec, libs_info, libs)
+    return 0
+
+
+def _flat(rec) -> dict:
+    """``--json FILE`` as before the harness: the results at the top level (``pieces``,
+    ``systems``, ...), ``libraries`` the timed ones; the record's header beside them
+    (its libraries as ``environment``)."""
+    head = {k: v for k, v in rec.doc.items() if k != "results"}
+    head["environment"] = head.pop("libraries")
+    results = dict(rec.results)
+    return {**head, "libraries": results.pop("libraries_timed"), **results}
+
+
+def _measure(args, rec, libs_info, libs):
+    rec.update({"libraries_timed": libs_info,
+                "threads_per_run": os.environ["OMP_NUM_THREADS"]})
+    record = rec.results
     t0 = time.perf_counter()
-    def partial(rows, done, total):
+
+    def partial(rows, done, total):      # the record after every case
+        rec.update({"cases_done": f"{done} of {total}", "pieces": summarize(rows, libs),
+                    "systems": rows})
         if args.json:
-            with open(args.json, "w") as fh:
-                json.dump({**record, "cases_done": f"{done} of {total}",
-                           "pieces": summarize(rows, libs), "systems": rows}, fh,
-                          indent=1, default=str)
+            harness.write_json(args.json, _flat(rec))
     rows, largest = capture(args, [] if args.no_timing else libs, partial)
     record["capture_wall_s"] = time.perf_counter() - t0
-    record["machine"]["load_1min_after"] = os.getloadavg()[0]
     record["pieces"] = summarize(rows, [] if args.no_timing else libs)
     record["systems"] = rows
     if args.memory:
         record["memory"] = memory(largest, ["ours", *libs])
-    print(f"machine: {record['machine']}")
+    print(f"machine: {rec.doc['machine']}")
     print("libraries: " + ", ".join(f"{n} {v.get('version') or 'missing'}"
                                      for n, v in libs_info.items()))
     if args.no_timing:
@@ -375,9 +380,7 @@ def main(argv=None):
             print(f"peak MB above the matrix, {piece[:60]}: " + ", ".join(
                 f"{w} {v.get('peak_mb', float('nan')):.0f}" for w, v in by.items()))
     if args.json:
-        with open(args.json, "w") as fh:
-            json.dump(record, fh, indent=1, default=str)
-    return 0
+        harness.write_json(args.json, _flat(rec))
 
 
 if __name__ == "__main__":

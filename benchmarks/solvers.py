@@ -38,11 +38,9 @@ extra ``bench``); without it those rows are skipped. Cases:
 from __future__ import annotations
 
 import argparse
-import gc
-import json
 import math
-import time
 
+import harness
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
@@ -62,21 +60,15 @@ except ImportError:  # the optional extra 'bench'
 
 
 def timed(fn):
-    gc.collect()
-    t0 = time.perf_counter()
-    out = fn()
-    return time.perf_counter() - t0, out
+    """(seconds, result) of one call."""
+    t = harness.alternate({"x": fn}, 1)["x"]
+    return t.median, t.last
 
 
 def alternate(alternatives, repeat):
-    """{name: fn}: run each in turn, ``repeat`` rounds; {name: (median s, last result)}."""
-    times = {k: [] for k in alternatives}
-    last = {}
-    for _ in range(repeat):
-        for name, fn in alternatives.items():
-            t, last[name] = timed(fn)
-            times[name].append(t)
-    return {k: (float(np.median(v)), last[k]) for k, v in times.items()}
+    """{name: fn}: run each in turn, ``repeat`` rounds (``harness.alternate``);
+    {name: (median s, last result)}."""
+    return {k: (t.median, t.last) for k, t in harness.alternate(alternatives, repeat).items()}
 
 
 def pardiso_factor_solve(A, b):
@@ -348,9 +340,16 @@ def main(argv=None):
     ap.add_argument("--only", nargs="*", choices=("spd", "plate", "body3d", "crossover3d",
                                                 "crossover2d", "pddo"),
                     default=("spd", "plate", "body3d"))
+    harness.add_arguments(ap)
     args = ap.parse_args(argv)
+    with harness.Record(__file__, args, argv=argv) as rec:
+        _measure(args, rec)
+        if args.json:
+            harness.write_json(args.json, rec.results)
+
+
+def _measure(args, out):
     print(f"median of {args.repeat}; PARDISO: {'pypardiso' if pypardiso else 'not installed'}")
-    out = {}
     if "spd" in args.only:
         bench_spd(args, out)
     if "plate" in args.only:
@@ -378,9 +377,6 @@ def main(argv=None):
         bench_crossover2d(args, out)
     if "pddo" in args.only:
         bench_pddo(args, out)
-    if args.json:
-        with open(args.json, "w") as fh:
-            json.dump(out, fh, indent=1)
 
 
 if __name__ == "__main__":

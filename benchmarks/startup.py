@@ -14,21 +14,19 @@ from __future__ import annotations
 
 import argparse
 import os
-import statistics
 import subprocess
 import sys
-import time
+
+import harness
 
 HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 COMMANDS = {"--version": ["--version"], "run bar1d-traction": ["run", "bar1d-traction"]}
 
 
-def once(root: str, args: list[str]) -> float:
+def once(root: str, args: list[str]) -> None:
     env = {**os.environ, "PYTHONPATH": root}
-    t0 = time.perf_counter()
     subprocess.run([sys.executable, "-m", "pdverify", *args], cwd=root, env=env,
                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, check=True)
-    return time.perf_counter() - t0
 
 
 def imports_sympy(root: str, args: list[str]) -> bool:
@@ -39,11 +37,17 @@ def imports_sympy(root: str, args: list[str]) -> bool:
                if line.startswith("import time:"))
 
 
-def main() -> None:
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--base", default=None, help="the other checkout (before the change)")
     ap.add_argument("--repeat", type=int, default=7)
-    a = ap.parse_args()
+    harness.add_arguments(ap)
+    a = ap.parse_args(argv)
+    with harness.Record(__file__, a, argv=argv) as rec:
+        _measure(a, rec)
+
+
+def _measure(a, rec) -> None:
     roots = {"this": HERE}
     if a.base:
         roots = {"base": os.path.abspath(a.base), "this": HERE}
@@ -53,17 +57,17 @@ def main() -> None:
     for name, args in COMMANDS.items():
         for root in roots.values():       # warm the file cache and .pyc files once
             once(root, args)
-        times = {n: [] for n in roots}
-        for _ in range(a.repeat):
-            for n, root in roots.items():
-                times[n].append(once(root, args))
-        med = {n: statistics.median(t) for n, t in times.items()}
+        t = harness.alternate({n: (lambda root=root: once(root, args))
+                               for n, root in roots.items()}, a.repeat)
+        med = {n: t[n].median for n in roots}
         line = f"{name:22s} " + " ".join(f"{med[n]:10.3f} s" for n in roots)
         if len(roots) == 2:
             line += f"   {med['base'] - med['this']:+8.3f} s   {med['base'] / med['this']:5.2f}x"
-        line += "   " + ", ".join(f"{n}: {'yes' if imports_sympy(r, args) else 'no'}"
-                                  for n, r in roots.items())
+        sympy = {n: imports_sympy(r, args) for n, r in roots.items()}
+        line += "   " + ", ".join(f"{n}: {'yes' if v else 'no'}" for n, v in sympy.items())
         print(line, flush=True)
+        rec[name] = {**harness.summary(t, base="this"), "imports_sympy": sympy,
+                     "roots": roots}
 
 
 if __name__ == "__main__":

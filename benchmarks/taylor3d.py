@@ -6,7 +6,8 @@ Plain script (no test runner):
                                   [--repeat N] [--only ALT ...] [--json FILE]
 
 Alternatives, each run in a fresh process (so that its peak memory, ``ru_maxrss``, is
-its own), median of ``--repeat`` (default 3) of setup (assembly) and solve:
+its own), alternating (``harness.alternate``), median of ``--repeat`` (default 3) of
+setup (assembly) and solve:
 
 - ``direct``: the Lagrange system [[K, B^T], [B, 0]] of the real displacements, sparse LU
   (``solver=direct``); K couples nodes two horizons apart.
@@ -23,13 +24,12 @@ accuracy.
 from __future__ import annotations
 
 import argparse
-import json
-import multiprocessing as mp
 import resource
-import statistics
 import time
 
 import numpy as np
+
+import harness
 
 ALTERNATIVES = ("direct", "nd-k-rows", "nd")
 
@@ -63,7 +63,8 @@ def _system(scene_id, spacing, order, alternative):
                         counts=system.counts)
 
 
-def _run(args, queue):
+def _run(args):
+    """One alternative, in its own (fresh) process: its times, peak memory, solution."""
     from pdverify.solvers.front import solve
     scene_id, spacing, order, alternative = args
     t0 = time.perf_counter()
@@ -72,24 +73,12 @@ def _run(args, queue):
         t1 = time.perf_counter()
         x, info = solve(system, where=f"bench/{alternative}")
     except Exception as exc:   # a near-singular system is a result here, not a crash
-        queue.put({"failed": str(exc)})
-        return
+        return {"failed": str(exc)}
     t2 = time.perf_counter()
     u = system.displacements(x)[:system.model.grid.n_interior]
-    queue.put({"setup_s": t1 - t0, "solve_s": t2 - t1, "nnz": int(system.K.nnz),
-               "condition": float(info.get("condition_estimate", np.nan)),
-               "peak_gb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2 ** 20,
-               "u": u})
-
-
-def _once(args):
-    ctx = mp.get_context("spawn")
-    queue = ctx.Queue()
-    proc = ctx.Process(target=_run, args=(args, queue))
-    proc.start()
-    out = queue.get()
-    proc.join()
-    return out
+    return {"setup_s": t1 - t0, "solve_s": t2 - t1, "nnz": int(system.K.nnz),
+            "condition": float(info.get("condition_estimate", np.nan)),
+            "peak_gb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2 ** 20, "u": u}
 
 
 def main(argv=None) -> int:
@@ -100,13 +89,25 @@ def main(argv=None) -> int:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--only", nargs="+", choices=ALTERNATIVES, default=list(ALTERNATIVES))
     ap.add_argument("--json")
+    harness.add_arguments(ap)
     a = ap.parse_args(argv)
-    rows = []
+    with harness.Record(__file__, a, argv=argv) as rec:
+        rec["rows"] = rows = []
+        _measure(a, rows, rec)
+        if a.json:
+            harness.write_json(a.json, rows)
+    return 0
+
+
+def _measure(a, rows, rec):
     for scene_id in a.scene:
         for h in a.spacing:
             first = None
+            timed = harness.alternate(
+                {alt: (lambda alt=alt: harness.fresh_call(_run, (scene_id, h, a.order, alt)))
+                 for alt in a.only}, a.repeat)
             for alt in a.only:
-                runs = [_once((scene_id, h, a.order, alt)) for _ in range(a.repeat)]
+                runs = timed[alt].results
                 if "failed" in runs[0]:
                     print(f"{scene_id} h={h:g} {alt:10s} failed: {runs[0]['failed']}")
                     rows.append({"scene": scene_id, "spacing": h, "alternative": alt,
@@ -115,8 +116,8 @@ def main(argv=None) -> int:
                 u = runs[0]["u"]
                 first = u if first is None else first
                 row = {"scene": scene_id, "spacing": h, "alternative": alt,
-                       "setup_s": statistics.median(r["setup_s"] for r in runs),
-                       "solve_s": statistics.median(r["solve_s"] for r in runs),
+                       "setup_s": harness.median(r["setup_s"] for r in runs),
+                       "solve_s": harness.median(r["solve_s"] for r in runs),
                        "peak_gb": max(r["peak_gb"] for r in runs), "nnz": runs[0]["nnz"],
                        "condition": runs[0]["condition"],
                        "diff_to_first": float(np.abs(u - first).max() / np.abs(first).max())}
@@ -125,10 +126,7 @@ def main(argv=None) -> int:
                       f"{row['solve_s']:7.2f} s  peak {row['peak_gb']:5.2f} GB  nnz "
                       f"{row['nnz']:>10,d}  cond {row['condition']:.2e}  "
                       f"diff {row['diff_to_first']:.1e}", flush=True)
-    if a.json:
-        with open(a.json, "w") as f:
-            json.dump(rows, f, indent=1)
-    return 0
+            rec.save()
 
 
 if __name__ == "__main__":

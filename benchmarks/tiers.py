@@ -49,12 +49,13 @@ from __future__ import annotations
 import argparse
 import os
 import resource
-import statistics
 import subprocess
 import sys
 import tempfile
 import threading
 import time
+
+import harness
 
 HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PAGE = os.sysconf("SC_PAGE_SIZE")
@@ -282,25 +283,36 @@ def main(argv=None):
                     help="name each process at the PSS peak, the test its worker was "
                          "running and the files it had run (tests/conftest.py's "
                          "PDVERIFY_TEST_TRACE); with DIR, keep the tests' logs there")
+    harness.add_arguments(ap)
     args = ap.parse_args(argv)
+    with harness.Record(__file__, args, argv=argv) as rec:
+        return _measure(args, rec)
+
+
+def _measure(args, rec):
     tiers = ("fast", "slow") if args.tier == "both" else (args.tier,)
     modes = args.modes.split(",")
     runs = []
+
+    def one(tier, mode):
+        runs.append(measure(tier, mode, args.trace))
+        show(runs[-1])
+        rec["runs"] = runs                  # the record after every run
     for tier in tiers:
-        for k in range(args.repeat):
-            for mode in (modes if k % 2 == 0 else modes[::-1]):
-                runs.append(measure(tier, mode, args.trace))
-                show(runs[-1])
+        # rotate: the modes' order changes every round, so neither always runs after the other
+        harness.alternate({mode: (lambda mode=mode: one(tier, mode)) for mode in modes},
+                          args.repeat)
     print("medians:")
     for tier in tiers:
         for mode in modes:
             mine = [r for r in runs if r["tier"] == tier and r["mode"] == mode]
-            med = {key: statistics.median(r[key] for r in mine)
+            med = {key: harness.median(r[key] for r in mine)
                    for key in ("wall_s", "cpu_s", "peak_rss_gb", "peak_pss_gb", "largest_gb")}
             print(f"{tier:4s} {mode:8s} n={len(mine)}  wall {med['wall_s']:7.1f} s  "
                   f"CPU {med['cpu_s']:7.1f} s  peak total RSS {med['peak_rss_gb']:5.2f} GB  "
                   f"PSS {med['peak_pss_gb']:5.2f} GB  "
                   f"largest process {med['largest_gb']:5.2f} GB")
+            rec[f"median {tier} {mode}"] = med
     return 0 if all(r["code"] in (0, 5) for r in runs) else 1
 
 

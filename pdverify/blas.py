@@ -8,11 +8,10 @@ machine, or in a report with ``--jobs 2`` if its workers shared the cores out. E
 (:meth:`pdverify.scenes.base.Scene.run`) therefore computes with one BLAS thread: the
 report's parallelism is its workers (``--jobs``), one run per core. It also bounds the
 address space: each BLAS thread reserves buffers of its own, and under a 6 GB
-``ulimit -v`` ``body3d-manufactured surface-nodes order=3 quadrature=moment-corrected``
-exhausted it at 1.8 GB resident with two threads and passed with one. The cost is
-measured by ``benchmarks/blas_threads.py``; on a busy machine one thread can also be the
-faster (the indentation's preconditioner: a 1,134-square dense coarse product took 8 ms
-of CPU with OpenBLAS's threads, 0.14 ms with one).
+``ulimit -v`` a 3D run exhausted it with two threads and passed with one, and on a
+busy machine one thread can also be the faster
+(benchmarks/records/blas_threads-2026-11-24-address-space.json). The cost is measured by
+``benchmarks/blas_threads.py``.
 """
 from __future__ import annotations
 

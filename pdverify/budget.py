@@ -24,8 +24,8 @@ The memory model (:func:`linear_system`) counts what dominates a static PD or FE
 The two constants were measured (``benchmarks/budget_calibration.py`` prints estimate
 against peak resident memory for every scene family at two sizes); the estimate is
 meant to be an upper bound within a factor of about 3 of the measured peak above the
-interpreter's own footprint (measured: 1.03x to 2.3x over 18 runs of all families above
-a few MB; FEM 1.03-1.15x, 3D dense 1.1-1.6x, 2D sparse 1.1-2.0x, 1D 2.3x).
+interpreter's own footprint
+(benchmarks/records/budget_calibration-2026-11-22-estimate-ratios.json).
 """
 from __future__ import annotations
 
@@ -46,12 +46,12 @@ MAX_TIME_STEPS = 20_000_000
 #: ceiling on implicit load increments of one run, each at least one linear solve: the FEM
 #: indentation study (800 increments over its levels) took 5 s, so this is ~2 minutes there
 MAX_LOAD_INCREMENTS = 20_000
-#: matrix and assembly arrays per stored non-zero: measured 61 B on the 3D boxes (dense
-#: path: 6000 unknowns, 13.1 M non-zeros, 1.37 GB; 9000 unknowns, 24.0 M, 2.75 GB)
+#: matrix and assembly arrays per stored non-zero: measured 61 B on the 3D boxes
+#: (benchmarks/records/budget_calibration-2026-11-22-bytes-per-nonzero.json)
 BYTES_PER_NONZERO = 64.0
 #: SuperLU factor per nested-dissection entry: measured 352-671 B on the 2D plates and
-#: sheets (plate2d 0.025 m: 475 B; sheet2d 0.0005 m: 477 B; plane-strain 0.01 m, COLAMD:
-#: 671 B); the same count with reach 2 bounds the Q2 FEM solves (1.03-1.15x)
+#: sheets; the same count with reach 2 bounds the Q2 FEM solves (benchmarks/records/
+#: budget_calibration-2026-11-22-bytes-per-factor-entry.json)
 BYTES_PER_FACTOR_ENTRY = 700.0
 
 _UNITS = {"": 1, "b": 1, "k": 2 ** 10, "kb": 10 ** 3, "kib": 2 ** 10, "m": 2 ** 20,
@@ -279,11 +279,9 @@ def iterative_system(nodes: float, dim: int, dofs_per_node: int, reach: float,
 #: geometric sum of 1 / (1 - 2^(-1/3)) = 4.85 top-separator blocks, for L and U each
 ND3D_LEVELS = 2.0 / (1.0 - 2.0 ** (-1.0 / 3.0))
 #: the mixed-precision nested-dissection solve (SuperLU in float32, refined in double) per
-#: factor entry, on top of the matrix: measured 16-23 B on body3d-traction, surface nodes
-#: (peak resident memory less the interpreter's 0.12 GB and 64 B per non-zero; h = 0.0625:
-#: 1.77e7 entries, 0.70 GB peak; h = 0.05: 4.60e7, 1.33 GB; h = 1/30: 2.79e8, 7.92 GB),
-#: rounded up so that the whole estimate bounds all three (2.0x, 1.9x, 1.15x the peak
-#: above the interpreter)
+#: factor entry, on top of the matrix: measured 16-23 B on body3d-traction, surface nodes,
+#: rounded up so that the whole estimate bounds all three sizes measured
+#: (benchmarks/records/budget_calibration-2026-11-23-nd3d-entry.json)
 BYTES_PER_ND3D_ENTRY = 28.0
 
 

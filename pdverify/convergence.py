@@ -121,9 +121,10 @@ def _levels(names, values) -> tuple:
     return tuple(dict(zip(names, v)) for v in values)
 
 
-#: seed 000's fictitious nodes in 3D: 35-40 s and 2 GB a run at h = 0.05, near-singular on
-#: the 10 x 5 x 5 box (body3d-manufactured's docstring): five study levels would add about
-#: three minutes of run time to the report; the scene's own cases run it at h = 0.05
+#: seed 000's fictitious nodes in 3D: near-singular on the 10 x 5 x 5 box
+#: (body3d-manufactured's docstring) and 35-40 s a run at h = 0.05: five study levels
+#: would add minutes to the report (benchmarks/records/taylor3d-2026-11-24-costly-3d.json);
+#: the scene's own cases run it at h = 0.05
 COSTLY_3D = ("taylor-fictitious",)
 
 
@@ -156,8 +157,8 @@ STUDIES = (
     # sheet2d-clamped: the side is side_factor x delta and the load a strain, so the
     # relative errors depend only on delta / L = 1 / side_factor and m; a delta-refinement
     # at a fixed sheet is a growing side_factor.
-    # 16: 10 s a run; --quick at m = 3 (side 8: 0.5 s for its six methods, 6.9 s at m = 6;
-    # issue 32), its side 4 the m-refinement's first level
+    # 16 is too slow for the report; --quick at m = 3, its side 4 the m-refinement's first
+    # level (benchmarks/records/quick_report-2026-11-26-quick-sheet2d-clamped.json)
     Study("sheet2d-clamped", "delta", _levels(("side_factor", "m_ratio"),
                                               [(float(s), 6.0) for s in (4, 8, 12)]),
           quick_levels=_levels(("side_factor", "m_ratio"), [(4.0, 3.0), (8.0, 3.0)])),
@@ -165,18 +166,19 @@ STUDIES = (
                                           [(4.0, float(m)) for m in (3, 6, 12)])),
     # seed 000 §6: the scene's own sweeps (same levels, so no extra runs in a full report)
     _m("plate2d-clamped", "delta", [(h, 3) for h in (0.2, 0.1, 0.05)]),
-    # --quick at delta = 0.4 (h = 0.2 at m = 2, 0.1 at m = 4: 1.5 s for the eight methods;
-    # 3.5 s at delta = 0.2, whose h = 1/15 level took 3.1 s; issue 32)
+    # --quick at delta = 0.4 (h = 0.2 at m = 2, 0.1 at m = 4), less than half the time
+    # of delta = 0.2 (benchmarks/records/quick_report-2026-11-26-quick-plate2d-clamped.json)
     _m("plate2d-clamped", "m", [(0.2 / m, m) for m in (2, 3, 4)],
        quick=[(0.2, 2), (0.1, 4)]),
     _m("plate2d-plane-strain", "delta", [(h, 3) for h in (0.1, 0.05, 0.025, 0.0125)]),
     _m("plate2d-plane-strain", "m", [(0.2 / m, m) for m in (2, 4, 8)]),
     # --quick (issue 32: the quick report in 30 s on 2 cores): the delta-refinement at
-    # h = 0.1 (the scene's own quick runs) and 1/12 (6 cells a side, 0.5-4 s a run),
-    # not 0.0625 (1-6.5 s a run, 16 s in all); the m-refinement is left out: its finer
-    # level, h = 1/18 at m = 3, took 30 s of the quick report's 111 s of runs (surface
-    # nodes alone 12 s), and no cheaper pair of whole m-ratios at one delta exists on the
-    # 1 x 0.5 x 0.5 box (order-3 surface nodes need 5 cells a side, whole m-ratios)
+    # h = 0.1 (the scene's own quick runs) and 1/12 (6 cells a side), not 0.0625; the
+    # m-refinement is left out: its finer level, h = 1/18 at m = 3, was over a quarter
+    # of the quick report's runs
+    # (benchmarks/records/quick_report-2026-11-26-quick-body3d-manufactured.json), and no
+    # cheaper pair of whole m-ratios at one delta exists on the 1 x 0.5 x 0.5 box
+    # (order-3 surface nodes need 5 cells a side, whole m-ratios)
     _m("body3d-manufactured", "delta", [(h, 3) for h in (0.1, 0.0625, 0.05)],
        skip=COSTLY_3D, quick=[(0.1, 3), (1 / 12, 3)]),
     _m("body3d-manufactured", "m", [(1 / (6 * m), m) for m in (2, 3)], skip=COSTLY_3D,

@@ -149,10 +149,8 @@ def _params(scene, method, overrides) -> dict:
 #: A worker process is replaced by a fresh one after this many runs, and after any run
 #: whose memory estimate is at least :data:`HEAVY_FRACTION` of the budget. A long-lived
 #: process's address space only grows (allocator arenas, fragmentation, module caches):
-#: under a 6 GB ``ulimit -v`` one worker that had run all cases failed 21 runs of two
-#: scenes with MemoryError from its 179th run on, each of which passes alone at 0.5 GB.
-#: Most of that growth was SuperLU memory that split factors never gave back (0.6 GB of
-#: address space for one sheet2d-tension run; mended, see pdverify.solvers.nested._pools);
+#: under a 6 GB ``ulimit -v`` one worker that had run all cases failed 21 runs
+#: that pass alone (benchmarks/records/worker_recycling-2026-11-27-ulimit-growth.json);
 #: the replacement stays for what else a process keeps. A fork of the report process
 #: costs milliseconds; the runs' results do not depend on which process ran them
 #: (tests/pdverify/test_cli.py: bitwise across jobs).
@@ -164,8 +162,8 @@ def retire(runs_done: int, estimate: float, limit: float, next_estimate: float =
     """Whether a worker that has run ``runs_done`` cases, the last with the memory
     ``estimate`` (bytes) under the budget ``limit``, is replaced by a fresh process; also
     when the next case of the queue (``next_estimate``) is heavy, so that a heavy run
-    starts in a fresh process and its peak is its own (measured: a worker that had run
-    earlier cases peaked at 3.45 GB in the full report, the heaviest run alone at 2.35)."""
+    starts in a fresh process and its peak is its own (benchmarks/records/
+    worker_recycling-2026-11-26-heavy-run-peak.json)."""
     heavy = HEAVY_FRACTION * limit
     return runs_done >= RUNS_PER_WORKER or estimate >= heavy or next_estimate >= heavy
 

@@ -5,12 +5,10 @@
   that the long runs start early and the workers finish together. The expected time is
   the run's own time in the previous report in the same output folder (same scene,
   method and params). The cases it does not know go first (an unknown run may be long),
-  in the plan's order. Measured on a full report's 381 run times (--jobs 2, loaded
-  machine, 4744 s of runs; ``benchmarks/schedule_replay.py`` replays them on 2 workers): the known
-  times longest first end at 2372 s, the lower bound (total / 2); the plan's order at
-  2379 s; the budget's memory estimates largest first at 2456 s (rank correlation of
-  estimate and time 0.84, but the indentation's FEM reference, 218 s at a 94 MB
-  estimate, then starts last). So the memory estimates do not order the unknown cases.
+  in the plan's order. Replayed on a full report's run
+  times (``benchmarks/schedule_replay.py``), the known times longest first end at
+  the lower bound and the memory estimates do not order the unknown cases
+  (benchmarks/records/schedule_replay-2026-11-23-issue32-orders.json).
 - **The memory budget holds for the runs in flight together**: a case starts only when
   its estimate and those of the runs still running fit the limit
   (:func:`pdverify.budget.memory_limit`), so a large run runs alone. A case that does not

@@ -13,9 +13,8 @@ _GAUSS_POINTS = 24
 def unique_ids(ids) -> np.ndarray:
     """The distinct values of an integer array (node or bond numbers, keys of node pairs),
     ascending: what ``np.unique(ids)`` returns, by a sort. numpy >= 2.3's ``np.unique``
-    without ``return_*`` hashes and then sorts, 40x slower on large id arrays: 0.72 s
-    against 17 ms for 0.7 million int64 keys (numpy 2.4.6, a side measurement), 0.6 s of
-    each paper-grid indentation run's setup (the half model's node pairs)."""
+    without ``return_*`` hashes and then sorts, 40x slower on large id arrays
+    (benchmarks/records/indentation-2026-11-27-unique-ids.json)."""
     s = np.sort(np.asarray(ids).ravel())
     if s.size:
         s = s[np.concatenate(([True], s[1:] != s[:-1]))]

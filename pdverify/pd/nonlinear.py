@@ -303,9 +303,8 @@ class NonlinearBondBased:
         :meth:`tangent_data` computes: per block p <= q the bonds' -B_pq, then the nodes'
         diagonal sums, then a zero (positions only a crossing bond of a half model reaches).
         A gather into the CSR data reads those values in data order instead of scattering
-        them bond by bond: an assembly on the paper grid took 116 ms against 145 ms (whole
-        block), 66 ms against 74 ms (half; CPU time, medians of 7 alternating, a side
-        measurement on a busy machine), the same numbers bit for bit. Frees the pattern's
+        them bond by bond, faster and the same numbers bit for bit
+        (benchmarks/records/indentation-2026-11-24-tangent-gather.json). Frees the pattern's
         per-bond positions, except the crossing bonds' (added on top)."""
         P, n, dim = self.pattern, self.n, self.dim
         nb = self.a.size
@@ -351,8 +350,8 @@ class NonlinearBondBased:
             np.negative(B, out=B)
         # mode="clip": the indices are in range by construction, so the same values; with
         # ``out`` numpy's default ("raise") always gathers into a buffer first (numpy.take's
-        # documentation): 58 ms against 27 ms on the paper grid's half model, 5.6 million
-        # entries (medians of 9 alternating, one BLAS thread, a busy machine)
+        # documentation), twice the time here
+        # (benchmarks/records/indentation-2026-11-26-take-clip.json)
         data = np.take(src, self._gather_index, out=self._data, mode="clip")
         if h is not None:
             c, ra, rb = h["plain"], h["ra"][h["plain"]:], h["rb"][h["plain"]:]

@@ -197,7 +197,8 @@ class StateBasedModel:
         stencil (the surface nodes' 3D stencil at order 3: 100 sources; B of
         body3d-manufactured at h = 0.05 has 48 M entries, A_e 2 M), while R A_e has one
         entry per node an equation sees: that run's setup then takes 2.4 s of CPU instead
-        of 4.4 s, and B's 0.6 GB is never held (benchmarks/setup3d.py). Mathematically
+        of 4.4 s, and B's 0.6 GB is never held
+        (benchmarks/records/setup3d-2026-11-27-issue32-surface-nodes.json). Mathematically
         the same; the sums round in another order (there the entries 2e-15 of the largest
         apart; tests/surface/test_surface_exactness.py bounds the difference)."""
         if map_last:

@@ -328,8 +328,9 @@ class Indentation(BondStaticScene):
         # CG never factors: the whole block's tangent (the half model's setup builds the
         # whole block's bonds), once more for the preconditioner's K P and its smoothed
         # prolongator (bounded by a second tangent), and the bond data. At the paper's
-        # grid 1.96 GiB, against a measured peak of 0.65-0.75 GB (half model) and about
-        # 1.0 GB (whole block); a sparse LU's factor (2.4 GiB more) is not counted
+        # grid 1.96 GiB, above the measured peaks (benchmarks/records/
+        # budget_calibration-2026-11-24-indentation-cg.json); a sparse LU's factor (2.4 GiB
+        # more) is not counted
         return budget.iterative_system(nodes, 2, 2, m, extra_bytes=400.0 * bonds)
 
     def cases(self, quick=False):

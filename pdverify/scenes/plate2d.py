@@ -16,9 +16,8 @@ from .family import FemStaticStateScene
 #: SuperLU ordering of the plate's direct solves: minimum degree on A + A^T, 2.9x faster
 #: than COLAMD on the h = 0.025 m Lagrange system (benchmarks/plate_solvers.py). The
 #: plate's problems ask for ``solver=auto`` (issue 32): nested dissection from
-#: policy.ND_FROM_UNKNOWNS unknowns, the rest direct with this ordering; the report's
-#: cases, one run each alternating: 20.9 s direct against 15.9 s (1.3x; the h = 0.05
-#: runs 1.2-1.8x), every run ok, rel_l2_error the same to 1e-12 relative.
+#: policy.ND_FROM_UNKNOWNS unknowns, the rest direct with this ordering (benchmarks/records/
+#: plate_solvers-2026-11-26-auto-solver.json).
 ORDERING = "MMD_AT_PLUS_A"
 
 #: the paper's discretisation (Table 4; the published remarks sit beside these runs only)

@@ -24,7 +24,8 @@ from . import influence_param, register, whole_cells
 from .family import FemStaticStateScene
 
 #: SuperLU ordering of the direct solves: minimum degree on A + A^T (4.5x faster than
-#: COLAMD on the hole plate's h = 0.0125 m system, 11.1 s against 49.7 s under load;
+#: COLAMD on the hole plate's h = 0.0125 m system, benchmarks/records/
+#: plate_solvers-2026-11-26-hole-plate-ordering.json;
 #: as the clamped plate's, plate2d.ORDERING)
 ORDERING = "MMD_AT_PLUS_A"
 

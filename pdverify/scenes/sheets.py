@@ -169,8 +169,9 @@ class TensionSheet(SheetScene):
         out = [("fem", {}), ("none", {}), ("energy-directional", {})]
         if quick:
             # the m = 4 grid (1.25 mm, 41 x 81 nodes) of the convergence studies, so these
-            # are the studies' runs too: 0.1-1.5 s a run instead of 1.5-4.4 s at Table 1's
-            # 1 mm grid (11 s of the quick report's runs; issue 32); every offered method
+            # are the studies' runs too, and a few times faster than Table 1's 1 mm grid
+            # (benchmarks/records/quick_report-2026-11-26-quick-sheet2d-tension.json);
+            # every offered method
             q = {"spacing": 0.00125}
             return [("fem", {}), ("none", dict(q)), ("energy-directional", dict(q))] + [
                 (name, dict(q)) for name, t in self.offered().items()

@@ -262,8 +262,8 @@ NO_EXTRA_NODES = ("treatments with fictitious or surface nodes only: one that ad
                   "leaves every node's bonds, so its nodal energy under a homogeneous strain "
                   "is the uncorrected model's (it corrects the equations, not the bonds)")
 #: the systems the fictitious-node treatments assemble here are never solved; the
-#: augmented form (dilatations as unknowns) is the sparser one to build (3D box, h =
-#: 0.05, surface nodes: 7.1 M against 24 M non-zeros, 1.4 against 3.8 s)
+#: augmented form (dilatations as unknowns) is the sparser one to build, a third of the
+#: non-zeros on the 3D box (benchmarks/records/setup3d-2026-11-24-assembly-form.json)
 ASSEMBLY_SOLVER = "nested-dissection"
 
 
