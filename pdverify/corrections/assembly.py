@@ -26,15 +26,11 @@ from scipy.spatial import cKDTree
 
 from ..pd import StateBasedModel
 from ..pd.build import build_model
-from ..pd.problem import FACES, LinearSystem, face_number
+from ..pd.problem import Face, LinearSystem
 
 
 def model_of(problem, grid, closure) -> StateBasedModel:
     return build_model(problem.body, problem.stencil, problem.material, closure, grid=grid)
-
-
-def side_sign(face: int) -> float:
-    return -1.0 if face % 2 == 0 else 1.0
 
 
 def system_matrix(model, P, solver, map_last: bool = False):
@@ -59,17 +55,19 @@ def padded(rhs, K):
 
 def residual_reaction(system_K, rhs_of):
     """Reaction through a face from the residual R = K x - rhs of the prescribed
-    unknowns on it (normal component, tension positive)."""
+    unknowns on it (normal component, tension positive; ``face``: a
+    :class:`~pdverify.pd.faces.Face`)."""
     def reaction(x, face, dofs_of):
         R = system_K @ x - rhs_of
-        return float(side_sign(face) * np.sum(R[dofs_of(face)]))
+        return float(face.sign * np.sum(R[dofs_of(face)]))
     return reaction
 
 
 def traction_of(problem):
-    """``traction(x, normal, face)`` of the mirror and PDDO modules: zero on free faces."""
+    """``traction(x, normal, face)`` of the mirror and PDDO modules (``face``: a
+    :class:`~pdverify.pd.faces.Face` or its name): zero on free faces."""
     def traction(x, n, face):
-        cond = problem.conditions.get(FACES[face])
+        cond = problem.conditions.get(Face.named(face).name)
         if cond is None or cond.traction is None:
             return np.zeros_like(x)
         return cond.traction(x, n)
@@ -120,7 +118,8 @@ def eliminated(model, K, rhs, fixed, values, solver, nodes, by_face, **extra):
     the right-hand side (n_unknown_nodes, d) flattened component-major and padded for the
     augmented system's nodal scalars, the unknowns' coordinates (``nodes``: the unknown
     nodes' positions) for nested dissection, and the reaction of each face's prescribed
-    normal components (``by_face``: face -> their unknowns)."""
+    normal components (``by_face``: :class:`~pdverify.pd.faces.Face` -> their unknowns;
+    the system's ``reaction`` takes the face's name)."""
     fixed, values = _sorted(fixed, values)
     rhs = rhs.T.ravel()
     if solver != "direct":
@@ -128,7 +127,7 @@ def eliminated(model, K, rhs, fixed, values, solver, nodes, by_face, **extra):
     react = residual_reaction(K, rhs)
     return LinearSystem(model, K, rhs, fixed, values, model.n_unknown_nodes, solver=solver,
                         coords=None if solver == "direct" else unknown_coords(model, nodes),
-                        reaction=lambda x, face: react(x, face_number(face), by_face.__getitem__),
+                        reaction=lambda x, face: react(x, Face.named(face), by_face.__getitem__),
                         **extra)
 
 
