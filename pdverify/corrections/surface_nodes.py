@@ -66,7 +66,8 @@ def displacement_stencils(grid, order: int):
 
 
 def nearest_surface_node(grid, ext_ids) -> np.ndarray:
-    """Surface node nearest to each node (step 7); ties go to the lowest face number."""
+    """Surface node nearest to each node (step 7); ties go to the first face in the
+    faces' order (x-, x+, y-, ...)."""
     idx = grid.index[ext_ids]
     X = 2 * idx + 1  # doubled coordinates: nodes odd, cell faces even (exact ties)
     best_d, best = None, None

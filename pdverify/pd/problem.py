@@ -14,7 +14,9 @@ value its reference has); ``where(cells) -> mask`` restricts them to part of the
 (the boundary cells' integer indices; seed 001's edge constraints); ``traction(x,
 normal) -> (n, d)`` is the applied traction (the other components; ``None``: free).
 Faces not listed are traction-free. A treatment that cannot impose a condition as
-stated (e.g. part of a face) says so through :meth:`StaticProblem.whole_faces`.
+stated (e.g. part of a face) says so through :meth:`StaticProblem.whole_faces`. A
+treatment reads the faces as :class:`~pdverify.pd.faces.Face` values (name, axis, side,
+outward sign; :meth:`StaticProblem.faces`, ``prescribed``, ``loaded``), never as numbers.
 
 A body that is not a box (``shape``, 2D: ``pdverify.pd.shapes``) keys its conditions by
 its boundary parts' names (``hole``, ``notch-x``, ...) instead of faces; a part's
