@@ -142,13 +142,13 @@ class MirrorNodes:
     for part of a face (:func:`prescribed_parts`; a face by name or as a
     :class:`~pdverify.pd.faces.Face`), with ``exact(x) -> (n, d)`` giving the prescribed
     values g; ``traction(x, normal, face) -> (n, d)`` the applied traction of each face
-    (``face``: a :class:`~pdverify.pd.faces.Face`; zero on free faces); ``moduli`` = (lambda, mu) of the material;
-    ``neumann``: how a traction becomes the gradient of the Neumann relation
-    (:data:`NEUMANN_READINGS`); ``mirror_point``: the nearest node as it is, or with its
-    mismatch corrected by its gradient, or taken as sitting at the mirror point
-    (:data:`MIRROR_POINTS`); ``gradient_at``: the cell whose central differences give
-    the tangential derivatives of the full traction relation, the mirror node's or the
-    boundary point's (:data:`GRADIENT_AT`; module docstring).
+    (``face``: a :class:`~pdverify.pd.faces.Face`; zero on free faces); ``moduli`` =
+    (lambda, mu) of the material; ``neumann``: how a traction becomes the gradient of
+    the Neumann relation (:data:`NEUMANN_READINGS`); ``mirror_point``: the nearest node
+    as it is, or with its mismatch corrected by its gradient, or taken as sitting at the
+    mirror point (:data:`MIRROR_POINTS`); ``gradient_at``: the cell whose central
+    differences give the tangential derivatives of the full traction relation, the
+    mirror node's or the boundary point's (:data:`GRADIENT_AT`; module docstring).
     """
 
     def __init__(self, grid, stencil, dirichlet, exact, traction, moduli,

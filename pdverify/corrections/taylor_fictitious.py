@@ -294,7 +294,8 @@ def assemble_taylor(problem, order: int, corners: str = "normal-only") -> Linear
     def reaction(x, face):
         if d != 1:
             raise ValueError("the Taylor reaction is defined for 1D bars only")
-        return float((model.crossing_selector([g.face_coordinate(Face.named(face))]) @ K_b @ x[:ni])[0])
+        plane = g.face_coordinate(Face.named(face))
+        return float((model.crossing_selector([plane]) @ K_b @ x[:ni])[0])
     counts = {"fictitious_nodes": int(g.n_ext - g.n_interior), "constraints": int(B.shape[0])}
     none = np.zeros(0, dtype=int), np.zeros(0)
     if solver == "direct":

@@ -34,10 +34,10 @@ class BoxGrid:
 
     Faces are :class:`~pdverify.pd.faces.Face` (named ``x-``, ``x+``, ...; side 0 at the
     lower end of the axis, 1 at the upper end); the surface arrays store them as
-    ``Face.code`` = ``2 * axis + side``. On a cell-centred grid a *surface node* sits at the centre of every
-    boundary cell face (seed 001 §3, Fig. 5; seed 002 in 1D); it is identified by its face
-    and the index of the boundary cell it belongs to. Surface nodes are extra nodes, not
-    part of the extended grid.
+    ``Face.code`` = ``2 * axis + side``. On a cell-centred grid a *surface node* sits at
+    the centre of every boundary cell face (seed 001 §3, Fig. 5; seed 002 in 1D); it is
+    identified by its face and the index of the boundary cell it belongs to. Surface nodes
+    are extra nodes, not part of the extended grid.
     """
 
     lengths: tuple
