@@ -71,3 +71,18 @@ def test_shared_quantities_declared_once():
     found = [f"{path.name}: {m.group(0)}" for path in sorted(scenes.glob("*.py"))
              for m in pattern.finditer(path.read_text())]
     assert not found, found
+
+
+def test_treatments_speak_face_names_only():
+    """The treatments read a face as a ``Face`` (``face.axis``, ``face.side``,
+    ``face.sign``) looked up by its name, never as a number ``2 * axis + side`` split by
+    ``divmod`` or converted from a name (issue 51: face names only). The grid's arrays
+    keep the integer code, read through ``Face.code`` / ``grid.surface_on`` only."""
+    import re
+    pattern = re.compile(r"divmod\(\s*face|face_number\(")
+    corrections = Path(__file__).parents[1] / "pdverify" / "corrections"
+    found = [f"{path.relative_to(corrections)}:{n}: {line.strip()}"
+             for path in sorted(corrections.rglob("*.py"))
+             for n, line in enumerate(path.read_text().splitlines(), 1)
+             if pattern.search(line)]
+    assert not found, found

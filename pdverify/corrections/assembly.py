@@ -26,15 +26,13 @@ from scipy.spatial import cKDTree
 
 from ..pd import StateBasedModel
 from ..pd.build import build_model
-from ..pd.problem import FACES, LinearSystem, face_number
+from ..pd.problem import Face, LinearSystem
 
 
 def model_of(problem, grid, closure) -> StateBasedModel:
     return build_model(problem.body, problem.stencil, problem.material, closure, grid=grid)
 
 
-def side_sign(face: int) -> float:
-    return -1.0 if face % 2 == 0 else 1.0
 
 
 def unknown_coords(model, nodes):
@@ -52,17 +50,19 @@ def padded(rhs, K):
 
 def residual_reaction(system_K, rhs_of):
     """Reaction through a face from the residual R = K x - rhs of the prescribed
-    unknowns on it (normal component, tension positive)."""
+    unknowns on it (normal component, tension positive; ``face``: a
+    :class:`~pdverify.pd.faces.Face`)."""
     def reaction(x, face, dofs_of):
         R = system_K @ x - rhs_of
-        return float(side_sign(face) * np.sum(R[dofs_of(face)]))
+        return float(face.sign * np.sum(R[dofs_of(face)]))
     return reaction
 
 
 def traction_of(problem):
-    """``traction(x, normal, face)`` of the mirror and PDDO modules: zero on free faces."""
+    """``traction(x, normal, face)`` of the mirror and PDDO modules (``face``: a
+    :class:`~pdverify.pd.faces.Face` or its name): zero on free faces."""
     def traction(x, n, face):
-        cond = problem.conditions.get(FACES[face])
+        cond = problem.conditions.get(Face.named(face).name)
         if cond is None or cond.traction is None:
             return np.zeros_like(x)
         return cond.traction(x, n)
@@ -115,7 +115,8 @@ def eliminated(problem, model, K, rhs, fixed, values, nodes, by_face, **extra):
     (n_unknown_nodes, d) flattened component-major and padded for the nodal scalars, the
     unknowns' coordinates (``nodes``: the unknown nodes' positions) for nested
     dissection, and the reaction of each face's prescribed normal components
-    (``by_face``: face -> their unknowns), solved by ``problem.solver``."""
+    (``by_face``: :class:`~pdverify.pd.faces.Face` -> their unknowns; the system's
+    ``reaction`` takes the face's name), solved by ``problem.solver``."""
     fixed, values = _sorted(fixed, values)
     rhs = rhs.T.ravel()
     scalars = K.shape[0] - rhs.size
@@ -124,7 +125,7 @@ def eliminated(problem, model, K, rhs, fixed, values, nodes, by_face, **extra):
     return LinearSystem(model, K, rhs, fixed, values, model.n_unknown_nodes,
                         solver=problem.solver, coords=unknown_coords(model, nodes),
                         scalars=scalars,
-                        reaction=lambda x, face: react(x, face_number(face), by_face.__getitem__),
+                        reaction=lambda x, face: react(x, Face.named(face), by_face.__getitem__),
                         **extra)
 
 

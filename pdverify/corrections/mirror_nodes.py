@@ -68,7 +68,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..pd.closure import Closure, real_identity
-from ..pd.problem import LinearSystem
+from ..pd.problem import Face, LinearSystem, box_faces
 from .assembly import model_of, padded, traction_of, unknown_coords
 
 
@@ -97,11 +97,13 @@ def _box_entry(x, n, lo, hi):
 
 
 def prescribed_parts(dirichlet):
-    """``[(face, component, where)]`` of the prescribed components: an item
-    ``(face, component)`` prescribes it on the whole face (``where=None``), an item
-    ``(face, component, where)`` on the boundary cells where ``where(cells)`` (integer
-    cell indices, (n, d)) is true, as :class:`~pdverify.pd.problem.FaceCondition`."""
-    return [(item[0], item[1], item[2] if len(item) > 2 else None) for item in dirichlet]
+    """``[(face, component, where)]`` of the prescribed components (``face``: a
+    :class:`~pdverify.pd.faces.Face`): an item ``(face, component)`` (the face or its
+    name) prescribes it on the whole face (``where=None``), an item ``(face, component,
+    where)`` on the boundary cells where ``where(cells)`` (integer cell indices, (n, d))
+    is true, as :class:`~pdverify.pd.problem.FaceCondition`."""
+    return [(Face.named(item[0]), item[1], item[2] if len(item) > 2 else None)
+            for item in dirichlet]
 
 
 def prescribed_at(where, cells) -> np.ndarray | bool:
@@ -136,15 +138,16 @@ class MirrorNodes:
     """Mirror nodes of a padded box grid and the affine map they give the fictitious nodes.
 
     ``dirichlet``: the prescribed (face, component) pairs, or (face, component, where)
-    for part of a face (:func:`prescribed_parts`), with ``exact(x) -> (n, d)`` giving
-    the prescribed values g; ``traction(x, normal, face) -> (n, d)`` the applied traction
-    of each face (zero on free faces); ``moduli`` = (lambda, mu) of the material;
-    ``neumann``: how a traction becomes the gradient of the Neumann relation
-    (:data:`NEUMANN_READINGS`); ``mirror_point``: the nearest node as it is, or with its
-    mismatch corrected by its gradient, or taken as sitting at the mirror point
-    (:data:`MIRROR_POINTS`); ``gradient_at``: the cell whose central differences give
-    the tangential derivatives of the full traction relation, the mirror node's or the
-    boundary point's (:data:`GRADIENT_AT`; module docstring).
+    for part of a face (:func:`prescribed_parts`; a face by name or as a
+    :class:`~pdverify.pd.faces.Face`), with ``exact(x) -> (n, d)`` giving the prescribed
+    values g; ``traction(x, normal, face) -> (n, d)`` the applied traction of each face
+    (``face``: a :class:`~pdverify.pd.faces.Face`; zero on free faces); ``moduli`` =
+    (lambda, mu) of the material; ``neumann``: how a traction becomes the gradient of
+    the Neumann relation (:data:`NEUMANN_READINGS`); ``mirror_point``: the nearest node
+    as it is, or with its mismatch corrected by its gradient, or taken as sitting at the
+    mirror point (:data:`MIRROR_POINTS`); ``gradient_at``: the cell whose central
+    differences give the tangential derivatives of the full traction relation, the
+    mirror node's or the boundary point's (:data:`GRADIENT_AT`; module docstring).
     """
 
     def __init__(self, grid, stencil, dirichlet, exact, traction, moduli,
@@ -173,9 +176,9 @@ class MirrorNodes:
         lam, mu = moduli
         tol = 1e-9 * h
         nf = fict.size
-        on_face = np.zeros((nf, 2 * d), dtype=bool)
-        for face in range(2 * d):
-            on_face[:, face] = np.abs(xB[:, face // 2] - g.face_coordinate(face)) < tol
+        faces = box_faces(d)
+        on_face = {face: np.abs(xB[:, face.axis] - g.face_coordinate(face)) < tol
+                   for face in faces}
         dirichlet_k = np.zeros((nf, d), dtype=bool)
         const_d = np.zeros((nf, d))                  # 2 g of the Dirichlet components
         const = np.zeros((nf, d))                    # traction terms of the Neumann ones
@@ -183,7 +186,7 @@ class MirrorNodes:
         # cells it covers
         parts = prescribed_parts(dirichlet)
         boundary_cells = cells_of(g, xB)
-        hits = [on_face[:, face] & prescribed_at(where, boundary_cells)
+        hits = [on_face[face] & prescribed_at(where, boundary_cells)
                 for face, _, where in parts]
         # the boundary values there only (elsewhere x_B can lie outside the body, where a
         # FEM reference is not defined, or off the prescribed part of a face)
@@ -211,18 +214,18 @@ class MirrorNodes:
             into.append((mask, k, p_, j, c))
             into.append((mask, k, q_, j, -c))
 
-        face_axis = np.full((nf, d), -1)            # the face (per axis) x_B lies on
-        for face in range(2 * d):
-            face_axis[on_face[:, face], face // 2] = face
+        side_on = np.full((nf, d), -1)              # the side of the face (per axis) x_B lies on
+        for face in faces:
+            side_on[on_face[face], face.axis] = face.side
         for b in range(d):
-            on_b = face_axis[:, b] >= 0
-            sgn = np.where(face_axis[:, b] % 2 == 0, -1.0, 1.0)
+            on_b = side_on[:, b] >= 0
+            sgn = np.where(side_on[:, b] == 0, -1.0, 1.0)
             tr = np.zeros((nf, d))
-            for face in (2 * b, 2 * b + 1):
-                hit = face_axis[:, b] == face
+            for face in (Face.at(b, 0), Face.at(b, 1)):
+                hit = side_on[:, b] == face.side
                 if np.any(hit):
                     nrm = np.zeros((int(hit.sum()), d))
-                    nrm[:, b] = -1.0 if face % 2 == 0 else 1.0
+                    nrm[:, b] = face.sign
                     tr[hit] = traction(xB[hit], nrm, face)
             for k in range(d):
                 w = step[:, b]                       # D_kb enters with (x_f - x_m)_b

@@ -47,7 +47,7 @@ import itertools
 import numpy as np
 import scipy.sparse as sp
 
-from ..pd.problem import LinearSystem
+from ..pd.problem import LinearSystem, box_faces
 from .assembly import model_of, traction_of
 from .factors import node_moments, solve_per_node
 from .mirror_nodes import prescribed_at, prescribed_parts
@@ -96,19 +96,20 @@ def _d2(D, l, m):
     return D[(min(l, m), max(l, m))]
 
 
-def _choose_faces(touches, parts, cells, d):
+def _choose_faces(touches, faces, parts, cells):
     """Per component k: (face, kind) of every node, kind 1 = Dirichlet, 2 = traction, 0 =
-    none (not an outer node). Dirichlet first (a face prescribing k at the node's cell:
-    ``parts`` as :func:`~pdverify.corrections.mirror_nodes.prescribed_parts`), then the
-    face normal to k, then any."""
+    none (not an outer node); the face as its position in ``faces`` (the box's faces,
+    the columns of ``touches``; -1: none). Dirichlet first (a face prescribing k at the
+    node's cell: ``parts`` as :func:`~pdverify.corrections.mirror_nodes.prescribed_parts`),
+    then the face normal to k, then any."""
     n = touches.shape[0]
     out = []
-    for k in range(d):
+    for k in range(cells.shape[1]):
         face_of, kind = np.full(n, -1), np.zeros(n, dtype=int)
-        steps = ([(f, touches[:, f] & prescribed_at(where, cells), 1)
-                  for f, k_, where in sorted(parts, key=lambda q: q[0]) if k_ == k]
-                 + [(f, touches[:, f], 2) for f in (2 * k, 2 * k + 1)]
-                 + [(f, touches[:, f], 2) for f in range(2 * d)])
+        steps = ([(faces.index(f), touches[:, faces.index(f)] & prescribed_at(where, cells), 1)
+                  for f, k_, where in sorted(parts, key=lambda q: faces.index(q[0])) if k_ == k]
+                 + [(i, touches[:, i], 2) for i, f in enumerate(faces) if f.axis == k]
+                 + [(i, touches[:, i], 2) for i in range(len(faces))])
         for face, on, kd in steps:
             hit = on & (face_of < 0)
             face_of[hit], kind[hit] = face, kd
@@ -121,15 +122,16 @@ def _choose_faces(touches, parts, cells, d):
 BULK_MODELS = ("lps", "pddo")
 
 
-def pddo_system(model, face_dirichlet, exact, traction, moduli, body_load=None,
+def pddo_system(model, dirichlet, exact, traction, moduli, body_load=None,
                 bulk_model="lps"):
     """The square system (A, rhs, counts) of the PDDO boundary layer on the uncorrected
     plain-grid ``model`` (its equilibrium rows serve the bulk): ``A`` (d n x d n,
     component-major: one row per component of every real node) and ``rhs``: the boundary
     data on the outer rows, ``body_load`` (n, d; b V per node) on the others.
-    ``face_dirichlet``: (face, component) pairs prescribed at ``exact(x)``, or
-    (face, component, where) on part of a face (per node: its cell);
-    ``traction(x, normal, face)``; ``bulk_model``: :data:`BULK_MODELS`."""
+    ``dirichlet``: (face, component) pairs prescribed at ``exact(x)``, or
+    (face, component, where) on part of a face (per node: its cell), a face by name or
+    as a :class:`~pdverify.pd.faces.Face`; ``traction(x, normal, face)`` (``face``: a
+    :class:`~pdverify.pd.faces.Face`); ``bulk_model``: :data:`BULK_MODELS`."""
     if bulk_model not in BULK_MODELS:
         raise ValueError(f"bulk_model={bulk_model!r}; allowed: {', '.join(BULK_MODELS)}")
     g, d, h = model.grid, model.dim, model.spacing
@@ -137,9 +139,8 @@ def pddo_system(model, face_dirichlet, exact, traction, moduli, body_load=None,
     lam, mu = moduli
     D = derivative_operators(model)
     x, cells = g.x, g.index
-    per_axis = np.asarray(g.nodes_per_axis)
-    touches = np.stack([cells[:, f // 2] == (0 if f % 2 == 0 else per_axis[f // 2] - 1)
-                        for f in range(2 * d)], axis=1)
+    faces = box_faces(d)
+    touches = np.stack([cells[:, f.axis] == g.boundary_layer(f) for f in faces], axis=1)
     outer = touches.any(axis=1)
     layer = ~outer & (g.distance_to_surface(x) <= 2.0 * model.horizon * (1 + 1e-12))
     if bulk_model == "pddo":
@@ -160,12 +161,12 @@ def pddo_system(model, face_dirichlet, exact, traction, moduli, body_load=None,
     rhs = np.zeros(d * n)
     if body_load is not None:
         rhs += np.where(np.tile(outer, d), 0.0, np.asarray(body_load).T.ravel())
-    chosen = _choose_faces(touches, prescribed_parts(face_dirichlet), cells, d)
+    chosen = _choose_faces(touches, faces, prescribed_parts(dirichlet), cells)
     for k, (face_of, kind) in enumerate(chosen):
-        for face in range(2 * d):
-            axis, side = divmod(face, 2)
+        for i, face in enumerate(faces):
+            axis = face.axis
             for kd in (1, 2):
-                nodes = np.flatnonzero((face_of == face) & (kind == kd))
+                nodes = np.flatnonzero((face_of == i) & (kind == kd))
                 if nodes.size == 0:
                     continue
                 xB = x[nodes].copy()
@@ -183,7 +184,7 @@ def pddo_system(model, face_dirichlet, exact, traction, moduli, body_load=None,
                     blocks = {k: scale * M}
                     rhs[k * n + nodes] = scale * exact(xB)[:, k]
                 else:         # t_k = s (lam delta_ka div u + mu (d_a u_k + d_k u_a))
-                    s = -1.0 if side == 0 else 1.0
+                    s = face.sign
                     scale = s * h ** (d - 1)
                     nrm = np.zeros_like(xB)
                     nrm[:, axis] = s

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..pd.closure import Closure
 from ..pd.problem import LinearSystem
-from .assembly import boundary_nodes, eliminated, model_of, shape_counts, side_sign
+from .assembly import boundary_nodes, eliminated, model_of, shape_counts
 
 
 def assemble_plain(problem, closure: Closure | None = None) -> LinearSystem:
@@ -28,24 +28,23 @@ def assemble_plain(problem, closure: Closure | None = None) -> LinearSystem:
     rhs = np.zeros((nu_, d))
     rhs[:ni] = problem.body_load(x_int, model.node_volume[g.interior_ids][:, None])
     for face, _ in problem.loaded():
-        axis, side = divmod(face, 2)
-        on = cells[:, axis] == g.boundary_layer(face)
+        on = cells[:, face.axis] == g.boundary_layer(face)
         xs = x_int[on].copy()
         if problem.load_point == "surface":
-            xs[:, axis] = g.face_coordinate(face)
+            xs[:, face.axis] = g.face_coordinate(face)
         nrm = np.zeros_like(xs)
-        nrm[:, axis] = side_sign(face)
+        nrm[:, face.axis] = face.sign
         rhs[:ni][on] += problem.face_forces(face, xs, nrm, g.face_area)
     u_ref = problem.exact(x_int)
     fixed, values, by_face = [], [], {}
     for face, k, where in problem.prescribed():
-        mask = cells[:, face // 2] == g.boundary_layer(face)
+        mask = cells[:, face.axis] == g.boundary_layer(face)
         if where is not None:
             mask &= where(cells)
         nodes = np.flatnonzero(mask)
         fixed.append(k * nu_ + nodes)
         values.append(u_ref[nodes, k])
-        if k == face // 2:
+        if k == face.axis:
             by_face[face] = k * nu_ + nodes
     return eliminated(problem, model, K, rhs, fixed, values, x_int, by_face)
 

@@ -10,7 +10,7 @@ import scipy.sparse as sp
 from ..errors import InputError
 from ..pd.bonds import bond_pairs
 from ..pd.closure import Closure, real_identity, with_rows
-from ..pd.problem import LinearSystem
+from ..pd.problem import LinearSystem, box_faces
 from .assembly import eliminated, model_of
 from .protocols import GridMap, Params
 from .taylor import extrapolation_rows, taylor_weights, window_start
@@ -65,7 +65,8 @@ def displacement_stencils(grid, order: int):
 
 
 def nearest_surface_node(grid, ext_ids) -> np.ndarray:
-    """Surface node nearest to each node (step 7); ties go to the lowest face number."""
+    """Surface node nearest to each node (step 7); ties go to the first face in the
+    faces' order (x-, x+, y-, ...)."""
     idx = grid.index[ext_ids]
     X = 2 * idx + 1  # doubled coordinates: nodes odd, cell faces even (exact ties)
     best_d, best = None, None
@@ -306,19 +307,19 @@ def impose_on_surface_nodes(problem, g, closure, flux) -> LinearSystem:
     rhs[:ni] = problem.body_load(x_int, model.node_volume[g.interior_ids][:, None])
     xs, nrm = g.surface_x, g.surface_normal
     for face, _ in problem.loaded():
-        sel = g.surface_face == face
+        sel = g.surface_on(face)
         rhs[ni:][sel] = problem.face_forces(face, xs[sel], nrm[sel], g.face_area)
     us_ref = problem.exact(xs)
     fixed, values, by_face = [], [], {}
     for face, k, where in problem.prescribed():
-        mask = g.surface_face == face
+        mask = g.surface_on(face)
         if where is not None:
             mask &= where(g.surface_cell)
         nodes = np.flatnonzero(mask)
         fixed.append(k * nu_ + ni + nodes)
         values.append(us_ref[nodes, k])
-    for face in range(2 * d):
-        by_face[face] = (face // 2) * nu_ + ni + np.flatnonzero(g.surface_face == face)
+    for face in box_faces(d):
+        by_face[face] = face.axis * nu_ + ni + np.flatnonzero(g.surface_on(face))
     return eliminated(problem, model, K, rhs, fixed, values, np.r_[x_int, xs], by_face,
                        extra_x=xs, counts={"surface_nodes": int(g.n_surface),
                                            "fictitious_nodes": int(g.n_ext - g.n_interior)})

@@ -27,8 +27,8 @@ import scipy.sparse as sp
 
 from ..pd.bonds import unique_ids
 from ..pd.closure import Closure, real_identity, with_rows
-from ..pd.problem import FACES, LinearSystem, face_number
-from .assembly import boundary_nodes, model_of, shape_counts, side_sign, unknown_coords
+from ..pd.problem import Face, LinearSystem, box_faces
+from .assembly import boundary_nodes, model_of, shape_counts, unknown_coords
 from .shape_fictitious import condition_rows, normal_closure
 from .surface_nodes import crossing_bonds
 from .taylor import extrapolation_rows, monomial_exponents, taylor_extrapolation_weights, taylor_weights
@@ -90,24 +90,25 @@ def fictitious_closure(grid, order: int) -> Closure:
                    dilatation_map=extrapolation_map(grid, order - 1))
 
 
-def boundary_lines(grid, face: str) -> np.ndarray:
-    """Integer indices (n_lines, dim) of the real nodes nearest ``face`` (its name,
-    :data:`~pdverify.pd.problem.FACES`): the anchor of each line perpendicular to it."""
-    face = face_number(face)
+def boundary_lines(grid, face: Face | str) -> np.ndarray:
+    """Integer indices (n_lines, dim) of the real nodes nearest ``face`` (a
+    :class:`~pdverify.pd.faces.Face` or its name): the anchor of each line
+    perpendicular to it."""
+    face = Face.named(face)
     real = grid.index[grid.interior_ids]
-    return real[real[:, face // 2] == grid.boundary_layer(face)]
+    return real[real[:, face.axis] == grid.boundary_layer(face)]
 
 
-def boundary_value_rows(grid, order: int, face: str) -> tuple[sp.csr_matrix, np.ndarray]:
+def boundary_value_rows(grid, order: int, face: Face | str) -> tuple[sp.csr_matrix, np.ndarray]:
     """Rows R (one per line perpendicular to ``face``) with R @ u_real = u at the boundary
     point of the line, by the 1D Taylor extrapolation of Eq. (58) from the ``order + 1``
     real nodes of the line nearest the face (the same rows serve every component,
     Remark 4). Returns ``(R, anchors)``, ``anchors`` the lines' boundary-node indices."""
     _check_size(grid, order)
     anchors = boundary_lines(grid, face)
-    face = face_number(face)
-    axis, side = divmod(face, 2)
-    inward = 1 if side == 0 else -1
+    face = Face.named(face)
+    axis = face.axis
+    inward = 1 if face.side == 0 else -1
     x_anchor = grid.x[grid.ext_id(anchors[:1]), axis][0]
     target = (grid.face_coordinate(face) - x_anchor) / grid.spacing   # in spacings
     s = np.arange(order + 1)
@@ -150,19 +151,19 @@ def clamped_rows(grid, order: int, faces, corners: str = "normal-only"):
     """
     if corners not in CORNER_RULES:
         raise ValueError(f"corners={corners!r}; allowed: {', '.join(CORNER_RULES)}")
-    faces = sorted({face_number(name) for name in faces})
+    faces = sorted({Face.named(name) for name in faces}, key=lambda f: f.code)
     n, d = grid.n_interior, grid.dim
     blocks, points, comps = [], [], []
     for face in faces:
-        axis = face // 2
-        R, anchors = boundary_value_rows(grid, order, FACES[face])
+        axis = face.axis
+        R, anchors = boundary_value_rows(grid, order, face)
         x = grid.x[grid.ext_id(anchors)]
         x[:, axis] = grid.face_coordinate(face)
         for k in range(d):
             at_corner = np.zeros(anchors.shape[0], dtype=bool)
             for other in faces:
-                if corners == "normal-only" and yields_component(axis, other // 2, k):
-                    at_corner |= anchors[:, other // 2] == grid.boundary_layer(other)
+                if corners == "normal-only" and yields_component(axis, other.axis, k):
+                    at_corner |= anchors[:, other.axis] == grid.boundary_layer(other)
             keep = np.flatnonzero(~at_corner)
             Rk = sp.coo_matrix(R[keep])
             blocks.append(sp.csr_matrix((Rk.data, (Rk.row, Rk.col + k * n)),
@@ -216,7 +217,8 @@ def assemble_taylor(problem, order: int, corners: str = "normal-only") -> Linear
     # clamped all round (seed 000's plate) then needs neither them nor the face-crossing
     # fictitious bonds, which enter no real node's equation
     clamped = all(c.where is None and len(c.prescribed) == d
-                  for c in (problem.conditions.get(f) for f in FACES[:2 * d]) if c is not None)
+                  for c in (problem.conditions.get(f.name) for f in box_faces(d))
+                  if c is not None)
     clamped &= len(problem.conditions) == 2 * d
     if d == 1 or clamped:
         closure = fictitious_closure(g, order)
@@ -239,16 +241,16 @@ def assemble_taylor(problem, order: int, corners: str = "normal-only") -> Linear
     rows, vals = [], []
     if flux is not None:   # force of each boundary cell face from the unknowns
         Fs = _flux_of_unknowns(model, flux, g.n_surface)
-    for face in range(2 * d):
-        axis, side = divmod(face, 2)
-        cond = problem.conditions.get(FACES[face])
-        R, anchors = boundary_value_rows(g, order, FACES[face])
+    for face in box_faces(d):
+        axis = face.axis
+        cond = problem.conditions.get(face.name)
+        R, anchors = boundary_value_rows(g, order, face)
         xb = g.x[g.ext_id(anchors)]
         xb[:, axis] = g.face_coordinate(face)
         exact = problem.exact(xb)
         cells_face = anchors
         if d > 1:
-            sel = np.flatnonzero(g.surface_face == face)
+            sel = np.flatnonzero(g.surface_on(face))
             cells_s = g.surface_cell[sel]
             nrm = g.surface_normal[sel]
             load = (problem.face_forces(face, g.surface_x[sel], nrm, g.face_area)
@@ -277,9 +279,9 @@ def assemble_taylor(problem, order: int, corners: str = "normal-only") -> Linear
                 # face is the outward traction: + at x+, - at x-
                 rows.append(sp.hstack([sp.csr_matrix(sec), sp.csr_matrix((1, width - sec.shape[1]))],
                                       format="csr"))
-                t = (cond.traction(xb, np.array([[side_sign(face)]]))[0, 0]
+                t = (cond.traction(xb, np.array([[face.sign]]))[0, 0]
                      if cond is not None and cond.traction is not None else 0.0)
-                vals.append(np.array([side_sign(face) * t * g.face_area
+                vals.append(np.array([face.sign * t * g.face_area
                                       * problem.thickness]))
             else:
                 idx = sel[order_s[free]]
@@ -291,7 +293,8 @@ def assemble_taylor(problem, order: int, corners: str = "normal-only") -> Linear
     def reaction(x, face):
         if d != 1:
             raise ValueError("the Taylor reaction is defined for 1D bars only")
-        return float((model.crossing_selector([g.face_coordinate(face_number(face))]) @ K_b @ x[:ni])[0])
+        plane = g.face_coordinate(Face.named(face))
+        return float((model.crossing_selector([plane]) @ K_b @ x[:ni])[0])
     counts = {"fictitious_nodes": int(g.n_ext - g.n_interior), "constraints": int(B.shape[0])}
     none = np.zeros(0, dtype=int), np.zeros(0)
     # the augmented system, the constraint rows beside it: the solver layer forms what
@@ -355,11 +358,11 @@ def _corner_lines(problem, g, anchors, axis, k):
     (or, in 3D, edge) node shared with another face prescribing component ``k`` on its
     whole face that takes ``k`` over (:func:`yields_component`)."""
     out = np.zeros(anchors.shape[0], dtype=bool)
-    for other in range(2 * g.dim):
-        cond = problem.conditions.get(FACES[other])
-        if (yields_component(axis, other // 2, k) and cond is not None
+    for other in box_faces(g.dim):
+        cond = problem.conditions.get(other.name)
+        if (yields_component(axis, other.axis, k) and cond is not None
                 and cond.where is None and k in cond.prescribed):
-            out |= anchors[:, other // 2] == g.boundary_layer(other)
+            out |= anchors[:, other.axis] == g.boundary_layer(other)
     return out
 
 
@@ -379,8 +382,8 @@ def _shear_pair_lines(problem, g, anchors, axis, k):
     out = np.zeros(anchors.shape[0], dtype=bool)
     if g.dim != 3 or k == axis or axis < k:
         return out
-    for other in (2 * k, 2 * k + 1):
-        cond = problem.conditions.get(FACES[other])
+    for other in (Face.at(k, 0), Face.at(k, 1)):
+        cond = problem.conditions.get(other.name)
         edge = anchors[:, k] == g.boundary_layer(other)
         if cond is not None and axis in cond.prescribed:
             edge &= ~(np.ones_like(edge) if cond.where is None else cond.where(anchors))

@@ -5,6 +5,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .faces import Face
+
 #: Where the nodes of a box sit. ``cell-centred``: one node at the centre of every cell of
 #: side ``spacing`` (seeds 000, 001, 002). ``on-surface``: nodes on the cell vertices, so
 #: the outermost nodes lie on the surface (seeds 003, 004).
@@ -30,11 +32,12 @@ class BoxGrid:
     "Interior" means "inside the body", as opposed to fictitious; it includes the nodes
     on the surface of an ``on-surface`` grid.
 
-    Faces are numbered ``2 * axis + side`` (side 0 at the lower end of the axis, 1 at the
-    upper end). On a cell-centred grid a *surface node* sits at the centre of every
-    boundary cell face (seed 001 §3, Fig. 5; seed 002 in 1D); it is identified by its face
-    and the index of the boundary cell it belongs to. Surface nodes are extra nodes, not
-    part of the extended grid.
+    Faces are :class:`~pdverify.pd.faces.Face` (named ``x-``, ``x+``, ...; side 0 at the
+    lower end of the axis, 1 at the upper end); the surface arrays store them as
+    ``Face.code`` = ``2 * axis + side``. On a cell-centred grid a *surface node* sits at
+    the centre of every boundary cell face (seed 001 §3, Fig. 5; seed 002 in 1D); it is
+    identified by its face and the index of the boundary cell it belongs to. Surface nodes
+    are extra nodes, not part of the extended grid.
     """
 
     lengths: tuple
@@ -106,15 +109,17 @@ class BoxGrid:
         index = np.asarray(index) + self.layers
         return np.ravel_multi_index(tuple(np.moveaxis(index, -1, 0)), self.ext_shape)
 
-    def face_coordinate(self, face: int) -> float:
-        """Coordinate of ``face`` (= 2 axis + side) along its axis."""
-        axis, side = divmod(face, 2)
-        return self.origin[axis] + (0.0 if side == 0 else self.lengths[axis])
+    def face_coordinate(self, face: Face) -> float:
+        """Coordinate of ``face`` (:class:`~pdverify.pd.faces.Face`) along its axis."""
+        return self.origin[face.axis] + (0.0 if face.side == 0 else self.lengths[face.axis])
 
-    def boundary_layer(self, face: int) -> int:
+    def boundary_layer(self, face: Face) -> int:
         """Index, along the face's axis, of the layer of real nodes nearest ``face``."""
-        axis, side = divmod(face, 2)
-        return 0 if side == 0 else self.nodes_per_axis[axis] - 1
+        return 0 if face.side == 0 else self.nodes_per_axis[face.axis] - 1
+
+    def surface_on(self, face: Face) -> np.ndarray:
+        """Which surface nodes lie on ``face`` (mask over the surface nodes)."""
+        return self.surface_face == face.code
 
     def tangential_axes(self, axis: int) -> tuple:
         return tuple(a for a in range(self.dim) if a != axis)
@@ -134,7 +139,7 @@ class BoxGrid:
                 cidx[:, list(tang)] = t_idx
                 cidx[:, axis] = 0 if side == 0 else self.cells[axis] - 1
                 x = np.asarray(self.origin) + (cidx + 0.5) * h
-                x[:, axis] = self.face_coordinate(2 * axis + side)
+                x[:, axis] = self.face_coordinate(Face.at(axis, side))
                 nrm = np.zeros((n, self.dim))
                 nrm[:, axis] = -1.0 if side == 0 else 1.0
                 faces.append((axis, side, shape))

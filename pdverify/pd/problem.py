@@ -14,7 +14,9 @@ value its reference has); ``where(cells) -> mask`` restricts them to part of the
 (the boundary cells' integer indices; seed 001's edge constraints); ``traction(x,
 normal) -> (n, d)`` is the applied traction (the other components; ``None``: free).
 Faces not listed are traction-free. A treatment that cannot impose a condition as
-stated (e.g. part of a face) says so through :meth:`StaticProblem.whole_faces`.
+stated (e.g. part of a face) says so through :meth:`StaticProblem.whole_faces`. A
+treatment reads the faces as :class:`~pdverify.pd.faces.Face` values (name, axis, side,
+outward sign; :meth:`StaticProblem.faces`, ``prescribed``, ``loaded``), never as numbers.
 
 A body that is not a box (``shape``, 2D: ``pdverify.pd.shapes``) keys its conditions by
 its boundary parts' names (``hole``, ``notch-x``, ...) instead of faces; a part's
@@ -28,8 +30,8 @@ from typing import Callable, Mapping
 import numpy as np
 
 from .build import Body, StateMaterial
+from .faces import FACES, Face, box_faces, face_names
 
-FACES = ("x-", "x+", "y-", "y+", "z-", "z+")
 
 #: Gauss-Legendre points per tangential axis of a face resultant (exact to degree 5).
 FACE_GAUSS = 3
@@ -40,11 +42,6 @@ FACE_LOADS = ("face-mean", "centre")
 #: Where the uncorrected model evaluates a surface load: at the loaded node itself
 #: (``node``) or at the face centre on the surface (``surface``).
 LOAD_POINTS = ("node", "surface")
-
-
-def face_number(name: str) -> int:
-    """``x-`` -> 0, ``x+`` -> 1, ... (``2 * axis + side``, the grid's numbering)."""
-    return FACES.index(name)
 
 
 def face_resultant(traction, centres, normals, spacing):
@@ -139,7 +136,7 @@ class StaticProblem:
     jitter_seed: int = 0
 
     def __post_init__(self):
-        allowed = (FACES[:2 * len(self.lengths)] if self.shape is None
+        allowed = (face_names(len(self.lengths)) if self.shape is None
                    else self.shape.part_names)
         bad = [f for f in self.conditions if f not in allowed]
         if bad:
@@ -166,20 +163,30 @@ class StaticProblem:
         """The state-based material (``pdverify.pd.build``)."""
         return StateMaterial(self.constants, self.influence, self.complete_m)
 
-    def faces(self):
-        """``(face number, condition)`` of every listed face, in face order."""
-        return sorted((face_number(k), c) for k, c in self.conditions.items())
+    def faces(self) -> list[tuple[Face, FaceCondition]]:
+        """``(face, condition)`` of every listed face (a :class:`Face`), in the faces'
+        order (:data:`FACES`). A shape has no faces: its conditions are keyed by parts."""
+        if self.shape is not None:
+            raise ValueError(f"{self.where}: a shape's conditions are keyed by its parts "
+                             f"{self.shape.part_names}, not by faces")
+        return [(f, self.conditions[f.name]) for f in box_faces(self.dim)
+                if f.name in self.conditions]
 
     def prescribed(self):
-        """``[(face, component, where)]`` of every prescribed component."""
+        """``[(face, component, where)]`` of every prescribed component (``face``: a
+        :class:`Face`)."""
         return [(f, k, c.where) for f, c in self.faces() for k in c.prescribed]
 
     def loaded(self):
-        """``[(face, traction)]`` of every face with an applied traction."""
+        """``[(face, traction)]`` of every face (a :class:`Face`) with an applied
+        traction."""
         return [(f, c.traction) for f, c in self.faces() if c.traction is not None]
 
     def whole_faces(self) -> bool:
-        """True when every prescribed component covers its whole face."""
+        """True when every prescribed component covers its whole face (a shape's
+        conditions always cover their whole part)."""
+        if self.shape is not None:
+            return True
         return all(w is None for _, _, w in self.prescribed())
 
     def body_load(self, x, volume) -> np.ndarray:
@@ -188,10 +195,10 @@ class StaticProblem:
             return np.zeros((len(x), self.dim))
         return self.body_force(x) * volume
 
-    def face_forces(self, face: int, centres, normals, face_area) -> np.ndarray:
-        """Force on each cell face of ``face`` at ``centres``: :attr:`face_load`'s rule
-        times the face area (and thickness)."""
-        traction = self.conditions[FACES[face]].traction
+    def face_forces(self, face: Face | str, centres, normals, face_area) -> np.ndarray:
+        """Force on each cell face of ``face`` (a :class:`Face` or its name) at
+        ``centres``: :attr:`face_load`'s rule times the face area (and thickness)."""
+        traction = self.conditions[Face.named(face).name].traction
         if self.face_load == "centre":
             t = traction(centres, normals)
         else:
@@ -309,7 +316,7 @@ class BondProblem:
     supports: str = ""
 
     def __post_init__(self):
-        faces = FACES[:2 * len(self.body.lengths)]
+        faces = face_names(len(self.body.lengths))
         clash = [k for k in self.parts if k in faces]
         bad = [k for k in self.conditions if k not in faces and k not in self.parts]
         if clash or bad:
@@ -337,17 +344,17 @@ class BondProblem:
         x = grid.x
         if name in self.parts:
             return np.flatnonzero(self.parts[name](x))
-        axis, side = divmod(face_number(name), 2)
-        lo = self.body.origin[axis]
-        bound = lo + self.body.lengths[axis] if side else lo
+        face = Face.named(name)
+        lo = self.body.origin[face.axis]
+        bound = lo + self.body.lengths[face.axis] if face.side else lo
         if self.body.placement != "on-surface":
-            bound += (-0.5 if side else 0.5) * self.body.spacing
-        return np.flatnonzero(np.isclose(x[:, axis], bound))
+            bound += (-0.5 if face.side else 0.5) * self.body.spacing
+        return np.flatnonzero(np.isclose(x[:, face.axis], bound))
 
     def clamped_box(self) -> ClampedBox:
         """The :class:`ClampedBox` of a ``clamped-sheet`` description: the body's box
         with the two faces of one axis prescribed."""
-        axes = {face_number(k) // 2 for k, c in self.conditions.items()
+        axes = {Face.named(k).axis for k, c in self.conditions.items()
                 if k in FACES and c.prescribed}
         if len(axes) != 1:
             raise ValueError(f"a clamped box prescribes the faces of one axis, not {axes}")

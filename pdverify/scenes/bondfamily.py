@@ -17,7 +17,7 @@ import numpy as np
 from ..errors import InputError
 from ..params import Param
 from ..pd import bond_micromodulus, build_stencil
-from ..pd.problem import FACES, BondProblem, BondSystem, assemble_bonds
+from ..pd.problem import BondProblem, BondSystem, Face, assemble_bonds
 from ..solvers.front import solve_with_dirichlet
 from ..solvers.iterative import Lattice
 from ..solvers.policy import AUTO_ITERATIVE_UNKNOWNS, SPD_LATTICE_SOLVERS
@@ -74,7 +74,7 @@ class BondStaticScene(FemAndPD):
         if problem.family is not None and t is not None and t.role(problem.family):
             box = problem.clamped_box()
             grid, closure, low, high = t.build_for(problem.family, box, p)
-            own = (grid, closure, {FACES[2 * box.axis]: low, FACES[2 * box.axis + 1]: high})
+            own = (grid, closure, {Face.at(box.axis, 0).name: low, Face.at(box.axis, 1).name: high})
             return problem, assemble_bonds(problem, own=own)
         return problem, assemble_bonds(problem, self.bond_closure(method, p))
 

@@ -8,7 +8,7 @@ from ..errors import InputError
 from ..metrics import plate_errors
 from ..params import Param, grid_params
 from ..pd import QUADRATURES, StateBasedConstants, get_influence, state_based_stencil
-from ..pd.problem import FACES, FaceCondition, StaticProblem
+from ..pd.problem import FaceCondition, StaticProblem, face_names
 from ..quotes import Quote as Q
 from . import Published, influence_param, register, whole_cells
 from .family import FemStaticStateScene
@@ -172,7 +172,7 @@ class ClampedPlate(FemStaticStateScene):
             (p["length"], p["width"]), (0.0, 0.0), float(p["spacing"]),
             state_based_stencil(2, p["m_ratio"], p["spacing"], inf, p["quadrature"]),
             StateBasedConstants("plane-stress", p["E"], p["nu"]), inf,
-            {face: clamped for face in FACES[:4]}, exact=value,
+            {face: clamped for face in face_names(2)}, exact=value,
             body_force=lambda x: np.c_[np.full(len(x), b), np.zeros(len(x))],
             thickness=p["thickness"], solver=self.fixed_solver, ordering=ORDERING,
             where=where)

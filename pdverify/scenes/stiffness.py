@@ -38,7 +38,7 @@ from ..pd import (StateBasedConstants, bond_micromodulus, build_stencil, get_inf
                   state_based_stencil)
 from ..pd.build import Body, BondMaterial, StateMaterial, build_model
 from ..pd.influence import INFLUENCES, bond_based_nu
-from ..pd.problem import FACES, BondProblem, FaceCondition, StaticProblem, assemble_bonds
+from ..pd.problem import BondProblem, FaceCondition, StaticProblem, assemble_bonds, face_names
 from ..pd.work import uniaxial, work_density
 from ..quotes import Quote as Q
 from . import MethodSpec, Outcome, Published, Scene, register, whole_cells
@@ -319,7 +319,7 @@ class _StateStiffness(StiffnessScene, StaticStateScene):
         every = FaceCondition(prescribed=tuple(range(d)))
         return StaticProblem(lengths, origin, p["spacing"], stencil,
                              StateBasedConstants(self.kind, p["E"], p["nu"]), inf,
-                             {face: every for face in FACES[:2 * d]},
+                             {face: every for face in face_names(d)},
                              exact=lambda x: x @ strain.T, solver=ASSEMBLY_SOLVER,
                              where=self.id)
 

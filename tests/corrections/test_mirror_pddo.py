@@ -7,6 +7,7 @@ from pdverify.corrections.mirror_nodes import MirrorNodes, peridynamic_gradient
 from pdverify.corrections.pddo import derivative_operators, monomial_orders, pddo_system
 from pdverify.pd import (BoxGrid, StateBasedConstants, StateBasedModel, get_influence,
                          state_based_stencil)
+from pdverify.pd.faces import face_names
 from pdverify.report.figures.surface_nodes import mnm_pattern, where_max
 from pdverify.scenes import get_scene
 from pdverify.solvers.front import solve_with_dirichlet
@@ -16,7 +17,7 @@ C = StateBasedConstants("plane-strain", 200e9, 0.3)
 LAM, MU = C.moduli()
 GRAD = np.array([[1e-3, 2e-4], [-3e-4, 5e-4]])
 SHIFT = np.array([1e-4, -2e-4])
-ALL_FACES = [(f, k) for f in range(4) for k in range(2)]
+ALL_FACES = [(f, k) for f in face_names(2) for k in range(2)]
 #: exactness after a sparse LU solve, relative to the largest displacement: machine
 #: epsilon times the systems' condition (measured: 8.7e3 for the mirror traction
 #: problem, 7 and 17 for the Dirichlet ones), with a margin of about fifty
