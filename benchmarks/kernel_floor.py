@@ -16,9 +16,8 @@ one after another in this process, each through ``Scene.run`` as a report worker
   (f2py's calls are not profiled; unwrapped they count in their caller's own time, with
   the caller's numpy work: the fronts' extend-add and copies), and scipy.linalg's and
   numpy.linalg's wrappers (their own time is their LAPACK call and argument checks);
-- **SuperLU**: its factor (``gstrf``) and solves, and the main thread's waits on locks,
-  which are the waits for the split factor's two halves (``pdverify.solvers.nested.
-  SplitLU``: SuperLU in two threads that cProfile does not see);
+- **SuperLU**: its factor (``gstrf``) and solves (the float32 factor's too,
+  ``pdverify.solvers.nested.SingleLU``);
 - **sparse products with vectors**: scipy's ``csr_matvec`` / ``csr_matvecs`` (CG's
   products, the refinement's residuals);
 - **sparse assembly and conversions**: scipy's other compiled sparse routines (products

@@ -1,9 +1,11 @@
-"""The 2D float32 factor: pdverify's ``SplitLU`` (the two halves of the top
-nested-dissection split factored by SuperLU in two threads, the separator by a dense
-Schur complement) against the whole matrix factored in one piece by the multifrontal
-``FrontalLU`` (the 3D boxes' float32 factor; ``policy.SPLIT_MAX_SEPARATOR = 0`` sends every
-system there) and by SuperLU in float32 (``FRONTAL_FACTOR = False`` as well), on the
-report's largest float32 runs.
+"""The 2D float32 factor: the whole matrix factored by SuperLU in float32 (``SingleLU``,
+today's) against the multifrontal ``FrontalLU`` (the 3D boxes' float32 factor;
+``policy.frontal_factor`` made always true sends every system there), on the report's
+largest float32 runs. The record ``split_lu-2026-11-28-all-cases`` was taken at commit
+d1d468f with a third variant, ``SplitLU`` (the two halves of the top split factored by
+SuperLU in two threads, the separator by a dense Schur complement), the 2D factor of
+that time, since removed: its rows are that variant's ``split``, ``superlu-whole`` is
+today's ``SingleLU``.
 
 Each run in a fresh process per variant, the variants alternating (rotated) per round:
 the run's solve seconds (wall), the process's CPU seconds (all its threads: what a run
@@ -33,7 +35,7 @@ CASES = [
     ("sheet2d-tension", "none", {"quadrature": "partial-volume"}),
     ("plate2d-clamped", "none", {}),
 ]
-VARIANTS = ("split", "frontal", "superlu-whole")
+VARIANTS = ("superlu-whole", "frontal")
 
 
 def one_run(scene_id, method, overrides, variant):
@@ -43,10 +45,9 @@ def one_run(scene_id, method, overrides, variant):
     sys.path.insert(0, harness.ROOT.as_posix())
     from pdverify.solvers import nested, policy
     from pdverify.scenes import get_scene
-    if variant != "split":
-        policy.SPLIT_MAX_SEPARATOR = 0
-    if variant == "superlu-whole":
-        nested.FRONTAL_FACTOR = False
+    if variant == "frontal":
+        policy.frontal_factor = lambda separator, unknowns: True
+    nested.FRONTAL_FACTOR = variant == "frontal"
     c0 = time.process_time()
     result = get_scene(scene_id).run(method, overrides)
     cpu = time.process_time() - c0
@@ -67,10 +68,10 @@ def main(argv=None):
         for scene_id, method, overrides in CASES[:args.cases]:
             runs = {v: [] for v in VARIANTS}
             for k in range(args.repeat):
-                order = VARIANTS[k % 3:] + VARIANTS[:k % 3]
+                order = VARIANTS[k % len(VARIANTS):] + VARIANTS[:k % len(VARIANTS)]
                 for v in order:
                     runs[v].append(harness.fresh_call(one_run, scene_id, method, overrides, v))
-            base = runs["split"][0]["metrics"]
+            base = runs[VARIANTS[0]][0]["metrics"]
             row = {}
             for v in VARIANTS:
                 med = {q: harness.median([r[q] for r in runs[v]])

@@ -81,12 +81,10 @@ class FrontalLU:
 
     ``solve(B, trans="N"|"T")``: one or several right-hand sides, float64 in and out,
     computed in ``dtype`` (each column scaled by a power of two near its largest entry, as
-    :class:`~pdverify.solvers.nested.SplitLU` does). ``factor_entries``: entries stored
+    :class:`~pdverify.solvers.nested.SingleLU` does). ``factor_entries``: entries stored
     (L and U of all fronts). Raises RuntimeError when a pivot is exactly zero or not finite.
     """
 
-    separator = 0           # as SplitLU's: no split, no separator rows pivoted across
-    crossed_pivots = 0
     kind = "multifrontal LU"
 
     def __init__(self, A, tree, dtype=np.float32, *, merge: int = MERGE_SIZE):
@@ -216,7 +214,7 @@ class FrontalLU:
         return step
 
     def solve(self, b, trans: str = "N"):
-        # each column scaled by a power of two, as SplitLU.solve (mixed.scaled_solve)
+        # each column scaled by a power of two, as SingleLU.solve (mixed.scaled_solve)
         return scaled_solve(b, trans, self._solve)
 
     def _solve(self, b, trans):

@@ -1,7 +1,8 @@
 """Mixed precision: a solve by an approximate (single-precision) factor, refined in double
 as LAPACK's dsgesv does, with a random probe refined alongside that tells a converged
 refinement from a near-singular system and gives the condition estimate. The factor is the
-caller's (:class:`~pdverify.solvers.nested.SplitLU` for nested dissection).
+caller's (:func:`~pdverify.solvers.nested.single_precision_factor` for nested
+dissection).
 
 When that refinement stalls (condition near 1/eps_single = 1.7e7, where each step gains
 little or the float32 round-off of the factor outweighs it), the same factor preconditions
@@ -185,7 +186,7 @@ def _fgmres(A, r, precondition, *, max_iterations: int | None = None,
     beyond those, up to ``max_iterations`` while the relative residual is above
     ``extended_tol`` (the condition estimator's passes, :data:`ESTIMATOR_MAX_ITERATIONS`)."""
     # r scaled by a power of two near its largest entry (exact), so that its norm neither
-    # overflows nor underflows (as SplitLU.solve scales its right-hand sides)
+    # overflows nor underflows (as the float32 factors' solves scale theirs)
     big = float(np.abs(r).max()) if r.size else 0.0
     if big == 0.0 or not np.isfinite(big):
         return np.zeros_like(r), 0

@@ -1,15 +1,9 @@
 """Sparse LU under a geometric nested-dissection ordering
 (:func:`pdverify.solvers.ordering.nested_dissection`), in double precision or, from
 :data:`~pdverify.solvers.policy.MIXED_FROM_UNKNOWNS` unknowns, as a single-precision
-:class:`SplitLU` (the two halves of the top split factored in parallel) refined in double
-(:mod:`pdverify.solvers.mixed`)."""
+:class:`SingleLU` (SuperLU's; in 3D the multifrontal
+:class:`~pdverify.solvers.frontal.FrontalLU`) refined in double (:mod:`pdverify.solvers.mixed`)."""
 from __future__ import annotations
-
-import itertools
-import os
-import traceback
-import weakref
-from concurrent import futures
 
 import numpy as np
 import scipy.sparse as sp
@@ -33,7 +27,7 @@ ND_PIVOT_THRESHOLD = 1e-3
 ND_OPTIONS = dict(permc_spec="NATURAL", diag_pivot_thresh=ND_PIVOT_THRESHOLD,
                   options=dict(SymmetricMode=True))
 
-#: ... and the single-precision factor's (:class:`SplitLU` in float32): 0.1 (issue 32),
+#: ... and the single-precision factor's (:class:`SingleLU`): 0.1 (issue 32),
 #: which bounds the element growth that eps_single multiplies. Measured
 #: (``benchmarks/mixed_precision.py --threshold``; one process each, the machine shared)
 #: on the 3D boxes' systems whose plain refinement stalls at 1e-3: at 0.1 it converges,
@@ -54,25 +48,14 @@ FLOAT32_PIVOT_THRESHOLD = 0.1
 
 
 def _options(dtype):
-    """SuperLU's options of a :class:`SplitLU` factor of this ``dtype``."""
+    """SuperLU's options of a :class:`SingleLU` factor of this ``dtype``."""
     if np.dtype(dtype) == np.float32:
         return {**ND_OPTIONS, "diag_pivot_thresh": FLOAT32_PIVOT_THRESHOLD}
     return ND_OPTIONS
 
 
-#: Shift of the separator blocks of the two halves' matrices (see :class:`SplitLU`; the
-#: factorisation is exact for any shift, it only sets how much float32 round-off the
-#: separator's Schur complement picks up). Measured on the plate at h = 0.01 (entries
-#: <= 1 after equilibration; condition of the halves' Schur complements / refinement
-#: steps to LAPACK's test): 0 -> 8.5e4, stalls at 1e-5 relative residual; 1 -> 110, 3;
-#: 2 -> 19, 3; 4 -> 5.5, 3; 8 -> 2.4, 3.
-SEPARATOR_SHIFT = 2.0
-#: At most this many separator rows may be pivoted into a half by SuperLU's threshold
-#: pivoting (each costs two solves and a rank-one term in :class:`SplitLU`); beyond it the
-#: whole matrix is factored in one piece. The plate at h = 0.0125: 1 of 741.
-MAX_CROSSED_PIVOTS = 32
-
-#: The whole-matrix float32 factor (separator too large to split at) is the multifrontal
+#: The float32 factor of a system whose top separator is large (the 3D boxes:
+#: :func:`~pdverify.solvers.policy.frontal_factor`) is the multifrontal
 #: :class:`~pdverify.solvers.frontal.FrontalLU` (dense BLAS-3 fronts), with SuperLU's as
 #: the fallback when it fails (issue 32). Measured (``benchmarks/frontal.py``: a fresh
 #: process each, one BLAS thread, alternating, medians of 3; SuperLU -> FrontalLU): the
@@ -98,9 +81,9 @@ class NestedFactor:
     unknown), after the equilibration of :func:`~pdverify.solvers.checks.equilibrate`.
 
     ``mixed`` (default: :func:`~pdverify.solvers.policy.mixed_precision`): factor in single
-    precision (:class:`SplitLU`, or :class:`~pdverify.solvers.frontal.FrontalLU` when the
-    separator is too large to split at) and refine each solve in double as LAPACK's dsgesv
-    does, or, when that stalls (condition ~1/eps_single = 1.7e7), by GMRES preconditioned
+    precision (:func:`single_precision_factor`: SuperLU's, or
+    :class:`~pdverify.solvers.frontal.FrontalLU` when the top separator is large) and
+    refine each solve in double as LAPACK's dsgesv does, or, when that stalls (condition ~1/eps_single = 1.7e7), by GMRES preconditioned
     with the same factor (:mod:`~pdverify.solvers.mixed`); a system whose single-precision
     factor fails or that neither refinement solves is factored in double instead (once),
     with the reason in the diagnostics (``mixed_precision``). A random right-hand side is
@@ -201,26 +184,23 @@ def ordered_system(A, rhs, coords, where: str, *, tree: bool = False):
 
 
 def single_precision_factor(A_p, n1: int, n2: int, tree=None):
-    """``(lu, note)``: the :class:`SplitLU` of ``A_p`` on its top split, or of the whole
-    matrix (``note`` says why) when the separator is too large to split at
-    (:func:`~pdverify.solvers.policy.split_too_large`; given the ordering's separator
-    ``tree``, by :class:`~pdverify.solvers.frontal.FrontalLU`, :data:`FRONTAL_FACTOR`) or
-    SuperLU's pivoting crosses between the blocks. Raises RuntimeError when the whole
-    matrix's float32 factor fails too."""
+    """``(lu, note)``: the float32 factor of the equilibrated, permuted ``A_p``: given the
+    ordering's separator ``tree``, the multifrontal
+    :class:`~pdverify.solvers.frontal.FrontalLU` when the top separator (``A_p``'s
+    unknowns beyond the halves ``n1``, ``n2``) is large
+    (:func:`~pdverify.solvers.policy.frontal_factor`; :data:`FRONTAL_FACTOR`), else (and
+    when that fails) SuperLU's (:class:`SingleLU`); ``note`` says which and why. Raises
+    RuntimeError when SuperLU's float32 factor fails."""
     note = ""
     separator = A_p.shape[0] - n1 - n2
-    if n1 and n2 and policy.split_too_large(separator, A_p.shape[0]):
-        n1 = n2 = 0
-        note = f" (whole matrix: separator of {separator} unknowns too large to split at)"
-        if FRONTAL_FACTOR and tree is not None:
-            try:
-                return FrontalLU(A_p, tree), note
-            except RuntimeError as exc:
-                note += f" (SuperLU: the multifrontal factor failed: {exc})"
-    try:
-        return SplitLU(A_p, n1, n2), note
-    except RuntimeError as exc:
-        return SplitLU(A_p, 0, 0), f" (whole matrix: {exc})"
+    if (FRONTAL_FACTOR and tree is not None and n1 and n2
+            and policy.frontal_factor(separator, A_p.shape[0])):
+        note = f" (multifrontal: top separator of {separator} unknowns)"
+        try:
+            return FrontalLU(A_p, tree), note
+        except RuntimeError as exc:
+            note = f" (SuperLU: the multifrontal factor failed: {exc})"
+    return SingleLU(A_p), note
 
 
 def _refined(A_p, b_p, lu, note: str):
@@ -236,8 +216,7 @@ def _refined(A_p, b_p, lu, note: str):
     diag.update(mixed_precision="float32 LU" + note + (
                     ", refined in float64 by GMRES-IR (plain refinement stalled)" if gmres
                     else ", refined in float64 (LAPACK dsgesv's test)"),
-                factor_entries=lu.factor_entries, separator_unknowns=lu.separator,
-                separator_rows_pivoted_into_halves=lu.crossed_pivots,
+                factor_entries=lu.factor_entries,
                 solver=f"sparse LU ({getattr(lu, 'kind', 'SuperLU')} in float32 + "
                        + ("GMRES-IR" if gmres else
                                                              "refinement")
@@ -245,202 +224,31 @@ def _refined(A_p, b_p, lu, note: str):
     return y, cond, diag
 
 
-class SplitLU:
-    """A single-precision LU of ``A = [[A11, 0, A1s], [0, A22, A2s], [As1, As2, Ass]]`` (the
-    top split of a nested-dissection ordering) whose two halves are factored in parallel.
+class SingleLU:
+    """SuperLU's LU of the whole ``A`` in single precision (``dtype``), under the
+    nested-dissection order ``A`` is given in (SuperLU's ``NATURAL`` column order,
+    symmetric mode, :data:`FLOAT32_PIVOT_THRESHOLD`). ``solve(B, trans="N")`` takes one or
+    several right-hand sides, each column scaled by a power of two
+    (:func:`~pdverify.solvers.mixed.scaled_solve`); ``trans="T"`` solves with A^T
+    (SuperLU's convention). Raises RuntimeError (from SuperLU) when the factor fails.
 
-    Each half is factored by SuperLU with the separator last, ``M_i = [[Aii, Ais],
-    [Asi, D_i]]``, ``D_i = Ass / 2 + g I`` (g = :data:`SEPARATOR_SHIFT`); the trailing block
-    of its LU is ``T_i = D_i - Asi Aii^-1 Ais``, read off the factor and multiplied out in
-    double. The Schur complement of the separator is then ``S = Ass - sum (D_i - T_i)
-    = T_1 + T_2 - 2 g I`` (SuperLU in double). A solve: ``M_i [z_i; w_i] = [b_i; 0]`` gives
-    ``Asi Aii^-1 b_i = -T_i w_i``, so ``x_s = S^-1 (b_s + T_1 w_1 + T_2 w_2)``, and then
-    ``M_i [x_i; x_s] = [b_i; T_i (x_s - w_i)]``. Should SuperLU's threshold pivoting take
-    a separator row as pivot of a half's column, the trailing block is the Schur complement
-    for the rows so pivoted; T_i follows from it by a rank-c correction (c such rows, at
-    most :data:`MAX_CROSSED_PIVOTS`; two solves each).
+    It replaced ``SplitLU`` (the two halves of the top split factored in two threads, the
+    separator by a dense Schur complement; issue 51): on the report's seven largest 2D
+    float32 runs it took 6.9 s of CPU against SplitLU's 8.9 s and the multifrontal
+    factor's 13.0 s, with 320-490 MB peak against 425-820 MB, the metrics the same to
+    2e-12 relative (``benchmarks/split_lu.py``, record
+    ``split_lu-2026-11-28-all-cases``): under ``report --jobs`` every core is busy, so
+    the split's second thread bought nothing."""
 
-    Without a split (``n1 = 0`` or ``n2 = 0``) it is one SuperLU factor of the whole
-    matrix. ``solve(B, trans="N")`` takes one or several right-hand sides; ``trans="T"``
-    solves with A^T (SuperLU's convention). Raises RuntimeError (from SuperLU, also for a
-    singular S, or for more crossed pivots).
-    """
+    kind = "SuperLU"
 
-    def __init__(self, A, n1: int, n2: int, dtype=np.float32):
-        A = sp.csr_matrix(A)
-        n = A.shape[0]
+    def __init__(self, A, dtype=np.float32):
         self.dtype = dtype
-        self.sizes = (n1, n2)
-        self.separator = n - n1 - n2 if n1 and n2 else 0
-        self.crossed_pivots = 0
-        if not self.separator:
-            self.lus = [spla.splu(A.tocsc().astype(dtype), **_options(dtype))]
-            self.factor_entries = int(self.lus[0].nnz)
-            return
-        s, g = self.separator, SEPARATOR_SHIFT
-        C = A.tocsc()
-        # M_i = the half's and the separator's rows and columns, with D_i in the corner
-        corner = (0.5 * C[n1 + n2:, n1 + n2:] - g * sp.identity(s, format="csc")).tocsc()
-        pools = _pools()
-        keys = [(k, next(_KEYS)) for k in (0, 1)]
-        jobs = [pools[k].submit(self._factor_half, C, np.r_[a:a + m, n1 + n2:n], corner, m,
-                                dtype, key)
-                for (k, key), (a, m) in zip(keys, ((0, n1), (n1, n2)))]
-        futures.wait(jobs)      # both halves done (or failed) before anything is raised
-        failed = next((job.exception() for job in jobs if job.exception() is not None), None)
-        if failed is not None:
-            del jobs            # their results hold a half factored beside the failed one,
-            _release(keys)      # which its thread then drops
-            raise failed
-        out = [job.result() for job in jobs]
-        del jobs
-        try:
-            self.lus = [o[0] for o in out]
-            self.factor_entries = int(sum(lu.nnz for lu in self.lus))
-            blocks = [self._separator_block(lu, L_ss, U_ss, m)
-                      for (lu, L_ss, U_ss), m in zip(out, (n1, n2))]
-            self.T = [T for T, _ in blocks]
-            self.crossed_pivots = int(sum(c for _, c in blocks))
-            # S by SuperLU (partial pivoting) in double, as LAPACK's threads stall when
-            # the machine is shared (measured, 921 unknowns, one of two cores busy:
-            # scipy's lu_factor 0.21 s, SuperLU 0.08 s, lu_factor with one BLAS thread
-            # 0.02 s)
-            S = self.T[0] + self.T[1] - 2 * g * np.eye(s)
-            self.S_lu = spla.splu(sp.csc_matrix(S), permc_spec="NATURAL")
-        except BaseException as exc:
-            # the finished frames of the traceback (a _separator_block's) hold a factor
-            traceback.clear_frames(exc.__traceback__)
-            out = self.lus = None
-            _release(keys)
-            raise
-        # held by their threads (_HELD) until this object goes (_release)
-        weakref.finalize(self, _release, keys).atexit = False
-
-    @staticmethod
-    def _factor_half(C, idx, corner, m: int, dtype, key):
-        """SuperLU of M_i (in its half's thread, which holds it in :data:`_HELD` under
-        ``key``): ``(lu, L_ss, U_ss)``, the trailing blocks of its factors in double."""
-        M = C[:, idx][idx, :]
-        M = (M - sp.block_diag([sp.csc_matrix((m, m)), corner], format="csc")).astype(dtype)
-        lu = _HELD[key] = spla.splu(M, **_options(dtype))
-        if np.any(lu.perm_c[:m] >= m):
-            del _HELD[key], lu          # freed here, not by the traceback's frame
-            raise RuntimeError("SuperLU's column order mixed a half with the separator")
-        L, U = lu.L, lu.U
-        return lu, L[m:, m:].toarray().astype(float), U[m:, m:].toarray().astype(float)
-
-    @staticmethod
-    def _separator_block(lu, L_ss, U_ss, m: int):
-        """T_i of a factored M_i: ``(T_i, separator rows pivoted into the half)``. The
-        products run here, after both halves are factored: BLAS's threads would compete
-        with the other half's factorisation."""
-        s = L_ss.shape[0]
-        pr, pc = lu.perm_r, lu.perm_c
-        # P_r M P_c = L U: the trailing L_ss U_ss is the Schur complement T' of M with
-        # respect to its rows pivoted into the leading positions and the half's columns,
-        # rows the rows pivoted to the trailing positions R', columns the separator's
-        trailing = L_ss @ U_ss
-        rows = np.argsort(pr)[m:]           # R', in trailing order
-        cols = np.argsort(pc)[m:] - m       # separator unknowns, in trailing order
-        moved_in = np.setdiff1d(np.arange(m, m + s), rows)   # separator rows now leading
-        if moved_in.size > MAX_CROSSED_PIVOTS:
-            raise RuntimeError(f"pivoting moved {moved_in.size} separator rows into a half")
-        moved_out = np.sort(rows[rows < m])                  # half rows now trailing
-        # B: T' with each row placed at its separator unknown; a half row j in R' takes the
-        # place of the separator row k it is paired with (moved_out[i] with moved_in[i])
-        slot = rows - m
-        slot[rows < m] = moved_in[np.searchsorted(moved_out, rows[rows < m])] - m
-        B = np.empty((s, s))
-        B[np.ix_(slot, cols)] = trailing
-        if not moved_in.size:
-            return B, 0
-        # T_i^-1 = (M^-1)[S, S], whose columns at the pairs' slots are (M^-1 e_k)[S] where
-        # T'^-1 = (M^-1)[S, R'] has (M^-1 e_j)[S]: a rank-c change of B^-1, inverted by
-        # the Woodbury identity
-        E = np.zeros((m + s, 2 * moved_in.size), dtype=lu.L.dtype)
-        E[moved_in, np.arange(moved_in.size)] = 1.0
-        E[moved_out, moved_in.size + np.arange(moved_in.size)] = 1.0
-        Z = lu.solve(E)[m:].astype(float)
-        W = Z[:, :moved_in.size] - Z[:, moved_in.size:]
-        BW = B @ W
-        K = moved_in - m
-        core = np.eye(moved_in.size) + BW[K]
-        return B - BW @ np.linalg.solve(core, B[K]), moved_in.size
-
-    def _half(self, i, rhs, trans):
-        return self.lus[i].solve(np.asarray(rhs, dtype=self.dtype), trans=trans).astype(float)
+        self.lu = spla.splu(sp.csc_matrix(A).astype(dtype), **_options(dtype))
+        self.factor_entries = int(self.lu.nnz)
 
     def solve(self, b, trans: str = "N"):
         return scaled_solve(b, trans, self._solve)
 
     def _solve(self, b, trans):
-        if not self.separator:
-            return self._half(0, b, trans)
-        n1, n2 = self.sizes
-        s = self.separator
-        T = [t.T for t in self.T] if trans == "T" else self.T
-        parts = (b[:n1], b[n1:n1 + n2])
-        b_s = b[n1 + n2:]
-        zero = np.zeros((s,) + b.shape[1:])
-        # the halves' solves run in their two threads (SuperLU releases the GIL)
-        pools = _pools()
-        w = [job.result() for job in [
-            pools[i].submit(lambda i: self._half(i, np.concatenate([parts[i], zero]),
-                                                 trans)[-s:], i) for i in (0, 1)]]
-        x_s = self.S_lu.solve(b_s + _matvec(T[0], w[0]) + _matvec(T[1], w[1]), trans=trans)
-        x = [job.result() for job in [
-            pools[i].submit(lambda i: self._half(i, np.concatenate(
-                [parts[i], _matvec(T[i], x_s - w[i])]), trans)[:-s], i) for i in (0, 1)]]
-        return np.concatenate([x[0], x[1], x_s])
-
-
-def _matvec(M, v):
-    """M @ v for the separator's dense blocks by numpy's own loops, one column of ``v`` at
-    a time: BLAS would run them on its threads, which stall when the machine is shared
-    (measured, one of two cores busy: a solve 0.15 s against 0.07 s)."""
-    if v.ndim == 1:
-        return np.einsum("ij,j->i", M, v)
-    return np.stack([np.einsum("ij,j->i", M, c) for c in v.T], axis=1)
-
-
-_POOLS: dict = {}
-#: The halves' SuperLU factors of the live :class:`SplitLU` objects, by key, each held
-#: here so that its last reference is dropped by the thread that made it
-#: (:func:`_release`)
-_HELD: dict = {}
-_KEYS = itertools.count()
-
-
-def _pools():
-    """One worker thread per half of :class:`SplitLU` (made on first use in each process:
-    a pool inherited through fork has no threads behind it). A half is factored, solved
-    with and freed in its own thread: scipy's SuperLU frees a factor's memory only in the
-    thread that made it (its allocations are tracked per thread), so a factor made in a
-    pool thread and dropped in another thread was never freed (scipy issue 15921): 0.6 GB
-    of address space and the factor's pages, ~60 MB resident, a sheet2d-tension run, each
-    run of a process adding its own (the test workers grew from 0.3 to 0.95 GB resident
-    over the fast tier)."""
-    pid = os.getpid()
-    if pid not in _POOLS:
-        _POOLS.clear()
-        _HELD.clear()           # a parent's factors: its threads are not here
-        _POOLS[pid] = tuple(futures.ThreadPoolExecutor(max_workers=1,
-                                                       thread_name_prefix=f"splitlu{k}")
-                            for k in (0, 1))
-    return _POOLS[pid]
-
-
-def _release(keys) -> None:
-    """Drop the factors held under ``keys`` (``(half, key)`` pairs), each in its half's
-    thread, where SuperLU frees it (:func:`_pools`); a key not held is skipped."""
-    if _POOLS.get(os.getpid()) is None:
-        return
-    pools = _pools()
-    for k, key in keys:
-        pools[k].submit(_drop, key)
-
-
-def _drop(key) -> None:
-    """(in a half's thread) Forget the factor held under ``key``; returns nothing, so that
-    no future holds it."""
-    _HELD.pop(key, None)
+        return self.lu.solve(np.asarray(b, dtype=self.dtype), trans=trans).astype(float)

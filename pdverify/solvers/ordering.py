@@ -9,7 +9,8 @@ plane-strain plate at h = 0.01 (augmented system, 30,600 unknowns) this ordering
 SuperLU's factor 3.1e7 entries against 6.6e7 under minimum degree (a side measurement),
 and the whole solve 6.0x faster than today's COLAMD solve of the multiplied-out stiffness
 (benchmarks/solvers.py: 3.22 s against 19.49 s). The first split also lets the two halves
-be factored in parallel (:class:`pdverify.solvers.nested.SplitLU`).
+be told apart (the top separator's size chooses the float32 factor,
+:func:`pdverify.solvers.policy.frontal_factor`).
 """
 from __future__ import annotations
 

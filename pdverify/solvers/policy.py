@@ -151,8 +151,8 @@ def auto_note(solver: str, unknowns: int) -> str:
 # -- nested dissection: single or double precision, split or whole --------------------
 
 #: From this many unknowns :func:`~pdverify.solvers.nested.solve_nested` factors in single
-#: precision (two halves in parallel, see :class:`~pdverify.solvers.nested.SplitLU`) and
-#: refines in double. Measured on the plane-strain plate (augmented system; float64 LU
+#: precision (:func:`~pdverify.solvers.nested.single_precision_factor`) and refines in
+#: double. Measured on the plane-strain plate (augmented system; float64 LU
 #: against mixed, medians of 5): 2,025 unknowns 0.065 s / 0.083 s; 5,040: 0.22 / 0.20;
 #: 7,800: 0.45 / 0.32; 19,680: 1.86 / 1.03; 30,600: 3.2 / 1.55.
 MIXED_FROM_UNKNOWNS = 5000
@@ -164,21 +164,20 @@ def mixed_precision(unknowns: int) -> bool:
     return unknowns >= MIXED_FROM_UNKNOWNS
 
 
-#: :class:`~pdverify.solvers.nested.SplitLU` splits at the top separator only while its
-#: dense blocks (s^2 entries, s^3 work) stay small against the halves: s^2 <= this many
-#: times the unknowns. The 2D plates have s^2 / n ~ 28 at every h (m = 3; 921 of 30,600
-#: unknowns at h = 0.01), the 3D bodies 236 (h = 0.1) and 336 (h = 0.05), where the split
-#: gains nothing over one float32 LU of the whole matrix (h = 0.05, quiet machine, the
-#: whole solve: 7.8-8.1 s against 7.5-8.5 s; each half's factor with the separator 1.9 s
-#: and 3.3 s against 0.5 s for a half alone: the separator's coupling, not the parallel
-#: factors, costs).
-SPLIT_MAX_SEPARATOR = 100
+#: The float32 factor is the multifrontal :class:`~pdverify.solvers.frontal.FrontalLU`
+#: when the top separator of the nested-dissection ordering is large, s^2 > this many
+#: times the unknowns: the 3D bodies have s^2 / n ~ 236 (h = 0.1) and 336 (h = 0.05), the
+#: 2D plates ~28 at every h (m = 3). In 3D its dense fronts beat SuperLU's float32 factor
+#: (body3d-traction's order-1 Taylor system: factor 27.7 -> 6.3 s; ``FRONTAL_FACTOR``'s
+#: note in :mod:`~pdverify.solvers.nested`); in 2D SuperLU's is the cheaper
+#: (``benchmarks/split_lu.py``: 6.9 against 13.0 s of CPU over seven plate and sheet runs).
+FRONTAL_SEPARATOR_RATIO = 100
 
 
-def split_too_large(separator: int, unknowns: int) -> bool:
-    """Whether a top separator of ``separator`` unknowns is too large to split at
-    (:data:`SPLIT_MAX_SEPARATOR`): the whole matrix is then factored in one piece."""
-    return separator ** 2 > SPLIT_MAX_SEPARATOR * unknowns
+def frontal_factor(separator: int, unknowns: int) -> bool:
+    """Whether a system with a top separator of ``separator`` of its ``unknowns`` is
+    factored by the multifrontal LU (:data:`FRONTAL_SEPARATOR_RATIO`)."""
+    return separator ** 2 > FRONTAL_SEPARATOR_RATIO * unknowns
 
 
 # -- eigenvalues (modal) ----------------------------------------------------------------

@@ -78,7 +78,7 @@ def test_frontal_lu_in_double_is_backward_stable(case, merge, trans):
     assert relative_residual(M, x, b) < n * EPS
     x1 = lu.solve(b[:, 0], trans=trans)
     assert x1.shape == (n,) and relative_residual(M, x1[:, None], b[:, :1]) < n * EPS
-    assert lu.factor_entries > A.nnz / 2 and lu.crossed_pivots == 0
+    assert lu.factor_entries > A.nnz / 2
 
 
 def test_float32_factor_solves_to_single_precision_and_refines():
@@ -191,18 +191,22 @@ def test_tree_is_consistent(case, merge):
 
 
 def test_whole_matrix_factor_is_frontal_and_falls_back_to_superlu(monkeypatch):
-    """single_precision_factor: with the tree, a separator too large to split at gives the
-    multifrontal factor; when that raises, SuperLU's, with the reason in the note."""
+    """single_precision_factor: with the tree, a large top separator gives the
+    multifrontal factor, a small one SuperLU's; when the multifrontal one raises,
+    SuperLU's, with the reason in the note."""
     A, tree = ordered("3d-3dofs")
-    monkeypatch.setattr(policy, "split_too_large", lambda s, n: True)
+    monkeypatch.setattr(policy, "frontal_factor", lambda s, n: False)
     lu, note = nested.single_precision_factor(A, 10, 10, tree)
-    assert isinstance(lu, FrontalLU) and "too large" in note
+    assert isinstance(lu, nested.SingleLU) and note == ""
+    monkeypatch.setattr(policy, "frontal_factor", lambda s, n: True)
+    lu, note = nested.single_precision_factor(A, 10, 10, tree)
+    assert isinstance(lu, FrontalLU) and "multifrontal: top separator" in note
 
     def fail(*args, **kwargs):
         raise RuntimeError("zero or non-finite pivot")
     monkeypatch.setattr(nested, "FrontalLU", fail)
     lu, note = nested.single_precision_factor(A, 10, 10, tree)
-    assert isinstance(lu, nested.SplitLU) and "multifrontal factor failed" in note
+    assert isinstance(lu, nested.SingleLU) and "multifrontal factor failed" in note
 
 
 def test_duplicate_entries_are_summed():

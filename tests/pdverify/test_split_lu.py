@@ -1,4 +1,5 @@
-"""Single-precision split LU with refinement in double (pdverify.solvers.nested.SplitLU)."""
+"""Single-precision LU with refinement in double (pdverify.solvers.nested: SingleLU, the
+refinement of pdverify.solvers.mixed, GMRES-IR)."""
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -8,7 +9,7 @@ from pdverify.errors import NumericalError
 from pdverify.solvers import mixed, nested, policy
 from pdverify.solvers.checks import equilibrate
 from pdverify.solvers.mixed import refine
-from pdverify.solvers.nested import SplitLU, solve_nested
+from pdverify.solvers.nested import SingleLU, solve_nested
 from pdverify.solvers.ordering import nested_dissection
 
 EPS = np.finfo(float).eps
@@ -34,7 +35,8 @@ def split_system(n=24, reach=2):
 
 
 def test_top_split_decouples_the_halves():
-    """What SplitLU relies on: no entry couples the two halves of the top split."""
+    """What the top separator's size (the float32 factor's choice) is measured on: no
+    entry couples the two halves of the top split."""
     A, n1, n2 = split_system()
     assert n1 > 0 and n2 > 0 and n1 + n2 < A.shape[0]
     assert A[:n1, n1:n1 + n2].nnz == 0 and A[n1:n1 + n2, :n1].nnz == 0
@@ -44,13 +46,12 @@ def test_top_split_decouples_the_halves():
 
 
 @pytest.mark.parametrize("trans", ["N", "T"])
-def test_split_lu_in_double_is_an_exact_inverse(trans):
-    """In float64 the block elimination is exact: condition ~20, n = 576, so a
-    backward-stable solve is accurate to ~kappa n eps ~ 1e4 eps."""
+def test_single_lu_in_double_is_an_exact_inverse(trans):
+    """SingleLU in float64 is SuperLU's LU: condition ~20, n = 576, so a backward-stable
+    solve is accurate to ~kappa n eps ~ 1e4 eps, one or several right-hand sides."""
     A, n1, n2 = split_system()
     b = np.random.default_rng(3).normal(size=(A.shape[0], 2))
-    lu = SplitLU(A, n1, n2, dtype=np.float64)
-    assert lu.separator == A.shape[0] - n1 - n2
+    lu = SingleLU(A, dtype=np.float64)
     M = A.toarray() if trans == "N" else A.toarray().T
     exact = np.linalg.solve(M, b)
     x = lu.solve(b, trans=trans)
@@ -59,53 +60,12 @@ def test_split_lu_in_double_is_an_exact_inverse(trans):
         exact).max()
 
 
-def crossed_system():
-    """The split system with three half unknowns' diagonals made weak (1e-5) and a large
-    entry (-40) in a separator row of their columns: SuperLU's threshold pivoting (1e-3)
-    takes a separator row as pivot of a half's column."""
-    A, n1, n2 = split_system()
-    C = A.tocsc()
-    pairs = [(j, k) for j in range(n1, n1 + n2)
-             for k in C[:, j].nonzero()[0][-1:] if k >= n1 + n2][:3]
-    A = A.tolil()
-    for j, k in pairs:
-        A[j, j], A[k, j] = 1e-5, -40.0
-    return A.tocsr(), n1, n2
-
-
-@pytest.mark.parametrize("trans", ["N", "T"])
-def test_split_lu_with_a_separator_pivot_is_exact_in_double(trans):
-    """The rank-one correction of T_i for a separator row pivoted into a half: still an
-    exact inverse in float64 (condition 531, numpy.linalg.cond; n = 576: ~kappa n eps =
-    7e-11, and 1e4 eps = 2e-12 holds)."""
-    A, n1, n2 = crossed_system()
-    lu = SplitLU(A, n1, n2, dtype=np.float64)
-    assert lu.crossed_pivots >= 1
-    b = np.random.default_rng(8).normal(size=(A.shape[0], 2))
-    M = A.toarray() if trans == "N" else A.toarray().T
-    exact = np.linalg.solve(M, b)
-    assert np.abs(lu.solve(b, trans=trans) - exact).max() / np.abs(exact).max() < 1e4 * EPS
-
-
-def test_crossed_pivots_in_float32_and_beyond_the_limit(monkeypatch):
-    A, n1, n2 = crossed_system()
-    b = np.random.default_rng(9).normal(size=A.shape[0])
-    exact = np.linalg.solve(A.toarray(), b)
-    lu = SplitLU(A, n1, n2)
-    assert lu.crossed_pivots >= 1
-    x, _, _, ok = refine(A, b, lu.solve)
-    assert ok and np.abs(x - exact).max() / np.abs(exact).max() < 1e4 * EPS
-    monkeypatch.setattr(nested, "MAX_CROSSED_PIVOTS", 0)
-    with pytest.raises(RuntimeError, match="separator rows into a half"):
-        SplitLU(A, n1, n2)
-
-
-def test_float32_split_lu_refines_to_double_accuracy():
+def test_float32_lu_refines_to_double_accuracy():
     """One float32 solve is accurate to ~kappa eps32 (kappa ~ 20: ~1e-5); the refinement
     then reaches LAPACK dsgesv's test, residual <= sqrt(n) eps."""
     A, n1, n2 = split_system()
     b = np.random.default_rng(4).normal(size=A.shape[0])
-    lu = SplitLU(A, n1, n2)
+    lu = SingleLU(A)
     exact = np.linalg.solve(A.toarray(), b)
     once = lu.solve(b)
     err_once = np.abs(once - exact).max() / np.abs(exact).max()
@@ -199,7 +159,7 @@ def test_near_singular_system_is_refused_on_the_gmres_path():
 
 
 class SpreadFactor:
-    """An approximate factor of known error, in place of the float32 SplitLU: ``solve``
+    """An approximate factor of known error, in place of the float32 SingleLU: ``solve``
     applies M^-1 = A^-1 D (transposed: D A^-T), A^-1 by SuperLU in double and D diagonal,
     so the preconditioned matrix A M^-1 is D exactly, up to double rounding. The float32
     factor of a matrix near kappa ~ 1/eps32 leaves a preconditioned spectrum set by the
@@ -210,13 +170,11 @@ class SpreadFactor:
     CPU."""
 
     kind = "SuperLU in float64, scaled"
-    crossed_pivots = 0
 
     def __init__(self, A, spread):
         self.lu = spla.splu(sp.csc_matrix(A))
         self.d = spread
         self.factor_entries = int(self.lu.nnz)
-        self.separator = 0
 
     def solve(self, B, trans="N"):
         B = np.asarray(B, dtype=float)
@@ -360,7 +318,7 @@ def test_singular_system_is_refused_either_way(mixed):
 def test_refinement_reports_divergence():
     """An approximate inverse that is not one (half the true solve) does not converge."""
     A, n1, n2 = split_system()
-    lu = SplitLU(A, n1, n2, dtype=np.float64)
+    lu = SingleLU(A, dtype=np.float64)
     b = np.ones(A.shape[0])
     _, _, history, ok = refine(A, b, lambda r: -0.5 * lu.solve(r))
     assert not ok and history[-1] > 0.5 * history[-2]
@@ -404,8 +362,8 @@ def test_right_hand_sides_beyond_single_precision_range(size):
 
 
 def test_solve_in_a_forked_process():
-    """The worker threads are made per process: a child forked after the parent used them
-    (as report workers may be) still solves instead of waiting on threads it lacks."""
+    """A child forked after the parent solved (as report workers may be) solves the same
+    system bit for bit."""
     import multiprocessing
     A, x = lattice_operator(24, 2)
     b = np.ones(A.shape[0])
@@ -414,7 +372,7 @@ def test_solve_in_a_forked_process():
     with ctx.Pool(1) as pool:
         child, info = pool.apply_async(solve_nested, (A, b, x),
                                        {"where": "test", "mixed": True}).get(timeout=120)
-    assert info["mixed_precision"].startswith("float32 LU") and info["separator_unknowns"] > 0
+    assert info["mixed_precision"].startswith("float32 LU")
     assert np.array_equal(child, parent)      # the same operations: bit for bit
 
 
@@ -436,58 +394,28 @@ def _malloc_in_use():
     return info.uordblks + info.hblkhd
 
 
-@pytest.mark.parametrize("failing", [None, "second half", "separator"])
-def test_a_dropped_split_factor_gives_its_memory_back(failing, monkeypatch):
-    """scipy's SuperLU frees a factor's memory only in the thread that made it (its
-    allocations are tracked per thread; scipy issue 15921): SplitLU's halves, factored in
-    worker threads, are dropped there too (nested._release), also when the other half's
-    factor or the separator step fails (``failing``: the constructor raises). Before,
-    every SplitLU left all of its halves' SuperLU memory behind (at least the factor's
-    entries, 8 bytes each in float32 with their row indices) when dropped: the test
-    workers grew by 0.6 GB over the fast tier. Here three of them made and dropped may
-    leave less than one factor's bytes (what the interpreter's own caches keep is far
-    below that)."""
+def test_a_dropped_float32_factor_gives_its_memory_back():
+    """A float32 factor made and dropped (three times) leaves less than one factor's
+    bytes behind (its entries, 8 bytes each in float32 with their row indices; what the
+    interpreter's own caches keep is far below that). SplitLU, which it replaced, made
+    its halves in worker threads, where scipy's SuperLU had to free them too (its
+    allocations are tracked per thread; scipy issue 15921)."""
     import gc
     n = 100
-    A = sp.diags([-1.0, -1.0, 4.0, -1.0, -1.0], [-n, -1, 0, 1, n], shape=(n * n, n * n))
-    idx = np.arange(n * n).reshape(n, n)
-    p = np.r_[idx[:49].ravel(), idx[50:].ravel(), idx[49]]
-    A = A.tocsr()[p][:, p]
+    A = sp.diags([-1.0, -1.0, 4.0, -1.0, -1.0], [-n, -1, 0, 1, n],
+                 shape=(n * n, n * n)).tocsr()
     if _malloc_in_use() is None:
         pytest.skip("needs glibc's mallinfo2")
-    half = SplitLU(A, 49 * n, 50 * n).factor_entries // 2     # entries of one half
-    factor_half, separator_block = SplitLU._factor_half, SplitLU._separator_block
-    if failing == "second half":
-        def factor(C, idx, corner, m, dtype, key):
-            if idx[0] != 0:                         # the second half's rows
-                raise RuntimeError("refused")
-            return factor_half(C, idx, corner, m, dtype, key)
-        monkeypatch.setattr(SplitLU, "_factor_half", staticmethod(factor))
-    elif failing == "separator":
-        def block(lu, L_ss, U_ss, m):
-            separator_block(lu, L_ss, U_ss, m)
-            raise RuntimeError("refused")
-        monkeypatch.setattr(SplitLU, "_separator_block", staticmethod(block))
+    entries = SingleLU(A).factor_entries
 
     def one():
-        try:
-            lu = SplitLU(A, 49 * n, 50 * n)
-            assert lu.separator == n and not lu.crossed_pivots
-            lu.solve(np.ones(n * n))
-            del lu
-        except RuntimeError as exc:
-            assert failing and "refused" in str(exc)
-            # hold the exception until the halves' threads have dropped their factors:
-            # what its frames still hold is then freed here, in the wrong thread
-            for pool in nested._pools():
-                pool.submit(int).result()
+        lu = SingleLU(A)
+        lu.solve(np.ones(n * n))
+        del lu
         gc.collect()
-        for pool in nested._pools():    # the halves' threads have dropped them
-            pool.submit(int).result()
 
     one()                               # the first allocations
     before = _malloc_in_use()
     for _ in range(3):
         one()
-    assert not nested._HELD
-    assert _malloc_in_use() - before < 8 * half, (_malloc_in_use() - before, half)
+    assert _malloc_in_use() - before < 8 * entries, (_malloc_in_use() - before, entries)
