@@ -13,24 +13,27 @@ The report's own systems never reach GMRES-IR (its float32 runs all converge by 
 refinement: ``results.json`` records no ``refinement = GMRES-IR``), so this is the piece's
 whole use: the fallback for systems near 1/eps_single.
 
-Usage: python benchmarks/gmres_ir.py [--repeat 3] [--json FILE]
+Usage: python benchmarks/gmres_ir.py [--repeat 3] [--no-record]
 """
 from __future__ import annotations
 
 import argparse
-import json
 import statistics
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
-import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from pdverify.solvers import mixed  # noqa: E402
 from pdverify.solvers.nested import solve_nested  # noqa: E402
+# the test suite's ill-conditioned lattice systems (the GMRES-IR tests solve them)
+from tests.pdverify.test_split_lu import ill_conditioned  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import harness  # noqa: E402
 
 OURS = mixed._fgmres
 
@@ -42,63 +45,49 @@ def _scaled(r):
     return r, float(np.exp2(np.round(np.log2(big))))
 
 
-def scipy_left(A, r, precondition, *, max_iterations=None, extended_tol=0.0):
+def scipy_gmres(A, r, precondition, *, max_iterations=None, extended_tol=0.0, side="left"):
+    """scipy's GMRES on the same factor: ``M=`` (``side="left"``, scipy's own), or on the
+    operator A M with z = M y (``"right"``; not flexible: M must be linear)."""
     r, scale = _scaled(r)
     if r is None:
         return np.zeros(A.shape[0]), 0
     m = max(mixed.GMRES_MAX_ITERATIONS, max_iterations or 0)
     count = [0]
     M = spla.LinearOperator(A.shape, matvec=precondition, dtype=float)
+    op = A if side == "left" else spla.LinearOperator(
+        A.shape, matvec=lambda v: A @ precondition(v), dtype=float)
     with np.errstate(all="ignore"):
-        z, _ = spla.gmres(A, r / scale, rtol=mixed.GMRES_INNER_TOL, atol=0.0, restart=m,
-                          maxiter=1, M=M, callback=lambda _r: count.__setitem__(0, count[0] + 1),
+        y, _ = spla.gmres(op, r / scale, rtol=mixed.GMRES_INNER_TOL, atol=0.0, restart=m,
+                          maxiter=1, M=M if side == "left" else None,
+                          callback=lambda _r: count.__setitem__(0, count[0] + 1),
                           callback_type="pr_norm")
+        z = y if side == "left" else precondition(y)
     return z * scale, count[0]
 
 
-def scipy_right(A, r, precondition, *, max_iterations=None, extended_tol=0.0):
-    r, scale = _scaled(r)
-    if r is None:
-        return np.zeros(A.shape[0]), 0
-    m = max(mixed.GMRES_MAX_ITERATIONS, max_iterations or 0)
-    count = [0]
-    AM = spla.LinearOperator(A.shape, matvec=lambda v: A @ precondition(v), dtype=float)
-    with np.errstate(all="ignore"):
-        y, _ = spla.gmres(AM, r / scale, rtol=mixed.GMRES_INNER_TOL, atol=0.0, restart=m,
-                          maxiter=1, callback=lambda _r: count.__setitem__(0, count[0] + 1),
-                          callback_type="pr_norm")
-        z = precondition(y)
-    return z * scale, count[0]
+def scipy_left(A, r, precondition, **kw):
+    return scipy_gmres(A, r, precondition, side="left", **kw)
+
+
+def scipy_right(A, r, precondition, **kw):
+    return scipy_gmres(A, r, precondition, side="right", **kw)
 
 
 VARIANTS = {"pdverify FGMRES": OURS, "scipy gmres, left M": scipy_left,
             "scipy gmres on A M (right)": scipy_right}
 
 
-def lattice_operator(n, reach, seed=1):
-    ij = np.stack(np.meshgrid(np.arange(n), np.arange(n), indexing="ij"), -1).reshape(-1, 2)
-    d = np.abs(ij[:, None, :] - ij[None, :, :]).max(-1)
-    rng = np.random.default_rng(seed)
-    A = np.where(d <= reach, rng.uniform(-1, 0, d.shape), 0.0)
-    np.fill_diagonal(A, 0.0)
-    np.fill_diagonal(A, -A.sum(1) + 1.0)
-    return sp.csr_matrix(A), ij.astype(float)
-
-
-def ill_conditioned(kappa, n=24, reach=2):
-    A, x = lattice_operator(n, reach)
-    S = 0.5 * (A + A.T).toarray()
-    w = np.linalg.eigvalsh(S)
-    S = S - (w[0] - w[-1] / kappa) * np.eye(S.shape[0])
-    return sp.csr_matrix(S), x
-
-
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--kappa", type=float, nargs="*", default=[1e7, 1e8, 1e9, 1e10])
-    ap.add_argument("--json", type=Path)
+    harness.add_arguments(ap)
     args = ap.parse_args(argv)
+    with harness.Record(__file__, args) as rec:
+        rec["rows"] = _measure(args, rec)
+
+
+def _measure(args, rec):
     rows = []
     for kappa in args.kappa:
         A, x = ill_conditioned(kappa, n=32)
@@ -123,8 +112,9 @@ def main(argv=None):
             print(f"kappa {kappa:7.0e}  {name:28s} {statistics.median(times[name]):7.3f} s  "
                   f"{'float32 kept' if kept.startswith('float32') else 'double LU took over':20s}"
                   f"  {path:9s} err {err:.1e}")
-    if args.json:
-        args.json.write_text(json.dumps(rows, indent=1))
+        rec["rows"] = rows
+        rec.save()
+    return rows
 
 
 if __name__ == "__main__":

@@ -152,7 +152,7 @@ class Capture:
         walls = collections.defaultdict(list)
         cpus = collections.defaultdict(list)
         res = {}
-        for k in range(len(self.rows), len(self.rows) + self.repeat):
+        for k in range(len(self.rows), len(self.rows) + (self.repeat if names else 0)):
             for name in names[k % len(names):] + names[: k % len(names)]:  # rotated
                 try:
                     x, w, c = timed(LIBRARIES[name][1], A, b)
@@ -367,8 +367,10 @@ def _measure(args, rec, libs_info, libs):
     record = rec.results
     t0 = time.perf_counter()
 
+    timed_libs = [] if args.no_timing else libs
+
     def partial(rows, done, total):      # the record after every case
-        rec.update({"cases_done": f"{done} of {total}", "pieces": summarize(rows, libs),
+        rec.update({"cases_done": f"{done} of {total}", "pieces": summarize(rows, timed_libs),
                     "systems": rows})
         if args.json:
             harness.write_json(args.json, _flat(rec))
