@@ -136,7 +136,8 @@ class FrontalLU:
             loc[upd] = nf + np.arange(nu)
             F = np.zeros((m, m), dtype=self.dtype, order="F")
             # extend-add: the largest child's update matrix is set (F is zero there, a
-            # plain scatter: ~6x faster than adding), the others added
+            # plain scatter, ~6x faster than adding: record
+            # frontal-2026-11-27-set-largest-child), the others added
             kids = sorted(kids, key=lambda c: -updates[c][0].size)
             for i, c in enumerate(kids):
                 cu, U = updates.pop(c)

@@ -33,8 +33,9 @@ from ..errors import NumericalError
 CG_RTOL = 1e-10
 #: The solver error must stay below this fraction of the method error it serves (issue 12).
 SOLVER_ERROR_FRACTION = 1e-3
-#: Jacobi weight, as a fraction of 1 / rho(D^-1 K): 1.3 measured best of 1.0 / 1.3 on the
-#: indentation-size stiffness (10-14 iterations); the smoother converges below 2.
+#: Jacobi weight, as a fraction of 1 / rho(D^-1 K): 1.3 the better of 1.0 and 1.3 on the
+#: indentation-size stiffness (record solvers-2026-11-22-smoother-weight); the smoother
+#: converges below 2.
 SMOOTHER_WEIGHT = 1.3
 #: Weight of the prolongator's Jacobi smoothing step, as a fraction of 1 / rho(D^-1 K).
 PROLONGATOR_WEIGHT = 0.6

@@ -50,9 +50,9 @@ def dense_lu(n, nnz) -> bool:
 # -- auto on SPD lattices: CG or direct -----------------------------------------------
 
 #: ``solver="auto"`` picks CG (SPD systems with a lattice) from this many free unknowns:
-#: below it the direct solve takes about a second (1.2 s at the sheets' default 10,150
-#: unknowns) and is exact to round-off, and the report's default-size runs keep their
-#: direct solutions bit for bit.
+#: below it the direct solve takes about a second (1.1 s at the sheets' default 10,150
+#: unknowns: record sheet_solvers-2026-11-28-repeat-3) and is exact to round-off, and the
+#: report's default-size runs keep their direct solutions bit for bit.
 AUTO_ITERATIVE_UNKNOWNS = 20000
 
 
