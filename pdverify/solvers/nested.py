@@ -210,11 +210,9 @@ class SingleLU:
 
     It replaced ``SplitLU`` (the two halves of the top split factored in two threads, the
     separator by a dense Schur complement; issue 51): on the report's seven largest 2D
-    float32 runs it took 6.9 s of CPU against SplitLU's 8.9 s and the multifrontal
-    factor's 13.0 s, with 320-490 MB peak against 425-820 MB, the metrics the same to
-    2e-12 relative (``benchmarks/split_lu.py``, record
-    ``split_lu-2026-11-28-all-cases``): under ``report --jobs`` every core is busy, so
-    the split's second thread bought nothing."""
+    float32 runs it took 6.9 s of CPU against SplitLU's 8.9 s, with less memory (record
+    split_lu-2026-11-28-all-cases): under ``report --jobs`` every core is busy, so the
+    split's second thread bought nothing."""
 
     kind = "SuperLU"
 
