@@ -210,11 +210,9 @@ def pddo_system(model, dirichlet, exact, traction, moduli, body_load=None,
 
 # ------------------------------------------------------------------------------ static assembly
 #: SuperLU's column ordering of the PDDO system (square, nonsymmetric, partial pivoting):
-#: minimum degree on A + A^T. Whole runs, COLAMD against it (benchmarks/solvers.py
-#: --only pddo, medians of 3 alternating, a busy machine): plate2d-plane-strain 1.6x,
-#: 2.3x, 2.1x at h = 0.025, 0.02, 0.0125 (11.1 -> 5.3 s), body3d-traction 1.5x,
-#: body3d-manufactured 1.0x; the exactness metrics stay round-off (max_error_pct
-#: 4.1e-11 -> 7.3e-11 % at h = 0.0125).
+#: minimum degree on A + A^T: plate2d-plane-strain's whole runs 2.1x faster than under
+#: COLAMD at h = 0.0125, the exactness metrics still round-off (record
+#: solvers-2026-11-26-pddo).
 PDDO_ORDERING = "MMD_AT_PLUS_A"
 
 

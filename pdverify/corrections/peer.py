@@ -13,7 +13,7 @@ real nodes, divided by the norm of pdverify's ``none`` field at the same params)
   its setting; the run fails, naming it, when the field is farther from that model's
   solution than :func:`pdverify.nodeset.equilibrium` allows, and when bonds were lost.
 Both linear models are assembled and solved by pdverify in the same run, in its solve
-phase beside LAMMPS (on body3d-traction at h = 0.1: 0.62 s of LAMMPS in a 0.66 s run).
+phase beside LAMMPS, which takes nearly all of it (record peers-2026-11-28-twin-solves).
 """
 from __future__ import annotations
 
@@ -46,8 +46,9 @@ def _rel(a, b, scale) -> float:
 
 
 #: the report's peer runs: scene -> overrides (each run in both settings, with LAMMPS's
-#: influence and whole-cell volumes where the scene has those parameters); sizes kept small
-#: so that the runs add seconds to a full report (the 3D box at h = 0.1: 250 atoms, ~1 s)
+#: influence and whole-cell volumes where the scene has those parameters); sizes kept
+#: small so that the runs add seconds to a full report (~1 s for the 3D box at h = 0.1:
+#: record peers-2026-11-28-report-runs)
 REPORT_RUNS = {"body3d-traction": {"spacing": 0.1}, "plate2d-clamped": {},
                "plate2d-plane-strain": {}, "bar1d-traction": {}, "sheet2d-tension": {"spacing": 0.0025}}
 #: the bond-based scenes that solve through a peer (their own assembly; the static-state

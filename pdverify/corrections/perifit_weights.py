@@ -17,8 +17,8 @@ weights is a parameter of every run (``perifit_version``), so it is in results.j
 
 The weights are cached (issue 32): they depend only on perifit's code and on what it is
 given (node positions and volumes, horizon, families, model kind), and perifit's own
-assembly loops over nodes (``compute_weights_2d``: 15-17 s on the indentation block and
-the largest tension sheet, about a tenth of a full report's run time). An entry of the
+assembly loops over nodes (``compute_weights_2d``: about a tenth of a full report's run
+time, record report_cost-2026-11-27-perifit-weights). An entry of the
 cache folder's ``perifit`` folder (:func:`pdverify.outputs.cache_root`) is keyed by a
 SHA-256 of all of these, perifit's version and the digest of its source; a run that
 reads it records the CPU seconds the weights took when computed (perifit runs on one

@@ -297,11 +297,11 @@ def assemble_taylor(problem, order: int, corners: str = "normal-only") -> Linear
         return float((model.crossing_selector([plane]) @ K_b @ x[:ni])[0])
     counts = {"fictitious_nodes": int(g.n_ext - g.n_interior), "constraints": int(B.shape[0])}
     none = np.zeros(0, dtype=int), np.zeros(0)
-    # the augmented system, the constraint rows beside it: the solver layer forms what
-    # its solver needs (pdverify.solvers.front.solve_augmented: for nested dissection the
-    # bordered system, whose separators are half as thick as those of K's Lagrange system
-    # (on the seed-001 plate at h = 0.0125: 6.7 s against 19.6 s, solutions equal to
-    # 5e-13), with the multipliers of rows on the dilatations (3D) kept sparse)
+    # the augmented system, the constraint rows beside it: the solver layer forms what its
+    # solver needs (pdverify.solvers.front.solve_augmented: for nested dissection the
+    # bordered system, whose separators are half as thick as those of K's Lagrange system,
+    # 3x faster on the seed-001 plate (record solvers-2026-11-28-bordered), with the
+    # multipliers of rows on the dilatations (3D) kept sparse)
     A = model.augmented_stiffness(P)
     return LinearSystem(model, A, np.r_[rhs, np.zeros(A.shape[0] - rhs.size)], *none, ni,
                         B=B, c=c, solver=problem.solver, coords=unknown_coords(model, x_int),
@@ -324,10 +324,9 @@ def _taylor_on_shape(problem, order: int) -> LinearSystem:
     counts = shape_counts(g, fictitious_nodes=int(np.sum(g.kind == 1)),
                            constraints=int(B.shape[0]), boundary_points=int(points))
     none = np.zeros(0, dtype=int), np.zeros(0)
-    # COLAMD: on the hole plate's bordered system at h = 0.0125 m (13,016 unknowns, 622
-    # rows) SuperLU factors in 8.5-10 s with 24 M entries in L + U, against 42-52 s and
-    # 72-76 M with the scenes' minimum degree on A + A^T (the zero block of the
-    # multipliers defeats it)
+    # COLAMD: on the hole plate's bordered system SuperLU factors 4-6x faster than with
+    # the scenes' minimum degree on A + A^T, whose fill the zero block of the multipliers
+    # defeats (record plate_solvers-2026-11-26-hole-plate-bordered)
     return LinearSystem(model, model.stiffness(model.equilibrium_rows()), rhs, *none, ni,
                         B=B, c=c, counts=counts, ordering="COLAMD")
 
@@ -337,11 +336,10 @@ def _bond_forces(model, bonds=None):
     unknowns (displacements, then the real dilatations), the flux rows' factor: in 3D
     [K_e A_e A_U, K_theta A_Theta], each block within
     one horizon, which (with the mu unknowns of assemble_taylor) takes body3d-traction at
-    h = 0.05 from 11.0 M to 6.2 M non-zeros, 5.3 GB to 2.1 GB and 42 s to 36 s (whole
-    runs, /usr/bin/time; benchmarks/taylor3d.py times the parts); in 2D the bond forces of
-    the displacements beside zero dilatation columns, as before: there the one-horizon
-    form raised the plane-strain plate's condition estimate at h = 0.0125 from 2.1e5 to
-    6.8e9 and moved its errors by 3e-7 (relative). ``bonds``: only these rows
+    h = 0.05 from 5.3 GB to 2.1 GB (record taylor3d-2026-11-24-bond-forces); in 2D the
+    bond forces of the displacements beside zero dilatation columns, as before: there the
+    one-horizon form raised the plane-strain plate's condition estimate at h = 0.0125 from
+    2.1e5 to 6.8e9 and moved its errors by 3e-7 (relative). ``bonds``: only these rows
     (ascending; the flux rows need the face-crossing bonds only)."""
     ni = model.A_theta.shape[0]
     rows = model.bond_a.size if bonds is None else len(bonds)

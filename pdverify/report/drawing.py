@@ -17,8 +17,8 @@ def figure_tasks(owned, results, studies, figdir) -> list:
     The order is the drawing processes' schedule (each takes the next task when it is
     done): the overview, one of the longest tasks, first, and the convergence figures,
     short pieces once split by scene, last, so that the processes end close together
-    (the overview and all convergence figures, 2-3 s each, were the last two tasks).
-    :func:`figures_drawn` sorts the results back."""
+    (record report_cost-2026-11-27-figure-order). :func:`figures_drawn` sorts the results
+    back."""
     from . import figures
     from .figures import convergence, overview
     scenes = [scene for scene, _ in owned]

@@ -66,7 +66,7 @@ def lead_figures(scene_id: str, figures) -> tuple[list, int]:
 
 #: figures of a scene shown unfolded: one, so that every scene shows its main picture and
 #: the page stays under 50,000 px at 1400 px wide (issue 52; 80,500 px with all 65 of the
-#: full report's figures open, ``benchmarks/page_height.py``)
+#: full report's figures open: record page_height-2026-11-28-lead-figures)
 LEAD_FIGURES = 1
 
 

@@ -38,10 +38,9 @@ def condense(K, f, fixed, values):
     u[fixed] = values
     K = sp.csr_matrix(K)
     if K.has_canonical_format:
-        # rows, then columns, in CSR: no conversion of K. The same matrix as the CSC
-        # route below, entry for entry, and the same sums in the same order (a
-        # side measurement on the indentation's tangent and a plate system: bit for bit,
-        # 0.09 s against 0.25 s); tests/pdverify/test_condense.py
+        # rows, then columns, in CSR: no conversion of K. The same matrix as the CSC route
+        # below, entry for entry, and the same sums in the same order, a third of its time
+        # (record indentation-2026-11-27-condense-csr); tests/pdverify/test_condense.py
         rows = K[free]
         K_free = rows[:, free]
         r = f[free] - rows[:, fixed] @ u[fixed] if np.size(fixed) else f[free]

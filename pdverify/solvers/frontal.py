@@ -17,10 +17,9 @@ post-order and back in reverse (:meth:`FrontalLU.solve`, also with A^T).
 An unknown with a zero diagonal entry (the Taylor systems' ghost rows) is eliminated in the
 front of its last coupled unknown, where its partners' elimination has filled its diagonal
 (:meth:`FrontalLU._fronts_of`). Pivots are chosen only among a front's fully summed rows
-(no delayed pivoting: tried with SuperLU's threshold test at 0.1 over the whole column and
-up to three passes per front, on body3d-manufactured's order-2 Taylor system it delayed 176
-pivots, made the factor 1.8x slower and its solves no more accurate); large fronts
-(:data:`MERGE_SIZE`) give the pivot search enough rows."""
+(no delayed pivoting: tried, it made the factor 1.8x slower and its solves no more
+accurate: record frontal-2026-11-27-delayed-pivoting); large fronts (:data:`MERGE_SIZE`)
+give the pivot search enough rows."""
 from __future__ import annotations
 
 import numpy as np
@@ -31,15 +30,10 @@ from .mixed import scaled_solve
 
 #: Subtrees of at most this many unknowns are one front (:meth:`SeparatorTree.merged`):
 #: fewer, larger dense fronts, fewer Python steps, and more rows for each front's pivot
-#: search, which is what sets the float32 factor's accuracy here. Measured
-#: (``benchmarks/frontal.py --merge``; error of the float32 solve of A x = b, random x,
-#: relative to max |x|): body3d-manufactured's order-2 Taylor system (12,880 unknowns)
-#: 2.7 at merge 1024, 2.2 at 2048, 0.17 at 4096, SuperLU's 0.21 (at 256 its plain
-#: refinement stalls and GMRES-IR takes 11 s); body3d-traction's order-1 surface-node
-#: system 1.5e-2, 1.9e-3, 5.1e-4, SuperLU's 5.6e-4; the factor time changes little (3.6,
-#: 3.6, 3.9 s on the Taylor system). The price is fill on the smaller 3D systems:
-#: body3d-traction's uncorrected system (7,880 unknowns) 26.5 M entries at 1024, 40.7 M
-#: at 4096 (SuperLU 21.6 M), its run's peak memory 0.54 -> 0.60 GB.
+#: search, which is what sets the float32 factor's accuracy here: the float32 solve's
+#: error on body3d-manufactured's order-2 Taylor system 0.17 at 4096 against 2.7 at 1024
+#: (SuperLU's 0.21), at the price of fill on the smaller 3D systems (record
+#: frontal-2026-11-27-merge).
 MERGE_SIZE = 4096
 
 
@@ -47,10 +41,9 @@ _dlaswp, = get_lapack_funcs(("laswp",), dtype=np.float64)
 
 
 #: From this many update unknowns a child's update matrix goes into its parent front
-#: column run by column run (:func:`_extend_add`); below, by one ``np.ix_`` scatter.
-#: Measured (float32, a side measurement, minimum of 3): 4,258 update unknowns in 61 runs
-#: of consecutive places 565 -> 109 ms, in 500 runs 520 -> 207 ms, each place its own run
-#: 579 -> 209 ms; 500 unknowns in 50 runs 2.0 -> 1.0 ms, in 500 runs 2.2 -> 2.8 ms.
+#: column run by column run (:func:`_extend_add`); below, by one ``np.ix_`` scatter:
+#: 2.5-5x faster by runs at 4,258 update unknowns, even at 500 (record
+#: frontal-2026-11-27-extend-add).
 EXTEND_ADD_BY_RUNS_FROM = 512
 
 
@@ -89,13 +82,12 @@ class FrontalLU:
 
     def __init__(self, A, tree, dtype=np.float32, *, merge: int = MERGE_SIZE):
         # the columns in the factor's precision (the fronts are), canonical (sorted, no
-        # duplicates: a transposition sorts, linear time); the rows from A itself unless it
-        # has duplicates (memory: one copy of A fewer while the fronts are factored). The
-        # values are cast after the transposition: scipy's astype first sorts and sums the
-        # duplicates of its input, and the nested-dissection ordering hands A over with
-        # unsorted rows (body3d-manufactured's order-3 surface-node system, 12.8 M
-        # entries, medians of 5: 0.20 s against 0.50 s, the same C bit for bit; a side
-        # measurement)
+        # duplicates: a transposition sorts, linear time); the rows from A itself unless
+        # it has duplicates (memory: one copy of A fewer while the fronts are factored).
+        # The values are cast after the transposition: scipy's astype first sorts and sums
+        # the duplicates of its input, and the nested-dissection ordering hands A over
+        # with unsorted rows (2.5x faster, the same C bit for bit: record
+        # frontal-2026-11-27-cast-order)
         self.dtype = np.dtype(dtype)
         A = sp.csr_matrix(A)
         C = A.tocsc().astype(self.dtype)
@@ -144,7 +136,8 @@ class FrontalLU:
             loc[upd] = nf + np.arange(nu)
             F = np.zeros((m, m), dtype=self.dtype, order="F")
             # extend-add: the largest child's update matrix is set (F is zero there, a
-            # plain scatter: ~6x faster than adding), the others added
+            # plain scatter, ~6x faster than adding: record
+            # frontal-2026-11-27-set-largest-child), the others added
             kids = sorted(kids, key=lambda c: -updates[c][0].size)
             for i, c in enumerate(kids):
                 cu, U = updates.pop(c)
@@ -152,8 +145,8 @@ class FrontalLU:
                 del U
             # A's entries whose first eliminated index is an own one (no duplicates: +=),
             # placed by their offsets in F's Fortran-ordered buffer: one-dimensional
-            # indexing, the same sums, half the time of F[rows, cols] (2.3 M entries:
-            # 0.075 s against 0.158 s, a side measurement)
+            # indexing, the same sums, half the time of F[rows, cols] (record
+            # frontal-2026-11-27-flat-index)
             flat = F.reshape(-1, order="F")     # a view
             keep = step[R.col] >= k
             flat[R.row[keep] + loc[R.col[keep]] * m] += R.data[keep]

@@ -6,18 +6,14 @@ so its high-frequency spectrum is flat (~ a constant times the identity) and wei
 Jacobi smooths it well; what Jacobi cannot reach are the smooth modes, above all the
 rigid-body motions. A coarse space spanned by the rigid-body modes of lattice blocks about
 one horizon wide (seed 003's m = 6 nodes), smoothed once by Jacobi, captures them. On the
-indentation-size bond-based stiffness (160 x 160 nodes, m = 6, 50,880 unknowns) CG
-converges to a relative residual of 1e-10 in 12 iterations, 0.41 s a solve
-(``benchmarks/solvers.py``); pyamg's smoothed aggregation with the same near-null space
-needed 12 iterations too, but its Gauss-Seidel smoother made a solve 1.5 s (a side
-measurement on the same matrix).
+indentation-size bond-based stiffness (50,880 unknowns) CG converges to 1e-10 in 12
+iterations, 0.41 s a solve, where pyamg's smoothed aggregation took 1.5 s (record
+solvers-2026-11-22-cg-two-level).
 
-The aggregates' width hardly matters: on a tangent of the half indentation model (26,082
-unknowns, a preconditioner built on the tangent 30 solves earlier; a side measurement,
-issue 32, one BLAS thread) widths 3, 4, 5, 6, 8 lattice nodes (coarse sizes 4,536 to
-692) took 19, 19, 20, 21, 23 iterations to 1e-6 at 34, 24, 19, 17, 16 ms an iteration:
-the Jacobi smoother, not the coarse space, sets the rate, and one horizon (m = 6) is as
-fast as any.
+The aggregates' width hardly matters: widths 3 to 8 lattice nodes took 19 to 23 iterations
+on a tangent of the half indentation model (record
+indentation-2026-11-27-aggregate-width): the Jacobi smoother, not the coarse space, sets
+the rate, and one horizon (m = 6) is as fast as any.
 """
 from __future__ import annotations
 
@@ -37,8 +33,9 @@ from ..errors import NumericalError
 CG_RTOL = 1e-10
 #: The solver error must stay below this fraction of the method error it serves (issue 12).
 SOLVER_ERROR_FRACTION = 1e-3
-#: Jacobi weight, as a fraction of 1 / rho(D^-1 K): 1.3 measured best of 1.0 / 1.3 on the
-#: indentation-size stiffness (10-14 iterations); the smoother converges below 2.
+#: Jacobi weight, as a fraction of 1 / rho(D^-1 K): 1.3 the better of 1.0 and 1.3 on the
+#: indentation-size stiffness (record solvers-2026-11-22-smoother-weight); the smoother
+#: converges below 2.
 SMOOTHER_WEIGHT = 1.3
 #: Weight of the prolongator's Jacobi smoothing step, as a fraction of 1 / rho(D^-1 K).
 PROLONGATOR_WEIGHT = 0.6
@@ -161,15 +158,13 @@ class TwoLevelPreconditioner:
         P = (T - sp.diags((PROLONGATOR_WEIGHT / rho) * d_inv) @ (K @ T)).tocsr()
         # The preconditioner works in single precision (CG itself in double): it only has
         # to be a fixed SPD approximation, and halving its bytes took a 12-iteration solve
-        # from 0.47 s to 0.40 s (a side measurement on the indentation-size stiffness).
+        # from 0.47 to 0.40 s (record solvers-2026-11-22-float32-preconditioner).
         self._P32 = P.astype(np.float32).tocsr()
         self._PT32 = self._P32.T.tocsr()
         self._P = P
         # fused: K (x1 + P e) = K x1 + (K P) e, one product with K per application instead
-        # of two; the same operator in exact arithmetic (float32 round-off apart), 8.1 ms
-        # against 12.5 ms an application on the half indentation's tangent (26,082 unknowns,
-        # CPU time, one BLAS thread, mean of 20, a side measurement;
-        # benchmarks/indentation.py times whole curves)
+        # of two; the same operator in exact arithmetic (float32 round-off apart), a third
+        # less time an application (record indentation-2026-11-24-fused)
         self.fused = fused
         self._operator_parts(K, d_inv, (P.T @ (K @ P)).toarray())
         self.setup_s = time.perf_counter() - t0
@@ -204,12 +199,9 @@ class TwoLevelPreconditioner:
         (the caller then builds anew), else True; either way its time is added to
         :attr:`setup_s`.
 
-        Why: on the paper grid's half indentation (26,082 unknowns) a preconditioner built
-        on an earlier tangent needed 31 CG iterations to 1e-8 where a fresh build needed
-        18; refreshed, 18 too, for about half a build's time (0.71 against 1.28 s, the
-        tentative and smoothed prolongators not recomputed; a side measurement on a
-        tangent saved mid-curve, a loaded machine), plus ~0.2 s for the radius check. ``benchmarks/indentation.py`` times
-        whole curves."""
+        Why: on the paper grid's half indentation a refreshed preconditioner needed 18 CG
+        iterations where one built on an earlier tangent needed 31, for about half a
+        build's time (record indentation-2026-11-27-refresh)."""
         t0 = time.perf_counter()
         K = sp.csr_matrix(K)
         d_inv = _inverse_diagonal(K)

@@ -11,16 +11,16 @@ from .checks import checked_condition, equilibrate, relative_residual
 
 
 #: SuperLU options for a symmetric positive definite K (no constraint rows): minimum
-#: degree on A + A^T and diagonal pivots, which keep the symmetric fill; on a 2D
-#: bond-based sheet (10k unknowns, 1.5 M non-zeros) 0.74 s against 1.87 s with the
-#: default COLAMD column ordering (benchmarks/sheet_solvers.py).
+#: degree on A + A^T and diagonal pivots, which keep the symmetric fill: 2.8x faster than
+#: the default COLAMD on the tension sheet (record sheet_solvers-2026-11-28-repeat-3;
+#: earlier sheet_solvers-2026-11-22-spd-options).
 SPD_OPTIONS = dict(permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
                    options=dict(SymmetricMode=True))
 
 # ``ordering`` of solve_constrained is SuperLU's permc_spec (COLAMD, MMD_AT_PLUS_A,
-# MMD_ATA, NATURAL). Measured, not assumed (benchmarks/plate_solvers.py): minimum degree
-# on A + A^T is ~3x faster than the default COLAMD on the seed-000 plate's Lagrange system,
-# but ~1.6x slower on the seed-001 surface-node plate, so each scene states its choice.
+# MMD_ATA, NATURAL). Measured, not assumed: minimum degree on A + A^T is ~3x faster than
+# COLAMD on the seed-000 plate's Lagrange system, slower on the seed-001 surface-node
+# plate (record plate_solvers-2026-11-22-orderings), so each scene states its choice.
 
 
 class SuperLUFactor:

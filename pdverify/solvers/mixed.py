@@ -94,9 +94,10 @@ def refine_with_probe(A, b, lu):
 
 
 #: GMRES-IR: each correction's GMRES stops at this relative residual (2-norm), so that an
-#: outer step gains ~8 digits (measured on body3d-manufactured's order-3 surface-node
-#: system, condition 9.2e6: two outer steps of 6 GMRES iterations each reach 4e-16,
-#: benchmarks/mixed_precision.py) ...
+#: outer step gains ~8 digits (two outer steps of 6 iterations reach 4e-16 on
+#: body3d-manufactured's order-3 surface-node system: record
+#: mixed_precision-2026-11-26-gmres-inner-tol; the flexible GMRES against scipy's: record
+#: gmres_ir-2026-11-28) ...
 GMRES_INNER_TOL = 1e-8
 #: ... within at most this many iterations (no restart: the two bases, V and Z, of 10^4
 #: unknowns x 60 are 10 MB); a correction that has not converged by then is used as it
@@ -104,19 +105,15 @@ GMRES_INNER_TOL = 1e-8
 GMRES_MAX_ITERATIONS = 60
 #: outer steps of GMRES-IR (each gains ~8 digits when GMRES converges)
 GMRES_OUTER_STEPS = 6
-#: The condition estimator's GMRES passes may run on beyond :data:`GMRES_MAX_ITERATIONS`, to
-#: at most this many iterations, while they have not reached a tenth of
-#: :data:`ESTIMATOR_RESIDUAL` (a margin for GMRES's recurrence residual against the true one
-#: that :meth:`GmresIR.solve` checks): near kappa ~ 1/eps_single the float32 factor leaves
-#: dozens of eigenvalues of the preconditioned matrix far from 1, and GMRES's residual stays
-#: at ~1 until it has them all. Measured on body3d-manufactured's order-2 Taylor system
-#: (12,880 unknowns, condition 1.3e7): the corrections converge in 55-60 iterations, the
-#: transposed pass from sign(x) stays above 0.99 for 70 iterations and reaches 4e-5 at 100
-#: (the factor's transposed solves are the poorer: relative residual 505 against A^T, 21
-#: against A, on a random vector; ``benchmarks/mixed_precision.py --estimator``). Capped
-#: at 60, that system was factored again in double though its solve had converged. Four
-#: times the corrections' limit: the bases of
-#: 10^4 unknowns x 240 are 40 MB, and only the iterations run are touched.
+#: The condition estimator's GMRES passes may run on beyond :data:`GMRES_MAX_ITERATIONS`,
+#: to at most this many iterations, while they have not reached a tenth of
+#: :data:`ESTIMATOR_RESIDUAL` (a margin for GMRES's recurrence residual against the true
+#: one that :meth:`GmresIR.solve` checks): near kappa ~ 1/eps_single the float32 factor
+#: leaves dozens of eigenvalues of the preconditioned matrix far from 1, and GMRES's
+#: residual stays at ~1 until it has them all (on body3d-manufactured's order-2 Taylor
+#: system for 70 iterations; capped at 60 it was factored again in double: record
+#: mixed_precision-2026-11-26-estimator-iterations). Four times the corrections' limit:
+#: the bases of 10^4 unknowns x 240 are 40 MB, and only the iterations run are touched.
 ESTIMATOR_MAX_ITERATIONS = 4 * GMRES_MAX_ITERATIONS
 #: The condition estimator's solves y ~ A^-1 v (one GMRES pass each) must reach this true
 #: relative residual ||A y - v|| / ||v|| (2-norm): then y = A^-1 (v + r) with ||r|| <= tau
@@ -136,10 +133,8 @@ class GmresIR:
     :data:`ESTIMATOR_MAX_ITERATIONS`, whose true residual it checks (``worst_residual``,
     the largest relative residual of its solves; see :data:`ESTIMATOR_RESIDUAL`; once a
     pass has failed, the later ones return zeros unsolved: the double LU decides).
-    Hager's estimator needs A^-1 x to a few digits only
-    (measured on body3d-manufactured's order-2 Taylor system, condition 1e7,
-    ``benchmarks/mixed_precision.py --stages``: the same estimate, 1.01e7, in 13.3 s
-    against 26.6 s with each solve refined to round-off; the solve itself 16.2 s).
+    Hager's estimator needs A^-1 x to a few digits only (the same estimate in half the
+    time of solves refined to round-off: record mixed_precision-2026-11-26-stages).
     ``iterations``: GMRES iterations of each pass, in order."""
 
     def __init__(self, A, lu):

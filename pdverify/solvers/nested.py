@@ -19,31 +19,19 @@ from .ordering import nested_dissection
 
 #: SuperLU's diagonal pivot threshold under the nested-dissection ordering: a diagonal
 #: entry is kept as pivot unless it is below 1e-3 of its column's largest, so the ordering
-#: survives. Measured on the plane-strain plate's augmented system at h = 0.01 (a side
-#: measurement): 1e-3 and 1e-2 give the same accuracy (solution error 7e-13, PARDISO's
-#: 6e-13); 0.1 is 1.7x slower, and 1.0 (full partial pivoting) 9.8x slower with 3.3x the
-#: fill.
+#: survives; 1e-2 is as accurate, full partial pivoting 9.8x slower (record
+#: solvers-2026-11-22-nd-pivot-threshold).
 ND_PIVOT_THRESHOLD = 1e-3
 ND_OPTIONS = dict(permc_spec="NATURAL", diag_pivot_thresh=ND_PIVOT_THRESHOLD,
                   options=dict(SymmetricMode=True))
 
-#: ... and the single-precision factor's (:class:`SingleLU`): 0.1 (issue 32),
-#: which bounds the element growth that eps_single multiplies. Measured
-#: (``benchmarks/mixed_precision.py --threshold``; one process each, the machine shared)
-#: on the 3D boxes' systems whose plain refinement stalls at 1e-3: at 0.1 it converges,
-#: with 2-4% more fill: body3d-manufactured's order-2 Taylor system (12,880 unknowns,
-#: condition 1.2e7) 7 steps, 3 s, against GMRES-IR's 55-60 iterations per correction
-#: (~40 s with the estimator); body3d-traction's order-1 7 steps, 1.2 s, against 18 s;
-#: body3d-manufactured's order-3 surface-node system 4 steps, 1.7 s, against 8.9 s. Over
-#: the report's float32 runs (each run at both thresholds alternating, a busy machine):
-#: the five 3D runs that took GMRES-IR at 1e-3 took 58.4 -> 20.7 s (Taylor order 2),
-#: 28.7 -> 19.7, 51.8 -> 37.9, 57.0 -> 21.6, 25.9 -> 19.2 s; a 3D run whose plain
-#: refinement converged at 1e-3 pays 14 % more fill (surface nodes order 1: 44.9 -> 51.1
-#: M entries, CPU 15.5 -> 17.5 s), the 57 float32 runs of the 2D plates and sheets 74.4
-#: against 74.5 s; every metric the same to 1e-9 relative or round-off. At 1e-3
-#: (ND_PIVOT_THRESHOLD, kept for the double factor) the symmetric 576-unknown operator
-#: with 200 small eigenvalues of tests/pdverify/test_split_lu.py (kappa 1e8) converges by
-#: GMRES-IR, at 0.1 by neither refinement (the double LU then solves it).
+#: ... and the single-precision factor's (:class:`SingleLU`): 0.1 (issue 32), which bounds
+#: the element growth that eps_single multiplies: on the 3D boxes' systems whose plain
+#: refinement stalls at 1e-3 it converges, and the report's five 3D runs that took
+#: GMRES-IR at 1e-3 ran 1.3-2.8x faster (record mixed_precision-2026-11-26-threshold). At
+#: 1e-3 (ND_PIVOT_THRESHOLD, kept for the double factor) the symmetric 576-unknown
+#: operator with 200 small eigenvalues of tests/pdverify/test_split_lu.py (kappa 1e8)
+#: converges by GMRES-IR, at 0.1 by neither refinement (the double LU then solves it).
 FLOAT32_PIVOT_THRESHOLD = 0.1
 
 
@@ -57,21 +45,9 @@ def _options(dtype):
 #: The float32 factor of a system whose top separator is large (the 3D boxes:
 #: :func:`~pdverify.solvers.policy.frontal_factor`) is the multifrontal
 #: :class:`~pdverify.solvers.frontal.FrontalLU` (dense BLAS-3 fronts), with SuperLU's as
-#: the fallback when it fails (issue 32). Measured (``benchmarks/frontal.py``: a fresh
-#: process each, one BLAS thread, alternating, medians of 3; SuperLU -> FrontalLU): the
-#: order-1 Taylor system of body3d-traction (12,840 unknowns) factor 27.7 -> 6.3 s,
-#: 72.0 -> 75.7 M entries, plain refinement 6 -> 5 steps, 2.1 -> 1.5 s, peak 678 -> 616
-#: MB; body3d-manufactured's order-2 Taylor system (12,880) 14.3 -> 3.3 s, 7 -> 8 steps,
-#: 1.2 -> 1.2 s, 679 -> 629 MB; its order-3 surface-node system (10,700) 11.7 -> 4.7 s,
-#: 61.6 -> 77.6 M entries, 4 -> 5 steps, 784 -> 921 MB; body3d-traction's uncorrected
-#: system (7,880) 5.3 -> 3.0 s, 21.6 -> 40.7 M entries, 334 -> 486 MB. The refined
-#: displacements differ from SuperLU's path by 4e-13, 8e-14, 1.5e-12 and 5e-14 of their
-#: largest entry (condition 3e7, 1e7, 9e6, 6e4: round-off; on the third the double LU and
-#: PARDISO differ by 1.3e-12). The report's runs on this path (body3d-traction,
-#: body3d-manufactured, plate2d-plane-strain): every metric the same to 1e-9 relative;
-#: body3d-traction's ten runs 155-188 s -> 88-103 s in all, body3d-manufactured's 21 on
-#: this path 159-165 s -> 104-148 s (two report passes each, alternating, the machine
-#: shared and busy).
+#: the fallback when it fails (issue 32): body3d-traction's order-1 Taylor factor 27.7 ->
+#: 6.3 s, the report's metrics the same to 1e-9 relative (record
+#: frontal-2026-11-27-superlu-frontal).
 FRONTAL_FACTOR = True
 
 
@@ -234,11 +210,9 @@ class SingleLU:
 
     It replaced ``SplitLU`` (the two halves of the top split factored in two threads, the
     separator by a dense Schur complement; issue 51): on the report's seven largest 2D
-    float32 runs it took 6.9 s of CPU against SplitLU's 8.9 s and the multifrontal
-    factor's 13.0 s, with 320-490 MB peak against 425-820 MB, the metrics the same to
-    2e-12 relative (``benchmarks/split_lu.py``, record
-    ``split_lu-2026-11-28-all-cases``): under ``report --jobs`` every core is busy, so
-    the split's second thread bought nothing."""
+    float32 runs it took 6.9 s of CPU against SplitLU's 8.9 s, with less memory (record
+    split_lu-2026-11-28-all-cases): under ``report --jobs`` every core is busy, so the
+    split's second thread bought nothing."""
 
     kind = "SuperLU"
 

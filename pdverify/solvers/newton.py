@@ -30,15 +30,9 @@ LINE_SEARCH_HALVINGS = 12
 #: min(FORCING_MAX, ||f|| / scale), which keeps Newton's quadratic convergence (the
 #: forcing term is O(||f||); Eisenstat and Walker 1996) and spends no iterations far away;
 #: it is never tighter than the last step to the stopping rule needs.
-#: The tangent predictor's solve uses it too. Measured and not taken (issue 32, the paper
-#: grid's half model, a side measurement): the predictor solved to 1e-3 instead (its own
-#: nonlinear error is ~1e-3 of its right-hand side, so 1e-2 leaves the first residual
-#: four-fifths linear error) took the corrected curve from 102 to 90 linear solves, the
-#: CG iterations unchanged (775 / 780), and its solve phase 3-5 % shorter, within the
-#: machine's noise; the failing runs failed at the same depths; the forces moved by
-#: 0.9e-9 (nonlinear) and 1.7e-9 (linear kinematics) relative, past the report's compare
-#: rule (1e-9) for a few per cent of one scene. A Galerkin start from the last three
-#: solutions (Krylov recycling) left 70-100 % of each right-hand side: no gain.
+#: The tangent predictor's solve uses it too; solved to 1e-3 instead it saved no
+#: measurable time and moved the forces past the compare rule (record
+#: indentation-2026-11-27-predictor-forcing).
 FORCING_MAX = 1e-2
 #: Floor of the CG tolerance (the reference tolerance of the solver layer).
 FORCING_MIN = 1e-10
@@ -51,11 +45,9 @@ FORCING_MIN = 1e-10
 #: estimate of a fresh one's, hence the factor. Counted in iterations, not seconds, so
 #: that a run is reproducible bit for bit.
 REBUILD_FACTOR = 3.0
-#: What a refresh costs in CG iterations: 0.45 s against ~18 ms per iteration on the paper
-#: grid's half indentation (26,082 unknowns; a build is 1.2 s); its radius check
-#: (iterative.REFRESH_RADIUS_GROWTH) added ~0.2 s later, not re-tuned. Refreshing instead
-#: of rebuilding (at 65 iterations a build) took the corrected curve from 1004 CG
-#: iterations and 3 builds to 775 and 1 build (benchmarks/indentation.py).
+#: What a refresh costs in CG iterations (0.45 s against ~18 ms an iteration on the paper
+#: grid's half indentation; refreshing took its corrected curve from 1004 CG iterations to
+#: 775: record indentation-2026-11-26-refresh-cost).
 REFRESH_COST_ITERATIONS = 25
 
 

@@ -5,10 +5,9 @@ set by its separators. Splitting the unknowns at the median coordinate of the lo
 extent, and taking as separator the unknowns of one side that the matrix couples to the
 other, gives separators one reach thick, the best possible for a lattice operator.
 SuperLU's own orderings (COLAMD, minimum degree) do not see the geometry: on the seed-001
-plane-strain plate at h = 0.01 (augmented system, 30,600 unknowns) this ordering makes
-SuperLU's factor 3.1e7 entries against 6.6e7 under minimum degree (a side measurement),
-and the whole solve 6.0x faster than today's COLAMD solve of the multiplied-out stiffness
-(benchmarks/solvers.py: 3.22 s against 19.49 s). The first split also lets the two halves
+plane-strain plate at h = 0.01 the whole solve under this ordering is 6.0x faster than
+COLAMD's of the multiplied-out stiffness (record solvers-2026-11-22-nested-dissection).
+The first split also lets the two halves
 be told apart (the top separator's size chooses the float32 factor,
 :func:`pdverify.solvers.policy.frontal_factor`).
 """
@@ -17,8 +16,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-#: Subdomains of at most this many unknowns are not split further (measured: 16-64 give
-#: the same factor time on the 2D plate; 256 is 25 % slower).
+#: Subdomains of at most this many unknowns are not split further: 16-64 give the same
+#: factor time on the 2D plate, 256 is 25 % slower (record solvers-2026-11-22-leaf-size).
 LEAF_SIZE = 64
 
 

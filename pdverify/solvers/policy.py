@@ -50,9 +50,9 @@ def dense_lu(n, nnz) -> bool:
 # -- auto on SPD lattices: CG or direct -----------------------------------------------
 
 #: ``solver="auto"`` picks CG (SPD systems with a lattice) from this many free unknowns:
-#: below it the direct solve takes about a second (1.2 s at the sheets' default 10,150
-#: unknowns) and is exact to round-off, and the report's default-size runs keep their
-#: direct solutions bit for bit.
+#: below it the direct solve takes about a second (1.1 s at the sheets' default 10,150
+#: unknowns: record sheet_solvers-2026-11-28-repeat-3) and is exact to round-off, and the
+#: report's default-size runs keep their direct solutions bit for bit.
 AUTO_ITERATIVE_UNKNOWNS = 20000
 
 
@@ -66,11 +66,8 @@ def lattice_uses_cg(requested: str, iterative_ok: bool, free_unknowns: int) -> b
 
 #: ... and below it, on a 2D lattice, nested dissection (the lattice's coordinates give
 #: the ordering) from :data:`ND_FROM_UNKNOWNS` free unknowns unless the dense LU applies
-#: (:func:`dense_lu`): sheet2d-clamped at m = 6 (10,366 unknowns) 1.4-2.3x faster than
-#: SuperLU's symmetric mode, at m = 12 (a dense LU) slower, perifit's tension sheet
-#: (10,150) even; over the full report's runs (benchmarks/lattice_nd.py, one run each
-#: alternating, a busy machine): sheet2d-clamped 91.9 -> 72.7 s (26 of 38 runs take it),
-#: sheet2d-tension 135.0 -> 126.8 s; the metrics equal to 6e-12 relative.
+#: (:func:`dense_lu`): sheet2d-clamped's full-report runs 92 -> 73 s, the metrics equal to
+#: 6e-12 relative (record lattice_nd-2026-11-26-full-report).
 LATTICE_ND_DIMS = (2,)
 
 
@@ -89,14 +86,11 @@ def lattice_note(use_cg: bool, free_unknowns: int, nd: bool = False) -> str:
             f"{ND_FROM_UNKNOWNS} on 2D lattices unless the LU is dense)")
 
 
-#: The indentation's Newton steps (:class:`~pdverify.solvers.newton.DirichletLinearSolver`):
-#: ``solver=auto`` uses CG from this many unknowns: on the quick grid (41 x 41 nodes,
-#: m = 6, 3,362 unknowns) a sparse LU per Newton step made the corrected curve 13 s, CG
-#: 2.6 s. On the paper grid's half model (26,082 unknowns, 5.6 M entries; a side
-#: measurement, issue 32) SuperLU's float32 factor of a tangent (MMD on A^T + A, symmetric
-#: mode) took 4.7 s with 46.8 M entries and 38 ms a solve: a factor per load step would
-#: cost more than the whole CG curve, and reused as CG's preconditioner an iteration
-#: (38 ms + the 8 ms product) would cost twice the two-level one's (~22 ms).
+#: The indentation's Newton steps
+#: (:class:`~pdverify.solvers.newton.DirichletLinearSolver`): ``solver=auto`` uses CG from
+#: this many unknowns: on the quick grid (3,362 unknowns) the corrected curve took 13 s
+#: with a sparse LU per Newton step, 2.6 s with CG (record
+#: indentation-2026-11-23-newton-cg).
 NEWTON_CG_FROM_UNKNOWNS = 1000
 
 
@@ -111,29 +105,23 @@ def newton_solver(requested: str, unknowns) -> str:
 # -- auto on state-based problems: nested dissection or direct ------------------------
 
 #: ``solver=auto`` solves the augmented system (dilatations as unknowns) under nested
-#: dissection from this many displacement unknowns in 2D. Whole runs of
-#: plate2d-plane-strain, direct against nested dissection (benchmarks/solvers.py --only
-#: crossover2d, medians of 3 alternating, a busy machine): 0.73x at 800 unknowns (none,
-#: h = 0.05) and 1.84x at 960 (surface nodes), 1.7-2.5x at 1,250-1,450 (h = 0.04),
-#: 3.0-3.7x at 3,200-5,400 (h = 0.025, 0.02; COLAMD's SuperLU took 1.5-4.7 s), 2.2-3.2x at
-#: m = 4, 5 and 1.1-1.4x at m = 8 (where the direct solve is a dense LU); the same
-#: rel_l2_error to the printed digits. It was 8,000 until issue 32, so that the
-#: default-size runs kept their solutions bit for bit; they now change at round-off
-#: (compare --rtol 1e-9 finds nothing).
+#: dissection from this many displacement unknowns in 2D: whole runs of
+#: plate2d-plane-strain 1.8x faster than the direct solve at 960 unknowns, 3.0-3.7x at h =
+#: 0.025-0.02 (record solvers-2026-11-26-crossover2d). It was 8,000 until issue 32; the
+#: default-size runs now change at round-off (compare --rtol 1e-9 finds nothing).
 ND_FROM_UNKNOWNS = 1000
-#: the same in 3D, where K is a dense LU: whole runs (assembly and solve) of body3d-traction,
-#: surface nodes, direct against nested dissection (benchmarks/solvers.py --only
-#: crossover3d, median of 3, quiet machine): 0.85 / 0.99 s at 2,376 unknowns, 1.79 / 2.02 s
-#: at 3,528, 4.22 / 2.99 s at 4,992 (where the float32 factor starts), and at the default
-#: 9,000 15.7 / 7.9 s with peak memory 2.67 / 1.33 GB (``pdverify run``, /usr/bin/time)
+#: the same in 3D, where K is a dense LU: body3d-traction at the default 9,000 unknowns 2x
+#: faster and half the peak memory under nested dissection (record
+#: solvers-2026-11-23-crossover3d)
 ND3D_FROM_UNKNOWNS = 4000
 
 
 def static_solver(requested: str, dim: int, unknowns: int) -> str:
     """The solver a static state-based run uses: ``requested``, or for ``auto`` nested
     dissection from :data:`ND_FROM_UNKNOWNS` unknowns in 2D (11x faster than the direct
-    solve at h = 0.01) and :data:`ND3D_FROM_UNKNOWNS` in 3D (2x faster and half the
-    memory of the dense LU at h = 0.05): benchmarks/solvers.py. 1D: always direct."""
+    solve at h = 0.01 with the float32 factor: commit aa3f0a1) and
+    :data:`ND3D_FROM_UNKNOWNS` in 3D (2x faster and half the memory of the dense LU at h =
+    0.05: record solvers-2026-11-23-crossover3d). 1D: always direct."""
     if requested != "auto":
         return requested
     if dim == 1:
@@ -152,9 +140,8 @@ def auto_note(solver: str, unknowns: int) -> str:
 
 #: From this many unknowns :func:`~pdverify.solvers.nested.solve_nested` factors in single
 #: precision (:func:`~pdverify.solvers.nested.single_precision_factor`) and refines in
-#: double. Measured on the plane-strain plate (augmented system; float64 LU
-#: against mixed, medians of 5): 2,025 unknowns 0.065 s / 0.083 s; 5,040: 0.22 / 0.20;
-#: 7,800: 0.45 / 0.32; 19,680: 1.86 / 1.03; 30,600: 3.2 / 1.55.
+#: double: on the plane-strain plate even at 5,040 unknowns, 2x faster at 30,600 (record
+#: solvers-2026-11-23-mixed-precision).
 MIXED_FROM_UNKNOWNS = 5000
 
 
@@ -168,9 +155,9 @@ def mixed_precision(unknowns: int) -> bool:
 #: when the top separator of the nested-dissection ordering is large, s^2 > this many
 #: times the unknowns: the 3D bodies have s^2 / n ~ 236 (h = 0.1) and 336 (h = 0.05), the
 #: 2D plates ~28 at every h (m = 3). In 3D its dense fronts beat SuperLU's float32 factor
-#: (body3d-traction's order-1 Taylor system: factor 27.7 -> 6.3 s; ``FRONTAL_FACTOR``'s
-#: note in :mod:`~pdverify.solvers.nested`); in 2D SuperLU's is the cheaper
-#: (``benchmarks/split_lu.py``: 6.9 against 13.0 s of CPU over seven plate and sheet runs).
+#: (``FRONTAL_FACTOR``'s note in :mod:`~pdverify.solvers.nested`); in 2D SuperLU's is the
+#: cheaper (6.9 against 13.0 s of CPU over seven plate and sheet runs: record
+#: split_lu-2026-11-28-all-cases).
 FRONTAL_SEPARATOR_RATIO = 100
 
 

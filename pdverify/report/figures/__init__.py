@@ -24,8 +24,8 @@ QUICK = False
 def quick_figures(quick: bool = True):
     """Draw the figures of a ``--quick`` report (:data:`QUICK`) inside the block; the
     drawing processes forked inside it inherit the setting. Issue 32: the quick report's
-    figures took 30 s of CPU (55 figures; ``benchmarks/quick_report.py``), three
-    quarters of it in ``savefig``'s layout and tick passes."""
+    figures took about 30 s of CPU, three quarters of it in ``savefig``'s layout and tick
+    passes (record quick_report-2026-11-27-issue32-findings)."""
     global QUICK
     old, QUICK = QUICK, bool(quick)
     try:
@@ -241,9 +241,8 @@ def node_image(x, spacing, values, unit=1.0):
 
 #: the figures' resolution (dots per inch)
 DPI = 110
-#: zlib level of the PNG files: 3 writes them in half the time of the default 6, the
-#: files 6 % larger (the quick report's 55 figures: 1.6 s against 2.9 s, 6.0 MB
-#: against 5.7 MB); lossless either way
+#: zlib level of the PNG files: 3 writes them in about half the time of the default 6, the
+#: files 6 % larger, lossless either way (record quick_report-2026-11-27-png-level)
 PNG_LEVEL = 3
 
 

@@ -132,8 +132,9 @@ def _maps_3d(scene, results, folder):
     live = [e for e in errs if not round_off(e, 100.0)]
     norm = shared_log_norm(live)
     _LAST_NORMS[:] = [norm]
-    # shared axes, labels on the outer panels only, no layout engine: a 4 x 8 grid of
-    # maps with every tick labelled took ~4x the time of the runs it shows (loaded box)
+    # shared axes, labels on the outer panels only, no layout engine: a 4 x 8 grid of maps
+    # with every tick labelled took ~4x the time of the runs it shows (record
+    # quick_report-2026-11-24-error-map-ticks)
     fig, axes = plt.subplots(len(runs), 4, figsize=(12, 1.75 * len(runs) + 0.7),
                              gridspec_kw={"width_ratios": [2, 2, 2, 1], "wspace": 0.3,
                                           "hspace": 0.5}, squeeze=False, sharex="col",
@@ -356,8 +357,9 @@ SECTION5 = (("pals", {}, "(a) PALS"), ("mirror-nodes", {"neumann": "full-tractio
 def _renderings_3d(scene, results, folder):
     """pyvista renderings of |u| and the error (:mod:`.fields3d`); a renderer that fails
     (no OpenGL, ...) costs these images only, with a warning naming the cause. None in a
-    ``--quick`` report (:data:`QUICK`): pyvista's import and the renders took 2-3 s of
-    its figures' time; the maps show the same fields."""
+    ``--quick`` report (:data:`QUICK`): pyvista's import and the renders took seconds of
+    its figures' time (record quick_report-2026-11-26-pyvista-quick); the maps show the
+    same fields."""
     from . import QUICK
     if QUICK:
         return []
