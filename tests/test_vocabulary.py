@@ -86,3 +86,22 @@ def test_treatments_speak_face_names_only():
              for n, line in enumerate(path.read_text().splitlines(), 1)
              if pattern.search(line)]
     assert not found, found
+
+
+def test_treatments_never_ask_the_solver_layer_what_to_build():
+    """A treatment assembles one form of its system (the state-based ones: the augmented
+    form, ``LinearSystem.scalars``) and the solver layer's front door forms what its
+    solver needs (issue 51): no treatment module imports the solver policy or branches on
+    the solver's name."""
+    import ast
+    corrections = Path(__file__).parents[1] / "pdverify" / "corrections"
+    found = []
+    for path in sorted(corrections.rglob("*.py")):
+        tree = ast.parse(path.read_text())
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom) and node.module and "policy" in node.module:
+                found.append(f"{path.name}:{node.lineno}: imports {node.module}")
+            if (isinstance(node, ast.Compare) and isinstance(node.left, ast.Name)
+                    and node.left.id == "solver"):
+                found.append(f"{path.name}:{node.lineno}: compares the solver's name")
+    assert not found, found
