@@ -235,17 +235,22 @@ def _cpu_jiffies() -> tuple[int, int]:
     return sum(f) - idle, sum(f)
 
 
-def _processes() -> dict:
-    """pid -> (command name, CPU jiffies so far) of every readable process."""
-    out = {}
+def proc_stats():
+    """``(pid, /proc/pid/stat text)`` of every process now readable in /proc."""
     for d in os.listdir("/proc"):
         if not d.isdigit():
             continue
         try:
             with open(f"/proc/{d}/stat") as fh:
-                s = fh.read()
+                yield int(d), fh.read()
         except OSError:
             continue
+
+
+def _processes() -> dict:
+    """pid -> (command name, CPU jiffies so far) of every readable process."""
+    out = {}
+    for d, s in proc_stats():
         name = s[s.find("(") + 1:s.rfind(")")]
         f = s[s.rfind(")") + 2:].split()
         out[int(d)] = (name, int(f[11]) + int(f[12]))

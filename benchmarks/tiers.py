@@ -66,17 +66,10 @@ MODES = {"serial": ["-p", "no:xdist"], "parallel": []}
 def _children_map():
     """{parent pid: [child pids]} over every process now visible in /proc."""
     kids = {}
-    for name in os.listdir("/proc"):
-        if not name.isdigit():
-            continue
-        try:
-            with open(f"/proc/{name}/stat") as fh:
-                stat = fh.read()
-        except OSError:
-            continue
+    for pid, stat in harness.proc_stats():
         # the command name (field 2) may hold spaces: the fields after its ')' are plain
         ppid = int(stat.rsplit(")", 1)[1].split()[1])
-        kids.setdefault(ppid, []).append(int(name))
+        kids.setdefault(ppid, []).append(pid)
     return kids
 
 
