@@ -5,8 +5,9 @@ solve_with_dirichlet`, :func:`~pdverify.solvers.front.factor`) asks this module 
 implementation to call; the implementations (``lu``: sparse LU with constraints;
 ``dense``: LAPACK LU; ``nested``: nested dissection and its single-precision factor;
 ``mixed``: single-precision factor refined in double; ``iterative``: CG with the lattice
-preconditioner; ``modal``: eigenvalues) read their crossovers from here at call time, so a test can move one by patching this module. Nothing here solves, and
-this module imports no other module of the package.
+preconditioner; ``modal``: eigenvalues) read their crossovers from here at call time, so
+a test can move one by patching this module. Nothing here solves, and this module imports
+no other module of the package.
 """
 from __future__ import annotations
 
