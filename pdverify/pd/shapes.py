@@ -49,7 +49,7 @@ shape would need faces of a polyhedron, which nothing uses yet.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable
 
 import numpy as np
@@ -311,13 +311,20 @@ class Shape:
             if not np.all(self.inside(pts)):
                 raise ValueError(f"crack {c.name!r}: every point past its start up to "
                                  f"its tip must lie inside the shape {self.name!r}")
-        have = {q.name for q in self.parts}
-        new = tuple(f for c in cracks for f in c.faces if f.name not in have)
+        crack_names = [c.name for c in cracks]
+        if len(set(crack_names)) != len(crack_names):
+            raise ValueError(f"shape {self.name!r}: crack names must differ, got {crack_names}")
+        have = set(self.parts)       # the faces already appended (dataclasses.replace)
+        new = tuple(f for c in cracks for f in c.faces if f not in have)
         names = [q.name for q in self.parts] + [f.name for f in new]
         if len(set(names)) != len(names):
             raise ValueError(f"shape {self.name!r}: part names must differ, got {names}")
         object.__setattr__(self, "cracks", cracks)
         object.__setattr__(self, "parts", tuple(self.parts) + new)
+
+    def with_cracks(self, *cracks) -> "Shape":
+        """This shape with ``cracks`` added to its own (their faces become parts)."""
+        return replace(self, cracks=tuple(self.cracks) + tuple(cracks))
 
     def severs(self, xa, xb) -> np.ndarray:
         """Which segments xa -> xb any crack cuts (:meth:`Crack.cuts`)."""
