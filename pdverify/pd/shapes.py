@@ -42,7 +42,20 @@ units of the crack (tolerance :data:`END` of its length):
   those of the shape without it, bit for bit);
 - near the tip: a node's neighbourhood loses only the bonds that cross the slit, so a
   node within a horizon of the tip keeps its bonds round the tip; its closest part is the
-  face of its side with the tip as closest point when it lies ahead of it.
+  face of its side with the tip as closest point when it lies ahead of it;
+- every node is on a side by its position (a jittered node by its moved one; a
+  fictitious node too: a bond between two fictitious nodes that crosses the crack's line
+  outside the body, u < 0 beyond an edge crack's mouth, is not cut);
+- the nodes of a face: :meth:`Shape.crack_nodes` (within a reach of the slit on the
+  face's side); :meth:`Shape.closest` names the face of the node's side. The samples of
+  a face go, like every part's, to the node of the cell that holds them moved inward
+  (``corrections.assembly.boundary_nodes``): right for a slit along cell faces, but a
+  slit through cells gives each such cell's node both faces' samples (an inclined crack
+  at 30 degrees: 35 of 108 samples of each face, on the other side's nodes).
+
+The model drops the bonds a crack cuts where its bonds are chosen
+(``pdverify.pd.closure.Closure.bond_mask``, for every treatment's ``keep``), so the
+weighted volumes, dilatations and forces of both theories see only the node's side.
 
 Only 2D: the two shape scenes are plane problems (issue 35 asks for 2D scenes); a 3D
 shape would need faces of a polyhedron, which nothing uses yet.
@@ -325,6 +338,16 @@ class Shape:
     def with_cracks(self, *cracks) -> "Shape":
         """This shape with ``cracks`` added to its own (their faces become parts)."""
         return replace(self, cracks=tuple(self.cracks) + tuple(cracks))
+
+    def crack_nodes(self, x, reach: float) -> dict:
+        """``{face name: mask}``: the rows of ``x`` within ``reach`` (a horizon) of each
+        crack on the face's side (:meth:`Crack.near`), whichever part is closest."""
+        out = {}
+        for c in self.cracks:
+            if c.length:
+                plus, minus = c.near(x, reach)
+                out[f"{c.name}+"], out[f"{c.name}-"] = plus, minus
+        return out
 
     def severs(self, xa, xb) -> np.ndarray:
         """Which segments xa -> xb any crack cuts (:meth:`Crack.cuts`)."""

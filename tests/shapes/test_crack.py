@@ -213,6 +213,9 @@ def test_the_faces_closest_points_normals_samples_and_nodes():
     xr = g.x[g.interior_ids]
     crack = cracked.cracks[0]
     plus, minus = crack.near(xr, 3 * H)
+    by_face = cracked.crack_nodes(xr, 3 * H)
+    assert list(by_face) == ["crack+", "crack-"]
+    assert np.array_equal(by_face["crack+"], plus) and np.array_equal(by_face["crack-"], minus)
     assert plus.any() and minus.any() and not (plus & minus).any()
     assert np.all(crack.side(xr[plus])) and not np.any(crack.side(xr[minus]))
     d = np.abs((xr - start) @ nu)
