@@ -50,8 +50,10 @@ units of the crack (tolerance :data:`END` of its length):
   face's side); :meth:`Shape.closest` names the face of the node's side. The samples of
   a face go, like every part's, to the node of the cell that holds them moved inward
   (``corrections.assembly.boundary_nodes``): right for a slit along cell faces, but a
-  slit through cells gives each such cell's node both faces' samples (an inclined crack
-  at 30 degrees: 35 of 108 samples of each face, on the other side's nodes).
+  slit through cells gives each such cell's node both faces' samples (a crack of slope
+  1/2 and length 9 h: 108 of each face's 216 samples, on 4 of its 8 nodes, go to a node
+  on the other side); a treatment that loads or constrains a crack face needs the
+  side's nodes instead.
 
 The model drops the bonds a crack cuts where its bonds are chosen
 (``pdverify.pd.closure.Closure.bond_mask``, for every treatment's ``keep``), so the
