@@ -25,7 +25,8 @@ class Closure:
     - ``keep``: which stencil pairs of the (extended) grid are bonds, as a mask over
       ``bond_pairs(grid.ext_shape, stencil.half_offsets)`` or a function ``keep(a, b)``
       returning one; default: pairs with at least one real node (and, on a shape's
-      grid, no void node: ``ShapeGrid.is_void``).
+      grid, no void node: ``ShapeGrid.is_void``). On a shape with cracks the pairs a
+      crack cuts are dropped from either (:func:`uncut`).
     - ``weighted_volume``: ``truncated`` or ``complete`` (see :data:`WEIGHTED_VOLUMES`).
     - ``displacement_map`` (n_ext x n_unknown_nodes): all node displacements from the
       unknowns, per component (identity on real nodes, extrapolation rows on fictitious
@@ -85,15 +86,29 @@ class Closure:
                              f"{', '.join(WEIGHTED_VOLUMES)}")
 
     def bond_mask(self, grid, a, b) -> np.ndarray:
-        """Which of the candidate pairs a-b are bonds (see ``keep``)."""
+        """Which of the candidate pairs a-b are bonds (see ``keep``), less the pairs a
+        crack of the grid's shape cuts (:func:`uncut`), whatever the treatment keeps."""
         if self.keep is None:
             mask = grid.is_interior[a] | grid.is_interior[b]
             void = getattr(grid, "is_void", None)   # a shape's lattice outside its layer
-            return mask if void is None else mask & ~void[a] & ~void[b]
+            return uncut(grid, a, b, mask if void is None else mask & ~void[a] & ~void[b])
         mask = self.keep(a, b) if callable(self.keep) else np.asarray(self.keep, dtype=bool)
         if mask.shape != a.shape:
             raise ValueError(f"keep: {mask.shape[0]} flags for {a.size} candidate pairs")
+        return uncut(grid, a, b, mask)
+
+
+def uncut(grid, a, b, mask) -> np.ndarray:
+    """``mask`` over the pairs a-b without the pairs a crack cuts (``Shape.severs`` on
+    the nodes' positions ``grid.x``; ``pdverify.pd.shapes`` states the conventions at the
+    tip and on the crack's line). A grid without a cracked shape: ``mask`` itself."""
+    shape = getattr(grid, "shape", None)
+    if not getattr(shape, "cracks", ()):
         return mask
+    live = np.flatnonzero(mask)
+    out = np.array(mask, dtype=bool)
+    out[live[shape.severs(grid.x[a[live]], grid.x[b[live]])]] = False
+    return out
 
 
 def real_identity(grid, n_cols: int | None = None) -> sp.csr_matrix:

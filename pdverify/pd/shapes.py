@@ -20,12 +20,51 @@ the body), so its outward normal is the segment direction turned clockwise; an
 :class:`Arc` says whether the body lies outside its circle (``hole=True``: the normal
 points to the centre) or inside.
 
+Cracks (:class:`Crack`, issue 54): a straight slit of zero width from ``start`` to its
+``tip`` inside the body, carried by a shape beside its outer parts (``Shape.cracks``). Its
+two traction-free faces are named parts like any other (:class:`CrackFace`, appended to
+``Shape.parts``): ``<name>+`` is the face of the material on the left of start -> tip
+(the side its left normal nu = the direction turned counter-clockwise points to), outward
+normal -nu; ``<name>-`` the face of the material on the right, outward normal +nu. A face
+is one-sided: a point sees it only from its own side (:meth:`CrackFace.sees`), so the
+closest part of a node beside the crack is the face of its own side. Conventions, in
+units of the crack (tolerance :data:`END` of its length):
+
+- side: a point on the crack's line (within END) is on the ``+`` side;
+- a bond is cut (:meth:`Crack.cuts`) when its two ends lie on different sides and it
+  meets the line at arc-length fraction u in [0, 1) of start -> tip: a bond through the
+  start point is cut (a centre crack is two cracks from its centre, and that point is
+  cut by both), a bond through the tip point itself is not (the tip is where the faces
+  meet: the ligament ahead of it, tip included, is intact), a bond that passes ahead of
+  the tip is kept (it goes round the tip through intact material), and a bond with one
+  end on the crack at a node is cut exactly when its other end is on the ``-`` side;
+- a crack of zero length is no crack: no faces, no cut bond (the shape's arrays are
+  those of the shape without it, bit for bit);
+- near the tip: a node's neighbourhood loses only the bonds that cross the slit, so a
+  node within a horizon of the tip keeps its bonds round the tip; its closest part is the
+  face of its side with the tip as closest point when it lies ahead of it;
+- every node is on a side by its position (a jittered node by its moved one; a
+  fictitious node too: a bond between two fictitious nodes that crosses the crack's line
+  outside the body, u < 0 beyond an edge crack's mouth, is not cut);
+- the nodes of a face: :meth:`Shape.crack_nodes` (within a reach of the slit on the
+  face's side); :meth:`Shape.closest` names the face of the node's side. The samples of
+  a face go, like every part's, to the node of the cell that holds them moved inward
+  (``corrections.assembly.boundary_nodes``): right for a slit along cell faces, but a
+  slit through cells gives each such cell's node both faces' samples (a crack of slope
+  1/2 and length 9 h: 108 of each face's 216 samples, on 4 of its 8 nodes, go to a node
+  on the other side); a treatment that loads or constrains a crack face needs the
+  side's nodes instead.
+
+The model drops the bonds a crack cuts where its bonds are chosen
+(``pdverify.pd.closure.Closure.bond_mask``, for every treatment's ``keep``), so the
+weighted volumes, dilatations and forces of both theories see only the node's side.
+
 Only 2D: the two shape scenes are plane problems (issue 35 asks for 2D scenes); a 3D
 shape would need faces of a polyhedron, which nothing uses yet.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable
 
 import numpy as np
@@ -94,6 +133,98 @@ class Segment:
         t = b - a
         n = np.array([t[1], -t[0]]) / np.linalg.norm(t)
         return a + s[:, None] * t, np.broadcast_to(n, (s.size, 2)).copy()
+
+
+@dataclass(frozen=True)
+class CrackFace(Segment):
+    """One face of a :class:`Crack`: the segment ``a`` -> ``b`` with the body of this face
+    on its left (outward normal the direction turned clockwise), seen only from that
+    side (module docstring: a point on the crack's line is on the ``+`` side, i.e. it
+    sees the ``+`` face)."""
+
+    plus: bool = True
+
+    def sees(self, x) -> np.ndarray:
+        """Which rows of ``x`` lie on this face's side of the crack's line."""
+        a, b = np.asarray(self.a, float), np.asarray(self.b, float)
+        e = b - a if self.plus else a - b        # start -> tip
+        start = a if self.plus else b
+        on_plus = _side(x, start, e)
+        return on_plus if self.plus else ~on_plus
+
+    def crossings(self, xa, xb):
+        """As :meth:`Segment.crossings`, the crossings of the segments that leave this
+        face's side only (sign +1): a bond through the slit crosses the face of the side
+        it starts on, once."""
+        hit, s, sign, alpha = super().crossings(xa, xb)
+        own = sign > 0
+        return hit[own], s[own], sign[own], alpha[own]
+
+
+def _side(x, start, e) -> np.ndarray:
+    """True where the rows of ``x`` lie on the left of the line start + u e or on it
+    (within :data:`END` of |e|: the ``+`` side)."""
+    r = np.asarray(x, dtype=float) - start
+    cross = e[0] * r[:, 1] - e[1] * r[:, 0]
+    return cross >= -END * float(e @ e)
+
+
+@dataclass(frozen=True)
+class Crack:
+    """A straight slit of zero width named ``name`` from ``start`` to ``tip`` (module
+    docstring: faces, sides, which bonds it cuts)."""
+
+    name: str
+    start: tuple
+    tip: tuple
+
+    @property
+    def length(self) -> float:
+        return float(np.linalg.norm(np.subtract(self.tip, self.start)))
+
+    @property
+    def faces(self) -> tuple:
+        """``(<name>+, <name>-)``; none for a crack of zero length."""
+        if self.length == 0:
+            return ()
+        s, t = tuple(map(float, self.start)), tuple(map(float, self.tip))
+        return (CrackFace(f"{self.name}+", s, t, plus=True),
+                CrackFace(f"{self.name}-", t, s, plus=False))
+
+    def side(self, x) -> np.ndarray:
+        """True where the rows of ``x`` are on the ``+`` side (left of start -> tip, or on
+        the crack's line)."""
+        start = np.asarray(self.start, float)
+        return _side(x, start, np.asarray(self.tip, float) - start)
+
+    def cuts(self, xa, xb) -> np.ndarray:
+        """Which segments xa -> xb (bonds; rows of (n, 2) arrays) the crack cuts: ends
+        on different sides and the crossing at u in [0, 1) along start -> tip, u within
+        :data:`END` of 1 counting as the tip (module docstring). Vectorised."""
+        xa, xb = np.asarray(xa, dtype=float), np.asarray(xb, dtype=float)
+        if self.length == 0:
+            return np.zeros(len(xa), dtype=bool)
+        s = np.asarray(self.start, float)
+        e = np.asarray(self.tip, float) - s
+        apart = self.side(xa) != self.side(xb)
+        d = xb - xa
+        den = e[0] * d[:, 1] - e[1] * d[:, 0]
+        den = np.where(apart & (den != 0), den, 1.0)
+        r = xa - s
+        u = (r[:, 0] * d[:, 1] - r[:, 1] * d[:, 0]) / den
+        return apart & (u >= -END) & (u < 1 - END)
+
+    def near(self, x, reach: float) -> tuple:
+        """``(plus, minus)``: the rows of ``x`` within ``reach`` of the slit (closed) on
+        each side, the nodes the faces ``<name>+`` and ``<name>-`` belong to."""
+        x = np.asarray(x, dtype=float)
+        if self.length == 0:
+            none = np.zeros(len(x), dtype=bool)
+            return none, none.copy()
+        p, _ = self.faces[0].closest(x)
+        close = np.linalg.norm(x - p, axis=1) <= reach
+        plus = self.side(x)
+        return close & plus, close & ~plus
 
 
 @dataclass(frozen=True)
@@ -168,15 +299,64 @@ class Arc:
 @dataclass(frozen=True)
 class Shape:
     """A 2D body: its boundary ``parts`` (named, see the module docstring), the vectorised
-    ``inside(x) -> bool`` and its bounding box ``lower``, ``upper``."""
+    ``inside(x) -> bool`` and its bounding box ``lower``, ``upper``; ``cracks``: its
+    :class:`Crack` slits, whose faces are appended to ``parts`` (each crack of non-zero
+    length adds ``<name>+``, ``<name>-``); ``inside`` does not see them (zero width)."""
 
     parts: tuple
     inside: Callable[[np.ndarray], np.ndarray]
     lower: tuple
     upper: tuple
     name: str = "shape"
+    cracks: tuple = ()
 
     dim = 2
+
+    def __post_init__(self):
+        if not self.cracks:
+            return
+        cracks = tuple(self.cracks)
+        for c in cracks:
+            if not isinstance(c, Crack):
+                raise ValueError(f"cracks: {c!r} is not a Crack")
+            if c.length == 0:
+                continue
+            u = np.linspace(0.0, 1.0, 65)[1:]
+            pts = np.asarray(c.start, float) + u[:, None] * np.subtract(c.tip, c.start)
+            if not np.all(self.inside(pts)):
+                raise ValueError(f"crack {c.name!r}: every point past its start up to "
+                                 f"its tip must lie inside the shape {self.name!r}")
+        crack_names = [c.name for c in cracks]
+        if len(set(crack_names)) != len(crack_names):
+            raise ValueError(f"shape {self.name!r}: crack names must differ, got {crack_names}")
+        have = set(self.parts)       # the faces already appended (dataclasses.replace)
+        new = tuple(f for c in cracks for f in c.faces if f not in have)
+        names = [q.name for q in self.parts] + [f.name for f in new]
+        if len(set(names)) != len(names):
+            raise ValueError(f"shape {self.name!r}: part names must differ, got {names}")
+        object.__setattr__(self, "cracks", cracks)
+        object.__setattr__(self, "parts", tuple(self.parts) + new)
+
+    def with_cracks(self, *cracks) -> "Shape":
+        """This shape with ``cracks`` added to its own (their faces become parts)."""
+        return replace(self, cracks=tuple(self.cracks) + tuple(cracks))
+
+    def crack_nodes(self, x, reach: float) -> dict:
+        """``{face name: mask}``: the rows of ``x`` within ``reach`` (a horizon) of each
+        crack on the face's side (:meth:`Crack.near`), whichever part is closest."""
+        out = {}
+        for c in self.cracks:
+            if c.length:
+                plus, minus = c.near(x, reach)
+                out[f"{c.name}+"], out[f"{c.name}-"] = plus, minus
+        return out
+
+    def severs(self, xa, xb) -> np.ndarray:
+        """Which segments xa -> xb any crack cuts (:meth:`Crack.cuts`)."""
+        out = np.zeros(len(xa), dtype=bool)
+        for c in self.cracks:
+            out |= c.cuts(xa, xb)
+        return out
 
     @property
     def part_names(self) -> tuple:
@@ -184,7 +364,8 @@ class Shape:
 
     def closest(self, x):
         """``(points, normals, distance, part index)`` of the closest boundary point of
-        every row of ``x`` (n, 2); ties go to the first part."""
+        every row of ``x`` (n, 2); ties go to the first part. A crack's face counts only
+        for the points on its side (:meth:`CrackFace.sees`)."""
         x = np.asarray(x, dtype=float)
         best = np.full(len(x), np.inf)
         P, N = np.zeros_like(x), np.zeros_like(x)
@@ -192,6 +373,8 @@ class Shape:
         for k, q in enumerate(self.parts):
             p, n = q.closest(x)
             dist = np.linalg.norm(x - p, axis=1)
+            if isinstance(q, CrackFace):
+                dist = np.where(q.sees(x), dist, np.inf)
             better = dist < best
             best = np.where(better, dist, best)
             P[better], N[better], part[better] = p[better], n[better], k
