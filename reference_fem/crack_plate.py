@@ -1,0 +1,343 @@
+"""DOCSTRING"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from skfem import Basis
+
+from . import params as _p
+from .cache import cached
+from .elasticity import Material
+from .mesh_elasticity import MeshElasticity, mapped_mesh
+from .meshing import power_graded
+from .results import MeshReferenceResult, RefinementRow, change_pct, field_change_pct
+
+REFERENCE = "plate-crack"
+EDGE_REFERENCE = "plate-edge-crack"
+KINDS = ("centre", "edge")
+
+
+@dataclass(frozen=True)
+class CrackPlateParams:
+    """Parameters of the cracked plate (the centre crack's defaults; see the module)."""
+
+    kind: str = "centre"           # "centre": centre crack, quarter model; "edge": SENT, half
+    width: float = 1.0             # W (centre: half-width; edge: the full width b) (m)
+    height: float = 3.0            # H: half-height (the traction acts on y = H) (m)
+    crack: float = 0.5             # a (centre: half-length; edge: the crack depth) (m)
+    thickness: float = 1.0         # m
+    E: float = 1e9                 # Pa
+    nu: float = 0.3
+    traction: float = 1e6          # sigma on y = H (Pa)
+    cells: int = 4                 # level 0: elements along each of the tip's segments
+    grading_power: float = 4.0     # power grading toward the tip (1: uniform)
+    levels: int = 5                # refinement levels (cells x 2^l)
+    j_radii: tuple = (0.1, 0.2, 0.4)       # J domains: radius R / min(a, W - a)
+    fit_window: tuple = (0.02, 0.3)        # opening fit: r / min(a, W - a) in this window
+    sample_spacing: float = 0.025  # grid of the field-change measure (PD default grid)
+
+    def __post_init__(self):
+        ref = reference_name(self.kind) if self.kind in KINDS else REFERENCE
+        _p.require(self.kind in KINDS, ref, f"kind must be one of {', '.join(KINDS)}, "
+                   f"got {self.kind!r}")
+        _p.positive(ref, width=self.width, height=self.height, crack=self.crack,
+                    thickness=self.thickness, E=self.E, sample_spacing=self.sample_spacing)
+        _p.require(-1 < self.nu < 0.5, ref, f"nu must lie in (-1, 0.5), got {self.nu}")
+        _p.require(math.isfinite(self.traction) and self.traction != 0, ref,
+                   f"traction must be finite and nonzero, got {self.traction}")
+        _p.require(0.05 <= self.crack / self.width <= 0.95, ref,
+                   f"crack/width = {self.crack / self.width:g} must be in [0.05, 0.95]")
+        _p.require(self.height >= min(self.crack, self.width - self.crack), ref,
+                   f"height {self.height} must be at least min(a, W - a)")
+        _p.require(2 <= self.cells <= 64, ref, f"cells must be 2..64, got {self.cells}")
+        _p.require(math.isfinite(self.grading_power) and 1.0 <= self.grading_power <= 8.0,
+                   ref, f"grading_power must be in [1, 8], got {self.grading_power}")
+        _p.require(2 <= self.levels <= 7, ref, f"levels must be 2..7, got {self.levels}")
+        radii = tuple(float(r) for r in self.j_radii)
+        _p.require(len(radii) >= 1 and all(0 < r <= 0.9 for r in radii), ref,
+                   f"j_radii must be fractions in (0, 0.9] of min(a, W - a), got {radii}")
+        lo, hi = (float(r) for r in self.fit_window)
+        _p.require(0 < lo < hi <= 0.9, ref,
+                   f"fit_window must be 0 < r0 < r1 <= 0.9 (of min(a, W - a)), got {(lo, hi)}")
+        for name, v in (("width", self.width), ("height", self.height)):
+            n = v / self.sample_spacing
+            _p.require(abs(n - round(n)) < 1e-9 * n and round(n) >= 1, ref,
+                       f"sample_spacing {self.sample_spacing} must divide {name} {v}")
+        nx, ny = self.finest_cells()
+        _p.require(nx * ny <= 2 ** 18, ref,
+                   f"the finest level would have {nx * ny} elements (at most 2^18)")
+
+    @property
+    def tip_length(self) -> float:
+        """min(a, W - a): the length of the graded segments about the tip."""
+        return min(self.crack, self.width - self.crack)
+
+    def far_cells(self, n: int) -> int:
+        """Elements on y in [L, H] at n cells per graded segment (L = tip_length)."""
+        L = self.tip_length
+        return 0 if self.height <= L * (1 + 1e-12) else n * max(
+            1, int(round((self.height - L) / (self.grading_power * L))))
+
+    def finest_cells(self) -> tuple[int, int]:
+        """(n_x, n_y) elements of the finest level."""
+        n = self.cells * 2 ** (self.levels - 1)
+        return 2 * n, n + self.far_cells(n)
+
+
+def reference_name(kind: str) -> str:
+    return REFERENCE if kind == "centre" else EDGE_REFERENCE
+
+
+# --- handbook formulas (Tada, Paris & Irwin) -------------------------------------------------
+
+def tada_centre(crack: float, width: float, sigma: float) -> float:
+    """K_I of a centre crack 2a in a strip of width 2W under remote tension sigma:
+    K = sigma sqrt(pi a) F(l), F = (1 - 0.025 l^2 + 0.06 l^4) sqrt(sec(pi l / 2)),
+    l = a / W (Tada, Paris & Irwin, The Stress Analysis of Cracks Handbook, 3rd ed., 2000,
+    p. 5.2, after Feddersen 1966 and Isida; accuracy 0.1 % for any l)."""
+    lam = crack / width
+    F = (1 - 0.025 * lam ** 2 + 0.06 * lam ** 4) * math.sqrt(1.0 / math.cos(0.5 * math.pi * lam))
+    return sigma * math.sqrt(math.pi * crack) * F
+
+
+def tada_edge(crack: float, width: float, sigma: float) -> float:
+    """K_I of a single edge crack a in a strip of width b under remote tension sigma
+    (ends free to rotate): K = sigma sqrt(pi a) F(a/b),
+    F = sqrt(2b/(pi a) tan(pi a / 2b)) (0.752 + 2.02 (a/b) + 0.37 (1 - sin(pi a / 2b))^3)
+    / cos(pi a / 2b) (Tada, Paris & Irwin, 3rd ed., p. 2.11; accuracy 0.5 % for any a/b)."""
+    lam = crack / width
+    c = 0.5 * math.pi * lam
+    F = (math.sqrt(math.tan(c) / c) * (0.752 + 2.02 * lam + 0.37 * (1 - math.sin(c)) ** 3)
+         / math.cos(c))
+    return sigma * math.sqrt(math.pi * crack) * F
+
+
+#: stated accuracy of the handbook formulas (fraction)
+HANDBOOK_ACCURACY = {"centre": 1e-3, "edge": 5e-3}
+
+
+def handbook_k(p: CrackPlateParams) -> float:
+    f = tada_centre if p.kind == "centre" else tada_edge
+    return f(p.crack, p.width, p.traction)
+
+
+def effective_modulus(E: float, nu: float) -> float:
+    """E' of K = sqrt(E' J) in plane stress: E' = E (plane strain would be E / (1 - nu^2))."""
+    return E
+
+
+# --- mesh and one level ----------------------------------------------------------------------
+
+def crack_nodes(p: CrackPlateParams, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """1D node positions (x, y) of the tensor grid graded toward the tip (a, 0)."""
+    a, W, H, L = p.crack, p.width, p.height, p.tip_length
+    g = p.grading_power
+    left = a - power_graded(0.0, a, n, g, "a")[::-1]            # [0, a], fine at a
+    right = a + power_graded(0.0, W - a, n, g, "a")             # [a, W], fine at a
+    x = np.concatenate([left, right[1:]])
+    y = power_graded(0.0, L, n, g, "a")
+    m = p.far_cells(n)
+    if m:
+        y = np.concatenate([y, np.linspace(L, H, m + 1)[1:]])
+    return x, y
+
+
+def crack_mesh(p: CrackPlateParams, n: int):
+    x, y = crack_nodes(p, n)
+    sx = np.linspace(0.0, 1.0, x.size)
+    sy = np.linspace(0.0, 1.0, y.size)
+
+    def F(s, t):               # piecewise linear in each logical direction: rectangles
+        return np.interp(s, sx, x), np.interp(t, sy, y)
+
+    h = min(np.diff(x).min(), np.diff(y).min())
+    return mapped_mesh([(sx, sy, F)], tol=1e-3 * h)
+
+
+def domain(p: CrackPlateParams) -> dict:
+    return {"box": [[0.0, p.width], [0.0, p.height]]}
+
+
+def solve_level(p: CrackPlateParams, level: int, material: Material | None = None):
+    """One level: returns (model, u, field, setup_s, solve_s)."""
+    t0 = time.perf_counter()
+    n = p.cells * 2 ** level
+    mat = material or Material(p.E, p.nu, "plane_stress", p.thickness)
+    model = MeshElasticity(crack_mesh(p, n), mat, domain(p))
+    W, H, a = p.width, p.height, p.crack
+    tol = 1e-9 * W
+    f = model.traction_load(lambda x, y: y > H - 1e-9 * H, [0.0, p.traction])
+    ligament = model.dofs(lambda x, y: (np.abs(y) < tol) & (x > a - tol), components=[1])
+    if p.kind == "centre":
+        other = model.dofs(lambda x, y: np.abs(x) < tol, components=[0])
+    else:   # one point against the rigid translation along x: the ligament's end (W, 0)
+        other = model.dofs(lambda x, y: (np.abs(x - W) < tol) & (np.abs(y) < tol),
+                           components=[0])
+    _ = model.stiffness
+    t1 = time.perf_counter()
+    u = model.solve(f, np.concatenate([ligament, other]))
+    fld = model.field(u)
+    return model, u, fld, t1 - t0, time.perf_counter() - t1
+
+
+# --- K extraction -------------------------------------------------------------------------------
+
+def j_integral(model: MeshElasticity, u: np.ndarray, tip: tuple, radius: float,
+               intorder: int = 8) -> float:
+    """J of the symmetric (mode I) crack from the upper half model by the equivalent
+    domain integral (Li, Shih & Needleman 1985, area form):
+
+        J = 2 int_A (sigma_ij u_i,1 - w delta_1j) q_,j dA,
+
+    the crack along -x from the tip, q(r) = (1 - (r/R)^2)^2 for r < R, 0 beyond (q = 1 at
+    the tip, C^1 at r = R), the factor 2 for the lower half (the ligament y = 0 adds
+    nothing: sigma_12 = 0 and u_2 = 0 there). Quadrature of degree ``intorder``."""
+    b = Basis(model.mesh, model.element, intorder=intorder)
+    lam, mu = model.material.lame()
+    G = b.interpolate(u).grad                                   # (2, 2, el, qp): du_i/dx_j
+    eps = 0.5 * (G + np.swapaxes(G, 0, 1))
+    tr = eps[0, 0] + eps[1, 1]
+    sig = 2 * mu * eps
+    sig[0, 0] += lam * tr
+    sig[1, 1] += lam * tr
+    w = 0.5 * np.einsum("ijeq,ijeq->eq", sig, eps)
+    X = b.global_coordinates().value                           # (2, el, qp)
+    dx, dy = X[0] - tip[0], X[1] - tip[1]
+    s = (dx * dx + dy * dy) / radius ** 2
+    inside = s < 1.0
+    dq = np.where(inside, -4.0 * (1.0 - s) / radius ** 2, 0.0)  # dq/dx_j = dq * x_j
+    qj = np.stack([dq * dx, dq * dy])                          # (2, el, qp)
+    integrand = np.einsum("ijeq,ieq,jeq->eq", sig, G[:, 0], qj) - w * qj[0]
+    return float(2.0 * np.sum(integrand * b.dx))
+
+
+def opening_fit(fld, p: CrackPlateParams, n_points: int = 64) -> float:
+    """K_I from the crack opening behind the tip: on the upper face (r = a - x, theta =
+    pi) Williams' mode I expansion gives u_y = (kappa + 1)/(2 mu) sqrt(r / 2 pi)
+    (K + c_1 r + c_2 r^2 + ...) (the integer-power terms vanish at theta = pi, and by
+    symmetry there is no rigid motion), in plane stress (kappa + 1)/(2 mu) = 4 / E;
+    least squares of u_y E sqrt(2 pi / r) / 4 on (1, r, r^2) over ``n_points`` points
+    uniform in r in the fit window."""
+    L = p.tip_length
+    r = np.linspace(p.fit_window[0] * L, p.fit_window[1] * L, n_points)
+    pts = np.stack([p.crack - r, np.zeros_like(r)], axis=1)
+    uy = fld.evaluate(pts)[:, 1]
+    kr = uy * p.E * np.sqrt(2 * np.pi / r) / 4.0
+    coef = np.polynomial.polynomial.polyfit(r, kr, 2)
+    return float(coef[0])
+
+
+def sample_points(p: CrackPlateParams) -> np.ndarray:
+    """Cell centres of the ``sample_spacing`` grid on [0, W] x [0, H] (the PD default grid)."""
+    nx = int(round(p.width / p.sample_spacing))
+    ny = int(round(p.height / p.sample_spacing))
+    cx = (np.arange(nx) + 0.5) * (p.width / nx)
+    cy = (np.arange(ny) + 0.5) * (p.height / ny)
+    X, Y = np.meshgrid(cx, cy, indexing="ij")
+    return np.stack([X.ravel(), Y.ravel()], axis=1)
+
+
+# --- the reference --------------------------------------------------------------------------
+
+@dataclass(frozen=True, eq=False, kw_only=True)
+class CrackPlateResult(MeshReferenceResult):
+    """Converged cracked plate (see :class:`ReferenceResult` for the common fields).
+
+    Attributes
+    ----------
+    k_j : K_I = sqrt(E' J) (Pa m^0.5) from the domain integral on the middle J domain;
+        equals ``quantity``.
+    k_j_domains : K_I of each J domain (``params["j_radii"]``), finest level.
+    j_domain_spread_pct : 100 (max - min) / mean of ``k_j_domains``.
+    k_fit : K_I from the crack-opening fit (finest level).
+    k_handbook : Tada's K_I of the plate; ``k_ratio`` = k_j / k_handbook.
+    handbook_accuracy_pct : the formula's stated accuracy (percent).
+    opening_mouth : u_y at (0, 0), the crack face at the plate's centre (centre crack:
+        half the central opening) or at the mouth (edge crack) (m).
+    field_change_pct : change of the field on the sample points over the last refinement.
+    """
+
+    k_j: float
+    k_j_domains: tuple
+    j_domain_spread_pct: float
+    k_fit: float
+    k_handbook: float
+    k_ratio: float
+    handbook_accuracy_pct: float
+    opening_mouth: float
+    field_change_pct: float
+
+    def metrics(self) -> dict:
+        return {"k_j": float(self.k_j), "k_fit": float(self.k_fit),
+                "k_handbook": float(self.k_handbook), "k_ratio": float(self.k_ratio),
+                "j_domain_spread_pct": float(self.j_domain_spread_pct),
+                "opening_mouth": float(self.opening_mouth),
+                "field_change_pct": float(self.field_change_pct),
+                "refinement_change_pct": float(self.refinement_change_pct)}
+
+
+def compute(p: CrackPlateParams) -> CrackPlateResult:
+    """Run the refinement study (no cache)."""
+    t_start = time.perf_counter()
+    pts = sample_points(p)
+    mouth = np.array([[0.0, 0.0]])
+    tip = (p.crack, 0.0)
+    Ep = effective_modulus(p.E, p.nu)
+    kh = handbook_k(p)
+    mid = len(p.j_radii) // 2
+    rows, prev_q, prev_sample = [], None, None
+    for level in range(p.levels):
+        model, u, fld, ts, tv = solve_level(p, level)
+        t1 = time.perf_counter()
+        ks = [math.sqrt(Ep * max(j_integral(model, u, tip, r * p.tip_length), 0.0))
+              for r in p.j_radii]
+        q = ks[mid]
+        sample = fld.evaluate(pts)
+        extra = {f"k_j_R{k}": v for k, v in enumerate(ks)}
+        extra.update(k_fit=opening_fit(fld, p), k_ratio=q / kh,
+                     j_domain_spread_pct=float(100 * (max(ks) - min(ks)) / np.mean(ks)),
+                     opening_mouth=float(fld.evaluate(mouth)[0, 1]))
+        if prev_sample is not None:
+            extra["field_change_pct"] = field_change_pct(sample, prev_sample)
+        tv += time.perf_counter() - t1
+        rows.append(RefinementRow(level=level, dofs=int(model.basis.N), h_min=model.min_edge(),
+                                  quantity=q, change_pct=change_pct(q, prev_q), setup_s=ts,
+                                  solve_s=tv, extra=extra))
+        prev_q, prev_sample = q, sample
+    last = rows[-1].extra
+    return CrackPlateResult(
+        reference=reference_name(p.kind), params=_p.as_dict(p),
+        quantity_name="K_I from J (Pa m^0.5)", quantity=q, refinement=tuple(rows),
+        refinement_change_pct=rows[-1].change_pct, setup_s=ts, solve_s=tv,
+        study_s=time.perf_counter() - t_start, field=fld, k_j=q, k_j_domains=tuple(ks),
+        j_domain_spread_pct=last["j_domain_spread_pct"], k_fit=last["k_fit"],
+        k_handbook=kh, k_ratio=q / kh, handbook_accuracy_pct=100 * HANDBOOK_ACCURACY[p.kind],
+        opening_mouth=last["opening_mouth"], field_change_pct=last["field_change_pct"])
+
+
+def _run(defaults: dict, params: dict, use_cache: bool) -> CrackPlateResult:
+    merged = {**defaults, **params}
+    ref = reference_name(merged.get("kind", "centre"))
+    p = _p.build(CrackPlateParams, ref, merged)
+    return cached(reference_name(p.kind), _p.as_dict(p), lambda: compute(p),
+                  {"CrackPlateResult": CrackPlateResult}, use_cache=use_cache)
+
+
+def crack_plate(*, use_cache: bool = True, **params) -> CrackPlateResult:
+    """Converged, cached FEM reference of the centre-cracked plate (issue 54), quarter
+    model. Keyword arguments override :class:`CrackPlateParams`; ``use_cache=False``
+    recomputes without reading or writing the cache."""
+    return _run({}, params, use_cache)
+
+
+#: the edge crack's defaults that differ from the centre crack's
+EDGE_DEFAULTS = {"kind": "edge", "height": 2.0}
+
+
+def edge_crack_plate(*, use_cache: bool = True, **params) -> CrackPlateResult:
+    """Converged, cached FEM reference of the single-edge-notched tension plate (issue
+    54), half model; defaults :class:`CrackPlateParams` with ``EDGE_DEFAULTS``."""
+    return _run(EDGE_DEFAULTS, params, use_cache)
