@@ -192,10 +192,14 @@ def j_integral(model: MeshElasticity, u: np.ndarray, tip: tuple, radius: float,
 
         J = 2 int_A (sigma_ij u_i,1 - w delta_1j) q_,j dA,
 
-    the crack along -x from the tip, q(r) = (1 - (r/R)^2)^2 for r < R, 0 beyond (q = 1 at
-    the tip, C^1 at r = R), the factor 2 for the lower half (the ligament y = 0 adds
-    nothing: sigma_12 = 0 and u_2 = 0 there). Quadrature of degree ``intorder``."""
+    the crack along -x from the tip; q the Q2 interpolant of (1 - (r/R)^2)^2 for r < R,
+    0 beyond (q = 1 at the tip, 0 outside the disk r < R: LSN's weight as nodal values
+    interpolated by the element's shape functions, so that on these rectangles the
+    integrand is a polynomial of degree <= 6 in each variable and the 4 x 4 Gauss rule of
+    ``intorder`` 8 integrates it exactly); the factor 2 for the lower half (the ligament
+    y = 0 adds nothing: sigma_12 = 0 and u_2 = 0 there)."""
     b = Basis(model.mesh, model.element, intorder=intorder)
+    bs = Basis(model.mesh, model.scalar.elem, intorder=intorder)
     lam, mu = model.material.lame()
     G = b.interpolate(u).grad                                   # (2, 2, el, qp): du_i/dx_j
     eps = 0.5 * (G + np.swapaxes(G, 0, 1))
@@ -204,12 +208,10 @@ def j_integral(model: MeshElasticity, u: np.ndarray, tip: tuple, radius: float,
     sig[0, 0] += lam * tr
     sig[1, 1] += lam * tr
     w = 0.5 * np.einsum("ijeq,ijeq->eq", sig, eps)
-    X = b.global_coordinates().value                           # (2, el, qp)
-    dx, dy = X[0] - tip[0], X[1] - tip[1]
-    s = (dx * dx + dy * dy) / radius ** 2
-    inside = s < 1.0
-    dq = np.where(inside, -4.0 * (1.0 - s) / radius ** 2, 0.0)  # dq/dx_j = dq * x_j
-    qj = np.stack([dq * dx, dq * dy])                          # (2, el, qp)
+    xn, yn = bs.doflocs
+    s = ((xn - tip[0]) ** 2 + (yn - tip[1]) ** 2) / radius ** 2
+    qn = np.where(s < 1.0, (1.0 - np.minimum(s, 1.0)) ** 2, 0.0)
+    qj = bs.interpolate(qn).grad                               # (2, el, qp)
     integrand = np.einsum("ijeq,ieq,jeq->eq", sig, G[:, 0], qj) - w * qj[0]
     return float(2.0 * np.sum(integrand * b.dx))
 
