@@ -202,3 +202,44 @@ def test_cache_round_trip(tmp_path, monkeypatch):
 def test_bad_parameters_are_refused(over, match):
     with pytest.raises(ValueError, match=match):
         rf.crack_plate(**over)
+
+
+# --- the boundary conditions ---------------------------------------------------------------
+
+@pytest.mark.parametrize("kind", ["centre", "edge"])
+def test_supports_carry_the_load_and_the_faces_open(kind):
+    """Level 2 of each model: the reactions on the supports balance the load (force
+    balance: the ligament's u_y supports carry sigma W t, the x supports nothing), the
+    crack face opens (u_y > 0 on 0 <= x < a, y = 0) and the ligament stays shut; the
+    tip node (a, 0) is a mesh node."""
+    p = cp.CrackPlateParams(kind=kind, height=3.0 if kind == "centre" else 2.0, levels=3)
+    model, u, fld, _, _ = cp.solve_level(p, 2)
+    tol = 1e-9 * p.width
+    lig = model.dofs(lambda x, y: (np.abs(y) < tol) & (x > p.crack - tol), components=[1])
+    f = model.traction_load(lambda x, y: y > p.height * (1 - 1e-9), [0.0, p.traction])
+    reaction = model.stiffness @ u - f
+    load = p.traction * p.width * p.thickness
+    # round-off of K u - f: |K| |u| ~ 1e9 * 1e-3 per DOF, 1e4 DOFs, eps 2e-16
+    assert reaction[lig].sum() == pytest.approx(-load, rel=1e-9)
+    free = np.setdiff1d(np.arange(model.basis.N), np.concatenate(
+        [lig, model.dofs(lambda x, y: np.abs(x - (0.0 if kind == "centre" else p.width))
+                         < tol, components=[0])]))
+    assert np.max(np.abs(reaction[free])) < 1e-9 * load
+    xs, ys = model.dof_coords_scalar
+    assert np.any((np.abs(xs - p.crack) < tol) & (ys == 0.0))
+    face = (ys == 0.0) & (xs < p.crack - tol)
+    assert np.all(u[model.split[1]][face] > 0)
+    np.testing.assert_array_equal(fld.evaluate(np.array([[p.crack + 0.1 * p.tip_length,
+                                                         0.0]]))[:, 1], 0.0)
+
+
+def test_domain_integral_is_integrated_exactly():
+    """With q interpolated by the Q2 shape functions the integrand is a polynomial of
+    degree <= 6 per variable on each rectangle: Gauss of degree 7 is exact, so degrees 7,
+    8 and 12 agree to round-off (a smooth q of r would leave a quadrature error of
+    ~1e-4 in K at level 3 on the elements that straddle r = R)."""
+    p = cp.CrackPlateParams(levels=3)
+    m, u, _, _, _ = cp.solve_level(p, 2)
+    J = [cp.j_integral(m, u, (p.crack, 0.0), 0.2 * p.tip_length, intorder=k) for k in (7, 8, 12)]
+    # round-off of a sum of ~1e5 terms of both signs, each ~|J|
+    np.testing.assert_allclose(J, J[0], rtol=1e-12)
