@@ -56,7 +56,7 @@ Refinement study (compared quantity K_I from J on the middle domain; each row's
 ``j_domain_spread_pct``, ``opening_mouth`` = u_y(0, 0), and from level 1
 ``field_change_pct``: the change of the field on the cell centres of the
 ``sample_spacing`` grid over the quarter, normalised as in ``plate.py``). Measured with
-the defaults (4 elements per tip segment at level 0, five levels, finest 64: 128 x 96
+the defaults (4 elements per tip segment at level 0, five levels, finest 64: 128 x 128
 elements, 132 098 DOFs, smallest edge 3.0e-8 m; each study 4-7 s under load):
 
 - centre, a/W = 0.5: K/K_Tada = 0.99387, 0.99990, 1.000325, 1.000366, 1.000368
