@@ -8,6 +8,8 @@ Public API: one function per reference, each returning its converged, cached res
     indentation(**params)    -> IndentationResult     seed 003 Sec. 4.2
     hole_plate(**params)     -> HolePlateResult       issue 35: plate with a hole
     l_plate(**params)        -> LPlateResult          issue 35: L-shaped bracket
+    crack_plate(**params)    -> CrackPlateResult      issue 54: centre crack (mode I)
+    edge_crack_plate(**params) -> CrackPlateResult    issue 54: single edge crack (SENT)
 
 Keyword arguments override the fields of the matching ``*Params`` dataclass;
 ``use_cache=False`` recomputes. The cache lives in ``$PDVERIFY_CACHE_DIR`` (default
@@ -22,6 +24,7 @@ __version__ = "0.1.0"
 
 from .cache import cache_dir, cache_key  # noqa: E402
 from .clamped_sheet import ClampedSheetParams, ClampedSheetResult, clamped_sheet  # noqa: E402
+from .crack_plate import CrackPlateParams, CrackPlateResult, crack_plate, edge_crack_plate  # noqa: E402,E501
 from .elasticity import Material, TensorElasticity  # noqa: E402
 from .field import FieldSolution  # noqa: E402
 from .hole_plate import HolePlateParams, HolePlateResult, hole_plate  # noqa: E402
@@ -40,15 +43,18 @@ REFERENCES = {
     "block2d-indentation": indentation,
     "plate-hole": hole_plate,
     "plate-l": l_plate,
+    "plate-crack": crack_plate,
+    "plate-edge-crack": edge_crack_plate,
 }
 
 __all__ = [
     "__version__", "REFERENCES", "cache_dir", "cache_key",
     "clamped_plate", "tension_sheet", "clamped_sheet", "indentation", "hole_plate", "l_plate",
+    "crack_plate", "edge_crack_plate",
     "PlateParams", "TensionSheetParams", "ClampedSheetParams", "IndentationParams",
-    "HolePlateParams", "LPlateParams",
+    "HolePlateParams", "LPlateParams", "CrackPlateParams",
     "PlateResult", "TensionSheetResult", "ClampedSheetResult", "IndentationResult",
-    "HolePlateResult", "LPlateResult",
+    "HolePlateResult", "LPlateResult", "CrackPlateResult",
     "ReferenceResult", "RefinementRow", "Material", "TensorElasticity", "FieldSolution",
     "MeshElasticity", "MeshField",
 ]
