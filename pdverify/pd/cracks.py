@@ -14,6 +14,8 @@ on the faces themselves (theta = pi) the even-n terms vanish and the opening is
 (8 / E') sqrt(r / 2 pi) (K + c_1 r + c_2 r^2 + ...), E' = E (plane stress) or
 E / (1 - nu^2) (plane strain).
 
+(``reference_fem.crack_plate.opening_fit`` fits the face form at points on the face
+itself, where a FEM field can be evaluated; a PD grid has no node there, hence this fit.)
 A PD grid has no node on the crack faces: the nodes nearest a slit between two node rows
 sit at +-h/2 from it. The fit therefore uses every term's full angular function at each
 pair's own (r, theta) (the angle theta = pi - O(h / r) matters: at r = 3 h the leading
@@ -30,9 +32,9 @@ odd orders (1, 3) on one row read K 1.8 .. 1.0 % high, (1, 3, 5) on one row 0.53
 0.16 %, the default -0.16 .. -0.07 % (``benchmarks/crack_k.py`` prints the fit of the
 FEM field beside every PD number).
 
-Window: the pairs whose r (distance to the tip along the crack, behind it) lies in
-[``tip_zone`` horizons, ``reach`` x min(a, W - a)], with a the crack length from its tip
-to the nearest other end and W - a the ligament. Inside the tip zone PD and LEFM cannot
+Window: the pairs behind the tip whose r (the node's distance to the tip) lies in
+[``tip_zone`` horizons, ``reach`` x min(a, W - a)] (defaults 2 horizons and 0.8), with a
+the crack's length from its tip to its other end or centre and W - a the ligament. Inside the tip zone PD and LEFM cannot
 agree (the nonlocal zone: a PD crack tip has no r^(1/2) singularity, its opening is
 blunted within a few horizons); beyond ``reach`` the finite body's higher terms grow.
 
