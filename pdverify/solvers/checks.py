@@ -23,6 +23,15 @@ def checked_condition(sol, A, lu, where: str) -> float:
     return cond
 
 
+def refuse_non_finite(where: str, *arrays) -> None:
+    """NumericalError naming ``where`` when any of ``arrays`` (dense, or sparse: its stored
+    entries) holds a non-finite value: a system is refused before any work on it."""
+    for a in arrays:
+        data = a.data if sp.issparse(a) else np.asarray(a, dtype=float)
+        if not np.all(np.isfinite(data)):
+            raise NumericalError(f"{where}: the system has non-finite entries")
+
+
 def refuse_near_singular(cond: float, where: str) -> None:
     """NumericalError naming ``where`` when the condition estimate ``cond`` of the
     equilibrated system exceeds :data:`~pdverify.solvers.policy.CONDITION_LIMIT`."""

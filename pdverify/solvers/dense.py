@@ -9,7 +9,8 @@ import scipy.sparse as sp
 from scipy.linalg import lapack
 
 from ..errors import NumericalError
-from .checks import equilibrate, refuse_near_singular, relative_residual, rounded_estimate
+from .checks import (equilibrate, refuse_near_singular, refuse_non_finite, relative_residual,
+                     rounded_estimate)
 
 
 class DenseFactor:
@@ -25,8 +26,7 @@ class DenseFactor:
         K = sp.csr_matrix(K)
         self.K, self.where = K, where
         n = K.shape[0]
-        if not np.all(np.isfinite(K.data)):
-            raise NumericalError(f"{where}: the system has non-finite entries")
+        refuse_non_finite(where, K)
         A_s, self.row_max, self.col_max = equilibrate(K, where)
         A = A_s.toarray()
         anorm = float(np.abs(A).sum(axis=0).max())
@@ -40,8 +40,7 @@ class DenseFactor:
 
     def solve(self, f) -> np.ndarray:
         f = np.asarray(f, dtype=float)
-        if not np.all(np.isfinite(f)):
-            raise NumericalError(f"{self.where}: the system has non-finite entries")
+        refuse_non_finite(self.where, f)
         u = sl.lu_solve((self.lu, self.piv), f / self.row_max, check_finite=False) / self.col_max
         if not np.all(np.isfinite(u)):
             raise NumericalError(f"{self.where}: solution has non-finite values (singular "
@@ -61,8 +60,7 @@ def solve_dense(K, f, *, where: str = "static solve"):
     Returns ``(u, info)``.
     """
     f = np.asarray(f, dtype=float)
-    if not np.all(np.isfinite(sp.csr_matrix(K).data)) or not np.all(np.isfinite(f)):
-        raise NumericalError(f"{where}: the system has non-finite entries")
+    refuse_non_finite(where, f)           # K: by the factor, before its work
     lu = DenseFactor(K, where=where)
     u = lu.solve(f)
     return u, lu.info

@@ -17,8 +17,8 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import NumericalError
 from . import policy
+from .checks import refuse_non_finite
 from .condense import condense
 from .dense import DenseFactor, solve_dense
 from .iterative import solve_spd
@@ -256,8 +256,7 @@ def solve_with_dirichlet(K, rhs, fixed, values, where, spd: bool = False,
 def _solved(A, b, where: str, **how):
     """``(x, info)`` of A x = b by :func:`factor` (``how``: its keywords)."""
     b = np.asarray(b, dtype=float)
-    if not np.all(np.isfinite(sp.csr_matrix(A).data)) or not np.all(np.isfinite(b)):
-        raise NumericalError(f"{where}: the system has non-finite entries")
+    refuse_non_finite(where, b)           # A: by the factor, before its work
     lu = factor(A, "auto", where=where, **how)
     x = lu.solve(b)
     return x, lu.info

@@ -7,7 +7,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..errors import NumericalError
-from .checks import checked_condition, equilibrate, relative_residual
+from .checks import checked_condition, equilibrate, refuse_non_finite, relative_residual
 
 
 #: SuperLU options for a symmetric positive definite K (no constraint rows): minimum
@@ -34,8 +34,7 @@ class SuperLUFactor:
     def __init__(self, A, *, where: str = "static solve", spd: bool = False,
                  ordering: str = "COLAMD"):
         A = sp.csc_matrix(A)
-        if not np.all(np.isfinite(A.data)):
-            raise NumericalError(f"{where}: the system has non-finite entries")
+        refuse_non_finite(where, A)
         self.A, self.where = A, where
         A_s, self.row_max, self.col_max = equilibrate(A, where)
         self.A_s = A_s.tocsc()
@@ -46,8 +45,7 @@ class SuperLUFactor:
 
     def solve(self, b) -> np.ndarray:
         b = np.asarray(b, dtype=float)
-        if not np.all(np.isfinite(b)):
-            raise NumericalError(f"{self.where}: the system has non-finite entries")
+        refuse_non_finite(self.where, b)
         sol = self.lu.solve(b / self.row_max) / self.col_max
         cond = checked_condition(sol, self.A_s, self.lu, self.where)
         self.info = {"unknowns": int(self.A.shape[0]),
@@ -82,8 +80,7 @@ def solve_constrained(K, f, B=None, c=None, *, where: str = "static solve", spd:
     else:
         A = K.tocsc()
         rhs = np.asarray(f, dtype=float)
-    if not np.all(np.isfinite(A.data)) or not np.all(np.isfinite(rhs)):
-        raise NumericalError(f"{where}: the system has non-finite entries")
+    refuse_non_finite(where, rhs)         # A: by the factor, before its work
     lu = SuperLUFactor(A, where=where, spd=spd, ordering=ordering)
     sol = lu.solve(rhs)
     return sol[:n], sol[n:], lu.info

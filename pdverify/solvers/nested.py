@@ -9,9 +9,9 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..errors import NumericalError
 from . import policy
-from .checks import checked_condition, equilibrate, refuse_near_singular, relative_residual
+from .checks import (checked_condition, equilibrate, refuse_near_singular, refuse_non_finite,
+                     relative_residual)
 from .lu import factor
 from .frontal import FrontalLU
 from .mixed import refine_with_probe, scaled_solve
@@ -73,8 +73,7 @@ class NestedFactor:
 
     def __init__(self, A, coords, *, where: str = "static solve", mixed: bool | None = None):
         A = sp.csr_matrix(A)
-        if not np.all(np.isfinite(A.data)):
-            raise NumericalError(f"{where}: the system has non-finite entries")
+        refuse_non_finite(where, A)
         self.A, self.where = A, where
         n = A.shape[0]
         self.A_p, self.row_max, self.perm, (n1, n2), self.col_max, tree = ordered_matrix(
@@ -100,8 +99,7 @@ class NestedFactor:
 
     def solve(self, rhs) -> np.ndarray:
         rhs = np.asarray(rhs, dtype=float)
-        if not np.all(np.isfinite(rhs)):
-            raise NumericalError(f"{self.where}: the system has non-finite entries")
+        refuse_non_finite(self.where, rhs)
         b_p = (rhs / self.row_max)[self.perm]
         info: dict = {"unknowns": int(self.A.shape[0])}
         y = None
@@ -131,8 +129,7 @@ def solve_nested(A, rhs, coords, *, where: str = "static solve", mixed: bool | N
     """Solve the square system A x = rhs by :class:`NestedFactor` (its docstring: the
     ordering, ``mixed``, the checks and the diagnostics). Returns ``(x, info)``."""
     rhs = np.asarray(rhs, dtype=float)
-    if not np.all(np.isfinite(sp.csr_matrix(A).data)) or not np.all(np.isfinite(rhs)):
-        raise NumericalError(f"{where}: the system has non-finite entries")
+    refuse_non_finite(where, rhs)         # A: by the factor, before its work
     lu = NestedFactor(A, coords, where=where, mixed=mixed)
     x = lu.solve(rhs)
     return x, lu.info
