@@ -133,8 +133,7 @@ class CrackPlate(ShapeScene):
     Cases: ``fem``; every method at the defaults; ``none`` and ``energy`` also at h = 1/60
     (m = 3): two levels of the study's three (1/80 would more than double the scene's
     report time; ``refinement``), so the figure's slopes join two points, not a rate. The
-    quick report runs the defaults (a coarser grid leaves too few pairs in the fit's
-    window). What the study found (its docstring, not retyped here): the uncorrected
+    quick report runs every method at h = 1/30 (``quick_spacing``). What the study found (its docstring, not retyped here): the uncorrected
     model reads K low by a few per cent, falling with h; ``volume`` is worse than none;
     ``energy`` comes closer in K than in the opening. The solves are nested dissection
     (``fixed_solver``).
@@ -151,8 +150,9 @@ class CrackPlate(ShapeScene):
     #: at h = 1/40, 119 s at 1/80, under load), the study's auto choice 3 and 18 s
     fixed_solver = "auto"
     #: the refinement of ``none`` and ``energy`` at fixed m = 3 beside the default 1/40:
-    #: two levels, not the study's three; with 1/80 the scene's report took 84 s (9 runs,
-    #: 115 s of run time, peak 3.6 GB at 1/80; under load), past the 60 s it may add
+    #: two levels, not the study's three: with 1/80 ``report --only plate-crack`` took 84 s
+    #: (load ~4) and 62 s (load ~1.3), past the 60 s it may add (each 1/80 run ~20 s, peak
+    #: 3.6 GB); with these two 23 s (load ~1.4)
     refinement = (1 / 60,)
     refined = ("none", "energy")
     delta_sweep = ()
@@ -163,11 +163,10 @@ class CrackPlate(ShapeScene):
         return (MethodSpec(fem.name, tuple(q for q in fem.params
                                            if q.name not in _FEM_FIXED)),)
 
-    @property
-    def quick_spacing(self) -> float:
-        """The quick report's grid: the default (1/40 m; a coarser grid leaves too few
-        pairs in the fit's window)."""
-        return next(q.default for q in self.pd_params if q.name == "spacing")
+    #: the quick report's grid (m = 3): 60 x 180 nodes, about half the default's time;
+    #: the fit's window [2 delta, 0.4 m] = [0.2, 0.4] m still holds 6 pairs a row (at 1/20
+    #: it would hold 2, as many as the fit's orders)
+    quick_spacing = 1 / 30
 
     @property
     def table_metrics(self):
@@ -243,8 +242,8 @@ class CrackPlate(ShapeScene):
     def cases(self, quick=False):
         runs = self.default_cases()
         out = [("fem", {})] + runs
-        if quick:
-            return out
+        if quick:    # every method, on the quick grid
+            return [("fem", {})] + [(m, {**q, "spacing": self.quick_spacing}) for m, q in runs]
         for h in self.refinement:
             out += [(m, {**q, "spacing": h}) for m, q in runs if m in self.refined]
         return out
