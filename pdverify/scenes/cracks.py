@@ -145,6 +145,9 @@ class CrackPlate(ShapeScene):
     params_class, function = "CrackPlateParams", "crack_plate"
     shared = ("width", "height", "crack", "thickness", "E", "nu", "traction")
     headline = "k_error_pct"
+    #: ``export`` and ``score`` refuse it (``pdverify.exchange``)
+    export_refusal = ("a node set does not carry the crack: the code that reads it builds "
+                      "its own bonds from the positions and would bond across the slit")
     #: nested dissection (``solvers.policy``): the direct solve under plate-hole's
     #: ordering took 4-7x longer on this 80 x 240 lattice (report --only plate-crack: 20 s
     #: at h = 1/40, 119 s at 1/80, under load), the study's auto choice 3 and 18 s

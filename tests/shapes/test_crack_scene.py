@@ -103,3 +103,14 @@ def test_bad_input_is_one_line_before_any_work(tmp_path, assignment, words):
     r, _ = _run(tmp_path, assignment)
     assert r.returncode == 2
     assert words in r.stderr and len(r.stderr.strip().splitlines()) == 1
+
+
+def test_export_refuses_the_cracked_plate_with_its_reason(tmp_path):
+    """A node set carries no cut bonds: another code would bond across the slit."""
+    from pdverify.exchange import exportable_ids
+    assert "plate-crack" not in exportable_ids() and "plate-hole" in exportable_ids()
+    r = subprocess.run([sys.executable, "-m", "pdverify", "export", "plate-crack",
+                        "--format", "csv", "--out", str(tmp_path / "x")],
+                       capture_output=True, text=True)
+    assert r.returncode == 2 and "would bond across the slit" in r.stderr
+    assert not (tmp_path / "x").exists()
