@@ -130,10 +130,10 @@ class CrackPlate(ShapeScene):
     either tip: the nonlocal zone, as the fit's window; ``tip_zone_nodes`` counts them);
     ``reference_change_pct``. The error maps show every node, the tip zone included.
 
-    Cases: ``fem``; every method at the defaults; ``none`` and ``energy`` also at h = 1/60
-    (m = 3): two levels of the study's three (1/80 would more than double the scene's
-    report time; ``refinement``), so the figure's slopes join two points, not a rate. The
-    quick report runs every method at h = 1/30 (``quick_spacing``). What the study found (its docstring, not retyped here): the uncorrected
+    Cases: ``fem`` and every method at the defaults; no refinement (its time and the
+    budget's estimate at h = 1/60 are past the report's limits: the comment at
+    ``delta_sweep``); the study's three levels are ``benchmarks/crack_k.py``'s. The quick
+    report runs every method at h = 1/30 (``quick_spacing``). What the study found (its docstring, not retyped here): the uncorrected
     model reads K low by a few per cent, falling with h; ``volume`` is worse than none;
     ``energy`` comes closer in K than in the opening. The solves are nested dissection
     (``fixed_solver``).
@@ -152,12 +152,12 @@ class CrackPlate(ShapeScene):
     #: ordering took 4-7x longer on this 80 x 240 lattice (report --only plate-crack: 20 s
     #: at h = 1/40, 119 s at 1/80, under load), the study's auto choice 3 and 18 s
     fixed_solver = "auto"
-    #: the refinement of ``none`` and ``energy`` at fixed m = 3 beside the default 1/40:
-    #: two levels, not the study's three: with 1/80 ``report --only plate-crack`` took 84 s
-    #: (load ~4) and 62 s (load ~1.3), past the 60 s it may add (each 1/80 run ~20 s, peak
-    #: 3.6 GB); with these two 23 s (load ~1.4)
-    refinement = (1 / 60,)
-    refined = ("none", "energy")
+    #: no refinement in the report: the study's levels 1/60 and 1/80 (m = 3) are past the
+    #: report's budgets. Three levels took ``report --only plate-crack`` to 84 s (load ~4)
+    #: and 62 s (load ~1.3), past the 60 s the scene may add; two levels (23 s) are
+    #: estimated at 5.6 GB at 1/60 (``budget.linear_system``'s sparse LU; measured peak
+    #: 1.96 GB under nested dissection), past the 4 GB every report case must stay under
+    #: (tests/reliability/test_budget.py). The refinement is ``benchmarks/crack_k.py``'s.
     delta_sweep = ()
 
     @property
@@ -247,6 +247,4 @@ class CrackPlate(ShapeScene):
         out = [("fem", {})] + runs
         if quick:    # every method, on the quick grid
             return [("fem", {})] + [(m, {**q, "spacing": self.quick_spacing}) for m, q in runs]
-        for h in self.refinement:
-            out += [(m, {**q, "spacing": h}) for m, q in runs if m in self.refined]
         return out
