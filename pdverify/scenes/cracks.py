@@ -133,10 +133,10 @@ class CrackPlate(ShapeScene):
     Cases: ``fem`` and every method at the defaults; no refinement (its time and the
     budget's estimate at h = 1/60 are past the report's limits: the comment at
     ``delta_sweep``); the study's three levels are ``benchmarks/crack_k.py``'s. The quick
-    report runs every method at h = 1/30 (``quick_spacing``). What the study found (its docstring, not retyped here): the uncorrected
-    model reads K low by a few per cent, falling with h; ``volume`` is worse than none;
-    ``energy`` comes closer in K than in the opening. The solves are nested dissection
-    (``fixed_solver``).
+    report runs every method at h = 1/30 (``quick_spacing``). What the study found (its
+    docstring, not retyped here): the uncorrected model reads K low by a few per cent,
+    falling with h; ``volume`` is worse than none; ``energy`` comes closer in K than in
+    the opening. The solves are nested dissection (``fixed_solver``).
     """
 
     id = "plate-crack"
