@@ -14,7 +14,9 @@ the mirror half. Rigid motions: four short parts of length h/2 at the middles of
 edges (``pin-l``, ``pin-r`` on x = -+W prescribe u_y; ``pin-b``, ``pin-t`` on y = -+H
 prescribe u_x and carry the traction as well), each at the FEM's value (the
 components that vanish on the symmetry lines, so the values are O(h) small; the nodes
-they fix are two per part, at a distance W - a = 0.5 m from the tips).
+they fix are two per part, at a distance W - a = 0.5 m from the tips). The plate, its
+conditions and the mirrored FEM field are ``pdverify.scenes.cracks``' (the scene
+``plate-crack``, which repeats this study's runs), imported here.
 
 PD: 2D linear state-based (LPS), hyperbolic influence, plane-stress constants,
 ``partial-volume`` quadrature, m = 3, cell-centred nodes at h = 1/40, 1/60, 1/80 m
@@ -88,8 +90,8 @@ from pdverify.corrections.plain import assemble_plain  # noqa: E402
 from pdverify.pd import StateBasedConstants, get_influence, state_based_stencil  # noqa: E402
 from pdverify.corrections.volume import volume_closure  # noqa: E402
 from pdverify.pd.cracks import fit_k, opening_pairs  # noqa: E402
-from pdverify.pd.problem import FaceCondition, StaticProblem  # noqa: E402
-from pdverify.pd.shapes import Crack, polygon  # noqa: E402
+from pdverify.pd.problem import StaticProblem  # noqa: E402
+from pdverify.scenes.cracks import crack_conditions, cracked_plate, mirrored  # noqa: E402
 from pdverify.solvers.front import solve  # noqa: E402
 from reference_fem.crack_plate import crack_plate, tada_centre  # noqa: E402
 
@@ -101,43 +103,14 @@ SPACINGS = (1 / 40, 1 / 60, 1 / 80)
 CLOSURES = {"none": lambda: None, "volume": volume_closure, "energy": energy_closure}
 
 
-def plate(h):
-    e = h / 4
-    v = [(-W, -H), (-e, -H), (e, -H), (W, -H), (W, -e), (W, e), (W, H), (e, H), (-e, H),
-         (-W, H), (-W, e), (-W, -e)]
-    names = ("y-a", "pin-b", "y-b", "x+a", "pin-r", "x+b", "y+a", "pin-t", "y+b", "x-a",
-             "pin-l", "x-b")
-    return polygon(v, names, "cracked plate").with_cracks(
-        Crack("right", (0.0, 0.0), (A, 0.0)), Crack("left", (0.0, 0.0), (-A, 0.0)))
-
-
-def mirrored(field):
-    """The quarter model's field on the whole plate (u_x odd in x, u_y odd in y)."""
-    def value(x):
-        x = np.asarray(x, float)
-        u = field.evaluate(np.abs(x))
-        return u * np.sign(np.where(x == 0, 1.0, x))
-    return value
-
-
-def conditions():
-    up = FaceCondition(traction=lambda x, n: np.c_[np.zeros(len(x)), np.full(len(x), SIGMA)])
-    down = FaceCondition(traction=lambda x, n: np.c_[np.zeros(len(x)),
-                                                     np.full(len(x), -SIGMA)])
-    c = {"y+a": up, "y+b": up, "y-a": down, "y-b": down,
-         "pin-t": FaceCondition(prescribed=(0,), traction=up.traction),
-         "pin-b": FaceCondition(prescribed=(0,), traction=down.traction),
-         "pin-l": FaceCondition(prescribed=(1,)), "pin-r": FaceCondition(prescribed=(1,))}
-    return c
-
-
 def run(h, method, exact):
     inf = get_influence("hyperbolic")
     problem = StaticProblem((2 * W, 2 * H), (-W, -H), h,
                             state_based_stencil(2, M, h, inf, "partial-volume"),
-                            StateBasedConstants("plane-stress", E, NU), inf, conditions(),
+                            StateBasedConstants("plane-stress", E, NU), inf,
+                            crack_conditions(SIGMA),
                             exact=exact, solver="auto", where=f"crack-k {method} h={h:g}",
-                            shape=plate(h))
+                            shape=cracked_plate(W, H, A, h))
     t0 = time.perf_counter()
     closure = CLOSURES[method]()
     system = assemble_plain(problem, closure)

@@ -68,8 +68,11 @@ def bond_based(scene) -> bool:
 def exportable(scene) -> bool:
     """A scene of the ``static-state`` family that states its problem (the stiffness
     scenes of the family prescribe every node and solve nothing), or a bond-based sheet
-    that builds and measures its own (:func:`bond_based`)."""
+    that builds and measures its own (:func:`bond_based`); not a scene that states an
+    ``export_refusal`` (a problem a node set does not carry)."""
     from .scenes.family import StaticStateScene
+    if getattr(scene, "export_refusal", None):
+        return False
     return bond_based(scene) or (isinstance(scene, StaticStateScene)
                                  and type(scene).problem is not StaticStateScene.problem
                                  and type(scene).measure is not StaticStateScene.measure)
@@ -85,6 +88,10 @@ def scene_of(scene_id: str):
     can (an unknown id: the registry's message with close matches)."""
     from .scenes import get_scene
     scene = get_scene(scene_id)
+    why = getattr(scene, "export_refusal", None)
+    if why:
+        raise InputError(f"scene {scene_id!r} cannot be exported or scored: {why}; these "
+                         f"can: {', '.join(exportable_ids())}")
     if not exportable(scene):
         raise InputError(f"scene {scene_id!r} is not a static problem with a node set "
                          "(the static-state family or a bond-based sheet) and cannot be "

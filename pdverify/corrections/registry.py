@@ -469,6 +469,12 @@ def _plugins():
         return
     if not eps:
         return
+    if SCENES is None:
+        # the plugins' answers are asked of every scene: a first call that comes before
+        # anything imported the scenes would otherwise load them with no scene to answer
+        # for (and every scene would say the plugin was loaded before it)
+        import importlib
+        importlib.import_module(__name__.rsplit(".", 2)[0] + ".scenes")
     # what the child's answers read of every scene, its own methods (the FEM-referenced
     # scenes import their reference modules), loaded here first: the child inherits it
     # and this process keeps it (else both would import them)

@@ -23,9 +23,9 @@ def _float_check(default):
 #: the units of the FEM references' dataclass fields (``reference_fem``, SI as their
 #: comments state); a field not listed is dimensionless or a count
 FEM_UNITS = {"width": "m", "height": "m", "length": "m", "radius": "m", "depth": "m",
-             "horizon": "m", "thickness": "m", "spacing": "m", "fine_half_width": "m",
-             "fine_depth": "m", "sample_spacing": "m", "E": "Pa", "traction": "Pa",
-             "body_force": "N/m^3"}
+             "crack": "m", "horizon": "m", "thickness": "m", "spacing": "m",
+             "fine_half_width": "m", "fine_depth": "m", "sample_spacing": "m", "E": "Pa",
+             "traction": "Pa", "body_force": "N/m^3"}
 
 
 def _field_param(name, field, cls_name) -> Param:

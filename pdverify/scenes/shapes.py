@@ -107,6 +107,11 @@ class ShapeScene(FemStaticStateScene):
     def conditions(self, p) -> dict:
         raise NotImplementedError
 
+    def reference_field(self, p):
+        """The FEM displacement at points (the problem's ``exact``): the reference's own
+        evaluation; a scene whose reference models part of its body maps it here."""
+        return self.reference_of(p).evaluate
+
     def box(self, p):
         s = self.shape(p)
         return tuple(np.subtract(s.upper, s.lower)), tuple(s.lower)
@@ -125,7 +130,7 @@ class ShapeScene(FemStaticStateScene):
         lengths, origin = self.box(p)
 
         def value(x):
-            return self.reference_of(p).evaluate(x)
+            return self.reference_field(p)(x)
         return StaticProblem(
             lengths, origin, float(p["spacing"]),
             state_based_stencil(2, p["m_ratio"], p["spacing"], inf, p["quadrature"]),

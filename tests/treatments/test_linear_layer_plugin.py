@@ -90,7 +90,7 @@ def test_it_runs_on_every_scene_of_its_family(registered):
     import pdverify.scenes as scenes
     family = [s for s in scenes.all_scenes() if s.family == "static-state"]
     boxes = [s for s in family if not s.has_shape]
-    assert len(boxes) == 10 and len(family) == 12
+    assert len(boxes) == 10 and len(family) == 13
     for scene in family:
         why = registered.why_not(scene)
         if scene.has_shape:
@@ -117,3 +117,36 @@ def test_it_runs_on_every_scene_of_its_family(registered):
             ref = scene.run("surface-nodes", {**_coarse(scene), "order": 1})
             for k in ("max_error_pct", "rel_l2_error"):
                 assert res.metrics[k] == pytest.approx(ref.metrics[k], rel=1e-6, abs=1e-9)
+
+
+def test_a_plugin_loaded_before_the_scenes_still_answers_for_every_scene():
+    """The first call of the treatment registry may come before anything imported the
+    scenes (a fresh process that asks for the methods first): the plugin is still asked
+    about every scene. Fails when the registry loads it with no scene to answer for (then
+    every scene says "the plugin was loaded before this scene")."""
+    import subprocess
+    script = f"""
+import importlib.metadata as md, sys
+sys.path.insert(0, {str(PLUGIN)!r})
+from pdverify.corrections import registry
+assert "pdverify.scenes" not in sys.modules
+class EP:
+    group = registry.ENTRY_POINT_GROUP
+    name, value = {NAME!r}, "pdverify_linear_layer:METHOD"
+    def load(self):
+        import pdverify_linear_layer
+        return pdverify_linear_layer.METHOD
+md.entry_points = lambda group=None: [EP()]
+t = registry.treatments()[{NAME!r}]
+import pdverify.scenes as scenes
+print(sum(t.why_not(s) is None for s in scenes.all_scenes()), len(t.answers))
+"""
+    root = Path(__file__).resolve().parents[2]
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                         cwd=root, env={**__import__("os").environ, "PYTHONPATH": str(root)},
+                         timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    offered, answered = map(int, out.stdout.split())
+    import pdverify.scenes as scenes
+    assert answered == len(scenes.all_scenes())
+    assert offered == 10     # the ten boxes of the static-state family (the test above)

@@ -1,0 +1,115 @@
+"""The ``plate-crack`` scene (issue 54): its runs repeat the study of
+``benchmarks/crack_k.py``, a crack of zero length is the uncracked plate, the treatments
+that cannot serve crack faces say why, bad input is one line."""
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pdverify.scenes import get_scene
+
+RECORD = (Path(__file__).resolve().parents[2] / "benchmarks" / "records"
+          / "crack_k-2026-11-28-default.json")
+
+
+def _run(tmp_path, *sets, method="none"):
+    out = tmp_path / "run.json"
+    r = subprocess.run([sys.executable, "-m", "pdverify", "run", "plate-crack", "--method",
+                        method, *[a for s in sets for a in ("--set", s)], "--json", str(out)],
+                       capture_output=True, text=True)
+    return r, (json.loads(out.read_text())["runs"][0] if r.returncode == 0 else None)
+
+
+def test_the_uncorrected_k_is_the_studys_at_h_1_40(tmp_path):
+    """The scene builds the study's problem (one builder, ``pdverify.scenes.cracks``) and
+    measures K with the study's fit, so K_PD / K_FEM and the opening error equal the
+    record's. Tolerance 1e-8 relative: two solves of one system differ by at most its
+    condition number times the backward error, and the refinement stops at 2 eps
+    (``solvers.mixed.REFINE_STOP``): 1e-8 allows a condition up to ~2e7, the
+    single-precision factor's own limit (``solvers.mixed``)."""
+    rows = json.loads(RECORD.read_text())["results"]["rows"]
+    study = next(r for r in rows if r["method"] == "none" and r["spacing"] == 0.025)
+    r, run = _run(tmp_path)
+    assert r.returncode == 0, r.stderr
+    m = run["metrics"]
+    assert m["k_ratio"] == pytest.approx(study["k_over_fem"], rel=1e-8)
+    assert m["k_error_pct"] == pytest.approx(100 * (study["k_over_fem"] - 1), rel=1e-7)
+    assert m["opening_error_pct"] == pytest.approx(study["opening_err_pct"], rel=1e-8)
+    assert m["k_fit_bias_pct"] == pytest.approx(100 * (study["k_fit_fem_over_fem"] - 1),
+                                                rel=1e-7)
+    # the field metrics leave the tip zone out: 2 horizons of either tip
+    h, delta = 0.025, 0.075
+    assert m["tip_zone_nodes"] == 2 * sum(
+        1 for i in range(-20, 20) for j in range(-20, 20)
+        if np.hypot((i + 0.5) * h, (j + 0.5) * h) < 2 * delta)
+    assert run["params"]["spacing"] == 0.025 and run["params"]["m_ratio"] == 3.0
+
+
+def test_a_crack_of_zero_length_is_the_uncracked_plate():
+    """The stiffness of the plate with a = 0 equals, bit for bit, that of the same polygon
+    without cracks (``pd.shapes``: a crack of zero length is no crack); with a = 0.5 it
+    does not (the check can fail)."""
+    from dataclasses import replace
+
+    from pdverify.corrections.plain import assemble_plain
+    from pdverify.scenes.cracks import cracked_plate, plate_outline
+    scene = get_scene("plate-crack")
+    p = {**scene.default_params(), "spacing": 0.25}
+
+    def stiffness(shape):
+        problem = replace(scene.problem(p, "test"), shape=shape)
+        return assemble_plain(problem, None).K.tocsr()
+
+    k0 = stiffness(cracked_plate(1.0, 3.0, 0.0, 0.25))
+    kp = stiffness(plate_outline(1.0, 3.0, 0.25))
+    assert k0.shape == kp.shape and (k0 != kp).nnz == 0
+    kc = stiffness(cracked_plate(1.0, 3.0, 0.5, 0.25))
+    assert (kc != kp).nnz > 0
+
+
+def test_the_list_shows_why_the_node_adding_treatments_and_the_peer_do_not_run():
+    out = subprocess.run([sys.executable, "-m", "pdverify", "list", "plate-crack"],
+                         capture_output=True, text=True, check=True).stdout
+    assert "taylor-fictitious: crack faces are not served yet: " \
+           "corrections.shape_fictitious would see each crack face as a straight part" in out
+    assert "peer:lammps: its code builds its own bonds from the node positions" in out
+    assert "surface-nodes: box faces only" in out
+    offered = set(get_scene("plate-crack").offered())
+    assert offered == {"none", "energy", "volume", "pals"}
+
+
+def test_the_cases_are_every_method_at_the_defaults_and_the_quick_grid():
+    scene = get_scene("plate-crack")
+    cases = scene.cases()
+    assert {m for m, _ in cases} == {"fem", "none", "energy", "volume", "pals"}
+    assert all(q == {} for _, q in cases)
+    quick = scene.cases(quick=True)
+    assert {m for m, _ in quick} == {m for m, _ in cases}
+    assert {q.get("spacing") for m, q in quick if m != "fem"} == {1 / 30}
+    d = scene.discretisation(scene.default_params())
+    assert (d.h, d.delta) == pytest.approx((0.025, 0.075), rel=1e-15)   # m = 3, round-off
+
+
+@pytest.mark.parametrize("assignment, words", [
+    ("spacing=0.3", "must divide"),                 # the tips off the cell faces
+    ("jitter=0.1", "allowed 0 only"),               # the fit pairs lattice nodes
+    ("m_ratio=8", "fewer than two spacings"),       # the fit's window too short
+])
+def test_bad_input_is_one_line_before_any_work(tmp_path, assignment, words):
+    r, _ = _run(tmp_path, assignment)
+    assert r.returncode == 2
+    assert words in r.stderr and len(r.stderr.strip().splitlines()) == 1
+
+
+def test_export_refuses_the_cracked_plate_with_its_reason(tmp_path):
+    """A node set carries no cut bonds: another code would bond across the slit."""
+    from pdverify.exchange import exportable_ids
+    assert "plate-crack" not in exportable_ids() and "plate-hole" in exportable_ids()
+    r = subprocess.run([sys.executable, "-m", "pdverify", "export", "plate-crack",
+                        "--format", "csv", "--out", str(tmp_path / "x")],
+                       capture_output=True, text=True)
+    assert r.returncode == 2 and "would bond across the slit" in r.stderr
+    assert not (tmp_path / "x").exists()
