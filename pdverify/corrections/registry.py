@@ -53,7 +53,7 @@ from .containment import what_it_did  # noqa: F401  (re-exported)
 from ..params import Param
 from ..pd.closure import Closure
 from .protocols import BondClosure, ParamCheck
-from .treatment import ENTRY_POINT_GROUP, THEORIES, Treatment  # noqa: F401  (re-exported)
+from .treatment import ENTRY_POINT_GROUP, Treatment
 
 
 @dataclass(frozen=True)

@@ -5,7 +5,6 @@ applied to the exact field at every node (fictitious nodes included, their dilat
 from complete neighbourhoods), so the solve must return the field to round-off when the
 Taylor extrapolation of order N (displacements) and N - 1 (dilatations) is exact.
 """
-from itertools import product
 
 import numpy as np
 import pytest

@@ -16,7 +16,6 @@ Tolerances name their sources in comments; the measured numbers are in the devia
 """
 import numpy as np
 import pytest
-import scipy.sparse.linalg as spl
 
 from pdverify.corrections.mirror_nodes import MirrorNodes
 from pdverify.corrections.assembly import traction_of

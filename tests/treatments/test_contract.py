@@ -2,7 +2,6 @@
 ``cases`` and published numbers, every empty cell of the method x scene matrix has its
 one-line reason, and the package's import graph runs one way."""
 import ast
-import inspect
 from pathlib import Path
 
 import pytest
