@@ -41,6 +41,22 @@ def ramp(bond_x, spacing, horizon):
                     (-1.0 / (2 * half)) * bond_x + (1.0 + (horizon - half) / (2 * half)), 1.0)
 
 
+def as_used_closure(model):
+    """The closure that gives pdverify's linear model LAMMPS's as-used bond weights on a
+    lattice of uniform volumes (``model``: :class:`pdverify.peers.lammps.Model`): its ramp
+    within h/2 of its horizon (m + 2e-4) h, whole cells inside, no bond beyond, in place of
+    the scene's quadrature's beta (``weight_factor`` multiplies beta, or the bond-based
+    spring stiffness, which holds beta)."""
+    from ..pd.closure import Closure
+    horizon = (model.m_ratio + lammps.EXAMPLES_MARGIN) * model.spacing
+
+    def lammps_weights(m):
+        keep = m.bond_x <= horizon
+        return np.where(keep, ramp(m.bond_x, model.spacing, horizon)
+                        / np.where(keep, m.bond_beta, 1.0), 0.0)
+    return Closure(weight_factor=lammps_weights)
+
+
 def _rel(a, b, scale) -> float:
     return float(np.linalg.norm(a - b) / scale) if scale > 0 else float(np.linalg.norm(a - b))
 
@@ -48,12 +64,16 @@ def _rel(a, b, scale) -> float:
 #: the report's peer runs: scene -> overrides (each run in both settings, with LAMMPS's
 #: influence and whole-cell volumes where the scene has those parameters); sizes kept
 #: small so that the runs add seconds to a full report (~1 s for the 3D box at h = 0.1:
-#: record peers-2026-11-28-report-runs)
+#: record peers-2026-11-28-report-runs); the clamped sheet at m = 4 (17 x 17 atoms, ~850
+#: FIRE steps; Table 2's m = 6 takes ~4x as long)
 REPORT_RUNS = {"body3d-traction": {"spacing": 0.1}, "plate2d-clamped": {},
-               "plate2d-plane-strain": {}, "bar1d-traction": {}, "sheet2d-tension": {"spacing": 0.0025}}
+               "plate2d-plane-strain": {}, "bar1d-traction": {}, "sheet2d-tension": {"spacing": 0.0025},
+               "sheet2d-clamped": {"m_ratio": 4.0}}
 #: the bond-based scenes that solve through a peer (their own assembly; the static-state
-#: family's scenes are served through the family)
-BOND_SCENES = ("sheet2d-tension",)
+#: family's scenes are served through the family): the clamped sheet's clamps are held
+#: atoms (``fix setforce`` on the group of each prescribed component, the atoms set to
+#: their prescribed positions first), as LAMMPS users hold a grip
+BOND_SCENES = ("sheet2d-tension", "sheet2d-clamped")
 
 
 def lammps_overrides(scene) -> dict:
@@ -118,7 +138,6 @@ class PeerTreatment(Treatment):
         solution (None when it is)."""
         from .plain import assemble_plain
         from ..nodeset import equilibrium, node_set_of, not_in_equilibrium, solution_vector
-        from ..pd.closure import Closure
         from ..solvers.front import solve as solve_system
         ns = node_set_of(scene, p, problem, system)
         model = lammps.state_based_model(ns)
@@ -135,15 +154,7 @@ class PeerTreatment(Treatment):
             if not np.allclose(ns.volume, model.uniform_volume, rtol=1e-12, atol=0):
                 own = None      # cut cells or half cells: no linear model of LAMMPS's here
             else:
-                horizon = (model.m_ratio + lammps.EXAMPLES_MARGIN) * model.spacing
-
-                def lammps_weights(m):
-                    """LAMMPS's weight of each bond (its ramp, whole cells within its
-                    horizon, none beyond) in place of the scene's quadrature's beta."""
-                    keep = m.bond_x <= horizon
-                    return np.where(keep, ramp(m.bond_x, model.spacing, horizon)
-                                    / np.where(keep, m.bond_beta, 1.0), 0.0)
-                ramped = assemble_plain(problem, Closure(weight_factor=lammps_weights))
+                ramped = assemble_plain(problem, as_used_closure(model))
                 x_ramp, _ = solve_system(ramped, where=where, ordering=problem.ordering)
                 own, u_own = node_set_of(scene, p, problem, ramped), ramped.displacements(x_ramp)
                 metrics["peer_gap_volumes"] = _rel(u_own, u_none, scale)
@@ -163,25 +174,56 @@ class PeerTreatment(Treatment):
         as ``export --format lammps`` writes it), with ``solve_none()`` pdverify's own
         solve ``(u, reactions, info)``; ``x`` holds LAMMPS's field as the system's
         unknowns. ``same-model`` is checked for equilibrium in the system's model
-        (:func:`pdverify.nodeset.equilibrium`, as ``score`` checks it); ``as-used`` has no
-        linear twin here (the sheet's edge nodes carry half cells, LAMMPS's atoms one
-        volume each) and is judged by LAMMPS's own stopping and bond count."""
+        (:func:`pdverify.nodeset.equilibrium`, as ``score`` checks it); ``as-used`` in
+        the linear model with LAMMPS's weights (:func:`as_used_closure`) where every
+        node carries a whole cell (``node_volumes=full`` on the clamped sheet), like the
+        state-based scenes; where edge nodes carry half cells (the sheets' default) it
+        has no linear twin (LAMMPS's atoms carry one volume each) and is judged by
+        LAMMPS's own stopping and bond count."""
         from ..nodeset import equilibrium, node_set_of, not_in_equilibrium, solution_vector
         ns = node_set_of(scene, p, problem, system)
         d, n = ns.dim, len(ns.x)
         setting = p["setting"]
+        model = lammps.bond_based_model(ns)
         with tempfile.TemporaryDirectory(prefix="pdverify-lammps-") as folder:
-            result = lammps.run(lammps.bond_based_model(ns), setting, folder, where=where)
+            result = lammps.run(model, setting, folder, where=where)
         u_none = solve_none()[0].reshape(d, n).T
         scale = float(np.linalg.norm(u_none))
         metrics = {"peer_diff_to_none": _rel(result.u, u_none, scale)}
         info = {"solver": self.name, "peer": result.info}
-        if setting == "same-model":
-            metrics["peer_gap_nonlinear"] = metrics["peer_diff_to_none"]
-            info["equilibrium"] = equilibrium(ns, result.u, u_none)
+        own, u_own = (ns, u_none) if setting == "same-model" else (None, None)
+        twin = _as_used_twin(problem, model) if setting == "as-used" else None
+        if twin is not None:
+            u_twin = scene.solve_fixed(twin.model, twin.fixed, twin.values, where, twin.rhs,
+                                       solver=p["solver"])[0]
+            own, u_own = node_set_of(scene, p, problem, twin), u_twin.reshape(d, n).T
+            metrics["peer_gap_volumes"] = _rel(u_own, u_none, scale)
+        if own is not None:
+            metrics["peer_gap_nonlinear"] = _rel(result.u, u_own, scale)
+            info["equilibrium"] = equilibrium(own, result.u, u_own)
             metrics["equilibrium_residual"] = info["equilibrium"]["residual"]
         return (solution_vector(system, result.u), info, metrics,
                 _trouble(result.info, info.get("equilibrium"), not_in_equilibrium))
+
+
+def _as_used_twin(problem, model):
+    """The bond-based linear model of LAMMPS's as-used run (None where there is none):
+    ``problem``'s body with a whole cell on every node (LAMMPS's one volume per atom; the
+    loads are nodal forces, which do not depend on the volumes) under
+    :func:`as_used_closure`; its system, when every node's volume is then LAMMPS's."""
+    import dataclasses
+    from ..pd.problem import assemble_bonds
+    body = problem.body
+    if getattr(body, "shape", None) is not None:
+        return None
+    whole = dataclasses.replace(problem, body=dataclasses.replace(body, boundary_volume="full"))
+    twin = assemble_bonds(whole, as_used_closure(model))
+    g = twin.model.grid
+    volume = np.asarray(twin.model.node_volume)[g.interior_ids]
+    if len(volume) != len(model.x) or not np.allclose(volume, model.uniform_volume,
+                                                      rtol=1e-12, atol=0):
+        return None
+    return twin
 
 
 def _trouble(peer: dict, balance: dict | None, not_in_equilibrium) -> str | None:
