@@ -68,12 +68,17 @@ def _rel(a, b, scale) -> float:
 #: FIRE steps; Table 2's m = 6 takes ~4x as long)
 REPORT_RUNS = {"body3d-traction": {"spacing": 0.1}, "plate2d-clamped": {},
                "plate2d-plane-strain": {}, "bar1d-traction": {}, "sheet2d-tension": {"spacing": 0.0025},
-               "sheet2d-clamped": {"m_ratio": 4.0}}
+               "sheet2d-clamped": {"m_ratio": 4.0},
+               # no solve: one LAMMPS process evaluates every strain state (~0.4 s each)
+               "stiffness2d-sheet": {"spacing": 0.002}, "stiffness3d-box-bond": {"spacing": 0.1}}
 #: the bond-based scenes that solve through a peer (their own assembly; the static-state
 #: family's scenes are served through the family): the clamped sheet's clamps are held
 #: atoms (``fix setforce`` on the group of each prescribed component, the atoms set to
 #: their prescribed positions first), as LAMMPS users hold a grip
 BOND_SCENES = ("sheet2d-tension", "sheet2d-clamped")
+#: the bond-based stiffness scenes: every atom placed at u = eps . x and LAMMPS's
+#: ``compute pe/atom`` read as the node's energy density (:meth:`PeerTreatment.peer_energies`)
+ENERGY_SCENES = ("stiffness2d-sheet", "stiffness3d-box-bond")
 
 
 def lammps_overrides(scene) -> dict:
@@ -98,7 +103,7 @@ class PeerTreatment(Treatment):
         return [{**lammps_overrides(scene), **over, "setting": s} for s in lammps.SETTINGS]
 
     def why_not(self, scene):
-        if scene.id in BOND_SCENES:
+        if scene.id in BOND_SCENES or scene.id in ENERGY_SCENES:
             return None
         return super().why_not(scene)
 
@@ -166,6 +171,22 @@ class PeerTreatment(Treatment):
         return (solution_vector(system, result.u), info, metrics,
                 _trouble(result.info, info.get("equilibrium"), not_in_equilibrium))
 
+    def peer_energies(self, scene, p, problem, model, where):
+        """The bond-based stiffness scenes: ``(ratios, info, metrics, trouble)``, W_i /
+        W_bulk per strain state of LAMMPS's peri/pmb (``compute pe/atom`` with every atom
+        at u = eps . x, :func:`pdverify.peers.lammps.energies`) on the uncorrected
+        ``model``'s atoms. W_bulk is the bulk of the setting's own lattice: pdverify's for
+        ``same-model``, LAMMPS's ramped one for ``as-used`` (:func:`lammps_bulk_work_density`;
+        ``peer_bulk_ratio`` is it over pdverify's, the ramp's toll on the bulk). The
+        metrics compare the energy densities themselves (relative L2 over nodes and
+        states): ``peer_diff_to_none`` against pdverify's ``none``, ``peer_gap_volumes``
+        (as-used) its linear twin (whole cells, LAMMPS's ramp) against ``none``,
+        ``peer_gap_nonlinear`` LAMMPS against its setting's linear model, which must stay
+        within :data:`pdverify.nodeset.DISTANCE_PER_GRADIENT` times the field's largest
+        relative bond displacement (the equilibrium check's rule; here the strain scale),
+        else the run fails naming it."""
+        return peer_energies_of(scene, p, problem, model, where)
+
     def peer_solve_bonds(self, scene, p, problem, system, where, solve_none):
         """The bond-based sheets (their own assembly: ``scene.bond_problem``):
         ``(x, info, metrics, trouble)`` of LAMMPS's peri/pmb on the node set of the
@@ -206,6 +227,63 @@ class PeerTreatment(Treatment):
                 _trouble(result.info, info.get("equilibrium"), not_in_equilibrium))
 
 
+def peer_energies_of(scene, p, problem, model_none, where):
+    """The bond-based stiffness scenes through LAMMPS (:meth:`PeerTreatment.peer_energies`)."""
+    from ..nodeset import DISTANCE_FLOOR, DISTANCE_PER_GRADIENT, between_shells
+    from ..pd.work import work_density
+    from ..scenes.stiffness import strain_states
+    g, d = model_none.grid, model_none.dim
+    ids = g.interior_ids
+    h, m = model_none.spacing, model_none.m_ratio
+    off = np.asarray(model_none.offsets)
+    lm = lammps.Model(g.x[ids], np.asarray(model_none.node_volume)[ids],
+                      np.zeros((len(ids), d)), {}, h, m,
+                      between_shells(h, np.r_[off, -off], d),
+                      h ** d * model_none.thickness, "peri/pmb", (model_none.c,),
+                      model_none.c * model_none.horizon ** (d + 1))
+    states = strain_states(d)
+    strains = [eps for _, eps in states]
+    setting = p["setting"]
+    with tempfile.TemporaryDirectory(prefix="pdverify-lammps-") as folder:
+        W, peer = lammps.energies(lm, setting, strains, folder, where=where)
+    W_none = np.stack([work_density(model_none, eps)[ids] for eps in strains])
+    scale = float(np.linalg.norm(W_none))
+    metrics = {"peer_diff_to_none": _rel(W, W_none, scale)}
+    if setting == "same-model":
+        bulk = [model_none.bulk_work_density(eps) for eps in strains]
+        W_own = W_none
+    else:
+        bulk = [lammps_bulk_work_density(model_none.c, h, m, d, lm.uniform_volume, eps)
+                for eps in strains]
+        twin = _as_used_twin(problem, lm)
+        W_own = (None if twin is None else
+                 np.stack([work_density(twin.model, eps)[twin.model.grid.interior_ids]
+                           for eps in strains]))
+        if W_own is not None:
+            metrics["peer_gap_volumes"] = _rel(W_own, W_none, scale)
+        metrics["peer_bulk_ratio"] = float(np.mean(
+            [b / model_none.bulk_work_density(eps) for b, eps in zip(bulk, strains)]))
+    ratios = {name: W[s] / bulk[s] for s, (name, _) in enumerate(states)}
+    info = {"solver": lammps.NAME, "peer": peer}
+    trouble = None
+    if peer["damage_sum"]:
+        trouble = f"LAMMPS lost bonds (damage summed over the atoms {peer['damage_sum']:.3g})"
+    if W_own is not None:
+        # the homogeneous field's largest relative bond displacement |u_b - u_a| / |xi|
+        # is STRAIN_SCALE times the largest |eps n|, the largest singular value of a state
+        gradient = lammps.STRAIN_SCALE * max(np.linalg.norm(e, 2) for e in strains)
+        limit = max(DISTANCE_PER_GRADIENT * gradient, DISTANCE_FLOOR)
+        gap = _rel(W, W_own, float(np.linalg.norm(W_own)))
+        metrics["peer_gap_nonlinear"] = gap
+        info["energy_check"] = {"distance": gap, "max_gradient": gradient, "limit": limit,
+                                "in_agreement": bool(gap <= limit)}
+        if trouble is None and not gap <= limit:
+            trouble = (f"LAMMPS's energy densities are {gap:.3g} (relative L2) from its "
+                       f"setting's linear model, above {limit:.3g} ({DISTANCE_PER_GRADIENT:g}"
+                       " x the largest relative bond displacement)")
+    return ratios, info, metrics, trouble
+
+
 def _as_used_twin(problem, model):
     """The bond-based linear model of LAMMPS's as-used run (None where there is none):
     ``problem``'s body with a whole cell on every node (LAMMPS's one volume per atom; the
@@ -224,6 +302,22 @@ def _as_used_twin(problem, model):
                                                       rtol=1e-12, atol=0):
         return None
     return twin
+
+
+def lammps_bulk_work_density(c, spacing, m_ratio, dim, volume, strain) -> float:
+    """W of an atom with a complete neighbourhood in LAMMPS's as-used lattice under the
+    homogeneous ``strain``: 1/4 sum_k c ramp(|xi|) V (n.strain.n)^2 |xi| over the lattice
+    offsets k within its horizon (m + 2e-4) h, every atom's volume ``volume``
+    (pdverify.pd.bondbased.BondBasedModel.bulk_work_density's form, LAMMPS's weights)."""
+    horizon = (m_ratio + lammps.EXAMPLES_MARGIN) * spacing
+    reach = int(np.floor(m_ratio + lammps.EXAMPLES_MARGIN))
+    axes = np.arange(-reach, reach + 1)
+    k = np.stack(np.meshgrid(*([axes] * dim), indexing="ij"), axis=-1).reshape(-1, dim)
+    r = np.linalg.norm(k, axis=1) * spacing
+    k, r = k[(r > 0) & (r <= horizon)], r[(r > 0) & (r <= horizon)]
+    n = k * spacing / r[:, None]
+    e_over_r = np.einsum("bi,ij,bj->b", n, np.asarray(strain, dtype=float), n)
+    return float(0.25 * np.sum(c * ramp(r, spacing, horizon) * volume * e_over_r ** 2 * r))
 
 
 def _trouble(peer: dict, balance: dict | None, not_in_equilibrium) -> str | None:
@@ -253,4 +347,5 @@ def peer_treatments() -> list[Treatment]:
         params=(SETTING,), theories=("state-based", "bond-based"), dims=(1, 2, 3),
         families=("static-state",), shapes=True, unavailable=lammps.unavailable(),
         scope="the static state-based scenes' uncorrected node sets (influence=hyperbolic) "
-              f"and the bond-based {', '.join(BOND_SCENES)} (micromodulus=constant)")]
+              f"and the bond-based {', '.join(BOND_SCENES + ENERGY_SCENES)} "
+              "(micromodulus=constant)")]

@@ -371,3 +371,103 @@ def parse_log(log: str) -> dict:
         elif s.startswith("pdverify-lost-bonds"):
             out["damage_sum"] = float(s.split()[1])
     return out
+
+
+# ------------------------------------------------------------------ homogeneous strains
+#: the strain states are applied at this scale (u = STRAIN_SCALE eps . x) and the energies
+#: divided by its square: LAMMPS's bonds are geometrically nonlinear, so its energy
+#: density is the linear one to a relative O(STRAIN_SCALE); the positions' round-off
+#: (17 digits on bodies of ~1e3 spacings) moves a bond's stretch by ~1e-13 / 1e-6 = 1e-7 of
+#: itself at most, below that
+STRAIN_SCALE = 1e-6
+
+
+def energy_deck(model: Model, setting: str, strains, *, title: str = "pdverify") -> dict:
+    """The deck's files for the energy densities of the atoms under each homogeneous
+    strain of ``strains`` (d x d each, applied at :data:`STRAIN_SCALE`): the node set of
+    :func:`deck` without loads or held atoms, the bond family made at the reference state
+    (``run 0`` twice: the s0 quirk of the module docstring), then per state the atoms put
+    at x0 + STRAIN_SCALE eps . x0 (``set`` with atom-style variables) and ``run 0`` with
+    ``compute pe/atom`` dumped. peri/pmb's per-atom energy is the bond-based W_i: each
+    bond i-j tallies 0.25 c s^2 |xi| V_j on atom i (``evdwl = 0.5 rk dr`` halved again by
+    ``ev_tally(i, i, ...)``: pair_peri_pmb.cpp), pdverify's 1/4 sum_j c s^2 |xi| V_j
+    (:meth:`pdverify.pd.bondbased.BondBasedModel.bulk_work_density`)."""
+    if model.pair != "peri/pmb":
+        raise InputError(f"{title}: the energy densities are read from peri/pmb only "
+                         f"(not {model.pair}: peri/lps tallies half of the deviatoric "
+                         "energy its forces derive from)")
+    files = deck(replace_loads(model), setting, title=title)
+    head = files["in.lammps"].split("include prescribed.in")[0]
+    head = head.replace("fix loads all addforce v_bx v_by v_bz energy v_ea\n"
+                        "fix_modify loads energy yes\n", "")
+    d = model.dim
+    lines = [head.rstrip("\n"), "compute pe all pe/atom pair",
+             "compute damage all damage/atom", "compute lost all reduce sum c_damage",
+             "thermo_style custom step pe c_lost", "thermo 1"]
+    for s, strain in enumerate(strains):
+        eps = np.zeros((3, 3))
+        eps[:d, :d] = STRAIN_SCALE * np.asarray(strain, dtype=float)
+        for k, a in enumerate("xyz"):
+            terms = "+".join(f"({f(eps[k, j])})*f_x0[{j + 1}]" for j in range(3))
+            lines.append(f"variable p{a}{s} atom f_x0[{k + 1}]+{terms}")
+        lines += [f"set group all x v_px{s} y v_py{s} z v_pz{s}",
+                  f"dump e{s} all custom 1 state{s}.dump id c_pe",
+                  f"dump_modify e{s} sort id format float %.17g",
+                  "run 0", f"undump e{s}",
+                  f'print "pdverify-lost-bonds-{s} $(c_lost:%.17g)"']
+    files["in.lammps"] = "\n".join(lines) + "\n"
+    files["prescribed.in"] = "\n"
+    return files
+
+
+def replace_loads(model: Model) -> Model:
+    """``model`` without loads or prescribed components (a homogeneous strain sets every
+    atom)."""
+    import dataclasses
+    return dataclasses.replace(model, forces=np.zeros_like(model.forces), fixed={},
+                               reference_force=0.0)
+
+
+def energies(model: Model, setting: str, strains, folder: str, *, where: str,
+             timeout: float = TIMEOUT_S) -> tuple[np.ndarray, dict]:
+    """``(W, info)``: the energy density [J/m^3] of every atom under each strain of
+    ``strains`` at unit scale (rows: states; LAMMPS's at :data:`STRAIN_SCALE`, divided by
+    its square), run in ``folder`` (an empty folder pdverify made); ``info`` holds the
+    version and the damage LAMMPS reported (any lost bond is a failed run)."""
+    exe, why = locate()
+    if exe is None:
+        raise InputError(f"{where}: {why}")
+    for name, text in energy_deck(model, setting, strains, title=where).items():
+        with open(os.path.join(folder, name), "w", encoding="utf-8") as fh:
+            fh.write(text)
+    try:
+        proc = subprocess.run(
+            [*exe.argv, "-in", "in.lammps", "-log", "log.lammps", "-screen", "none",
+             "-nocite"], cwd=folder, env=exe.env, capture_output=True, text=True,
+            timeout=timeout, stdin=subprocess.DEVNULL)
+    except subprocess.TimeoutExpired:
+        raise NumericalError(f"{where}: LAMMPS did not finish within {timeout:g} s") from None
+    except OSError as exc:
+        raise NumericalError(f"{where}: LAMMPS ({exe.where}) could not start: {exc}") from None
+    log = _read(os.path.join(folder, "log.lammps"))
+    dumps = [os.path.join(folder, f"state{s}.dump") for s in range(len(strains))]
+    if proc.returncode != 0 or not all(os.path.exists(p) for p in dumps):
+        error = next((ln.strip() for ln in (log + proc.stdout + proc.stderr).splitlines()
+                      if ln.startswith("ERROR")), f"exit status {proc.returncode}")
+        raise NumericalError(f"{where}: LAMMPS failed: {error[:300]}")
+    info = {k: v for k, v in parse_log(log).items() if k == "version"}
+    lost = [float(ln.split()[1]) for ln in log.splitlines()
+            if ln.startswith("pdverify-lost-bonds-")]
+    info.update({"executable": exe.where, "setting": setting, "pair_style": model.pair,
+                 "strain_scale": STRAIN_SCALE, "damage_sum": float(sum(lost))})
+    W = np.empty((len(strains), len(model.x)))
+    for s, path in enumerate(dumps):
+        dump = np.loadtxt(path, skiprows=9, ndmin=2)
+        ids = dump[:, 0].astype(int)
+        if len(ids) != len(model.x) or np.any(np.sort(ids) != np.arange(1, len(ids) + 1)):
+            raise NumericalError(f"{where}: LAMMPS wrote {len(ids)} atoms, the deck has "
+                                 f"{len(model.x)} (atoms lost)")
+        W[s] = dump[np.argsort(ids), 1] / STRAIN_SCALE ** 2
+    if not np.all(np.isfinite(W)):
+        raise NumericalError(f"{where}: LAMMPS's energies hold non-finite numbers")
+    return W, info

@@ -140,6 +140,9 @@ class StiffnessScene(Scene):
     def check(self, method, p):
         whole_cells(f"{self.id} --method {method}", p["spacing"],
                     [(f"l_{a}", L) for a, L in zip(AXES, self.lengths(p))])
+        t = self.offered().get(method)
+        if getattr(t, "peer", False):
+            t.check((), p, f"{self.id} --method {method}")
 
     def estimate(self, method, p):
         """Bond arrays and the model's sparse operators: ~ (d + 4) entries a bond."""
@@ -151,8 +154,18 @@ class StiffnessScene(Scene):
                                f"{nodes:.4g} nodes, ~{bonds:.3g} bonds, no solve")
 
     def solve(self, method, p, timer):
+        t = self.offered().get(method)
+        peer = getattr(t, "peer_energies", None)
         with timer.phase("setup"):
             model = self.build(method, p, self.bond_closure(method, p))
+        if peer is not None:      # another code's energies (pdverify.peers)
+            where = f"{self.id}/{method}"
+            with timer.phase("solve"):
+                ratios, info, metrics, trouble = peer(self, p, self.bond_problem(p, where),
+                                                      model, where)
+            outcome = self.measure_ratios(p, model, ratios)
+            outcome.diagnostics = info
+            return t.finish(outcome, metrics, trouble, where)
         with timer.phase("solve"):
             ratios = energy_ratios(model)
         return self.measure_ratios(p, model, ratios)
