@@ -70,7 +70,9 @@ REPORT_RUNS = {"body3d-traction": {"spacing": 0.1}, "plate2d-clamped": {},
                "plate2d-plane-strain": {}, "bar1d-traction": {}, "sheet2d-tension": {"spacing": 0.0025},
                "sheet2d-clamped": {"m_ratio": 4.0},
                # no solve: one LAMMPS process evaluates every strain state (~0.4 s each)
-               "stiffness2d-sheet": {"spacing": 0.002}, "stiffness3d-box-bond": {"spacing": 0.1}}
+               "stiffness2d-sheet": {"spacing": 0.002}, "stiffness3d-box-bond": {"spacing": 0.1},
+               # seed 004's bars at the paper's sizes (9 and 17 + 9 + 12 atoms), same model
+               "bar1d-homogenization": {}, "bar1d-constraints": {}}
 #: the bond-based scenes that solve through a peer (their own assembly; the static-state
 #: family's scenes are served through the family): the clamped sheet's clamps are held
 #: atoms (``fix setforce`` on the group of each prescribed component, the atoms set to
@@ -79,6 +81,36 @@ BOND_SCENES = ("sheet2d-tension", "sheet2d-clamped")
 #: the bond-based stiffness scenes: every atom placed at u = eps . x and LAMMPS's
 #: ``compute pe/atom`` read as the node's energy density (:meth:`PeerTreatment.peer_energies`)
 ENERGY_SCENES = ("stiffness2d-sheet", "stiffness3d-box-bond")
+#: seed 004's static bars: a line of atoms on the x axis (y and z held at zero) with
+#: peri/pmb's c matched to the bar's c1 (pdverify.peers.lammps.bar_types: the triangular
+#: micromodulus by type pair), same-model only (:data:`BAR_AS_USED`)
+BAR_SCENES = ("bar1d-homogenization", "bar1d-constraints")
+#: why a bar has no as-used run
+BAR_AS_USED = ("LAMMPS is a 3D code and its users give peri/pmb the 3D c = 18 K / (pi "
+               "delta^4); a line of atoms with it is not seed 004's 1D bar (nothing of the "
+               "bar's c1 or cross-section enters), so only the same model runs, c matched "
+               "to c1: --set setting=same-model")
+#: the bars' setting: the same model only
+BAR_SETTING = Param("setting", "same-model", "how LAMMPS runs: driven to solve the bar's "
+                    "discrete model (peri/pmb on a line of atoms, c matched to c1 by type "
+                    "pair, each point's volume); no as-used run: " + BAR_AS_USED.split(
+                        ": --set")[0], choices=("same-model",))
+#: the scenes of the bond-based models that LAMMPS cannot run as they are stated, and
+#: what it would take
+REFUSED = {
+    "bar1d-vibration": (
+        "a dynamic run (the pre-strained bar released, its end's history fitted to Rao's "
+        "series): not wired; it would take LAMMPS's fix nve (velocity Verlet, the scene's "
+        "central difference) from the pre-strained atoms at the scene's time step, the "
+        "monitored atom dumped every step, and the bar's c1 matched as on the static bars"),
+    "block2d-indentation": (
+        "its sticking contact is not a prescribed-displacement set: the top atoms the "
+        "indenter reaches are caught after each equilibrium (the set grows with the depth) "
+        "and then move with it, which one LAMMPS deck cannot state (fix indent is a "
+        "frictionless penalty wall, another contact law); it would take driving LAMMPS "
+        "increment by increment (its Python module: minimize, read the top atoms, hold "
+        "the caught ones on the indenter, repeat) with the scene's Newton stopping rule"),
+}
 
 
 def lammps_overrides(scene) -> dict:
@@ -100,11 +132,25 @@ class PeerTreatment(Treatment):
         over = REPORT_RUNS.get(scene.id)
         if over is None:
             return []
-        return [{**lammps_overrides(scene), **over, "setting": s} for s in lammps.SETTINGS]
+        settings = ("same-model",) if scene.id in BAR_SCENES else lammps.SETTINGS
+        return [{**lammps_overrides(scene), **over, "setting": s} for s in settings]
+
+    def params_for(self, scene):
+        """:data:`BAR_SETTING` on seed 004's bars, else its own."""
+        return (BAR_SETTING,) if scene.id in BAR_SCENES else self.params
+
+    def check_bar(self, params, where):
+        """A seed-004 bar: same-model only (:data:`BAR_SETTING`'s one choice); any
+        micromodulus (by type pair, :func:`pdverify.peers.lammps.bar_types`)."""
+        if params["setting"] != "same-model":     # the Param's choices refuse it first
+            raise InputError(f"{where}: setting={params['setting']!r} on a 1D bar: "
+                             f"{BAR_AS_USED}")
 
     def why_not(self, scene):
-        if scene.id in BOND_SCENES or scene.id in ENERGY_SCENES:
+        if scene.id in BOND_SCENES or scene.id in ENERGY_SCENES or scene.id in BAR_SCENES:
             return None
+        if scene.id in REFUSED:
+            return REFUSED[scene.id]
         return super().why_not(scene)
 
     def check(self, cells, params, where):
@@ -186,6 +232,57 @@ class PeerTreatment(Treatment):
         relative bond displacement (the equilibrium check's rule; here the strain scale),
         else the run fails naming it."""
         return peer_energies_of(scene, p, problem, model, where)
+
+    def peer_solve_bar(self, scene, p, problem, system, where, u_none, centred=False):
+        """A seed-004 bar (:class:`~pdverify.pd.problem.BondSystem` of ``problem``) run by
+        LAMMPS in the same model (peri/pmb on a line of atoms, c1 by type pair, each
+        point's volume; held points as held atoms): ``(u, info, metrics, trouble)`` with
+        ``u`` (n,) its displacements, shifted like ``u_none`` (pdverify's, (n,)) to rest
+        at the bar's centre when ``centred`` (the free bar under end forces: its rigid
+        translation is no part of the answer), and its equilibrium checked in the bar's
+        linear model (:func:`pdverify.nodeset.equilibrium`, against ``u_none``)."""
+        from ..nodeset import DISTANCE_FLOOR, equilibrium, node_set_of, not_in_equilibrium
+        ns = node_set_of(scene, p, problem, system)
+        with tempfile.TemporaryDirectory(prefix="pdverify-lammps-") as folder:
+            result = lammps.run(lammps.bond_based_model(ns), p["setting"], folder,
+                                where=where)
+        u = np.asarray(result.u[:, 0], dtype=float)
+        if centred:
+            n = u.size
+            u = u - 0.5 * (u[(n - 1) // 2] + u[n // 2])
+        diff = _rel(u, u_none, float(np.linalg.norm(u_none)))
+        metrics = {"peer_diff_to_none": diff, "peer_gap_nonlinear": diff}
+        balance = equilibrium(ns, u[:, None], np.asarray(u_none)[:, None])
+        # a line of atoms is geometrically linear (a collinear bond's stretch is
+        # (u_j - u_i) / |xi| exactly while no bond inverts; the bar strains by sigma / E,
+        # 1 here, which would make the gradient rule's limit ~10): LAMMPS's equilibrium
+        # is the linear one, so the distance is the stopping rule's alone, held to the
+        # floor of nodeset.equilibrium (1e-6, FTOL_REL = 1e-9 times the cut systems'
+        # condition numbers, below 10 at the report's sizes)
+        balance["limit"] = DISTANCE_FLOOR
+        balance["in_equilibrium"] = bool(balance["distance"] <= DISTANCE_FLOOR)
+        info = {"solver": self.name, "peer": result.info, "equilibrium": balance}
+        metrics["equilibrium_residual"] = balance["residual"]
+        trouble = _trouble(result.info, None, not_in_equilibrium)
+        if trouble is None and not balance["in_equilibrium"]:
+            trouble = (f"not in equilibrium: {balance['distance']:.3g} (relative L2) from "
+                       f"the bar's linear solution, above {DISTANCE_FLOOR:g} (a collinear "
+                       "bar is geometrically linear: only the stopping rule may move it); "
+                       f"relative residual {balance['residual']:.3g}")
+        return u, info, metrics, trouble
+
+    def finish_bars(self, outcome, runs, where):
+        """The outcome of a scene of several bars (``runs``: name -> the
+        :meth:`peer_solve_bar` tuple): the largest of each peer metric over the bars, each
+        bar's in the diagnostics, the first bar's trouble."""
+        metrics = {}
+        for name in ("peer_diff_to_none", "peer_gap_nonlinear", "equilibrium_residual"):
+            metrics[name] = max(r[2][name] for r in runs.values())
+        for k, (_u, info, m, _t) in runs.items():
+            outcome.diagnostics[f"bar_{k}_peer"] = {**info["peer"], **m,
+                                                    "equilibrium": info["equilibrium"]}
+        trouble = next((f"bar ({k}): {r[3]}" for k, r in runs.items() if r[3]), None)
+        return self.finish(outcome, metrics, trouble, where)
 
     def peer_solve_bonds(self, scene, p, problem, system, where, solve_none):
         """The bond-based sheets (their own assembly: ``scene.bond_problem``):
@@ -347,5 +444,5 @@ def peer_treatments() -> list[Treatment]:
         params=(SETTING,), theories=("state-based", "bond-based"), dims=(1, 2, 3),
         families=("static-state",), shapes=True, unavailable=lammps.unavailable(),
         scope="the static state-based scenes' uncorrected node sets (influence=hyperbolic) "
-              f"and the bond-based {', '.join(BOND_SCENES + ENERGY_SCENES)} "
+              f"and the bond-based {', '.join(BOND_SCENES + ENERGY_SCENES + BAR_SCENES)} "
               "(micromodulus=constant)")]

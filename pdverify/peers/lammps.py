@@ -155,6 +155,11 @@ class Model:
     #: components at the reference state [N/m^3]: the stopping tolerance's scale of a
     #: problem without loads (0: the loads' own)
     reference_force: float = 0.0
+    #: atom types 1..T (None: one type) and the pair coefficients of each type pair
+    #: ``{(ti, tj): coefficients}``, ti <= tj (a bar's micromodulus by bond length:
+    #: :func:`bar_types`)
+    types: np.ndarray | None = None
+    pair_coefficients: dict | None = None
 
     @property
     def dim(self) -> int:
@@ -191,9 +196,41 @@ def bond_based_model(ns) -> Model:
     from ..nodeset import written_horizon
     model = ns.system.model
     h, d, c = model.spacing, ns.dim, model.c
+    types = coefficients = None
+    if d == 1 and not np.allclose(bond_weights(model), 1.0, rtol=1e-14, atol=0):
+        types, coefficients = bar_types(model, ns.x)
     return Model(ns.x, np.asarray(ns.volume, float), ns.forces, ns.fixed, h, model.m_ratio,
                  written_horizon(ns), h ** d * model.thickness,
-                 "peri/pmb", (c,), c * model.horizon ** (d + 1), prescribed_force(ns))
+                 "peri/pmb", (c,), c * model.horizon ** (d + 1), prescribed_force(ns),
+                 types, coefficients)
+
+
+def bond_weights(model) -> np.ndarray:
+    """omega(|xi|) beta of each of a bond-based model's bond offsets (its half offsets)."""
+    r = np.linalg.norm(np.asarray(model.offsets, float), axis=1) * model.spacing
+    return model.influence.omega(r, model.horizon) * np.asarray(model.beta_k, float)
+
+
+def bar_types(model, x) -> tuple[np.ndarray, dict]:
+    """A 1D bar's micromodulus by bond length as LAMMPS's per-type-pair c (peri/pmb has
+    one c per pair of atom types): atom i of the bar (x_i = x_1 + (i - 1) h) gets type
+    (i mod T) + 1 with T = 2 k_max + 1, k_max the longest bond in spacings; the types of
+    a bond of k spacings (|k| <= k_max < T / 2) differ by k mod T, which gives back |k|,
+    so the pair (a, b) gets c omega(|k| h) beta_k, pdverify's spring of that length
+    (seed 004's triangular c(xi), the element cut in two counted half). Pairs whose types
+    differ by 0 are never bonded (T h beyond the horizon): they get c, unused."""
+    h = model.spacing
+    k = np.rint(np.abs(np.asarray(model.offsets, float)[:, 0])).astype(int)
+    weight = dict(zip(k.tolist(), bond_weights(model).tolist()))
+    T = 2 * int(k.max()) + 1
+    index = np.rint((x[:, 0] - x[:, 0].min()) / h).astype(int)
+    coefficients = {}
+    for a in range(1, T + 1):
+        for b in range(a, T + 1):
+            apart = (b - a) % T
+            apart = min(apart, T - apart)
+            coefficients[(a, b)] = (model.c * weight.get(apart, 0.0 if apart else 1.0),)
+    return index % T + 1, coefficients
 
 
 def prescribed_force(ns) -> float:
@@ -230,10 +267,11 @@ def deck(model: Model, setting: str, *, title: str = "pdverify") -> dict:
     b = np.zeros((n, 3))
     b[:, :d] = model.forces / volume[:, None]
     lo, hi = X.min(axis=0) - 2 * h, X.max(axis=0) + 2 * h
-    data = [f"{title}: {setting}\n", f"{n} atoms", "1 atom types", ""]
+    types = np.ones(n, dtype=int) if model.types is None else np.asarray(model.types, int)
+    data = [f"{title}: {setting}\n", f"{n} atoms", f"{int(types.max())} atom types", ""]
     data += [f"{f(lo[k])} {f(hi[k])} {a}lo {a}hi" for k, a in enumerate("xyz")]
     data += ["", "Atoms # peri", ""]
-    data += [f"{i + 1} 1 {f(volume[i])} 1.0 {f(X[i, 0])} {f(X[i, 1])} {f(X[i, 2])}"
+    data += [f"{i + 1} {types[i]} {f(volume[i])} 1.0 {f(X[i, 0])} {f(X[i, 1])} {f(X[i, 2])}"
              for i in range(n)]
     loads = [f"set atom {i + 1} d_bx {f(b[i, 0])} d_by {f(b[i, 1])} d_bz {f(b[i, 2])}"
              for i in np.flatnonzero(np.any(b != 0, axis=1))]
@@ -260,16 +298,23 @@ def deck(model: Model, setting: str, *, title: str = "pdverify") -> dict:
     # FIRE's first step: a fifth of 1/omega_max, omega_max^2 ~ (stiffness / rho) (m / h)^2
     # per bond shell times the neighbour count; FIRE grows it to 10x where it can
     dt = 0.2 / math.sqrt(model.stiffness / 1.0 * (2 * model.m_ratio + 1) ** d / h ** 2)
-    coeff = " ".join(f(c) for c in model.coefficients)
+    tail = f"{f(horizon)} 1e300 0.0  # s00 = 1e300, alpha = 0: no bond breaks"
+    if model.pair_coefficients is None:
+        pair_coeff = [f"pair_coeff * * {' '.join(f(c) for c in model.coefficients)} {tail}"]
+    else:
+        pair_coeff = [f"pair_coeff {a} {b} {' '.join(f(c) for c in cs)} {tail}"
+                      for (a, b), cs in sorted(model.pair_coefficients.items())]
     lines = [
         f"# {title}: LAMMPS PERI deck written by pdverify (setting {setting})",
-        "units si", "dimension 3", "boundary f f f", "atom_style peri",
+        # shrink-wrapped with the initial box as its least extent: an atom that moves
+        # beyond it (seed 004's bars strain by sigma / E = 1) is kept, not lost
+        "units si", "dimension 3", "boundary m m m", "atom_style peri",
         "atom_modify map array sort 0 0.0",
         (f"lattice none {NO_LATTICE!r}  # no volume ramp, no contact forces" if same
          else f"lattice sc {f(h)}  # LAMMPS's volume ramp and contact forces, as its examples"),
         "read_data nodes.data",
         f"pair_style {model.pair}",
-        f"pair_coeff * * {coeff} {f(horizon)} 1e300 0.0  # s00 = 1e300, alpha = 0: no bond breaks",
+        *pair_coeff,
         f"neighbor {f(0.1 * h)} bin", "neigh_modify every 1 delay 0 check yes",
         "fix loads_b all property/atom d_bx d_by d_bz",
         "include loads.in",

@@ -156,6 +156,9 @@ class BondBarScene(Scene):
         if t is not None:
             from ..corrections.registry import plugin_call
             plugin_call(t, "check", t.check, (p["nodes"],), p, where)
+        peer = self.offered().get(method)
+        if getattr(peer, "peer", False):
+            peer.check_bar(p, where)
 
     def estimate(self, method, p):
         m, _ = split_horizon_ratio(p["horizon_ratio"])
@@ -422,12 +425,17 @@ class Homogenization(BondBarScene):
                     if ratio not in covered]
         return out
 
+    def end_loaded_problem(self, p, nodes, spacing) -> BondProblem:
+        """The bar's description with -sigma A on point 1 and +sigma A on point N."""
+        F = p["stress"] * AREA
+        return self.bar_problem(p, nodes, spacing,
+                                {"x-": PartCondition(force=lambda x: np.full((len(x), 1), -F)),
+                                 "x+": PartCondition(force=lambda x: np.full((len(x), 1), F))})
+
     def end_loaded(self, method, p, nodes, spacing) -> BondSystem:
         """The bar with -sigma A on point 1 and +sigma A on point N."""
-        F = p["stress"] * AREA
-        return self.bar(method, p, nodes, spacing,
-                        {"x-": PartCondition(force=lambda x: np.full((len(x), 1), -F)),
-                         "x+": PartCondition(force=lambda x: np.full((len(x), 1), F))})
+        return assemble_bonds(self.end_loaded_problem(p, nodes, spacing),
+                              self.bond_closure(method, p))
 
     def strain_factor(self, system: BondSystem, p) -> tuple[float, np.ndarray]:
         """f(N) and u of the end-loaded bar :meth:`end_loaded`, solved in the statically
@@ -438,15 +446,41 @@ class Homogenization(BondBarScene):
         length = (model.grid.n_ext - 1) * model.spacing
         return float((u[-1] - u[0]) / length * p["E"] / p["stress"]), u
 
+    @staticmethod
+    def model_metrics(p, model) -> dict:
+        """The bar model's own numbers (any method that runs it, a peer code's too)."""
+        return {
+            "micromodulus_factor": micromodulus_factor(float(p["horizon_ratio"]),
+                                                       p["micromodulus"]),
+            # Table 14: b_1 / (c1 A) = C sigma Delta / E with b_1 = sigma / (w Delta) on an
+            # end element of weight w, so C = E / (c1 A Delta^2 w): a check on c1
+            "end_load_C": p["E"] / (model.c * AREA * model.spacing ** 2
+                                    * (0.5 if p["end_weight"] == "half" else 1.0))}
+
     def solve(self, method, p, timer):
         N = p["nodes"]
+        t = self.offered().get(method)
+        peer = getattr(t, "peer_solve_bar", None)
         with timer.phase("setup"):
-            bar = self.end_loaded(method, p, N, p["length"] / (N - 1))
+            problem = self.end_loaded_problem(p, N, p["length"] / (N - 1))
+            bar = assemble_bonds(problem, self.bond_closure(method, p))
             model = bar.model
         with timer.phase("solve"):
             f, u = self.strain_factor(bar, p)
+            if peer is not None:    # another code solves the bar (pdverify.peers)
+                u, info, peer_metrics, trouble = peer(self, p, problem, bar,
+                                                      f"{self.id}/{method}", u, centred=True)
+                length = (N - 1) * model.spacing
+                f = float((u[-1] - u[0]) / length * p["E"] / p["stress"])
         x = model.grid.x[:, 0] - 0.5 * p["length"]
         u_cl = p["stress"] / p["E"] * x
+        if peer is not None:        # one bar: the sweep over N is pdverify's own
+            metrics = {"strain_factor": f, **self.model_metrics(p, model),
+                       "max_error_pct": max_error_of_peak_pct(u, u_cl),
+                       "rel_l2_error": rel_l2_error(u, u_cl)}
+            outcome = Outcome(metrics=metrics, size=bar_size(model),
+                              fields={"x": x, "u": u, "u_ref": u_cl}, diagnostics=info)
+            return t.finish(outcome, peer_metrics, trouble, f"{self.id}/{method}")
         with timer.phase("sweep"):  # f(N) over N for the report's Table-12 figure
             m, _ = split_horizon_ratio(p["horizon_ratio"])
             sweep_n = np.unique(np.round(np.geomspace(2 * m + 1, self.SWEEP_MAX, 24)).astype(int))
@@ -454,14 +488,9 @@ class Homogenization(BondBarScene):
                                                    p)[0] for n in sweep_n])
         metrics = {
             "strain_factor": f,
-            "micromodulus_factor": micromodulus_factor(float(p["horizon_ratio"]),
-                                                       p["micromodulus"]),
             "max_error_pct": max_error_of_peak_pct(u, u_cl),
             "rel_l2_error": rel_l2_error(u, u_cl),
-            # Table 14: b_1 / (c1 A) = C sigma Delta / E with b_1 = sigma / (w Delta) on an
-            # end element of weight w, so C = E / (c1 A Delta^2 w): a check on c1
-            "end_load_C": p["E"] / (model.c * AREA * model.spacing ** 2
-                                    * (0.5 if p["end_weight"] == "half" else 1.0)),
+            **self.model_metrics(p, model),
             # Tables 6, 7, 11: the factor on the bond (1, 1 + k)
             **{f"end_factor_{k}": a for k, a in
                enumerate(end_factors(model)[:FACTOR_METRICS], start=1)},
@@ -567,18 +596,26 @@ class Constraints(BondBarScene):
             "b": (n_b, [0], 0.0, 0.0),
             "c": (n_c, list(range(m)), 0.0, -(m - 1) * spacing),
         }
+        t = self.offered().get(method)
+        peer = getattr(t, "peer_solve_bar", None)
         with timer.phase("setup"):
-            bars = {k: self.bar(method, p, n, spacing, *self.conditions(held, left, force))
-                    for k, (n, held, left, _x0) in specs.items()}
-        u, x, info = {}, {}, {}
+            problems = {k: self.bar_problem(p, n, spacing, *self.conditions(held, left, force))
+                        for k, (n, held, left, _x0) in specs.items()}
+            bars = {k: assemble_bonds(problem, self.bond_closure(method, p))
+                    for k, problem in problems.items()}
+        u, x, info, peer_runs = {}, {}, {}, {}
         with timer.phase("solve"):
             for k, (n, _held, _left, x0) in specs.items():
                 system = bars[k]      # the held points as Lagrange rows (seed 004 §6.2)
                 held = system.fixed
                 B = np.zeros((held.size, n))
                 B[np.arange(held.size), held] = 1.0
+                where = f"{self.id}/{method} bar ({k})"
                 u[k], _, info[k] = solve_constrained(system.K, system.rhs, B, system.values,
-                                                     where=f"{self.id}/{method} bar ({k})")
+                                                     where=where)
+                if peer is not None:  # another code solves the bar (its held atoms)
+                    peer_runs[k] = peer(self, p, problems[k], system, where, u[k])
+                    u[k] = peer_runs[k][0]
                 x[k] = x0 + system.model.grid.x[:, 0]
         half_a = u["a"][n_a // 2:]
         scale = np.max(np.abs(u["a"]))
@@ -601,7 +638,10 @@ class Constraints(BondBarScene):
         size = {"nodes": n_a + n_b + n_c, "bonds": sum(b.model.n_bonds() for b in bars.values())}
         diagnostics = {f"bar_{k}_{key}": info[k][key] for k in info
                        for key in ("relative_residual", "condition_estimate")}
-        return Outcome(metrics=metrics, size=size, fields=fields, diagnostics=diagnostics)
+        outcome = Outcome(metrics=metrics, size=size, fields=fields, diagnostics=diagnostics)
+        if peer is None:
+            return outcome
+        return t.finish_bars(outcome, peer_runs, f"{self.id}/{method}")
 
 
 # --------------------------------------------------------------------------- Sec. 6.3

@@ -31,6 +31,11 @@ def homogenization_figures(scene, results, folder):
     for r in sweeps:  # the other stiffness corrections (energy, volume, plugins) on the left
         if r.method in ("none", "homogenized"):
             continue
+        if "sweep_nodes" not in r.fields:     # a peer code's run: its one bar
+            ax1.semilogx([r.params["nodes"]], [r.metrics["strain_factor"]], "D", ms=7,
+                         mfc="none", mew=1.3, label=f"{r.method} (one bar), delta/Delta = "
+                         f"{_case(r)}")
+            continue
         ax1.semilogx(r.fields["sweep_nodes"], r.fields["sweep_f"], "^:", ms=3, lw=1,
                      label=f"{r.method}, delta/Delta = {_case(r)}")
     for r in sweeps:
