@@ -110,6 +110,13 @@ REFUSED = {
         "frictionless penalty wall, another contact law); it would take driving LAMMPS "
         "increment by increment (its Python module: minimize, read the top atoms, hold "
         "the caught ones on the indenter, repeat) with the scene's Newton stopping rule"),
+    **{scene: (
+        "peri/lps's compute pe/atom is not the node's energy density: it tallies half of "
+        "the deviatoric energy its forces derive from (pair_peri_lps.cpp: K theta^2 / 2 + "
+        "15 G / (4 m) sum omega e_d^2 V; LPS has 15 G / (2 m)); not wired: it would take "
+        "W_i = 2 pe_i - K theta_i^2 / 2 with compute dilatation/atom, and a check that "
+        "LAMMPS's split of the energy among the atoms is pdverify's (the work of each "
+        "node's own force state)") for scene in ("stiffness3d-box", "stiffness2d-plate")},
 }
 
 

@@ -499,3 +499,23 @@ def test_bar_with_one_spring_for_every_bond_is_a_failed_run(monkeypatch):
     monkeypatch.setattr(lammps, "bar_types", one_spring)
     r = get_scene("bar1d-homogenization").run(lammps.NAME, {})
     assert r.status == "failed" and "not in equilibrium: 0.55" in r.message
+
+
+def test_list_serves_the_bond_scenes_or_says_what_it_would_take():
+    # issue 55: the bond-based scenes LAMMPS was "not a problem description yet" for are
+    # served, or refused with their own reason (what it would take); none falls back to
+    # the family's generic line
+    from pdverify.corrections.registry import from_name
+    peer = from_name(lammps.NAME)
+    served = ("sheet2d-clamped", "stiffness2d-sheet", "stiffness3d-box-bond",
+              "bar1d-homogenization", "bar1d-constraints")
+    for scene_id in served:
+        assert peer.why_not(get_scene(scene_id)) is None, scene_id
+    reasons = {s: peer.why_not(get_scene(s)) for s in
+               ("bar1d-vibration", "block2d-indentation", "stiffness3d-box",
+                "stiffness2d-plate")}
+    assert "fix nve" in reasons["bar1d-vibration"]
+    assert "not a prescribed-displacement set" in reasons["block2d-indentation"]
+    for scene_id in ("stiffness3d-box", "stiffness2d-plate"):
+        assert "half of the deviatoric energy" in reasons[scene_id]
+    assert not any("assembles static-state problems" in r for r in reasons.values())
