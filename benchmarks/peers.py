@@ -2,7 +2,7 @@
 
 Plain script (no test runner):
 
-    python benchmarks/peers.py [--repeat N] [--minimisers] [--json FILE]
+    python benchmarks/peers.py [--repeat N] [--only SCENE ...] [--minimisers] [--json FILE]
 
 Times every peer run of the full report (pdverify.corrections.peer.REPORT_RUNS, both
 settings) ``--repeat`` times (default 3), each in a fresh process, and prints the median
@@ -12,7 +12,9 @@ run time, LAMMPS's iterations and the sum (issue 49's budget: the peer runs add 
 minimisers side by side (cg with the quadratic and forcezero line searches, fire) and
 prints each one's stopping criterion, iterations, wall time and its field's relative L2
 difference to pdverify's none (the minimiser the deck uses is the one that reaches the
-force tolerance).
+force tolerance). ``--only`` times the named scenes' runs alone (issue 55's added scenes:
+``--only sheet2d-clamped stiffness2d-sheet stiffness3d-box-bond bar1d-homogenization
+bar1d-constraints``, budget ~10 s in all).
 """
 from __future__ import annotations
 
@@ -39,13 +41,15 @@ def _one(scene_id, overrides) -> dict:
                          cwd=ROOT, env=dict(os.environ, PYTHONPATH=ROOT))
 
 
-def runs(repeat: int) -> list[dict]:
+def runs(repeat: int, only=None) -> list[dict]:
     from pdverify.corrections.peer import PeerTreatment
     from pdverify.scenes import get_scene
     from pdverify.corrections.registry import treatments
     peer = next(t for t in treatments().values() if isinstance(t, PeerTreatment))
     rows = []
     for scene_id in sorted(__import__("pdverify.corrections.peer", fromlist=["x"]).REPORT_RUNS):
+        if only and scene_id not in only:
+            continue
         for over in peer.report_runs(get_scene(scene_id), False):
             got = harness.alternate({"run": lambda: _one(scene_id, over)}, repeat)["run"].results
             rows.append({"scene": scene_id, "overrides": over,
@@ -95,6 +99,7 @@ def minimisers() -> list[dict]:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--only", nargs="+", metavar="SCENE", help="these scenes' runs only")
     ap.add_argument("--minimisers", action="store_true")
     ap.add_argument("--json", metavar="FILE")
     harness.add_arguments(ap)
@@ -113,7 +118,7 @@ def _measure(a, rec) -> None:
         for r in doc["minimisers"]:
             print(f"{r['minimiser']:32s} {r['stopping']:32s} {r['iterations']:>6} it "
                   f"{r['wall_s']:7.2f} s  diff to none {r['diff_to_none']:.3g}")
-    rec["runs"] = runs(a.repeat)
+    rec["runs"] = runs(a.repeat, a.only)
     for r in doc["runs"]:
         print(f"{r['scene']:22s} {r['overrides'].get('setting'):11s} {r['status']:6s} "
               f"median {r['median_s']:7.2f} s  {r['iterations']} FIRE iterations")
