@@ -224,9 +224,9 @@ class PeerTreatment(Treatment):
         return (solution_vector(system, result.u), info, metrics,
                 _trouble(result.info, info.get("equilibrium"), not_in_equilibrium))
 
-    def peer_energies(self, scene, p, problem, model, where):
+    def peer_energies(self, scene, p, problem, model, states, where):
         """The bond-based stiffness scenes: ``(ratios, info, metrics, trouble)``, W_i /
-        W_bulk per strain state of LAMMPS's peri/pmb (``compute pe/atom`` with every atom
+        W_bulk per strain state (``states``: ``(name, eps)`` each) of LAMMPS's peri/pmb (``compute pe/atom`` with every atom
         at u = eps . x, :func:`pdverify.peers.lammps.energies`) on the uncorrected
         ``model``'s atoms. W_bulk is the bulk of the setting's own lattice: pdverify's for
         ``same-model``, LAMMPS's ramped one for ``as-used`` (:func:`lammps_bulk_work_density`;
@@ -238,7 +238,7 @@ class PeerTreatment(Treatment):
         within :data:`pdverify.nodeset.DISTANCE_PER_GRADIENT` times the field's largest
         relative bond displacement (the equilibrium check's rule; here the strain scale),
         else the run fails naming it."""
-        return peer_energies_of(scene, p, problem, model, where)
+        return peer_energies_of(scene, p, problem, model, states, where)
 
     def peer_solve_bar(self, scene, p, problem, system, where, u_none, centred=False):
         """A seed-004 bar (:class:`~pdverify.pd.problem.BondSystem` of ``problem``) run by
@@ -331,11 +331,10 @@ class PeerTreatment(Treatment):
                 _trouble(result.info, info.get("equilibrium"), not_in_equilibrium))
 
 
-def peer_energies_of(scene, p, problem, model_none, where):
+def peer_energies_of(scene, p, problem, model_none, states, where):
     """The bond-based stiffness scenes through LAMMPS (:meth:`PeerTreatment.peer_energies`)."""
     from ..nodeset import DISTANCE_FLOOR, DISTANCE_PER_GRADIENT, between_shells
     from ..pd.work import work_density
-    from ..scenes.stiffness import strain_states
     g, d = model_none.grid, model_none.dim
     ids = g.interior_ids
     h, m = model_none.spacing, model_none.m_ratio
@@ -345,7 +344,6 @@ def peer_energies_of(scene, p, problem, model_none, where):
                       between_shells(h, np.r_[off, -off], d),
                       h ** d * model_none.thickness, "peri/pmb", (model_none.c,),
                       model_none.c * model_none.horizon ** (d + 1))
-    states = strain_states(d)
     strains = [eps for _, eps in states]
     setting = p["setting"]
     with tempfile.TemporaryDirectory(prefix="pdverify-lammps-") as folder:

@@ -162,7 +162,7 @@ class StiffnessScene(Scene):
             where = f"{self.id}/{method}"
             with timer.phase("solve"):
                 ratios, info, metrics, trouble = peer(self, p, self.bond_problem(p, where),
-                                                      model, where)
+                                                      model, strain_states(model.dim), where)
             outcome = self.measure_ratios(p, model, ratios)
             outcome.diagnostics = info
             return t.finish(outcome, metrics, trouble, where)
