@@ -1,6 +1,9 @@
 """``peer:lammps`` as a treatment of the ``static-state`` family and of the bond-based
-sheets: the scene's uncorrected problem solved by LAMMPS (:mod:`pdverify.peers.lammps`)
-instead of pdverify's linear solve, and measured by the scene's own ``measure``.
+scenes that state their problem (the sheets, :data:`BOND_SCENES`; the stiffness scenes,
+:data:`ENERGY_SCENES`, whose atoms LAMMPS evaluates at u = eps . x; seed 004's static bars,
+:data:`BAR_SCENES`): the scene's uncorrected problem solved by LAMMPS
+(:mod:`pdverify.peers.lammps`) instead of pdverify's linear solve, and measured by the
+scene's own ``measure``; the bond-based scenes it cannot run say why (:data:`REFUSED`).
 
 Beside the scene's metrics a run records, as metrics (all relative L2 norms over the
 real nodes, divided by the norm of pdverify's ``none`` field at the same params):
@@ -14,6 +17,10 @@ real nodes, divided by the norm of pdverify's ``none`` field at the same params)
   solution than :func:`pdverify.nodeset.equilibrium` allows, and when bonds were lost.
 Both linear models are assembled and solved by pdverify in the same run, in its solve
 phase beside LAMMPS, which takes nearly all of it (record peers-2026-11-28-twin-solves).
+On the stiffness scenes the same metrics compare the nodal energy densities (relative L2
+over nodes and strain states) and ``equilibrium_residual`` has no meaning (nothing is
+solved): LAMMPS's energies must lie within the equilibrium check's rule of its setting's
+linear model (:func:`peer_energies_of`).
 """
 from __future__ import annotations
 
