@@ -154,9 +154,16 @@ class InclinedCrackParams:
             n = 2 * v / self.sample_spacing
             _p.require(abs(n - round(n)) < 1e-9 * n and round(n) >= 1, ref,
                        f"sample_spacing {self.sample_spacing} must divide 2 {name} = {2 * v}")
+        nx, ny = self.finest_cells()
+        _p.require(nx * ny <= 2 ** 18, ref,
+                   f"the finest level would have {nx * ny} elements (at most 2^18)")
+
+    def finest_cells(self) -> tuple[int, int]:
+        """(along, across) elements of the finest level, both blocks: the polyline's
+        4 n + 2 (n / 2) by the 2 (n + n / 2) across."""
         n = self.cells * 2 ** (self.levels - 1)
-        _p.require(2 * 4 * n * (n + n // 2) <= 2 ** 18, ref,
-                   f"the finest level would have {8 * n * (n + n // 2)} elements (at most 2^18)")
+        m = max(1, n // 2)
+        return 4 * n + 2 * m, 2 * (n + m)
 
     @property
     def direction(self) -> np.ndarray:
