@@ -197,7 +197,11 @@ def fit_k(x, u, tip, direction, *, E: float, nu: float, plane: str, horizon: flo
 # series' disk of convergence (the distance to the other tip and to the body's edge).
 # Accuracy as fit_k's: K_I and K_II are linear functionals of the displacements,
 # K = sum_i w_i u_i, so an error e_i of the field changes them by at most
-# sum_i |w_i| max |e_i| (``amplification``, one per mode).
+# sum_i |w_i| max |e_i| (``amplification``, one per mode). Orders: measured on the
+# converged FEM field of plate-inclined-crack (beta = 30, a = 0.5, W = H = 1) sampled at
+# the PD nodes, h = 1/30 .. 1/80, annulus [2 horizons, 0.4 m]: orders 1..5 read K_I,
+# K_II 0.39-0.42 % and 0.35-0.39 % low, 1..7 (the default) within 0.005 % and 0.031 %,
+# 1..9 within 0.003 % and 0.011 % (the amplification about the same, 3.1e9 Pa m^-0.5).
 
 
 def williams_mode2(r, theta, n: int, E: float, nu: float, plane: str):
@@ -249,7 +253,7 @@ class KMixedFit:
 
 
 def fit_k_mixed(x, u, tip, direction, *, E: float, nu: float, plane: str, horizon: float,
-                reach: float, tip_zone: float = 2.0, orders: tuple = (1, 2, 3, 4, 5),
+                reach: float, tip_zone: float = 2.0, orders: tuple = (1, 2, 3, 4, 5, 6, 7),
                 mask=None) -> KMixedFit:
     """K_I and K_II by the Williams fit of both displacement components in the annulus
     r in [``tip_zone`` x ``horizon``, ``reach``] about ``tip`` (the section's comment):
