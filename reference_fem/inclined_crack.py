@@ -29,7 +29,7 @@ elements power graded toward the crack line over the share l / (H - a sin beta) 
 blocks are rectangles. ``W tan beta`` must stay below 0.9 H.
 
 K_I and K_II by the interaction integral (Yau, Wang & Corten, J. Appl. Mech. 47, 1980;
-domain form as Moes, Dolbow & Belytschko, IJNME 46, 1999, eq. 29): in the tip's frame
+domain form as in Moes, Dolbow & Belytschko, IJNME 46, 1999, sec. 5): in the tip's frame
 (x_1 ahead along the crack, x_2 its left normal),
 
     I = int_A (sigma_ij u^aux_i,1 + sigma^aux_ij u_i,1 - sigma_kl eps^aux_kl delta_1j)
@@ -46,9 +46,11 @@ the compared values are the middle domain's. By the point symmetry the left tip 
 same K (measured: equal to the round-off, :func:`k_left`).
 
 Handbook (Tada, Paris & Irwin, The Stress Analysis of Cracks Handbook, 3rd ed. 2000,
-p. 5.1; the crack in the infinite plate under uniaxial tension sigma at the angle beta
-to the crack's normal): K_I = sigma sqrt(pi a) cos^2 beta, K_II = sigma sqrt(pi a)
-sin beta cos beta, exact for the infinite plate. The handbook has no finite-plate
+part 5, the crack in the infinite plate under uniform remote stress: K_I = sigma_n
+sqrt(pi a), K_II = tau sqrt(pi a) with the remote normal and shear stress on the crack's
+plane; the uniaxial tension sigma at the angle beta to the crack's normal gives):
+K_I = sigma sqrt(pi a) cos^2 beta, K_II = sigma sqrt(pi a) sin beta cos beta, exact
+for the infinite plate. The handbook has no finite-plate
 formula for the inclined crack, so the check is made on a plate large enough that the
 finite size is below the claimed accuracy, measured by doubling it (below).
 
@@ -59,8 +61,8 @@ K_II^2) / (E' J) - 100, ``k1_over_k0``, ``k2_over_k0`` with K_0 = sigma sqrt(pi 
 from level 1 ``field_change_pct`` on the cell centres of the ``sample_spacing`` grid
 over the plate; the row's ``quantity`` is K_I, its change the larger of the changes of
 K_I and K_II in % of K_0). Measured with the defaults (W = H = 1, a = 0.5, beta = 30; four
-levels, 4 .. 32 elements per segment, finest 124 160 DOFs, 14 s under load; the study
-~20 s):
+levels, 4 .. 32 elements per segment, finest 124 160 DOFs; the finest level 10-14 s
+and the whole study 42 s under load, load average ~13 on the 2 cores):
 
 - K_I / K_0 = 1.0014296, 1.0062126, 1.0068274, 1.0068895; K_II / K_0 = 0.526821,
   0.5348402, 0.5353851, 0.535428; the larger change 0.80, 0.061, 0.0062 % of K_0 (a
@@ -189,7 +191,7 @@ def k0(p: InclinedCrackParams) -> float:
 
 def handbook_k(p: InclinedCrackParams) -> tuple[float, float]:
     """(K_I, K_II) of the inclined crack in the infinite plate (Tada, Paris & Irwin 3rd
-    ed., p. 5.1): sigma sqrt(pi a) (cos^2 beta, sin beta cos beta)."""
+    ed., part 5): sigma sqrt(pi a) (cos^2 beta, sin beta cos beta)."""
     b = math.radians(p.angle)
     return k0(p) * math.cos(b) ** 2, k0(p) * math.sin(b) * math.cos(b)
 
