@@ -89,7 +89,10 @@ class InclinedCrackPlate(CrackPlate):
     of either tip); ``tip_zone_nodes``; ``reference_change_pct``.
 
     Cases: ``fem`` and every method at the defaults, no refinement (as ``plate-crack``);
-    the quick report at h = 1/30.
+    the quick report at h = 1/30. The refinement at m = 3 (h = 1/30, 1/40, 1/60) is
+    ``benchmarks/inclined_crack_k.py``'s (its docstring: the levels are pre-asymptotic,
+    K within 1 % for none; ``energy`` closest in K_I and halving the field error;
+    ``volume`` worse than none in the field; ``pals`` the best field, the worst K_II).
     """
 
     id = "plate-inclined-crack"

@@ -110,3 +110,24 @@ def test_bad_input_is_one_line_before_any_work(tmp_path, assignment, words):
     r, _ = _run(tmp_path, assignment)
     assert r.returncode == 2, r.stderr
     assert words in r.stderr and len(r.stderr.strip().splitlines()) == 1
+
+
+def test_the_pd_solution_is_point_symmetric():
+    """The lattice, the two cracks from the centre and the pins (at the FEM's values,
+    point symmetric to 1e-7 of its largest displacement: tests/reference_fem/
+    test_inclined_crack.py) are point symmetric, so the PD field is, u(-x) = -u(x), and
+    the fit reads the same K_I, K_II at both tips; bound 1e-7 (the pins' values; measured
+    2e-10 for the field, 2e-13 for K)."""
+    from scipy.spatial import cKDTree
+
+    from pdverify.pd.cracks import fit_k_mixed
+    res = get_scene(ID).run("none", {"spacing": 1 / 30})
+    x, u = np.asarray(res.fields["x"]), np.asarray(res.fields["u"])
+    d, i = cKDTree(x).query(-x)
+    assert d.max() < 1e-12
+    assert np.abs(u + u[i]).max() < 1e-7 * np.abs(u).max()
+    e = np.array([math.cos(math.pi / 6), math.sin(math.pi / 6)])
+    kw = dict(E=1e9, nu=0.3, plane="plane-stress", horizon=0.1, reach=0.4)
+    right = fit_k_mixed(x, u, 0.5 * e, e, **kw)
+    left = fit_k_mixed(x, u, -0.5 * e, -e, **kw)
+    assert abs(left.k1 / right.k1 - 1) < 1e-7 and abs(left.k2 / right.k2 - 1) < 1e-7
