@@ -567,6 +567,16 @@ DEVIATIONS = (
               "scenes/cracks.py, pd/cracks.py fit_k, reference_fem/crack_plate.py; "
               "benchmarks/crack_k.py",
               summary="Ours: the full cracked plate, K by the opening fit"),
+    Deviation(("plate-inclined-crack",), "choice",
+              "Ours, not a paper's: plate-crack's plate with the centre crack at 30 degrees "
+              "to the lattice (the slit crosses cells; the bonds that cross it are cut, a "
+              "staircase of nodes on each face); K_I and K_II by the Williams fit of both "
+              "displacement components in an annulus outside a tip zone of 2 horizons "
+              "(orders 1..7 of both modes), against the FEM's interaction integral; the "
+              "node-adding treatments are not run (crack faces are not served yet).",
+              "scenes/inclined_crack.py, pd/cracks.py fit_k_mixed, "
+              "reference_fem/inclined_crack.py; benchmarks/inclined_crack_k.py",
+              summary="Ours: the inclined crack, K_I and K_II by the annulus fit"),
     Deviation(("plate-l",), "finding",
               "Taylor along the normal is worse than the uncorrected model at the re-entrant "
               "corner (rel L2 {{t2}} against {{none}} at h = 0.025, order 2), though it reproduces "

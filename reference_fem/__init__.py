@@ -10,6 +10,7 @@ Public API: one function per reference, each returning its converged, cached res
     l_plate(**params)        -> LPlateResult          issue 35: L-shaped bracket
     crack_plate(**params)    -> CrackPlateResult      issue 54: centre crack (mode I)
     edge_crack_plate(**params) -> CrackPlateResult    issue 54: single edge crack (SENT)
+    inclined_crack(**params) -> InclinedCrackResult   issue 54: inclined centre crack
 
 Keyword arguments override the fields of the matching ``*Params`` dataclass;
 ``use_cache=False`` recomputes. The cache lives in ``$PDVERIFY_CACHE_DIR`` (default
@@ -28,6 +29,7 @@ from .crack_plate import CrackPlateParams, CrackPlateResult, crack_plate, edge_c
 from .elasticity import Material, TensorElasticity  # noqa: E402
 from .field import FieldSolution  # noqa: E402
 from .hole_plate import HolePlateParams, HolePlateResult, hole_plate  # noqa: E402
+from .inclined_crack import InclinedCrackParams, InclinedCrackResult, inclined_crack  # noqa: E402,E501
 from .indentation import IndentationParams, IndentationResult, indentation  # noqa: E402
 from .l_plate import LPlateParams, LPlateResult, l_plate  # noqa: E402
 from .mesh_elasticity import MeshElasticity  # noqa: E402
@@ -45,16 +47,17 @@ REFERENCES = {
     "plate-l": l_plate,
     "plate-crack": crack_plate,
     "plate-edge-crack": edge_crack_plate,
+    "plate-inclined-crack": inclined_crack,
 }
 
 __all__ = [
     "__version__", "REFERENCES", "cache_dir", "cache_key",
     "clamped_plate", "tension_sheet", "clamped_sheet", "indentation", "hole_plate", "l_plate",
-    "crack_plate", "edge_crack_plate",
+    "crack_plate", "edge_crack_plate", "inclined_crack",
     "PlateParams", "TensionSheetParams", "ClampedSheetParams", "IndentationParams",
-    "HolePlateParams", "LPlateParams", "CrackPlateParams",
+    "HolePlateParams", "LPlateParams", "CrackPlateParams", "InclinedCrackParams",
     "PlateResult", "TensionSheetResult", "ClampedSheetResult", "IndentationResult",
-    "HolePlateResult", "LPlateResult", "CrackPlateResult",
+    "HolePlateResult", "LPlateResult", "CrackPlateResult", "InclinedCrackResult",
     "ReferenceResult", "RefinementRow", "Material", "TensorElasticity", "FieldSolution",
     "MeshElasticity", "MeshField",
 ]

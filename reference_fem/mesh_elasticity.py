@@ -27,16 +27,20 @@ from .mesh_field import TENSOR_NODES, MeshField
 _EDGES = np.array([[0, 3, 6], [6, 7, 8], [8, 5, 2], [2, 1, 0]])
 
 
-def mapped_mesh(blocks: Sequence[tuple], tol: float) -> MeshQuad2:
+def mapped_mesh(blocks: Sequence[tuple], tol: float,
+                slit: Callable[..., np.ndarray] | None = None) -> MeshQuad2:
     """One ``MeshQuad2`` from structured blocks.
 
     Each block is ``(s, t, F)``: increasing logical coordinates s, t in [0, 1] (the
     element edges along each logical axis) and a vectorised map ``F(s, t) -> (x, y)``.
     Blocks must meet node to node; coincident vertices (closer than ``tol``) are
     merged, and every element's nine nodes are placed at F of their logical positions.
+    ``slit(x, y)`` (vectorised, optional) marks the vertices of a slit: two blocks that
+    meet there keep their own vertices (a crack's two faces), merged only within a block.
     """
     elem_nodes = []          # (n_el, 9, 2) physical positions in the tensor order
-    for (s, t, F) in blocks:
+    block_of = []
+    for b, (s, t, F) in enumerate(blocks):
         s = np.asarray(s, float)
         t = np.asarray(t, float)
         ns, nt = s.size - 1, t.size - 1
@@ -48,10 +52,15 @@ def mapped_mesh(blocks: Sequence[tuple], tol: float) -> MeshQuad2:
         lt = t[j][:, None] + dt * TENSOR_NODES[None, :, 1]
         x, y = F(ls, lt)
         elem_nodes.append(np.stack([x, y], axis=2))
+        block_of.append(np.full(i.size, b))
     X = np.concatenate(elem_nodes)                                 # (n_el, 9, 2)
     # unique vertices (tensor corners 0, 6, 8, 2 counter-clockwise)
     corners = X[:, [0, 6, 8, 2], :].reshape(-1, 2)
     pairs = cKDTree(corners).query_pairs(tol, output_type="ndarray")
+    if slit is not None and len(pairs):
+        block = np.repeat(np.concatenate(block_of), 4)
+        on = np.asarray(slit(corners[:, 0], corners[:, 1]), dtype=bool)
+        pairs = pairs[~(on[pairs[:, 0]] & (block[pairs[:, 0]] != block[pairs[:, 1]]))]
     graph = sp.coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])),
                           shape=(len(corners),) * 2)
     _, label = connected_components(graph, directed=False)

@@ -25,7 +25,7 @@ def _float_check(default):
 FEM_UNITS = {"width": "m", "height": "m", "length": "m", "radius": "m", "depth": "m",
              "crack": "m", "horizon": "m", "thickness": "m", "spacing": "m",
              "fine_half_width": "m", "fine_depth": "m", "sample_spacing": "m", "E": "Pa",
-             "traction": "Pa", "body_force": "N/m^3"}
+             "traction": "Pa", "body_force": "N/m^3", "angle": "deg"}
 
 
 def _field_param(name, field, cls_name) -> Param:
