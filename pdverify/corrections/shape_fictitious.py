@@ -16,6 +16,16 @@ cut boundary has no such lines, and a jittered node set no lattice at all, so he
   reproduces it), as seed 000's series is; its dilatation the same fit of order n - 1 of
   the real nodes' dilatations (order 0: the nearest real node's), and m of a complete
   neighbourhood at every node (as on the box);
+- a fictitious node seen from two sides (issue 55): at a re-entrant corner a fictitious
+  node in the notch takes the series of its closest part, one arm's, and a real node of
+  the other arm bonded to it would read that arm's field across the notch (finding
+  035-l-plate-bridging). A bond whose real end does not see the fictitious node's
+  closest point through the body (``Shape.hides``: the segment crosses another part)
+  reads instead a value of its own (``Closure.shadow``), the same fit about the point
+  of the nearest part the real end does see (:func:`seen_points`: the other notch
+  face); its dilatation likewise. Every fit reproduces the polynomials of its order, so
+  the exactness above is kept; on a convex corner, a straight part or a hole's arc no
+  bond changes;
 - the conditions at boundary points by Lagrange multipliers (seed 000 Eq. 63): one point
   per boundary node and part (the mean of the part's boundary samples that belong to the
   node, ``assembly.boundary_nodes``, moved onto the part). A prescribed component's
@@ -107,9 +117,14 @@ def normal_closure(g, shape, order: int, stencil=None) -> Closure:
     A_U = (eye + _rows(nodes, w, g.n_ext, ni, fict)).tocsr()
     nodes, w = fit(x_real, p, g.x[fict], order - 1, h)
     A_T = (eye + _rows(nodes, w, g.n_ext, ni, fict)).tocsr()
-    keep = None if stencil is None else crossing_keep(g, shape, stencil)
+    keep = shadow = None
+    if stencil is not None:
+        keep = crossing_keep(g, shape, stencil)
+        shadow = shadow_rows(g, shape, stencil, keep, order)
+    info = {"fictitious_nodes": int(fict.size),
+            "bridging_bonds": 0 if shadow is None else int(shadow[0].size)}
     return Closure(keep=keep, weighted_volume="complete", displacement_map=A_U,
-                   dilatation_map=A_T, info={"fictitious_nodes": int(fict.size)})
+                   dilatation_map=A_T, shadow=shadow, info=info)
 
 
 def boundary_points(g, shape, samples):
@@ -141,6 +156,58 @@ def crossing_keep(g, shape, stencil):
     seg = shape.crossings(g.x[a[ff]], g.x[b[ff]])[0]
     keep[ff[np.unique(seg)]] = True
     return keep
+
+
+def bridging(g, shape, a, b, pairs):
+    """The pairs (of the mask ``pairs`` over a-b) that join a real node to a fictitious
+    one whose closest boundary point the real node does not see through the body
+    (``Shape.hides``: the segment between them crosses another part, as across a
+    re-entrant corner's notch), with the real and fictitious ends: ``(pair ids, real,
+    fictitious)``."""
+    mixed = np.flatnonzero(pairs & (g.is_interior[a] != g.is_interior[b]))
+    real = np.where(g.is_interior[a[mixed]], a[mixed], b[mixed])
+    fict = np.where(g.is_interior[a[mixed]], b[mixed], a[mixed])
+    if mixed.size == 0:
+        return mixed, real, fict
+    p, _, _, part = shape.closest(g.x[fict])
+    hidden = shape.hides(g.x[real], p, part)
+    return mixed[hidden], real[hidden], fict[hidden]
+
+
+def seen_points(g, shape, real, fict):
+    """For each bridging bond (:func:`bridging`), the boundary point its fictitious node
+    is extrapolated about as seen from its real end: the fictitious node's closest point
+    on the nearest part whose closest point the real node sees (``Shape.hides``); where
+    no part qualifies, the node's own closest point (the bond then bridges as before)."""
+    xf, xr = g.x[fict], g.x[real]
+    best = np.full(len(fict), np.inf)
+    out = shape.closest(xf)[0]
+    for k, q in enumerate(shape.parts):
+        pk, _ = q.closest(xf)
+        dist = np.linalg.norm(xf - pk, axis=1)
+        ok = ~shape.hides(xr, pk, np.full(len(fict), k)) & (dist < best)
+        best = np.where(ok, dist, best)
+        out[ok] = pk[ok]
+    return out
+
+
+def shadow_rows(g, shape, stencil, keep, order: int):
+    """``Closure.shadow`` of the normal closure (module docstring): every bridging bond's
+    fictitious value and dilatation fitted, as the node's own, about the point its real
+    end sees (:func:`seen_points`)."""
+    from ..pd.bonds import bond_pairs
+    from ..pd.closure import uncut
+    a, b, _ = bond_pairs(g.ext_shape, stencil.offsets[stencil.half])
+    pairs, real, fict = bridging(g, shape, a, b, uncut(g, a, b, keep))
+    if pairs.size == 0:
+        return None
+    ni, h = g.n_interior, g.spacing
+    x_real = g.x[g.interior_ids]
+    p = seen_points(g, shape, real, fict)
+    nodes, w = fit(x_real, p, g.x[fict], order, h)
+    U = _rows(nodes, w, pairs.size, ni)
+    nodes, w = fit(x_real, p, g.x[fict], order - 1, h)
+    return pairs, U, _rows(nodes, w, pairs.size, ni)
 
 
 def crossings(model, shape):
