@@ -202,10 +202,10 @@ def family_treatments() -> list[Treatment]:
             "for quadratics) for the boundary rows and the equilibrium within 2 delta, LPS "
             "beyond", "Behera, Roy, Anicode, Madenci, Spencer 2022; seed 001 §5.3",
             params=PDDO_PARAMS, theories=STATE, families=FAMILY,
-            scope="state-based boxes; the boundary row (Dirichlet or traction) is chosen "
-                  "per boundary node", build=_pddo,
-            box_only="its boundary rows take each node's box face and that face's normal "
-                     "(seed 001 §5.3); a curved part's normal turns within a horizon"),
+            scope="state-based; the boundary row (Dirichlet or traction) is chosen per "
+                  "boundary node; on a shape at each boundary node's points with the "
+                  "part's local normal (pddo.pddo_shape_system: our generalisation)",
+            build=_pddo, shapes=True),
     ]
 
 
