@@ -180,10 +180,12 @@ def family_treatments() -> list[Treatment]:
             "fictitious layer by Taylor extrapolation about the nearest surface node",
             "Scabbia, Zaccariotto, Galvanetto 2023 (seed 001); seed 002",
             params=(SURFACE_ORDER,), theories=STATE, families=FAMILY, footprint="surface",
-            build=_surface, checker=_check_surface,
-            box_only="its surface nodes sit at the centres of boundary cell faces and its "
-                     "Taylor stencils run along lattice lines normal to a face (seed 001 "
-                     "§3); a curved or cut boundary has neither",
+            build=_surface, checker=_check_surface, shapes=True,
+            scope="state-based boxes and shapes; on a shape the surface nodes sit at "
+                  "the boundary nodes' points on each part, the series about the nearest "
+                  "one runs along the local normal with derivatives from a least-squares "
+                  "fit, arcs take the series' traction (surface_nodes."
+                  "surface_nodes_on_shape: our generalisation)",
             roles=(("wave-bar", Role(wave_extension, (WAVE_ORDER,), check_wave_order)),)),
         FamilyTreatment(
             "mirror-nodes", "seed 001 §5: a delta-thick fictitious layer whose nodes copy "

@@ -97,6 +97,41 @@ def fit(x_real, centres, targets, order: int, h: float, gradient: bool = False):
     return nodes, value, np.stack(out, axis=1)
 
 
+def centred_fit(x_real, centres, centre_cols, targets, order: int, h: float,
+                gradient: bool = False):
+    """The order-``order`` Taylor series about each centre whose value there is an
+    unknown of its own (a surface node: column ``centre_cols``), its derivatives fitted
+    by least squares to the differences u_j - u_centre of the ``neighbours(order)``
+    real nodes nearest it (Gaussian weights as :func:`fit`): ``(columns (F, k + 1), value
+    weights at targets (F, k + 1))``, the centre's column first, and with ``gradient``
+    the weights of d/dx, d/dy there (F, 2, k + 1). Exact for every polynomial of degree
+    <= order; the series passes through the centre's value (seed 001's Taylor series
+    about the surface node, its derivatives from a fit instead of lattice lines)."""
+    k = min(neighbours(order), len(x_real))
+    _, nodes = cKDTree(x_real).query(centres, k=k)
+    nodes = nodes.reshape(len(centres), k)
+    E = exponents(order)[1:]                                       # no constant term
+    z = (x_real[nodes] - centres[:, None, :]) / h
+    sw = np.exp(-0.5 * np.sum(z * z, axis=-1) / WEIGHT_LENGTH ** 2)[..., None]
+    pinv = np.linalg.pinv(sw * _vander(z, E)) * np.swapaxes(sw, 1, 2)   # (F, M - 1, k)
+    cols = np.c_[np.asarray(centre_cols)[:, None], nodes]
+    zt = (targets - centres) / h
+
+    def with_centre(w):
+        return np.concatenate([-w.sum(axis=-1, keepdims=True), w], axis=-1)
+    value = with_centre(np.einsum("fm,fmk->fk", _vander(zt, E), pinv))
+    value[:, 0] += 1.0
+    if not gradient:
+        return cols, value
+    out = []
+    for axis in (0, 1):
+        dE = E.copy()
+        c = dE[:, axis].astype(float)
+        dE[:, axis] = np.maximum(dE[:, axis] - 1, 0)
+        out.append(with_centre(np.einsum("fm,fmk->fk", c * _vander(zt, dE) / h, pinv)))
+    return cols, value, np.stack(out, axis=1)
+
+
 def _rows(nodes, weights, n_rows, n_cols, row_ids=None, col_offset=0):
     """Sparse rows of ``weights`` over the columns ``nodes`` (+ ``col_offset``: the
     component's block of the component-major unknowns)."""
@@ -233,12 +268,47 @@ def condition_rows(model, problem, order: int, samples):
     ni, h = g.n_interior, g.spacing
     x_real = g.x[g.interior_ids]
     pts, nrm, part, _, group = boundary_points(g, shape, samples)
-    P, W = samples[0], samples[1]
     nodes, value, grad = fit(x_real, pts, pts, order, h, gradient=True)
+    exact = problem.exact(pts)
+    pres = prescribed(problem, part)
+    free = free_rows(model, problem, samples, (pts, nrm, part, group), nodes, grad, ni)
+    rows, vals = [], []
+    for k in range(2):
+        if pres[:, k].any():
+            sel = np.flatnonzero(pres[:, k])
+            rows.append(_rows(nodes[sel], value[sel], sel.size, 2 * ni, col_offset=k * ni))
+            vals.append(exact[sel, k])
+        for _, R, c in free[k]:
+            rows.append(R)
+            vals.append(c)
+    return sp.vstack(rows).tocsr(), np.concatenate(vals), len(pts)
+
+
+def prescribed(problem, part) -> np.ndarray:
+    """(n, 2): whether the part of each point prescribes each component."""
+    names = problem.shape.part_names
+    out = np.zeros((len(part), 2), dtype=bool)
+    for name, cond in problem.conditions.items():
+        for k in cond.prescribed:
+            out[:, k] |= part == names.index(name)
+    return out
+
+
+def free_rows(model, problem, samples, points, nodes, grad, n_cols):
+    """Per component k, the rows of the boundary points (``points``: ``(pts, nrm,
+    part, group)`` of :func:`boundary_points`) whose part does not prescribe k, over
+    the unknowns' displacements (component-major, 2 ``n_cols`` columns): ``[(point ids,
+    rows, values)]``, first the straight parts' force flux through each point's
+    stretch (equal to the traction's resultant over it), then the arcs' traction of
+    the fit (``nodes``, ``grad``: the fits' columns and gradient weights at the points)
+    equal to the applied traction."""
+    g, shape = model.grid, problem.shape
+    h = g.spacing
+    pts, nrm, part, group = points
+    P, W = samples[0], samples[1]
     curved = ~np.array([q.straight for q in shape.parts])[part]
     lam, mu = problem.constants.moduli()
     names = shape.part_names
-    exact = problem.exact(pts)
     # each crossing counts for the boundary point whose stretch of its part holds it
     # (the stretch: the node's samples, to the midpoints between neighbouring points;
     # on a straight face one cell face), half for each on the edge between two (seed
@@ -259,27 +329,20 @@ def condition_rows(model, problem, order: int, samples):
     resultant = share_s.T @ (W[:, None] * problem.thickness
                              * _traction_at(problem, P, samples[2], spart, names))
     traction_pts = _traction_at(problem, pts, nrm, part, names)
-    rows, vals = [], []
+    pres = prescribed(problem, part)
+    out = []
     for k in range(2):
-        pres = np.zeros(len(pts), dtype=bool)
-        for name, cond in problem.conditions.items():
-            if k in cond.prescribed:
-                pres |= part == names.index(name)
-        load = resultant[:, k]
-        if pres.any():
-            sel = np.flatnonzero(pres)
-            rows.append(_rows(nodes[sel], value[sel], sel.size, 2 * ni, col_offset=k * ni))
-            vals.append(exact[sel, k])
-        free = np.flatnonzero(~pres & ~curved)
+        mine = []
+        free = np.flatnonzero(~pres[:, k] & ~curved)
         if free.size:
             S = (share_c[:, free].T @ sp.diags(sign * model.bond_n[bonds, k])).tocsr()
-            rows.append((S @ F).tocsr())
-            vals.append(load[free])
-        bent = np.flatnonzero(~pres & curved)
+            mine.append((free, (S @ F).tocsr(), resultant[free, k]))
+        bent = np.flatnonzero(~pres[:, k] & curved)
         if bent.size:
-            rows.append(_traction_rows(nodes[bent], grad[bent], nrm[bent], k, lam, mu, ni))
-            vals.append(traction_pts[bent, k])
-    return sp.vstack(rows).tocsr(), np.concatenate(vals), len(pts)
+            mine.append((bent, _traction_rows(nodes[bent], grad[bent], nrm[bent], k, lam,
+                                              mu, n_cols), traction_pts[bent, k]))
+        out.append(mine)
+    return out
 
 
 def _params(shape, x, xpart):
@@ -328,7 +391,7 @@ def stretches(shape, pts, part, s_samples, spart, group, s_all, xpart, h) -> sp.
                          shape=(len(s_all), n))
 
 
-def _traction_rows(nodes, grad, nrm, k, lam, mu, ni):
+def _traction_rows(nodes, grad, nrm, k, lam, mu, n_cols):
     """Rows of the traction component k, sigma(grad u_fit) n with the continuum moduli
     (plane: t_k = lam (div u) n_k + mu sum_l (d_l u_k + d_k u_l) n_l), over the fit's
     nodes' displacements."""
@@ -339,7 +402,7 @@ def _traction_rows(nodes, grad, nrm, k, lam, mu, ni):
         c = c + mu * nrm[:, a][:, None] * grad[:, k]
         if a == k:
             c = c + mu * np.einsum("fl,flk->fk", nrm, grad)
-        blocks.append(_rows(nodes, c, F, 2 * ni, col_offset=a * ni))
+        blocks.append(_rows(nodes, c, F, 2 * n_cols, col_offset=a * n_cols))
     return (blocks[0] + blocks[1]).tocsr()
 
 

@@ -45,3 +45,23 @@ def test_pddo_on_a_shape_is_exact_for_quadratics(shape, field, mode):
     problem = _box_problem(shape, _conditions(shape, mode, t), exact=u, body_force=b,
                            quadrature=quadrature)
     assert _error(assemble_pddo(problem), u) < 1e-9
+
+
+@pytest.mark.parametrize("shape", SHAPES, ids=IDS)
+@pytest.mark.parametrize("field", sorted(CASES))
+@pytest.mark.parametrize("mode", ["dirichlet", "mixed"])
+def test_surface_nodes_on_a_shape_are_exact_for_their_order(shape, field, mode):
+    """Surface nodes along the normal: order 1 reproduces the affine field, order 2 the
+    quadratic one with its body force (moment-corrected stencil), every part prescribed
+    or x- prescribed and the rest loaded by the field's traction (flux rows on straight
+    parts, the series' traction on the arc; a traction holds exactly where the
+    lattice's moduli are the continuum's: the moment-corrected stencil, as for the
+    Taylor extension's test). Tolerance: round-off through the system's condition
+    (~1e7; 1e-16 x 1e7 = 1e-9)."""
+    from pdverify.corrections.surface_nodes import assemble_surface_nodes
+    u, b, t, order, quadrature = CASES[field]
+    if mode == "mixed":
+        quadrature = "moment-corrected"
+    problem = _box_problem(shape, _conditions(shape, mode, t), exact=u, body_force=b,
+                           quadrature=quadrature)
+    assert _error(assemble_surface_nodes(problem, order), u) < 1e-9
