@@ -193,12 +193,12 @@ def family_treatments() -> list[Treatment]:
             "traction through the Neumann relation)",
             "Zhao, Jafarzadeh, Chen, Bobaru 2020; seed 001 §5.2", params=MIRROR_PARAMS,
             theories=STATE, families=FAMILY, footprint="fictitious",
-            scope="state-based boxes; the mirror relation (Dirichlet or traction) is "
-                  "chosen per boundary cell face",
-            build=_mirror, checker=_check_mirror,
-            box_only="its mirror nodes are reflections across a plane face (seed 001 §5.2); "
-                     "across a curved part the reflection needs the local normal and "
-                     "curvature, which this implementation does not take"),
+            scope="state-based; the mirror relation (Dirichlet or traction) is chosen "
+                  "per boundary cell face, on a shape per fictitious node at its closest "
+                  "point, the reflection across the local tangent and the traction "
+                  "relation with the local normal (mirror_nodes.MirrorNodesOnShape: our "
+                  "generalisation)",
+            build=_mirror, checker=_check_mirror, shapes=True),
         FamilyTreatment(
             "pddo", "seed 001 §5: peridynamic differential operator (moment matrices exact "
             "for quadratics) for the boundary rows and the equilibrium within 2 delta, LPS "
