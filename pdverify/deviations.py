@@ -558,8 +558,8 @@ DEVIATIONS = (
               ours="stress concentration {{scf}}", paper="Kirsch (infinite plate): 3"),
     Deviation(("plate-l",), "finding",
               "Taylor along the normal was worse than the uncorrected model at the re-entrant "
-              "corner (rel L2 0.142 against the same none at h = 0.025, order 2; the report "
-              "of 674b0c4), though it reproduces a smooth cubic field on the same L-shape to "
+              "corner (rel L2 about 1.5 times none's at h = 0.025, order 2; the report of "
+              "674b0c4), though it reproduces a smooth cubic field on the same L-shape to "
               "1.7e-3: the cause was bonds that bridge the notch from fictitious nodes "
               "extrapolated from the other arm. Fixed (issue 55): such a bond, whose "
               "real end does not see the fictitious node's closest point through the body, "
