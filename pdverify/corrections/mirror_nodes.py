@@ -330,32 +330,65 @@ class MirrorNodesOnShape(MirrorNodes):
     faces or through a vertex of cell corners (the box, the whole L: exact there), not
     along an arc (the hole with every part prescribed: 3.2e-3 relative; the test
     shows it); no reading is exact for quadratic fields (a first-order relation; the
-    box's neither: 7.2e-4 on the hole, corrected). No bond
-    bridging a re-entrant notch is treated (the Taylor extension's ``Closure.shadow``
-    takes one displacement map; the mirror map is per component)."""
+    box's neither: 7.2e-4 on the hole, corrected). A bond that bridges a re-entrant
+    notch (its real end does not see the fictitious node's closest point through the
+    body, ``Shape.hides``) reads its own relation, about the point of the part its real
+    end sees (``shape_fictitious.seen_points``; ``Closure.shadow`` per component), as
+    the Taylor extension does: the relations stay exact for affine fields."""
 
     def __init__(self, grid, problem, neumann="full-traction", mirror_point="nearest",
                  gradient_at="mirror"):
-        from scipy.spatial import cKDTree
-
-        from .shape_fictitious import fit
+        from ..pd.bonds import bond_pairs
+        from ..pd.closure import uncut
+        from .shape_fictitious import bridging, seen_points
         for name, value, allowed in (("neumann", neumann, NEUMANN_READINGS),
                                      ("mirror_point", mirror_point, MIRROR_POINTS),
                                      ("gradient_at", gradient_at, GRADIENT_AT)):
             if value not in allowed:
                 raise ValueError(f"{name}={value!r}; allowed: {', '.join(allowed)}")
-        g, d, h = grid, 2, grid.spacing
-        shape = problem.shape
-        self.grid = g
+        g, shape = grid, problem.shape
+        self.grid, self.problem = g, problem
+        self.readings = (neumann, mirror_point, gradient_at)
         fict = np.flatnonzero(g.kind == 1)
-        x = g.x[fict]
-        xB, nrm, _, part = shape.closest(x)
+        xB, nrm, _, part = shape.closest(g.x[fict])
+        self.fictitious = fict
+        rel = self._relations(g.x[fict], xB, nrm, part)
+        self.mirror, self.boundary_point = rel["mirror"], xB
+        self.dirichlet_k, self.entries = rel["dirichlet_k"], rel["entries"]
+        self.dirichlet_entries, self.const = rel["dirichlet_entries"], rel["const"]
+        # bonds that bridge a re-entrant notch: their own relation about the point the
+        # real end sees (as the Taylor extension's ``Closure.shadow``)
+        st = problem.stencil
+        a, b, _ = bond_pairs(g.ext_shape, st.offsets[st.half])
+        keep = (g.is_interior[a] | g.is_interior[b]) & ~g.is_void[a] & ~g.is_void[b]
+        pairs, real, far = bridging(g, shape, a, b, uncut(g, a, b, keep))
+        self.shadow_pairs, self.shadow_rel = pairs, None
+        if pairs.size:
+            p, ppart = seen_points(g, shape, real, far)
+            pn = np.zeros_like(p)
+            for k, q in enumerate(shape.parts):
+                on = ppart == k
+                if on.any():
+                    pn[on] = q.closest(p[on])[1]
+            self.shadow_rel = self._relations(g.x[far], p, pn, ppart)
+        self.counts = {"fictitious_nodes": int(fict.size), "bridging_bonds": int(pairs.size)}
+
+    def _relations(self, x, xB, nrm, part) -> dict:
+        """The mirror relations of fictitious positions ``x`` about boundary points
+        ``xB`` on ``part`` with outward normals ``nrm`` (class docstring): the mirror
+        nodes (grid ids), the Dirichlet components, the gradient entries and the
+        constants."""
+        from scipy.spatial import cKDTree
+
+        from .shape_fictitious import fit
+        g, problem, d, h = self.grid, self.problem, 2, self.grid.spacing
+        neumann, mirror_point, gradient_at = self.readings
+        shape = problem.shape
         star = 2.0 * xB - x
         x_real = g.x[g.interior_ids]
         mirror_real = cKDTree(x_real).query(star)[1]
         mirror = g.interior_ids[mirror_real]
-        self.fictitious, self.mirror, self.boundary_point = fict, mirror, xB
-        nf = fict.size
+        nf = len(x)
         lam, mu = problem.constants.moduli()
         names = shape.part_names
         # the parts that hold x_B (a vertex: both) and their conditions
@@ -403,10 +436,53 @@ class MirrorNodesOnShape(MirrorNodes):
             for k in range(d):
                 for col in range(mids.shape[1]):
                     dirichlet_entries.append((all_f, k, mids[:, col], k, wo[:, col]))
-        self.dirichlet_k, self.entries = dirichlet_k, entries
-        self.dirichlet_entries = dirichlet_entries
-        self.const = np.where(dirichlet_k, 2.0 * g_exact, const_n)
-        self.counts = {"fictitious_nodes": int(nf)}
+        return dict(mirror=mirror, dirichlet_k=dirichlet_k, entries=entries,
+                    dirichlet_entries=dirichlet_entries,
+                    const=np.where(dirichlet_k, 2.0 * g_exact, const_n))
+
+    def _rows_of(self, rel, rows, n_rows) -> sp.csr_matrix:
+        """(d n_rows) x (d n_real), component-major: the relations ``rel`` on the node
+        rows ``rows`` (nothing elsewhere)."""
+        g, d = self.grid, 2
+        ni, num = g.n_interior, g.interior_number
+        m, dk = rel["mirror"], rel["dirichlet_k"]
+        R, C, V = [], [], []
+        for k in range(d):
+            R.append(k * n_rows + rows)
+            C.append(k * ni + num[m])
+            V.append(np.where(dk[:, k], -1.0, 1.0))
+        for entries, want in ((rel["entries"], False), (rel["dirichlet_entries"], True)):
+            for mask, k, nodes, j, coef in entries:
+                use = mask & (dk[:, k] == want) & (coef != 0)
+                R.append(k * n_rows + rows[use])
+                C.append(j * ni + num[nodes[use]])
+                V.append(coef[use])
+        return sp.csr_matrix((np.concatenate(V), (np.concatenate(R), np.concatenate(C))),
+                             shape=(d * n_rows, d * ni))
+
+    def shadow(self):
+        """``Closure.shadow`` of the bridging bonds (per component), or None."""
+        rel = self.shadow_rel
+        if rel is None:
+            return None
+        g = self.grid
+        k = self.shadow_pairs.size
+        T = sp.csr_matrix((np.ones(k), (np.arange(k), g.interior_number[rel["mirror"]])),
+                          shape=(k, g.n_interior))
+        return self.shadow_pairs, self._rows_of(rel, np.arange(k), k), T
+
+    def constant_displacements(self) -> np.ndarray:
+        """The affine part of the fictitious displacements, (n_ext, d), with the shadow
+        ends' appended (``Closure.shadow``); zero on real nodes."""
+        out = super().constant_displacements()
+        if self.shadow_rel is not None:
+            out = np.r_[out, self.shadow_rel["const"]]
+        return out
+
+    def closure(self) -> Closure:
+        return Closure(weighted_volume="complete",
+                       displacement_map_full=self.displacement_map(),
+                       dilatation_map=self.dilatation_map(), shadow=self.shadow())
 
 
 # ------------------------------------------------------------------------------ static assembly
@@ -441,6 +517,5 @@ def assemble_mirror(problem, neumann: str, mirror_point: str,
     return LinearSystem(model, K, rhs, np.zeros(0, dtype=int), np.zeros(0), nu_,
                         solver=problem.solver, coords=unknown_coords(model, x_int),
                         scalars=scalars,
-                        counts={"fictitious_nodes": int(np.sum(~g.is_interior
-                                                               & ~getattr(g, "is_void", False)))},
-                        offset=U_c)
+                        counts=getattr(mirror, "counts", None)
+                        or {"fictitious_nodes": int(g.n_ext - g.n_interior)}, offset=U_c)

@@ -397,7 +397,7 @@ def surface_nodes_on_shape(problem, order: int) -> LinearSystem:
     pairs, real, far = bridging(g, shape, a, b, uncut(g, a, b, keep))
     shadow = None
     if pairs.size:
-        shadow = (pairs, *extension(g.x[far], seen_points(g, shape, real, far)))
+        shadow = (pairs, *extension(g.x[far], seen_points(g, shape, real, far)[0]))
     closure = Closure(keep=keep, weighted_volume="complete", displacement_map=A_U,
                       dilatation_map=A_T, n_unknown_nodes=nu_, shadow=shadow)
     model = model_of(problem, g, closure)

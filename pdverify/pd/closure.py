@@ -68,8 +68,12 @@ class Closure:
       displacement rows (k x n_unknown_nodes) and its dilatation from the k-th row of
       the dilatation rows (k x n_real) instead of the node's rows of the maps (a
       "shadow" of the node: its position, volume and m; the node's other bonds keep
-      its own value). State-based LPS models only (no ``displacement_map_full``, no
-      ``constitutive``). Default: none.
+      its own value); with ``displacement_map_full`` the displacement rows are (d k x
+      d n_unknown_nodes), component-major like it. A displacement or dilatation given
+      per node to the model (``rows_of_state``, ``bond_end_forces``' offset) reaches a
+      shadow end as its node's, unless given with the shadow ends' rows appended
+      (n_ext + k rows). State-based LPS models only (no ``constitutive``). Default:
+      none.
 
     Flux and constraint rows are built by the correction from the model's bonds after
     construction (e.g. :meth:`StateBasedModel.bond_force_rows`). ``info``: what the

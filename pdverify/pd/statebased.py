@@ -129,9 +129,8 @@ class StateBasedModel:
         self.shadow = closure.shadow
         if closure.shadow is None:
             return
-        if closure.displacement_map_full is not None or closure.constitutive is not None:
-            raise ValueError("shadow ends need the LPS force state and a displacement map "
-                             "per component")
+        if closure.constitutive is not None:
+            raise ValueError("shadow ends need the LPS force state")
         pairs = np.asarray(closure.shadow[0], dtype=int)
         if not keep[pairs].all():
             raise ValueError("shadow: every pair must be a kept bond")
@@ -162,15 +161,23 @@ class StateBasedModel:
         self.A_U = (cl.displacement_map if cl.displacement_map is not None
                     else real_identity(g, nu_)).tocsr()
         ca, cb, nc = self.col_a, self.col_b, self.col_node.size   # the ends' columns
-        if self.shadow is not None:       # the shadow ends' rows (Closure.shadow)
+        if self.shadow is not None and cl.displacement_map_full is None:
+            # the shadow ends' rows (Closure.shadow)
             self.A_U = sp.vstack([self.A_U, sp.csr_matrix(self.shadow[1])]).tocsr()
         # bond extension from all-node displacements (component-major columns)
         self.A_e = sp.hstack([sp.csr_matrix((np.r_[-n[:, k], n[:, k]],
                                              (np.r_[rows, rows], np.r_[ca, cb])), shape=(nb, nc))
                               for k in range(d)]).tocsr()
-        self.A_U_full = (cl.displacement_map_full.tocsr()
-                         if cl.displacement_map_full is not None
-                         else sp.kron(sp.identity(d, format="csr"), self.A_U, format="csr"))
+        if cl.displacement_map_full is None:
+            self.A_U_full = sp.kron(sp.identity(d, format="csr"), self.A_U, format="csr")
+        elif self.shadow is None:
+            self.A_U_full = cl.displacement_map_full.tocsr()
+        else:   # each component's block: its nodes' rows, then its shadow ends' rows
+            full, S, k = (cl.displacement_map_full.tocsr(), sp.csr_matrix(self.shadow[1]),
+                          nc - ne)
+            self.A_U_full = sp.vstack([blk for c in range(d) for blk in
+                                       (full[c * ne:(c + 1) * ne], S[c * k:(c + 1) * k])]
+                                      ).tocsr()
         if cl.constitutive is not None:  # another force state on the same bonds (PALS)
             (self.K_e, self.K_theta, self.A_theta, self.A_Theta,
              self.ke_share_a) = cl.constitutive.operators(self)
@@ -293,8 +300,10 @@ class StateBasedModel:
         ``offset``: (n_ext, d) displacements of the grid nodes added to the unknowns'
         image (a treatment's affine part, ``LinearSystem.offset``)."""
         U = self.A_U_full @ np.asarray(u, dtype=float)
-        if offset is not None:    # a shadow column moves with its node
-            U = U + np.asarray(offset, dtype=float)[self.col_node].T.ravel()
+        if offset is not None:    # a shadow column moves with its node, or has its own
+            offset = np.asarray(offset, dtype=float)
+            U = U + (offset if len(offset) == self.col_node.size
+                     else offset[self.col_node]).T.ravel()
         e = self.A_e @ U
         Theta = self.A_Theta @ (self.A_theta @ e)
         KT = self.K_theta.tocoo()
@@ -364,7 +373,10 @@ class StateBasedModel:
         """
         P = self.equilibrium_rows() if P is None else P
         U, Theta = np.asarray(U_ext, dtype=float), np.asarray(Theta_ext, dtype=float)
-        if self.shadow is not None:   # a shadow column takes its node's given state
-            U, Theta = U[self.col_node], Theta[self.col_node]
+        if self.shadow is not None:   # a shadow column takes its node's given state,
+            if len(U) != self.col_node.size:          # unless it is given its own
+                U = U[self.col_node]
+            if len(Theta) != self.col_node.size:
+                Theta = Theta[self.col_node]
         f = self.K_e @ (self.A_e @ U.T.ravel()) + self.K_theta @ Theta
         return P @ f
