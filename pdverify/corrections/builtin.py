@@ -180,10 +180,12 @@ def family_treatments() -> list[Treatment]:
             "fictitious layer by Taylor extrapolation about the nearest surface node",
             "Scabbia, Zaccariotto, Galvanetto 2023 (seed 001); seed 002",
             params=(SURFACE_ORDER,), theories=STATE, families=FAMILY, footprint="surface",
-            build=_surface, checker=_check_surface,
-            box_only="its surface nodes sit at the centres of boundary cell faces and its "
-                     "Taylor stencils run along lattice lines normal to a face (seed 001 "
-                     "§3); a curved or cut boundary has neither",
+            build=_surface, checker=_check_surface, shapes=True,
+            scope="state-based boxes and shapes; on a shape the surface nodes sit at "
+                  "the boundary nodes' points on each part, the series about the nearest "
+                  "one runs along the local normal with derivatives from a least-squares "
+                  "fit, arcs take the series' traction (surface_nodes."
+                  "surface_nodes_on_shape: our generalisation)",
             roles=(("wave-bar", Role(wave_extension, (WAVE_ORDER,), check_wave_order)),)),
         FamilyTreatment(
             "mirror-nodes", "seed 001 §5: a delta-thick fictitious layer whose nodes copy "
@@ -191,21 +193,21 @@ def family_treatments() -> list[Treatment]:
             "traction through the Neumann relation)",
             "Zhao, Jafarzadeh, Chen, Bobaru 2020; seed 001 §5.2", params=MIRROR_PARAMS,
             theories=STATE, families=FAMILY, footprint="fictitious",
-            scope="state-based boxes; the mirror relation (Dirichlet or traction) is "
-                  "chosen per boundary cell face",
-            build=_mirror, checker=_check_mirror,
-            box_only="its mirror nodes are reflections across a plane face (seed 001 §5.2); "
-                     "across a curved part the reflection needs the local normal and "
-                     "curvature, which this implementation does not take"),
+            scope="state-based; the mirror relation (Dirichlet or traction) is chosen "
+                  "per boundary cell face, on a shape per fictitious node at its closest "
+                  "point, the reflection across the local tangent and the traction "
+                  "relation with the local normal (mirror_nodes.MirrorNodesOnShape: our "
+                  "generalisation)",
+            build=_mirror, checker=_check_mirror, shapes=True),
         FamilyTreatment(
             "pddo", "seed 001 §5: peridynamic differential operator (moment matrices exact "
             "for quadratics) for the boundary rows and the equilibrium within 2 delta, LPS "
             "beyond", "Behera, Roy, Anicode, Madenci, Spencer 2022; seed 001 §5.3",
             params=PDDO_PARAMS, theories=STATE, families=FAMILY,
-            scope="state-based boxes; the boundary row (Dirichlet or traction) is chosen "
-                  "per boundary node", build=_pddo,
-            box_only="its boundary rows take each node's box face and that face's normal "
-                     "(seed 001 §5.3); a curved part's normal turns within a horizon"),
+            scope="state-based; the boundary row (Dirichlet or traction) is chosen per "
+                  "boundary node; on a shape at each boundary node's points with the "
+                  "part's local normal (pddo.pddo_shape_system: our generalisation)",
+            build=_pddo, shapes=True),
     ]
 
 

@@ -16,6 +16,18 @@ cut boundary has no such lines, and a jittered node set no lattice at all, so he
   reproduces it), as seed 000's series is; its dilatation the same fit of order n - 1 of
   the real nodes' dilatations (order 0: the nearest real node's), and m of a complete
   neighbourhood at every node (as on the box);
+- a fictitious node seen from two sides (issue 55): at a re-entrant corner a fictitious
+  node in the notch takes the series of its closest part, one arm's, and a real node of
+  the other arm bonded to it would read that arm's field across the notch (finding
+  035-l-plate-bridging). A bond whose real end does not see the fictitious node's
+  closest point through the body (``Shape.hides``: the segment crosses another part)
+  reads instead a value of its own (``Closure.shadow``), the same fit about the point
+  of the nearest part the real end does see (:func:`seen_points`: the other notch
+  face); its dilatation likewise. Every fit reproduces the polynomials of its order, so
+  the exactness above is kept. On a convex corner, a straight part or along a hole's
+  arc no bond changes; on plate-hole 6 bonds do at h = 0.05 and 1/30 (none at 0.025):
+  beside the arc's end on a symmetry plane, where a fictitious node below the plane has
+  that end as its closest point and a real node sees it only through the hole;
 - the conditions at boundary points by Lagrange multipliers (seed 000 Eq. 63): one point
   per boundary node and part (the mean of the part's boundary samples that belong to the
   node, ``assembly.boundary_nodes``, moved onto the part). A prescribed component's
@@ -87,6 +99,41 @@ def fit(x_real, centres, targets, order: int, h: float, gradient: bool = False):
     return nodes, value, np.stack(out, axis=1)
 
 
+def centred_fit(x_real, centres, centre_cols, targets, order: int, h: float,
+                gradient: bool = False):
+    """The order-``order`` Taylor series about each centre whose value there is an
+    unknown of its own (a surface node: column ``centre_cols``), its derivatives fitted
+    by least squares to the differences u_j - u_centre of the ``neighbours(order)``
+    real nodes nearest it (Gaussian weights as :func:`fit`): ``(columns (F, k + 1), value
+    weights at targets (F, k + 1))``, the centre's column first, and with ``gradient``
+    the weights of d/dx, d/dy there (F, 2, k + 1). Exact for every polynomial of degree
+    <= order; the series passes through the centre's value (seed 001's Taylor series
+    about the surface node, its derivatives from a fit instead of lattice lines)."""
+    k = min(neighbours(order), len(x_real))
+    _, nodes = cKDTree(x_real).query(centres, k=k)
+    nodes = nodes.reshape(len(centres), k)
+    E = exponents(order)[1:]                                       # no constant term
+    z = (x_real[nodes] - centres[:, None, :]) / h
+    sw = np.exp(-0.5 * np.sum(z * z, axis=-1) / WEIGHT_LENGTH ** 2)[..., None]
+    pinv = np.linalg.pinv(sw * _vander(z, E)) * np.swapaxes(sw, 1, 2)   # (F, M - 1, k)
+    cols = np.c_[np.asarray(centre_cols)[:, None], nodes]
+    zt = (targets - centres) / h
+
+    def with_centre(w):
+        return np.concatenate([-w.sum(axis=-1, keepdims=True), w], axis=-1)
+    value = with_centre(np.einsum("fm,fmk->fk", _vander(zt, E), pinv))
+    value[:, 0] += 1.0
+    if not gradient:
+        return cols, value
+    out = []
+    for axis in (0, 1):
+        dE = E.copy()
+        c = dE[:, axis].astype(float)
+        dE[:, axis] = np.maximum(dE[:, axis] - 1, 0)
+        out.append(with_centre(np.einsum("fm,fmk->fk", c * _vander(zt, dE) / h, pinv)))
+    return cols, value, np.stack(out, axis=1)
+
+
 def _rows(nodes, weights, n_rows, n_cols, row_ids=None, col_offset=0):
     """Sparse rows of ``weights`` over the columns ``nodes`` (+ ``col_offset``: the
     component's block of the component-major unknowns)."""
@@ -107,9 +154,14 @@ def normal_closure(g, shape, order: int, stencil=None) -> Closure:
     A_U = (eye + _rows(nodes, w, g.n_ext, ni, fict)).tocsr()
     nodes, w = fit(x_real, p, g.x[fict], order - 1, h)
     A_T = (eye + _rows(nodes, w, g.n_ext, ni, fict)).tocsr()
-    keep = None if stencil is None else crossing_keep(g, shape, stencil)
+    keep = shadow = None
+    if stencil is not None:
+        keep = crossing_keep(g, shape, stencil)
+        shadow = shadow_rows(g, shape, stencil, keep, order)
+    info = {"fictitious_nodes": int(fict.size),
+            "bridging_bonds": 0 if shadow is None else int(shadow[0].size)}
     return Closure(keep=keep, weighted_volume="complete", displacement_map=A_U,
-                   dilatation_map=A_T, info={"fictitious_nodes": int(fict.size)})
+                   dilatation_map=A_T, shadow=shadow, info=info)
 
 
 def boundary_points(g, shape, samples):
@@ -143,6 +195,59 @@ def crossing_keep(g, shape, stencil):
     return keep
 
 
+def bridging(g, shape, a, b, pairs):
+    """The pairs (of the mask ``pairs`` over a-b) that join a real node to a fictitious
+    one whose closest boundary point the real node does not see through the body
+    (``Shape.hides``: the segment between them crosses another part, as across a
+    re-entrant corner's notch), with the real and fictitious ends: ``(pair ids, real,
+    fictitious)``."""
+    mixed = np.flatnonzero(pairs & (g.is_interior[a] != g.is_interior[b]))
+    real = np.where(g.is_interior[a[mixed]], a[mixed], b[mixed])
+    fict = np.where(g.is_interior[a[mixed]], b[mixed], a[mixed])
+    if mixed.size == 0:
+        return mixed, real, fict
+    p, _, _, part = shape.closest(g.x[fict])
+    hidden = shape.hides(g.x[real], p, part)
+    return mixed[hidden], real[hidden], fict[hidden]
+
+
+def seen_points(g, shape, real, fict):
+    """For each bridging bond (:func:`bridging`), the boundary point its fictitious node
+    is extrapolated about as seen from its real end: the fictitious node's closest point
+    on the nearest part whose closest point the real node sees (``Shape.hides``); where
+    no part qualifies, the node's own closest point (the bond then bridges as before).
+    Returns ``(points, their parts)``."""
+    xf, xr = g.x[fict], g.x[real]
+    best = np.full(len(fict), np.inf)
+    out, _, _, part = shape.closest(xf)
+    for k, q in enumerate(shape.parts):
+        pk, _ = q.closest(xf)
+        dist = np.linalg.norm(xf - pk, axis=1)
+        ok = ~shape.hides(xr, pk, np.full(len(fict), k)) & (dist < best)
+        best = np.where(ok, dist, best)
+        out[ok], part[ok] = pk[ok], k
+    return out, part
+
+
+def shadow_rows(g, shape, stencil, keep, order: int):
+    """``Closure.shadow`` of the normal closure (module docstring): every bridging bond's
+    fictitious value and dilatation fitted, as the node's own, about the point its real
+    end sees (:func:`seen_points`)."""
+    from ..pd.bonds import bond_pairs
+    from ..pd.closure import uncut
+    a, b, _ = bond_pairs(g.ext_shape, stencil.offsets[stencil.half])
+    pairs, real, fict = bridging(g, shape, a, b, uncut(g, a, b, keep))
+    if pairs.size == 0:
+        return None
+    ni, h = g.n_interior, g.spacing
+    x_real = g.x[g.interior_ids]
+    p, _ = seen_points(g, shape, real, fict)
+    nodes, w = fit(x_real, p, g.x[fict], order, h)
+    U = _rows(nodes, w, pairs.size, ni)
+    nodes, w = fit(x_real, p, g.x[fict], order - 1, h)
+    return pairs, U, _rows(nodes, w, pairs.size, ni)
+
+
 def crossings(model, shape):
     """Every crossing of a boundary part by a bond of the model whose ends both lie
     within a horizon of the boundary: ``(bond, part, arc length, sign, alpha)``
@@ -166,12 +271,47 @@ def condition_rows(model, problem, order: int, samples):
     ni, h = g.n_interior, g.spacing
     x_real = g.x[g.interior_ids]
     pts, nrm, part, _, group = boundary_points(g, shape, samples)
-    P, W = samples[0], samples[1]
     nodes, value, grad = fit(x_real, pts, pts, order, h, gradient=True)
+    exact = problem.exact(pts)
+    pres = prescribed(problem, part)
+    free = free_rows(model, problem, samples, (pts, nrm, part, group), nodes, grad, ni)
+    rows, vals = [], []
+    for k in range(2):
+        if pres[:, k].any():
+            sel = np.flatnonzero(pres[:, k])
+            rows.append(_rows(nodes[sel], value[sel], sel.size, 2 * ni, col_offset=k * ni))
+            vals.append(exact[sel, k])
+        for _, R, c in free[k]:
+            rows.append(R)
+            vals.append(c)
+    return sp.vstack(rows).tocsr(), np.concatenate(vals), len(pts)
+
+
+def prescribed(problem, part) -> np.ndarray:
+    """(n, 2): whether the part of each point prescribes each component."""
+    names = problem.shape.part_names
+    out = np.zeros((len(part), 2), dtype=bool)
+    for name, cond in problem.conditions.items():
+        for k in cond.prescribed:
+            out[:, k] |= part == names.index(name)
+    return out
+
+
+def free_rows(model, problem, samples, points, nodes, grad, n_cols):
+    """Per component k, the rows of the boundary points (``points``: ``(pts, nrm,
+    part, group)`` of :func:`boundary_points`) whose part does not prescribe k, over
+    the unknowns' displacements (component-major, 2 ``n_cols`` columns): ``[(point ids,
+    rows, values)]``, first the straight parts' force flux through each point's
+    stretch (equal to the traction's resultant over it), then the arcs' traction of
+    the fit (``nodes``, ``grad``: the fits' columns and gradient weights at the points)
+    equal to the applied traction."""
+    g, shape = model.grid, problem.shape
+    h = g.spacing
+    pts, nrm, part, group = points
+    P, W = samples[0], samples[1]
     curved = ~np.array([q.straight for q in shape.parts])[part]
     lam, mu = problem.constants.moduli()
     names = shape.part_names
-    exact = problem.exact(pts)
     # each crossing counts for the boundary point whose stretch of its part holds it
     # (the stretch: the node's samples, to the midpoints between neighbouring points;
     # on a straight face one cell face), half for each on the edge between two (seed
@@ -192,27 +332,20 @@ def condition_rows(model, problem, order: int, samples):
     resultant = share_s.T @ (W[:, None] * problem.thickness
                              * _traction_at(problem, P, samples[2], spart, names))
     traction_pts = _traction_at(problem, pts, nrm, part, names)
-    rows, vals = [], []
+    pres = prescribed(problem, part)
+    out = []
     for k in range(2):
-        pres = np.zeros(len(pts), dtype=bool)
-        for name, cond in problem.conditions.items():
-            if k in cond.prescribed:
-                pres |= part == names.index(name)
-        load = resultant[:, k]
-        if pres.any():
-            sel = np.flatnonzero(pres)
-            rows.append(_rows(nodes[sel], value[sel], sel.size, 2 * ni, col_offset=k * ni))
-            vals.append(exact[sel, k])
-        free = np.flatnonzero(~pres & ~curved)
+        mine = []
+        free = np.flatnonzero(~pres[:, k] & ~curved)
         if free.size:
             S = (share_c[:, free].T @ sp.diags(sign * model.bond_n[bonds, k])).tocsr()
-            rows.append((S @ F).tocsr())
-            vals.append(load[free])
-        bent = np.flatnonzero(~pres & curved)
+            mine.append((free, (S @ F).tocsr(), resultant[free, k]))
+        bent = np.flatnonzero(~pres[:, k] & curved)
         if bent.size:
-            rows.append(_traction_rows(nodes[bent], grad[bent], nrm[bent], k, lam, mu, ni))
-            vals.append(traction_pts[bent, k])
-    return sp.vstack(rows).tocsr(), np.concatenate(vals), len(pts)
+            mine.append((bent, _traction_rows(nodes[bent], grad[bent], nrm[bent], k, lam,
+                                              mu, n_cols), traction_pts[bent, k]))
+        out.append(mine)
+    return out
 
 
 def _params(shape, x, xpart):
@@ -261,7 +394,7 @@ def stretches(shape, pts, part, s_samples, spart, group, s_all, xpart, h) -> sp.
                          shape=(len(s_all), n))
 
 
-def _traction_rows(nodes, grad, nrm, k, lam, mu, ni):
+def _traction_rows(nodes, grad, nrm, k, lam, mu, n_cols):
     """Rows of the traction component k, sigma(grad u_fit) n with the continuum moduli
     (plane: t_k = lam (div u) n_k + mu sum_l (d_l u_k + d_k u_l) n_l), over the fit's
     nodes' displacements."""
@@ -272,7 +405,7 @@ def _traction_rows(nodes, grad, nrm, k, lam, mu, ni):
         c = c + mu * nrm[:, a][:, None] * grad[:, k]
         if a == k:
             c = c + mu * np.einsum("fl,flk->fk", nrm, grad)
-        blocks.append(_rows(nodes, c, F, 2 * ni, col_offset=a * ni))
+        blocks.append(_rows(nodes, c, F, 2 * n_cols, col_offset=a * n_cols))
     return (blocks[0] + blocks[1]).tocsr()
 
 

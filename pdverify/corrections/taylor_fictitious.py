@@ -316,13 +316,15 @@ def _taylor_on_shape(problem, order: int) -> LinearSystem:
     # (a cut cell's outside part is the fictitious nodes'), so that an affine field, or
     # a quadratic one on an isotropic stencil, is a solution as on the box
     g.node_volume[g.interior_ids] = g.volume
-    model = model_of(problem, g, normal_closure(g, problem.shape, order, problem.stencil))
+    closure = normal_closure(g, problem.shape, order, problem.stencil)
+    model = model_of(problem, g, closure)
     ni = g.n_interior
     x_int = g.x[g.interior_ids]
     rhs = problem.body_load(x_int, model.node_volume[g.interior_ids][:, None]).T.ravel()
     B, c, points = condition_rows(model, problem, order, boundary_nodes(g, problem.shape))
     counts = shape_counts(g, fictitious_nodes=int(np.sum(g.kind == 1)),
-                           constraints=int(B.shape[0]), boundary_points=int(points))
+                           constraints=int(B.shape[0]), boundary_points=int(points),
+                           bridging_bonds=closure.info["bridging_bonds"])
     none = np.zeros(0, dtype=int), np.zeros(0)
     # COLAMD: on the hole plate's bordered system SuperLU factors 4-6x faster than with
     # the scenes' minimum degree on A + A^T, whose fill the zero block of the multipliers

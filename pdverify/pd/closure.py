@@ -60,6 +60,21 @@ class Closure:
       and ``bulk_work_density(model, strain)``. Plain grids only. Default: the
       model's own (LPS).
 
+    - ``shadow``: per-bond values at a fictitious end (issue 55: a fictitious node seen
+      from two sides of a re-entrant corner), ``(pairs, displacement rows, dilatation
+      rows)``: ``pairs`` (k,) indices into ``bond_pairs(grid.ext_shape,
+      stencil.half_offsets)`` of kept pairs with one real and one fictitious end; that
+      bond reads its fictitious end's displacement from the k-th row of the
+      displacement rows (k x n_unknown_nodes) and its dilatation from the k-th row of
+      the dilatation rows (k x n_real) instead of the node's rows of the maps (a
+      "shadow" of the node: its position, volume and m; the node's other bonds keep
+      its own value); with ``displacement_map_full`` the displacement rows are (d k x
+      d n_unknown_nodes), component-major like it. A displacement or dilatation given
+      per node to the model (``rows_of_state``, ``bond_end_forces``' offset) reaches a
+      shadow end as its node's, unless given with the shadow ends' rows appended
+      (n_ext + k rows). State-based LPS models only (no ``constitutive``). Default:
+      none.
+
     Flux and constraint rows are built by the correction from the model's bonds after
     construction (e.g. :meth:`StateBasedModel.bond_force_rows`). ``info``: what the
     treatment reports about itself (no effect on the model).
@@ -76,6 +91,7 @@ class Closure:
     weight_factor: Callable[[object], np.ndarray] | None = None
     force_factor: Callable[[object], np.ndarray] | None = None
     constitutive: object | None = None
+    shadow: tuple | None = None
     #: facts the treatment reports beside the run's metrics (e.g. seed 004's
     #: ``end_factors``); no effect on the model
     info: dict = field(default_factory=dict, compare=False)

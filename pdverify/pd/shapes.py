@@ -358,6 +358,29 @@ class Shape:
             out |= c.cuts(xa, xb)
         return out
 
+    def hides(self, x, p, part) -> np.ndarray:
+        """Which boundary points ``p`` (rows, on the parts ``part``) the points ``x`` do not
+        see through the body: the segment x -> p crosses a part other than p's own
+        farther than 1e-9 |x - p| from p (it passes through the body's exterior, as a
+        segment across a re-entrant corner's notch does), or a crack cuts it
+        (:meth:`severs`). A segment that dips outside across p's own part (a chord of
+        a hole's arc) is not hidden: the exterior it crosses is the one p's part bounds.
+        At a convex corner p's segment never leaves the body. Vectorised; a loop over
+        the few parts."""
+        x, p = np.asarray(x, dtype=float), np.asarray(p, dtype=float)
+        part = np.asarray(part)
+        out = self.severs(x, p)
+        gap = 1e-9 * np.linalg.norm(x - p, axis=1)
+        for k, q in enumerate(self.parts):
+            other = np.flatnonzero(part != k)
+            if other.size == 0 or isinstance(q, CrackFace):
+                continue
+            hit, s, _, _ = q.crossings(x[other], p[other])
+            at, _ = q.point(s / q.length)
+            far = np.linalg.norm(at - p[other[hit]], axis=1) > gap[other[hit]]
+            out[other[hit[far]]] = True
+        return out
+
     @property
     def part_names(self) -> tuple:
         return tuple(p.name for p in self.parts)

@@ -89,6 +89,7 @@ class StateBasedModel:
         a, b, which = bond_pairs(grid.ext_shape, stencil.offsets[half])
         beta_h = stencil.beta[half]
         keep = closure.bond_mask(grid, a, b)
+        self._shadow_bonds(closure, grid, a, b, keep)
         a, b, which = a[keep], b[keep], which[keep]
         self.bond_a, self.bond_b = a, b
         xi = grid.bond_vectors(a, b)
@@ -119,6 +120,29 @@ class StateBasedModel:
             self.K_e = (sp.diags(g) @ self.K_e).tocsr()
             self.K_theta = (sp.diags(g) @ self.K_theta).tocsr()
 
+    def _shadow_bonds(self, closure, grid, a, b, keep):
+        """The columns of each kept bond's ends in the operators: its nodes, or for the
+        bonds of ``closure.shadow`` a shadow column n_ext + s at the fictitious end
+        (``Closure.shadow``). ``col_node``: the grid node of every column."""
+        self.col_a, self.col_b = a[keep].copy(), b[keep].copy()
+        self.col_node = np.arange(grid.n_ext)
+        self.shadow = closure.shadow
+        if closure.shadow is None:
+            return
+        if closure.constitutive is not None:
+            raise ValueError("shadow ends need the LPS force state")
+        pairs = np.asarray(closure.shadow[0], dtype=int)
+        if not keep[pairs].all():
+            raise ValueError("shadow: every pair must be a kept bond")
+        bond = (np.cumsum(keep) - 1)[pairs]
+        real_a = grid.is_interior[a[pairs]]
+        if np.any(real_a == grid.is_interior[b[pairs]]):
+            raise ValueError("shadow: every pair joins a real and a fictitious node")
+        cols = grid.n_ext + np.arange(pairs.size)
+        self.col_b[bond[real_a]] = cols[real_a]
+        self.col_a[bond[~real_a]] = cols[~real_a]
+        self.col_node = np.r_[self.col_node, np.where(real_a, b[pairs], a[pairs])]
+
     # ------------------------------------------------------------------ assembly
     @property
     def dim(self) -> int:
@@ -136,19 +160,32 @@ class StateBasedModel:
 
         self.A_U = (cl.displacement_map if cl.displacement_map is not None
                     else real_identity(g, nu_)).tocsr()
+        ca, cb, nc = self.col_a, self.col_b, self.col_node.size   # the ends' columns
+        if self.shadow is not None and cl.displacement_map_full is None:
+            # the shadow ends' rows (Closure.shadow)
+            self.A_U = sp.vstack([self.A_U, sp.csr_matrix(self.shadow[1])]).tocsr()
         # bond extension from all-node displacements (component-major columns)
         self.A_e = sp.hstack([sp.csr_matrix((np.r_[-n[:, k], n[:, k]],
-                                             (np.r_[rows, rows], np.r_[a, b])), shape=(nb, ne))
+                                             (np.r_[rows, rows], np.r_[ca, cb])), shape=(nb, nc))
                               for k in range(d)]).tocsr()
-        self.A_U_full = (cl.displacement_map_full.tocsr()
-                         if cl.displacement_map_full is not None
-                         else sp.kron(sp.identity(d, format="csr"), self.A_U, format="csr"))
+        if cl.displacement_map_full is None:
+            self.A_U_full = sp.kron(sp.identity(d, format="csr"), self.A_U, format="csr")
+        elif self.shadow is None:
+            self.A_U_full = cl.displacement_map_full.tocsr()
+        else:   # each component's block: its nodes' rows, then its shadow ends' rows
+            full, S, k = (cl.displacement_map_full.tocsr(), sp.csr_matrix(self.shadow[1]),
+                          nc - ne)
+            self.A_U_full = sp.vstack([blk for c in range(d) for blk in
+                                       (full[c * ne:(c + 1) * ne], S[c * k:(c + 1) * k])]
+                                      ).tocsr()
         if cl.constitutive is not None:  # another force state on the same bonds (PALS)
             (self.K_e, self.K_theta, self.A_theta, self.A_Theta,
              self.ke_share_a) = cl.constitutive.operators(self)
             return
         self.A_Theta = (cl.dilatation_map if cl.dilatation_map is not None
                         else real_identity(g)).tocsr()
+        if self.shadow is not None:
+            self.A_Theta = sp.vstack([self.A_Theta, sp.csr_matrix(self.shadow[2])]).tocsr()
         # real-node dilatations: every bond counts at each real end, with the other end's V
         coef = c.c_theta * om * x * be
         ia, ib = g.is_interior[a], g.is_interior[b]
@@ -161,8 +198,8 @@ class StateBasedModel:
         self.K_e = sp.diags(c.k_e * om * be * VV * (1.0 / m[a] + 1.0 / m[b]))
         self.ke_share_a = (1.0 / m[a]) / (1.0 / m[a] + 1.0 / m[b])
         kt = c.k_theta * om * x * be * VV
-        self.K_theta = sp.csr_matrix((np.r_[kt / m[a], kt / m[b]], (np.r_[rows, rows], np.r_[a, b])),
-                                     shape=(nb, ne))
+        self.K_theta = sp.csr_matrix((np.r_[kt / m[a], kt / m[b]], (np.r_[rows, rows], np.r_[ca, cb])),
+                                     shape=(nb, nc))
 
     def bond_force_rows(self, node_rows, bonds, weights) -> sp.csr_matrix:
         """Rows r (d * n_unknown_nodes x bonds) with r @ f = sum weights f_b n_b per node.
@@ -263,12 +300,14 @@ class StateBasedModel:
         ``offset``: (n_ext, d) displacements of the grid nodes added to the unknowns'
         image (a treatment's affine part, ``LinearSystem.offset``)."""
         U = self.A_U_full @ np.asarray(u, dtype=float)
-        if offset is not None:
-            U = U + np.asarray(offset, dtype=float).T.ravel()
+        if offset is not None:    # a shadow column moves with its node, or has its own
+            offset = np.asarray(offset, dtype=float)
+            U = U + (offset if len(offset) == self.col_node.size
+                     else offset[self.col_node]).T.ravel()
         e = self.A_e @ U
         Theta = self.A_Theta @ (self.A_theta @ e)
         KT = self.K_theta.tocoo()
-        at_a = KT.col % self.grid.n_ext == self.bond_a[KT.row]
+        at_a = self.col_node[KT.col % self.col_node.size] == self.bond_a[KT.row]
         ke = self.K_e @ e
         f_a = (self.ke_share_a * ke
                + np.bincount(KT.row[at_a], KT.data[at_a] * Theta[KT.col[at_a]],
@@ -333,6 +372,11 @@ class StateBasedModel:
         applied to an exact field gives discrete manufactured loads.
         """
         P = self.equilibrium_rows() if P is None else P
-        U = np.asarray(U_ext, dtype=float).T.ravel()
-        f = self.K_e @ (self.A_e @ U) + self.K_theta @ np.asarray(Theta_ext, dtype=float)
+        U, Theta = np.asarray(U_ext, dtype=float), np.asarray(Theta_ext, dtype=float)
+        if self.shadow is not None:   # a shadow column takes its node's given state,
+            if len(U) != self.col_node.size:          # unless it is given its own
+                U = U[self.col_node]
+            if len(Theta) != self.col_node.size:
+                Theta = Theta[self.col_node]
+        f = self.K_e @ (self.A_e @ U.T.ravel()) + self.K_theta @ Theta
         return P @ f

@@ -267,3 +267,65 @@ def test_taylor_on_a_rectangle_shape_matches_the_box_rows():
             got, want = system.displacements(x)[:g.n_interior], u(g.x[g.interior_ids])
             errors.append(np.linalg.norm(got - want) / np.linalg.norm(want))
         assert abs(errors[1] - errors[0]) < 0.1 * errors[0], (order, errors)
+
+
+def _outside_along(shape, x, p, samples=801):
+    """Brute force: whether the segment x -> p has a sample strictly outside the closed
+    body before p (farther than 1e-7 from the boundary)."""
+    t = np.linspace(0.0, 1.0, samples)[1:-1]
+    pts = x[:, None, :] + t[None, :, None] * (p - x)[:, None, :]
+    flat = pts.reshape(-1, 2)
+    out = ~shape.inside(flat) & (shape.closest(flat)[2] > 1e-7)
+    return out.reshape(len(x), -1).any(axis=1)
+
+
+def test_hides_is_the_segment_leaving_the_body_through_another_part():
+    """``Shape.hides`` on the L-shape (straight parts: a segment from inside leaves the
+    body before p exactly when it crosses another part) against sampling the segment;
+    on the hole plate a chord of the arc dips into the hole and is not hidden, every
+    segment to a point of a straight part is (sampled) as on the L."""
+    rng = np.random.default_rng(3)
+    L = l_shape(1.0)
+    x = rng.uniform(0, 1, (1500, 2))
+    x = x[L.inside(x)]
+    # boundary points of the two notch faces and the others
+    s = L.samples(0.05)
+    pick = rng.integers(0, len(s[0]), len(x))
+    p, part = s[0][pick], s[3][pick]
+    got = L.hides(x, p, part)
+    want = _outside_along(L, x, p)
+    assert got.sum() > 100 and np.array_equal(got, want)
+    H = quarter_hole(1.0, 0.2)
+    x = rng.uniform(0, 0.5, (1200, 2))
+    x = x[H.inside(x)]
+    p, _, _, part = H.closest(rng.uniform(-0.1, 0.5, (len(x), 2)))
+    got = H.hides(x, p, part)
+    arc = part == H.part_names.index("hole")
+    assert not got[arc].any() and _outside_along(H, x[arc], p[arc]).any()
+    assert np.array_equal(got[~arc], _outside_along(H, x[~arc], p[~arc]))
+
+
+def test_shadow_ends_with_the_nodes_own_rows_change_nothing():
+    """``Closure.shadow`` whose rows are the fictitious nodes' own rows of the maps gives
+    the model without it to round-off (the same sums over other columns)."""
+    from pdverify.corrections.assembly import model_of
+    from pdverify.corrections.shape_fictitious import bridging, normal_closure
+    from pdverify.pd.bonds import bond_pairs
+    shape = l_shape(1.0)
+    problem = _box_problem(shape, {"x-": FaceCondition(prescribed=(0, 1))}, exact=_affine)
+    g = problem.body.grid(problem.stencil.reach)
+    g.node_volume[g.interior_ids] = g.volume
+    closure = normal_closure(g, shape, 2, problem.stencil)
+    assert closure.shadow is not None
+    pairs = closure.shadow[0]
+    a, b, _ = bond_pairs(g.ext_shape, problem.stencil.offsets[problem.stencil.half])
+    fict = np.where(g.is_interior[a[pairs]], b[pairs], a[pairs])
+    ref = model_of(problem, g, normal_closure(g, shape, 2, problem.stencil))
+    closure.shadow = (pairs, closure.displacement_map[fict], closure.dilatation_map[fict])
+    same = model_of(problem, g, closure)
+    closure.shadow = None
+    plain = model_of(problem, g, closure)
+    K0, K1 = plain.stiffness(), same.stiffness()
+    assert abs(K0 - K1).max() <= 1e-13 * abs(K0).max()
+    assert abs(ref.stiffness() - K0).max() > 1e-6 * abs(K0).max()   # the shadow acts
+    assert bridging(g, shape, a, b, closure.keep)[0].size == pairs.size

@@ -13,20 +13,22 @@ SHAPES = ("plate-hole", "plate-l")
 
 
 @pytest.mark.parametrize("scene_id", SHAPES)
-def test_every_treatment_that_can_serve_a_shape_runs_and_the_others_say_why(scene_id):
+def test_every_treatment_that_can_serve_a_shape_runs_there(scene_id):
+    """Issue 55: the node-adding methods run along the local normal, so every built-in
+    treatment of the family is offered on the shapes (a plugin that declares no shapes
+    is refused with its ``box_only`` reason: tests/treatments/test_linear_layer_plugin.py)."""
     scene = get_scene(scene_id)
     offered = set(scene.offered())
-    assert {"none", "taylor-fictitious", "energy", "volume", "pals"} <= offered
-    from pdverify.corrections.registry import from_name
-    for name in ("surface-nodes", "mirror-nodes", "pddo"):
-        assert name not in offered
-        assert from_name(name).why_not(scene).startswith("box faces only: ")
+    assert {"none", "taylor-fictitious", "energy", "volume", "pals", "surface-nodes",
+            "mirror-nodes", "pddo"} <= offered
 
 
-def test_the_list_names_the_box_only_reason():
+def test_the_list_offers_the_node_adding_methods_on_the_shapes():
     out = subprocess.run([sys.executable, "-m", "pdverify", "list", "plate-hole"],
                          capture_output=True, text=True, check=True).stdout
-    assert "surface-nodes: box faces only: its surface nodes sit at the centres" in out
+    for name in ("surface-nodes", "mirror-nodes", "pddo"):
+        assert f"\n    {name}  - " in out, name
+    assert "box faces only" not in out
     assert "jitter=0" in out
 
 
@@ -113,13 +115,13 @@ def test_the_report_shows_the_hole_scene_its_reference_and_the_jitter_study(tmp_
 @pytest.mark.slow   # three solves of the L-plate at h = 0.025 and its FEM reference: ~15 s
 def test_finding_035_l_plate_bridging():
     """Finding 035-l-plate-bridging (deviations.py): at the re-entrant corner Taylor along
-    the normal (order 2) is worse than the uncorrected model (measured rel L2 0.142
-    against 0.097), and dropping the bonds that bridge the notch from a real node of one
-    arm to a fictitious node extrapolated from the other takes it to 0.092 (measured;
-    the bounds below sit halfway to the measured values' neighbours)."""
+    the normal (order 2) with one value per fictitious node is worse than the uncorrected
+    model (measured rel L2 0.142 against 0.097: the shadow values switched off here); with
+    a value per bridging bond from its real end's side (``Closure.shadow``) it is 0.0975
+    (measured). Bounds: halfway to the measured values' neighbours; the fix must take
+    the error to within 5 % of none's (it was 47 % above)."""
     import pdverify.corrections.shape_fictitious as sf
     from pdverify.corrections.taylor_fictitious import assemble_taylor
-    from pdverify.pd.bonds import bond_pairs
     from pdverify.results import Timer
     from pdverify.solvers.front import solve
 
@@ -133,26 +135,15 @@ def test_finding_035_l_plate_bridging():
         g = system.model.grid
         u = system.displacements(x)[:g.n_interior]
         ref = scene.reference_of(p).evaluate(g.x[g.interior_ids])
-        return np.linalg.norm(u - ref) / np.linalg.norm(ref)
+        return np.linalg.norm(u - ref) / np.linalg.norm(ref), system.counts
 
-    as_is = rel_l2()
-    keep_all = sf.crossing_keep
-
-    def no_bridge(g, shape, stencil):
-        keep = keep_all(g, shape, stencil)
-        a, b, _ = bond_pairs(g.ext_shape, stencil.offsets[stencil.half])
-        notch = lambda i: (g.x[i, 0] > 0.5) & (g.x[i, 1] > 0.5)       # noqa: E731
-        side = shape.part_names.index("notch-y")
-        pa, pb = shape.closest(g.x[a])[3], shape.closest(g.x[b])[3]
-        lower = lambda i: g.x[i, 1] < 0.5                                # noqa: E731
-        bridge = ((g.is_interior[a] & notch(b) & (lower(a) != (pb == side)))
-                  | (g.is_interior[b] & notch(a) & (lower(b) != (pa == side))))
-        return keep & ~bridge
-
-    sf.crossing_keep = no_bridge
+    fixed, counts = rel_l2()
+    shadow_rows = sf.shadow_rows
+    sf.shadow_rows = lambda *a, **k: None
     try:
-        bridged = rel_l2()
+        bridged, _ = rel_l2()
     finally:
-        sf.crossing_keep = keep_all
-    assert 0.12 < as_is < 0.16 and 0.08 < none < 0.11 and as_is > 1.3 * none
-    assert bridged < 0.75 * as_is
+        sf.shadow_rows = shadow_rows
+    assert counts["bridging_bonds"] > 0
+    assert 0.12 < bridged < 0.16 and 0.08 < none < 0.11 and bridged > 1.3 * none
+    assert fixed < 1.05 * none and fixed < 0.75 * bridged
