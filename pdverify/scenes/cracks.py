@@ -80,10 +80,11 @@ _FEM_FIXED = ("kind", "j_radii", "fit_window")
 
 #: why the treatments that add nodes do not run here
 _NO_CRACK_FACES = (
-    "crack faces are not served yet: corrections.shape_fictitious would see each crack "
-    "face as a straight part (fictitious nodes along its normal, across the slit into the "
-    "other face's material, and force-flux rows on it); a slit has no outside to "
-    "extrapolate into")
+    "crack faces are not served yet: the node-adding treatments on shapes "
+    "(corrections.shape_fictitious and the surface-node, mirror-node and PDDO forms built "
+    "on it) would see each crack face as a straight part (fictitious or mirror nodes along "
+    "its normal, across the slit into the other face's material, and boundary rows on it); "
+    "a slit has no outside to extrapolate into")
 
 
 @register
