@@ -569,7 +569,7 @@ DEVIATIONS = (
               summary="Ours: the full cracked plate, K by the opening fit"),
     Deviation(("plate-edge-crack",), "choice",
               "Ours, not a paper's: the whole single-edge-notched tension strip (H = b, "
-              "where the FEM's K is within 0.04 % of Tada's long strip) with its edge crack "
+              "where the FEM's K is within 3.1e-4 of its long strip's) with its edge crack "
               "as one crack from the mouth, not the FEM's half (as plate-crack); K_I by the "
               "same opening fit at its one tip; the node-adding treatments are not run "
               "(crack faces are not served yet).",

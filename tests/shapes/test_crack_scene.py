@@ -133,7 +133,7 @@ def test_the_edge_crack_scene_shares_the_centre_cracks_builder_and_refines_k():
     methods = {"none", "energy", "volume", "pals"}
     assert {m for m, _ in cases} == methods | {"fem"}
     assert sorted({q.get("spacing", 0.025) for m, q in cases if m != "fem"}) == sorted(
-        (1 / 80, 1 / 60, 0.025, 1 / 30))
+        (1 / 60, 0.025, 1 / 30))
     assert all(q.get("m_ratio", 3.0) == 3.0 for _, q in cases)
     assert {q.get("spacing") for m, q in edge.cases(quick=True) if m != "fem"} == {1 / 30}
 
