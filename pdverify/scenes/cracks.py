@@ -172,7 +172,8 @@ class CrackScene(ShapeScene):
 
     @property
     def table_metrics(self):
-        return ("k_ratio", "opening_error_pct", "max_error_pct", "rel_l2_error")
+        return ("k_ratio", "k_net_error_pct", "opening_error_pct", "max_error_pct",
+                "rel_l2_error")
 
     def tips(self, p) -> tuple:
         """``((tip, direction, crack_length, ligament), ...)``: the fitted tip first
@@ -319,9 +320,12 @@ class CrackPlate(CrackScene):
     #: no refinement in the report: the study's levels 1/60 and 1/80 (m = 3) are past the
     #: report's budgets. Three levels took ``report --only plate-crack`` to 84 s (load ~4)
     #: and 62 s (load ~1.3), past the 60 s the scene may add; two levels (23 s) are
-    #: estimated at 5.6 GB at 1/60 (``budget.linear_system``'s sparse LU; measured peak
-    #: 1.96 GB under nested dissection), past the 4 GB every report case must stay under
-    #: (tests/reliability/test_budget.py). The refinement is ``benchmarks/crack_k.py``'s.
+    #: estimated at 4.2 GB at 1/60 (``budget.nested_dissection_2d``, which bounds PALS's
+    #: peak with a margin of 1.25 and the uncorrected model's 1.9 GB by 2.2x; the sparse
+    #: LU's estimate before it was 5.6 GB), past the 4 GB every report case must stay
+    #: under (tests/reliability/test_budget.py). The refinement in the report is
+    #: ``plate-edge-crack``'s (its strip has a third of the nodes); this plate's is
+    #: ``benchmarks/crack_k.py``'s.
     delta_sweep = ()
 
     def tips(self, p):

@@ -149,3 +149,23 @@ def test_the_edge_crack_fem_field_is_the_half_models_mirror_image():
     np.testing.assert_array_equal(field(x), ref.field.evaluate(x))
     np.testing.assert_array_equal(field(low), ref.field.evaluate(x) * [1, -1])
     assert ref.k_ratio == pytest.approx(1.0, abs=5e-3)   # Tada's SENT accuracy, 0.5 %
+
+
+def test_an_edge_crack_of_zero_length_is_the_uncracked_strip():
+    """As for the centre crack: the strip's stiffness with a = 0 equals, bit for bit, that
+    of the outline without a crack; with a = 0.5 it does not."""
+    from dataclasses import replace
+
+    from pdverify.corrections.plain import assemble_plain
+    from pdverify.scenes.cracks import edge_cracked_strip, edge_outline
+    scene = get_scene("plate-edge-crack")
+    p = {**scene.default_params(), "spacing": 0.125}
+
+    def stiffness(shape):
+        problem = replace(scene.problem(p, "test"), shape=shape)
+        return assemble_plain(problem, None).K.tocsr()
+
+    k0 = stiffness(edge_cracked_strip(1.0, 1.0, 0.0, 0.125))
+    kp = stiffness(edge_outline(1.0, 1.0, 0.125))
+    assert k0.shape == kp.shape and (k0 != kp).nnz == 0
+    assert (stiffness(edge_cracked_strip(1.0, 1.0, 0.5, 0.125)) != kp).nnz > 0
