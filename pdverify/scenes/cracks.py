@@ -164,6 +164,19 @@ class CrackScene(ShapeScene):
     #: scene says
     delta_sweep = ()
 
+    #: the reference's ``kind`` (a fixed field, not a parameter)
+    fem_kind = "centre"
+
+    def check(self, method, p):
+        if method == "fem":      # the dataclass checks with the scene's own kind
+            try:
+                self._cls()(**{**p, "kind": self.fem_kind})
+            except (TypeError, ValueError) as exc:
+                raise InputError(f"{self.id} --method {method}: {exc}".replace("\n", " ")
+                                 ) from None
+            return
+        super().check(method, p)
+
     @property
     def methods(self):
         (fem,) = FemAndPD.methods.fget(self)
@@ -412,6 +425,7 @@ class EdgeCrackPlate(CrackScene):
     seed = "ours (issue 54; Tada's handbook SENT K as the check)"
     params_class, function = "CrackPlateParams", "edge_crack_plate"
     mirror_about_x = False
+    fem_kind = "edge"
     fixed_solver = "auto"
     #: the scene's own defaults of the reference's fields: the strip's half-height H = b
     #: (the class docstring: K within 3.1e-4 of the long strip's)

@@ -169,3 +169,11 @@ def test_an_edge_crack_of_zero_length_is_the_uncracked_strip():
     kp = stiffness(edge_outline(1.0, 1.0, 0.125))
     assert k0.shape == kp.shape and (k0 != kp).nnz == 0
     assert (stiffness(edge_cracked_strip(1.0, 1.0, 0.5, 0.125)) != kp).nnz > 0
+
+
+def test_the_edge_scenes_fem_checks_name_the_edge_reference(tmp_path):
+    """The FEM method's bad input is checked as the edge crack's reference (kind fixed)."""
+    r = subprocess.run([sys.executable, "-m", "pdverify", "run", "plate-edge-crack",
+                        "--method", "fem", "--set", "cells=1"], capture_output=True, text=True)
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
+    assert "plate-edge-crack --method fem: plate-edge-crack: cells must be 2..64" in r.stderr
