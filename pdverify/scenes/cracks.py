@@ -14,6 +14,7 @@ module functions; ``benchmarks/crack_k.py`` (the study before the scenes) import
 from __future__ import annotations
 
 import dataclasses
+import functools
 
 import numpy as np
 
@@ -163,19 +164,6 @@ class CrackScene(ShapeScene):
     #: spacings of the refinement at fixed m (beside the default's): none unless a
     #: scene says
     delta_sweep = ()
-
-    #: the reference's ``kind`` (a fixed field, not a parameter)
-    fem_kind = "centre"
-
-    def check(self, method, p):
-        if method == "fem":      # the dataclass checks with the scene's own kind
-            try:
-                self._cls()(**{**p, "kind": self.fem_kind})
-            except (TypeError, ValueError) as exc:
-                raise InputError(f"{self.id} --method {method}: {exc}".replace("\n", " ")
-                                 ) from None
-            return
-        super().check(method, p)
 
     @property
     def methods(self):
@@ -356,6 +344,13 @@ class CrackPlate(CrackScene):
         return (2 * W, 2 * H), (-W, -H)
 
 
+@functools.cache
+def _edge_params(base):
+    """``base`` (``reference_fem.crack_plate.CrackPlateParams``) with ``kind="edge"``."""
+    return dataclasses.make_dataclass("CrackPlateParams", [("kind", str, "edge")],
+                                      bases=(base,), frozen=True)
+
+
 @register
 class EdgeCrackPlate(CrackScene):
     """A strip with a single edge crack under tension, mode I, plane stress: single-edge-
@@ -425,12 +420,17 @@ class EdgeCrackPlate(CrackScene):
     seed = "ours (issue 54; Tada's handbook SENT K as the check)"
     params_class, function = "CrackPlateParams", "edge_crack_plate"
     mirror_about_x = False
-    fem_kind = "edge"
     fixed_solver = "auto"
     #: the scene's own defaults of the reference's fields: the strip's half-height H = b
     #: (the class docstring: K within 3.1e-4 of the long strip's)
     scene_defaults = {"height": 1.0}
     delta_sweep = (1 / 30, 1 / 60)
+
+    def _cls(self):
+        """The reference's dataclass with the edge crack's ``kind`` as its default, so
+        that the ``fem`` method's input is checked as the edge crack's (its errors name
+        plate-edge-crack)."""
+        return _edge_params(super()._cls())
 
     @property
     def params(self):
