@@ -173,8 +173,10 @@ class CrackScene(ShapeScene):
 
     @property
     def table_metrics(self):
-        return ("k_ratio", "k_net_error_pct", "opening_error_pct", "max_error_pct",
-                "rel_l2_error")
+        # the compact table shows the headline and the next three (report.html)
+        return tuple(m for m in ("k_error_pct", "k_net_error_pct", "opening_error_pct",
+                                 "max_error_pct", "k_ratio", "rel_l2_error")
+                     if m != self.headline)
 
     def tips(self, p) -> tuple:
         """``((tip, direction, crack_length, ligament), ...)``: the fitted tip first
@@ -389,7 +391,8 @@ class EdgeCrackPlate(CrackScene):
     closures drop the cut bonds); the treatments that add nodes and the peer code are
     refused with ``plate-crack``'s reasons (``list plate-edge-crack``).
 
-    Metrics (:class:`CrackScene`): K at the one tip (a, 0), the fit's window r in
+    Metrics (:class:`CrackScene`; the headline ``k_net_error_pct``, the comment at
+    ``headline``): K at the one tip (a, 0), the fit's window r in
     [2 horizons, 0.8 min(a, b - a)] = [0.15, 0.4] m at the defaults; the opening of the
     nearest rows behind the tip at r >= 2 horizons (up to the mouth); the field errors
     outside the tip zone of 2 horizons.
@@ -420,6 +423,12 @@ class EdgeCrackPlate(CrackScene):
     seed = "ours (issue 54; Tada's handbook SENT K as the check)"
     params_class, function = "CrackPlateParams", "edge_crack_plate"
     mirror_about_x = False
+    #: the headline is the PD model's own error of K, net of the opening fit's bias: on
+    #: this strip the fit reads the FEM field's K 0.6-1.3 % high over the refinement's
+    #: levels (``k_fit_bias_pct``), more than the treatments differ, so ``k_error_pct``
+    #: would rank them by how they offset the fit's bias (on ``plate-crack`` the bias is
+    #: -0.16 %, and its headline stays ``k_error_pct``)
+    headline = "k_net_error_pct"
     fixed_solver = "auto"
     #: the scene's own defaults of the reference's fields: the strip's half-height H = b
     #: (the class docstring: K within 3.1e-4 of the long strip's)
