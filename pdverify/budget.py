@@ -300,6 +300,36 @@ def nested_dissection_3d(nodes: float, dofs_per_node: int, reach: float,
                             f"nested-dissection LU with ~{factor:.3g} factor entries")
 
 
+#: the 2D nested-dissection solve (``solvers.nested``, the ``auto`` choice of the crack
+#: scenes) per factor entry of :func:`nested_dissection_2d`'s count, on top of the
+#: matrix: the peaks of benchmarks/budget_nd2d.py (fresh processes, plate-crack and
+#: plate-edge-crack at 7 200 .. 43 200 nodes, plate2d-plane-strain's report cases)
+#: imply 27-32 B for the uncorrected model and surface nodes and 56-63 B for PALS (whose
+#: setup holds more than the factor); 80 B bounds the largest, 63.4 B, with a margin of
+#: 1.26: the estimate is 1.19-2.21x the measured peaks of the ten cases, where the
+#: sparse LU's was 1.84-3.58x (record budget_nd2d-2026-11-28-default.json)
+BYTES_PER_ND2D_ENTRY = 80.0
+
+
+def nested_dissection_2d(nodes: float, dofs_per_node: int, reach: float,
+                         extra_bytes: float = 0.0) -> Estimate:
+    """Memory of the 2D nested-dissection solve on ``nodes`` lattice nodes whose stencil
+    reaches ``reach`` spacings: the matrix as :func:`linear_system` counts it, and a factor
+    of ``d^2 r^2 N log2(N / r^2)`` entries (d = ``dofs_per_node``, r = ``reach``, N =
+    ``nodes``: a separator of a 2D lattice is a band r nodes wide, and each of the
+    log2(N / r^2) levels of the dissection holds separators whose dense blocks add to
+    d^2 r^2 N entries; George 1973's O(N log N) fill of nested dissection on a 2D grid)
+    at :data:`BYTES_PER_ND2D_ENTRY`. ``linear_system``'s sparse LU, which it replaces for
+    this solver, overestimated the measured peaks 3.0-3.15x (benchmarks/budget_nd2d.py)."""
+    n, nnz = _unknowns_and_nonzeros(nodes, 2, dofs_per_node, reach)
+    r = float(reach)
+    factor = min(dofs_per_node ** 2 * r * r * float(nodes)
+                 * math.log2(max(float(nodes) / (r * r), 2.0)), n * n)
+    memory = BYTES_PER_NONZERO * nnz + extra_bytes + BYTES_PER_ND2D_ENTRY * factor
+    return Estimate(memory, f"{nodes:.4g} nodes, {n:.4g} unknowns, ~{nnz:.3g} non-zeros, "
+                            f"nested-dissection LU with ~{factor:.3g} factor entries")
+
+
 def quadratic_elements(cells) -> Estimate:
     """A Q2 (9- or 27-node) vector FEM solve on a tensor mesh with ``cells`` elements per
     axis: (2 n + 1) nodes per axis, one element spans two node spacings."""

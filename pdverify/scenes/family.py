@@ -98,6 +98,8 @@ class StaticStateScene(Scene):
         solver = static_solver(self.declared(p, "solver") or self.fixed_solver, d, d * nodes)
         if d == 3 and solver == "nested-dissection":
             return budget.nested_dissection_3d(nodes, d + 1, m, extra_bytes=rows)
+        if d == 2 and solver == "nested-dissection":
+            return budget.nested_dissection_2d(nodes, d + 1, m, extra_bytes=rows)
         return budget.linear_system(nodes, d, d, 2 * m, dense_allowed=True, extra_bytes=rows)
 
     # ----------------------------------------------------------------- solve

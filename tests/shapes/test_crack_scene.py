@@ -70,14 +70,15 @@ def test_a_crack_of_zero_length_is_the_uncracked_plate():
     assert (kc != kp).nnz > 0
 
 
-def test_the_list_shows_why_the_node_adding_treatments_and_the_peer_do_not_run():
-    out = subprocess.run([sys.executable, "-m", "pdverify", "list", "plate-crack"],
+@pytest.mark.parametrize("scene_id", ["plate-crack", "plate-edge-crack"])
+def test_the_list_shows_why_the_node_adding_treatments_and_the_peer_do_not_run(scene_id):
+    out = subprocess.run([sys.executable, "-m", "pdverify", "list", scene_id],
                          capture_output=True, text=True, check=True).stdout
     for method in ("taylor-fictitious", "surface-nodes", "mirror-nodes", "pddo"):
         assert f"{method}: crack faces are not served yet: the node-adding treatments on " \
                "shapes" in out, method
     assert "peer:lammps: its code builds its own bonds from the node positions" in out
-    offered = set(get_scene("plate-crack").offered())
+    offered = set(get_scene(scene_id).offered())
     assert offered == {"none", "energy", "volume", "pals"}
 
 
@@ -104,12 +105,75 @@ def test_bad_input_is_one_line_before_any_work(tmp_path, assignment, words):
     assert words in r.stderr and len(r.stderr.strip().splitlines()) == 1
 
 
-def test_export_refuses_the_cracked_plate_with_its_reason(tmp_path):
+@pytest.mark.parametrize("scene_id", ["plate-crack", "plate-edge-crack"])
+def test_export_refuses_the_cracked_plate_with_its_reason(tmp_path, scene_id):
     """A node set carries no cut bonds: another code would bond across the slit."""
     from pdverify.exchange import exportable_ids
-    assert "plate-crack" not in exportable_ids() and "plate-hole" in exportable_ids()
-    r = subprocess.run([sys.executable, "-m", "pdverify", "export", "plate-crack",
+    assert scene_id not in exportable_ids() and "plate-hole" in exportable_ids()
+    r = subprocess.run([sys.executable, "-m", "pdverify", "export", scene_id,
                         "--format", "csv", "--out", str(tmp_path / "x")],
                        capture_output=True, text=True)
     assert r.returncode == 2 and "would bond across the slit" in r.stderr
     assert not (tmp_path / "x").exists()
+
+
+def test_the_edge_crack_scene_shares_the_centre_cracks_builder_and_refines_k():
+    """plate-edge-crack is a :class:`CrackScene` like plate-crack (one measure, one set of
+    checks); its cases: fem, every method at the defaults (h = 1/40, H = b) and at the
+    refinement's spacings (m = 3), the quick grid 1/30."""
+    from pdverify.scenes.cracks import CrackScene
+    edge, centre = get_scene("plate-edge-crack"), get_scene("plate-crack")
+    assert isinstance(edge, CrackScene) and isinstance(centre, CrackScene)
+    assert type(edge).measure is type(centre).measure is CrackScene.measure
+    p = edge.default_params()
+    assert (p["width"], p["height"], p["crack"], p["spacing"], p["m_ratio"]) == (
+        1.0, 1.0, 0.5, 0.025, 3.0)
+    assert edge.reference_params(p)["height"] == 1.0
+    cases = edge.cases()
+    methods = {"none", "energy", "volume", "pals"}
+    assert {m for m, _ in cases} == methods | {"fem"}
+    assert sorted({q.get("spacing", 0.025) for m, q in cases if m != "fem"}) == sorted(
+        (1 / 60, 0.025, 1 / 30))
+    assert all(q.get("m_ratio", 3.0) == 3.0 for _, q in cases)
+    assert {q.get("spacing") for m, q in edge.cases(quick=True) if m != "fem"} == {1 / 30}
+
+
+def test_the_edge_crack_fem_field_is_the_half_models_mirror_image():
+    """u_x even and u_y odd in y; at y >= 0 the half model's own values."""
+    scene = get_scene("plate-edge-crack")
+    p = scene.default_params()
+    field = scene.reference_field(p)
+    ref = scene.reference_of(p)
+    x = np.array([[0.3, 0.2], [0.7, 0.01], [0.45, 0.6]])
+    low = x * [1, -1]
+    np.testing.assert_array_equal(field(x), ref.field.evaluate(x))
+    np.testing.assert_array_equal(field(low), ref.field.evaluate(x) * [1, -1])
+    assert ref.k_ratio == pytest.approx(1.0, abs=5e-3)   # Tada's SENT accuracy, 0.5 %
+
+
+def test_an_edge_crack_of_zero_length_is_the_uncracked_strip():
+    """As for the centre crack: the strip's stiffness with a = 0 equals, bit for bit, that
+    of the outline without a crack; with a = 0.5 it does not."""
+    from dataclasses import replace
+
+    from pdverify.corrections.plain import assemble_plain
+    from pdverify.scenes.cracks import edge_cracked_strip, edge_outline
+    scene = get_scene("plate-edge-crack")
+    p = {**scene.default_params(), "spacing": 0.125}
+
+    def stiffness(shape):
+        problem = replace(scene.problem(p, "test"), shape=shape)
+        return assemble_plain(problem, None).K.tocsr()
+
+    k0 = stiffness(edge_cracked_strip(1.0, 1.0, 0.0, 0.125))
+    kp = stiffness(edge_outline(1.0, 1.0, 0.125))
+    assert k0.shape == kp.shape and (k0 != kp).nnz == 0
+    assert (stiffness(edge_cracked_strip(1.0, 1.0, 0.5, 0.125)) != kp).nnz > 0
+
+
+def test_the_edge_scenes_fem_checks_name_the_edge_reference(tmp_path):
+    """The FEM method's bad input is checked as the edge crack's reference (kind fixed)."""
+    r = subprocess.run([sys.executable, "-m", "pdverify", "run", "plate-edge-crack",
+                        "--method", "fem", "--set", "cells=1"], capture_output=True, text=True)
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
+    assert "plate-edge-crack --method fem: plate-edge-crack: cells must be 2..64" in r.stderr

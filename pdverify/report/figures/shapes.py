@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.ticker import FormatStrFormatter
 
 from . import family, fem_then_pd, legend_outside, node_image, palette, save
 
@@ -51,9 +52,16 @@ def _error_maps(scene, runs, folder):
     vmax = max(e.max() for e in err)
     for ax, r, e in zip(axes.flat, pick, err):
         img, ext = node_image(r.fields["x"], r.fields["spacing"], e)
+        half = 0.5 * r.fields["spacing"]     # each node's cell: the image spans the body
+        ext = (ext[0] - half, ext[1] + half, ext[2] - half, ext[3] + half)
         im = ax.imshow(img, origin="lower", extent=ext, cmap="magma_r", vmin=0, vmax=vmax)
         ax.set_title(f"{_name(r)} (max {e.max():.2f} %)", fontsize=8.5)
         ax.set_aspect("equal")
+        # three x ticks, the body's ends and middle: on a narrow body (the 2 x 6 m
+        # cracked plate) the default ticks ran into each other ("-0.50.00.5")
+        ax.set_xticks(np.linspace(ext[0], ext[1], 3))
+        ax.xaxis.set_major_formatter(FormatStrFormatter("%.2g"))
+        ax.tick_params(labelsize=8)
     for ax in axes.flat[len(pick):]:
         ax.set_axis_off()
     fig.colorbar(im, ax=axes, shrink=0.85, label="largest component error [% of max |u_FEM|]")
