@@ -21,7 +21,7 @@ from . import register, whole_cells
 from .base import MethodSpec
 from .cracks import TIP_ZONE, CrackPlate, plate_outline
 from .fem_references import FemAndPD
-from .shapes import shape_errors
+from .shapes import ShapeScene, shape_errors
 
 #: the K fit's outer radius as a fraction of min(a, the distance from the tip to the
 #: plate's edge): inside the series' disk of convergence (the other tip at 2a, the edge)
@@ -126,7 +126,7 @@ class InclinedCrackPlate(CrackPlate):
         return self.reference_of(p).evaluate
 
     def check_pd(self, where, method, p):
-        super(CrackPlate, self).check_pd(where, method, p)     # the shape scenes' checks
+        ShapeScene.check_pd(self, where, method, p)     # the shape scenes' checks only
         h = p["spacing"]
         whole_cells(where, h, [("width", p["width"]), ("height", p["height"])])
         try:
