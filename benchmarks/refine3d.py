@@ -35,11 +35,36 @@ when other processes load the machine) of the assembly, the preconditioner and t
   as near-null space, pyamg's defaults otherwise (symmetric Gauss-Seidel);
 - ``cg-pyamg-jacobi``: the same with Jacobi smoothing (omega 4/3) in the cycle.
 
+``cg-pyamg*`` need pyamg (the optional extra ``bench``: ``python -m pip install -e
+".[bench]"``); without it those rows fail and the others run.
+
 Every CG stops at a relative residual of 1e-10. Its error is measured against the direct
 solution where ``direct`` ran, else against a CG solve to 1e-13; the run's method error
 (``rel_l2_error`` against the manufactured field, the study's metric) is printed beside
 it: the argument that the iterative solve leaves the discretisation error unchanged is
 that its error is at least 100x below the method error.
+
+Measured 2026-11-28 under load (load average 10-17 on the 2 cores, so wall times are
+inflated several-fold and noisy; CPU seconds compare the alternatives fairly), ``none``
+(records refine3d-2026-11-28-levels-0.05-to-1-36, -cpu-none-1-30, -cpu-volume-pals-1-30,
+-direct-reach); set-up of the preconditioner + solve, the assembly apart:
+
+    spacing  unknowns  direct            cg-jacobi          cg-ilu        cg-pyamg
+    0.05       8,000   15.6 s  0.58 GB   1.05 s  91 it      7.9 s  41 it  3.3 s  16 it
+    1/24      13,824   25.0 s  0.91 GB   1.4 s  109 it     19.5 s  43 it  6.0 s  17 it
+    1/30      27,000   67 s    2.04 GB   4.8 s CPU 137 it   -             5.4 s CPU 15 it
+    1/36      46,656   -                 34 s (wall) 165 it -             8.2 s CPU 19 it
+
+(peak with the assembly: CG 0.30, 0.47, 0.89, 1.52 GB; pyamg 5-10 % more). ``volume``
+at 1/30: Jacobi 4.95 s of CPU, pyamg 5.44 s. Every CG solution is within 5e-10 of the
+direct one (Jacobi and pyamg within 2.3e-11), against a method error (rel_l2_error) of
+0.59 to 0.37: nine orders below it, far past the 100x the study needs. What it shows:
+the multifrontal solve ends at h = 1/30 (2.0 GB); Jacobi-CG is the fastest up to 1/30
+(no set-up, and its ~1/h iterations are cheap); at 1/36 the two took about the same
+wall time (34 and 33 s), so pyamg's hierarchy may pay off past the report's sizes; ILU's
+factorisation costs more than it saves. The direct solve of the systems
+that are not symmetric at spacing 1/24: energy 0.93 GB, mirror nodes 1.08 GB, PDDO
+0.89 GB (6-10 s of CPU each), surface nodes 2.23 GB.
 """
 from __future__ import annotations
 

@@ -318,8 +318,8 @@ class JacobiPreconditioner:
     spectrum is flat, and on these boxes (m = 3, at most 30 cells a side) the smooth modes
     CG must still resolve are few: 91, 109, 137 iterations at h = 0.05, 1/24, 1/30 (~1/h)
     cost less than pyamg's set-up and cycles (15-17 iterations). Its iterations grow as
-    1/h and pyamg's do not: at h = 1/36 pyamg took 8.2 s of CPU (record
-    refine3d-2026-11-28-levels-0.05-to-1-36), so past the report's sizes it would be the
+    1/h and pyamg's do not: at h = 1/36 the two took about the same wall time (record
+    refine3d-2026-11-28-levels-0.05-to-1-36), so past the report's sizes pyamg may be the
     better choice."""
 
     label = "Jacobi"
