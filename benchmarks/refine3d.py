@@ -55,8 +55,10 @@ inflated several-fold and noisy; CPU seconds compare the alternatives fairly), `
     1/30      27,000   67 s    2.04 GB   4.8 s CPU 137 it   -             5.4 s CPU 15 it
     1/36      46,656   -                 34 s (wall) 165 it -             8.2 s CPU 19 it
 
-(peak with the assembly: CG 0.30, 0.47, 0.89, 1.52 GB; pyamg 5-10 % more). ``volume``
-at 1/30: Jacobi 4.95 s of CPU, pyamg 5.44 s. Every CG solution is within 5e-10 of the
+(peak with the assembly: CG 0.30, 0.47, 0.89, 1.52 GB; pyamg 5-10 % more). At 1/30
+``volume``: Jacobi 4.95 s of CPU (136 it), pyamg 5.44 s; ``pals`` (two scalars a node):
+Jacobi 5.92 s (138 it, 1.33 GB), pyamg 7.13 s. ``energy``'s K is 2.0e-5 off symmetric
+at 1/24 (the others 4e-18 to 2e-17), so CG is not applied to it. Every CG solution is within 5e-10 of the
 direct one (Jacobi and pyamg within 2.3e-11), against a method error (rel_l2_error) of
 0.59 to 0.37: nine orders below it, far past the 100x the study needs. What it shows:
 the multifrontal solve ends at h = 1/30 (2.0 GB); Jacobi-CG is the fastest up to 1/30
