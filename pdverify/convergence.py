@@ -306,13 +306,18 @@ def collect(results, quick: bool = False) -> list[dict]:
                 note = "fewer than two levels: no rate"
             else:
                 rate = fit_rate([lv["h"] for lv in levels], errs)
+            # the rate between each pair of successive levels: a rate still drifting at
+            # the finest pair says the levels are pre-asymptotic (three levels or more)
+            pairs = ([fit_rate([a["h"], b["h"]], [a["error"], b["error"]])
+                      for a, b in zip(levels, levels[1:])]
+                     if rate is not None and len(levels) >= 3 else [])
             if len(reached) < len(st.used_levels(quick)):
                 h_stop, why = st.stop(method)
                 note = "; ".join(x for x in (note, f"stops at h = {h_stop:.4g}: {why}") if x)
             out.append({"scene": st.scene, "dim": scene.dim, "study": st.kind,
                         "fixed": st.fixed_in(quick), "h": st.h_label,
                         "metric": st.metric, "method": method, "rate": rate, "note": note,
-                        "levels": levels})
+                        "pair_rates": pairs, "levels": levels})
     return out
 
 

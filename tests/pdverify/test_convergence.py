@@ -141,6 +141,8 @@ def test_methods_that_stop_early_are_fitted_over_the_levels_they_reach():
     entries = {e["method"]: e for e in convergence.collect(runs) if e["study"] == "delta"}
     assert entries["none"]["rate"] == pytest.approx(0.7, rel=1e-12)
     assert len(entries["none"]["levels"]) == 5 and not entries["none"]["note"]
+    # the successive pairs' rates: four for five levels, each p for an exact power law
+    assert entries["none"]["pair_rates"] == pytest.approx([0.7] * 4, rel=1e-12)
     sn = entries["surface-nodes"]
     assert len(sn["levels"]) == 3 and sn["rate"] == pytest.approx(2.0, rel=1e-12)
     assert sn["note"].startswith("stops at h = 0.15: its system is not symmetric (no CG)")
