@@ -46,14 +46,14 @@ that its error is at least 100x below the method error.
 
 Measured 2026-11-28 under load (load average 10-17 on the 2 cores, so wall times are
 inflated several-fold and noisy; CPU seconds compare the alternatives fairly), ``none``
-(records refine3d-2026-11-28-levels-0.05-to-1-36, -cpu-none-1-30, -cpu-volume-pals-1-30,
--direct-reach); set-up of the preconditioner + solve, the assembly apart:
+(records refine3d-2026-11-28-levels-0.05-to-1-36, -cpu-none-1-30, -cpu-none-1-36,
+-cpu-volume-pals-1-30, -direct-reach); set-up of the preconditioner + solve, the assembly apart:
 
     spacing  unknowns  direct            cg-jacobi          cg-ilu        cg-pyamg
     0.05       8,000   15.6 s  0.58 GB   1.05 s  91 it      7.9 s  41 it  3.3 s  16 it
     1/24      13,824   25.0 s  0.91 GB   1.4 s  109 it     19.5 s  43 it  6.0 s  17 it
     1/30      27,000   67 s    2.04 GB   4.8 s CPU 137 it   -             5.4 s CPU 15 it
-    1/36      46,656   -                 34 s (wall) 165 it -             8.2 s CPU 19 it
+    1/36      46,656   -                 7.1 s CPU 165 it   -             8.1 s CPU 19 it
 
 (peak with the assembly: CG 0.30, 0.47, 0.89, 1.52 GB; pyamg 5-10 % more). At 1/30
 ``volume``: Jacobi 4.95 s of CPU (136 it), pyamg 5.44 s; ``pals`` (two scalars a node):
@@ -62,9 +62,10 @@ at 1/24 (the others 4e-18 to 2e-17), so CG is not applied to it. Every CG soluti
 direct one (Jacobi and pyamg within 2.3e-11), against a method error (rel_l2_error) of
 0.59 to 0.37: nine orders below it, far past the 100x the study needs. What it shows:
 the multifrontal solve ends at h = 1/30 (2.0 GB); Jacobi-CG is the fastest up to 1/30
-(no set-up, and its ~1/h iterations are cheap); at 1/36 the two took about the same
-wall time (34 and 33 s), so pyamg's hierarchy may pay off past the report's sizes; ILU's
-factorisation costs more than it saves. The direct solve of the systems
+(no set-up, and its ~1/h iterations are cheap), and still at 1/36 (7.1 against 8.1 s
+of CPU, record -cpu-none-1-36), though the gap narrows as Jacobi's iterations grow and
+pyamg's do not, so pyamg's hierarchy may pay off on larger boxes; ILU's factorisation
+costs more than it saves. The direct solve of the systems
 that are not symmetric at spacing 1/24: energy 0.93 GB, mirror nodes 1.08 GB, PDDO
 0.89 GB (6-10 s of CPU each), surface nodes 2.23 GB.
 """

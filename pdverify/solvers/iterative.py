@@ -311,16 +311,16 @@ class JacobiPreconditioner:
     condensed LPS system (``none``) it was the fastest of scipy CG with Jacobi, with an
     incomplete LU of the bond block A_uu and with pyamg's smoothed aggregation of A_uu
     (rigid-body modes as near-null space), and of the multifrontal direct solve, at h =
-    0.05, 1/24 and 1/30 (benchmarks/refine3d.py; under load, so CPU seconds compare them:
-    at h = 1/30 Jacobi 4.8 s of CPU for set-up and solve, pyamg 5.4 s, record
-    refine3d-2026-11-28-cpu-none-1-30; the multifrontal solve 2.0 GB against CG's 0.9 GB,
-    record refine3d-2026-11-28-levels-0.05-to-1-36). A PD operator's high-frequency
+    0.05, 1/24, 1/30 and 1/36 (benchmarks/refine3d.py; under load, so CPU seconds compare
+    them: Jacobi 4.8 and 7.1 s of CPU for set-up and solve at h = 1/30 and 1/36, pyamg 5.4
+    and 8.1 s, records refine3d-2026-11-28-cpu-none-1-30 and -1-36; the multifrontal
+    solve 2.0 GB at 1/30 against CG's 0.9 GB, record
+    refine3d-2026-11-28-levels-0.05-to-1-36). A PD operator's high-frequency
     spectrum is flat, and on these boxes (m = 3, at most 30 cells a side) the smooth modes
     CG must still resolve are few: 91, 109, 137 iterations at h = 0.05, 1/24, 1/30 (~1/h)
-    cost less than pyamg's set-up and cycles (15-17 iterations). Its iterations grow as
-    1/h and pyamg's do not: at h = 1/36 the two took about the same wall time (record
-    refine3d-2026-11-28-levels-0.05-to-1-36), so past the report's sizes pyamg may be the
-    better choice."""
+    cost less than pyamg's set-up and cycles (15-19 iterations). Its iterations grow as
+    1/h and pyamg's do not, so the gap narrows (12 % at 1/36): on boxes larger than the
+    report's, pyamg may become the better choice."""
 
     label = "Jacobi"
 
