@@ -64,6 +64,26 @@ class Study:
     quick_levels: tuple | None = None
     #: how the fixed m-ratio is written where the scene's paper writes it otherwise
     m_name: str = "m"
+    #: methods that stop before the finest levels, each with the finest level they run
+    #: and why: ``((methods, level, why), ...)``. A level finer than theirs (a smaller h)
+    #: is not run for them; their rate is fitted over the levels they reach, and the
+    #: study says where and why they stop (:meth:`stop`)
+    stops: tuple = ()
+
+    def stop(self, method: str):
+        """``(finest h, why)`` of a method that stops early (:attr:`stops`), else None."""
+        for names, level, why in self.stops:
+            if method in names:
+                return self.h(level), why
+        return None
+
+    def levels_for(self, method: str, quick: bool) -> tuple:
+        """The levels of :meth:`used_levels` that ``method`` runs (:attr:`stops`)."""
+        stop = self.stop(method)
+        levels = self.used_levels(quick)
+        if stop is None:
+            return levels
+        return tuple(lv for lv in levels if self.h(lv) >= stop[0] * (1 - 1e-12))
 
     def grid(self, level: dict):
         """The level's :class:`~pdverify.scenes.base.Discretisation`: the scene's
@@ -128,6 +148,25 @@ def _levels(names, values) -> tuple:
 COSTLY_3D = ("taylor-fictitious",)
 
 
+#: the methods of body3d-manufactured's delta-refinement that stop before its finest level:
+#: their systems are not symmetric, so CG does not apply, and each goes as far as the
+#: direct solver allows within the 2 GB a run may take (issue 55). Measured under load
+#: (benchmarks/records/refine3d-2026-11-28-direct-reach.json): at spacing 1/24 surface
+#: nodes 2.2 GB; energy, mirror nodes and PDDO 0.9-1.1 GB and 6-10 s of CPU; at 1/30 the
+#: multifrontal solve of none's system (the size of energy's and the mirror nodes') took
+#: 2.0 GB (refine3d-2026-11-28-levels-0.05-to-1-36.json)
+STOP_3D = (
+    (("surface-nodes",), {"spacing": 0.05, "m_ratio": 3.0},
+     "its system is not symmetric (no CG), and the direct solve took 2.2 GB at spacing "
+     "1/24, over the 2 GB a run may take"),
+    (("energy", "mirror-nodes", "pddo"), {"spacing": 1 / 24, "m_ratio": 3.0},
+     "not symmetric (no CG); the direct solve took 0.9-1.1 GB at spacing 1/24, and 2.0 GB "
+     "at 1/30 on a system of the same size"),
+    (("perifit",), {"spacing": 0.05, "m_ratio": 3.0},
+     "an optional extra whose K's symmetry this study has not measured"),
+)
+
+
 def _m(scene, kind, levels, skip=(), quick=None):
     """A study of a scene whose grid is its ``spacing`` and ``m_ratio``; ``levels`` and
     ``quick`` are (spacing, m_ratio) pairs."""
@@ -179,8 +218,15 @@ STUDIES = (
     # (benchmarks/records/quick_report-2026-11-26-quick-body3d-manufactured.json), and no
     # cheaper pair of whole m-ratios at one delta exists on the 1 x 0.5 x 0.5 box
     # (order-3 surface nodes need 5 cells a side, whole m-ratios)
-    _m("body3d-manufactured", "delta", [(h, 3) for h in (0.1, 0.0625, 0.05)],
-       skip=COSTLY_3D, quick=[(0.1, 3), (1 / 12, 3)]),
+    # issue 55: on to h = 1/24 and 1/30 (delta = 0.125, 0.1), where ``auto`` solves the
+    # symmetric systems (none, volume, pals) by CG (policy.CG3D_FROM_UNKNOWNS); the others
+    # stop where the direct solver does (STOP_3D)
+    Study("body3d-manufactured", "delta",
+          _levels(("spacing", "m_ratio"),
+                  [(h, 3.0) for h in (0.1, 0.0625, 0.05, 1 / 24, 1 / 30)]),
+          skip=COSTLY_3D, quick_levels=_levels(("spacing", "m_ratio"),
+                                               [(0.1, 3.0), (1 / 12, 3.0)]),
+          stops=STOP_3D),
     _m("body3d-manufactured", "m", [(1 / (6 * m), m) for m in (2, 3)], skip=COSTLY_3D,
        quick=[]),
 )
@@ -208,7 +254,7 @@ def cases(scene_ids, quick: bool = False) -> list[tuple[str, str, dict]]:
         for method in methods(scene):
             if method in st.skip:
                 continue
-            for level in st.used_levels(quick):
+            for level in st.levels_for(method, quick):
                 out.append((st.scene, method, dict(level)))
     return out
 
@@ -238,7 +284,8 @@ def collect(results, quick: bool = False) -> list[dict]:
             if method in st.skip:
                 continue
             levels, note = [], ""
-            for level in st.used_levels(quick):
+            reached = st.levels_for(method, quick)
+            for level in reached:
                 # the run at exactly the level's params (the method's other params at
                 # their defaults), not another case of the scene at the same spacing
                 want = run_key(st.scene, method, scene.resolve(method, level))
@@ -255,12 +302,22 @@ def collect(results, quick: bool = False) -> list[dict]:
                 note = f"exact at every level (largest error {max(errs):.2g})"
             elif min(errs) <= 0:
                 note = "an error of 0 at some level: no rate"
+            elif len(levels) < 2:
+                note = "fewer than two levels: no rate"
             else:
                 rate = fit_rate([lv["h"] for lv in levels], errs)
+            # the rate between each pair of successive levels: a rate still drifting at
+            # the finest pair says the levels are pre-asymptotic (three levels or more)
+            pairs = ([fit_rate([a["h"], b["h"]], [a["error"], b["error"]])
+                      for a, b in zip(levels, levels[1:])]
+                     if rate is not None and len(levels) >= 3 else [])
+            if len(reached) < len(st.used_levels(quick)):
+                h_stop, why = st.stop(method)
+                note = "; ".join(x for x in (note, f"stops at h = {h_stop:.4g}: {why}") if x)
             out.append({"scene": st.scene, "dim": scene.dim, "study": st.kind,
                         "fixed": st.fixed_in(quick), "h": st.h_label,
                         "metric": st.metric, "method": method, "rate": rate, "note": note,
-                        "levels": levels})
+                        "pair_rates": pairs, "levels": levels})
     return out
 
 

@@ -350,6 +350,7 @@ def convergence_section(studies, figures) -> Markup:
             e = next((s for s in studies if s["method"] == method and s["study"] == k), None)
             cells.append(None if e is None else {
                 "rate": None if e["rate"] is None else f"{e['rate']:.2f}", "note": e["note"],
+                "pairs": ", ".join(f"{r:.2f}" for r in e.get("pair_rates", [])),
                 "errors": ["failed" if lv["error"] is None else f"{lv['error']:.3g}"
                            for lv in e["levels"]]})
         rows.append((method, cells))

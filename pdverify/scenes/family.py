@@ -96,7 +96,18 @@ class StaticStateScene(Scene):
         nodes = math.prod(cells) + extra
         rows = budget.BYTES_PER_NONZERO * fictitious * d * d * budget.lattice_neighbours(d, m)
         solver = static_solver(self.declared(p, "solver") or self.fixed_solver, d, d * nodes)
-        if d == 3 and solver == "nested-dissection":
+        t = self.treatment(method)
+        if d == 3 and solver == "cg" and (t.baseline or t.kind == "closure"):
+            # the uncorrected LPS system and the bond methods' (LPS with bond factors):
+            # symmetric, so CG solves it (the augmented matrix and the condensed operator's
+            # copy of it, no factor; 0.9 GB measured at h = 1/30 against 1.6 GB estimated).
+            # Not a bound for the energy method, whose K is not symmetric: the front door
+            # falls back to nested dissection (2.0 GB measured at h = 1/30 on none's system;
+            # record refine3d-2026-11-28-levels-0.05-to-1-36)
+            return budget.iterative_system(nodes, d, d + 1, m, extra_bytes=rows)
+        # cg for the others: the front door falls back to nested dissection where CG does
+        # not apply (a system that is not symmetric), so that solve's memory bounds it
+        if d == 3 and solver in ("nested-dissection", "cg"):
             return budget.nested_dissection_3d(nodes, d + 1, m, extra_bytes=rows)
         if d == 2 and solver == "nested-dissection":
             return budget.nested_dissection_2d(nodes, d + 1, m, extra_bytes=rows)

@@ -349,6 +349,15 @@ class Body3DManufactured(Body3D):
     ``quadrature=moment-corrected`` N = 3 gives {{sn3_moment}} %.
     Metrics as in ``body3d-traction``.
 
+    The delta-refinement (the report's convergence table): h = 0.1, 0.0625, 0.05, 1/24,
+    1/30 at m = 3 (delta = 0.3 to 0.1). From h = 1/24 (10,368 displacement unknowns)
+    ``auto`` solves the symmetric systems, ``none``, ``volume`` and ``pals``, by CG on the
+    condensed K (docs/solvers.md): the multifrontal direct solve took 2.0 GB at h = 1/30,
+    CG 0.9 GB (benchmarks/refine3d.py); the table gives their errors and rates. The
+    other systems are not symmetric, so they go as far as the direct solver allows within
+    2 GB a run: surface nodes to h = 0.05 (2.2 GB at 1/24), ``energy``, mirror nodes and
+    PDDO to 1/24 (the table's note gives the numbers).
+
     ``taylor-fictitious`` (seed 000's Taylor-extrapolated fictitious nodes, Lagrange rows;
     on the 3D boxes too): order 2 gives {{taylor2}} % at h = 0.05 (surface nodes N = 2:
     {{sn2}} %), order 1 13.2 % (N = 1: {{sn1}} %); 35-40 s and 2.0-2.2 GB a run

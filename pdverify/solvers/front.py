@@ -21,7 +21,7 @@ from . import policy
 from .checks import refuse_non_finite
 from .condense import condense
 from .dense import DenseFactor, solve_dense
-from .iterative import solve_spd
+from .iterative import CondensedOperator, solve_condensed, solve_spd
 from .lu import SuperLUFactor, solve_constrained
 from .nested import NestedFactor, solve_nested
 
@@ -136,7 +136,13 @@ def solve_augmented(system, *, where: str, ordering: str = "COLAMD"):
       put ``B_t^T lambda`` into theta's rows and solve another problem; the multipliers'
       forces on the displacements must be ``(B_u + B_t G)^T lambda``, kept sparse by
       ``mu = B_t^T lambda`` as more unknowns at the scalars' nodes:
-      ``[[A, [G^T; 0], [B_u^T; 0]], [0, I, -B_t^T], [B, 0, 0]]``.
+      ``[[A, [G^T; 0], [B_u^T; 0]], [0, I, -B_t^T], [B, 0, 0]]``;
+    - ``cg`` (``auto`` in 3D from :data:`~pdverify.solvers.policy.CG3D_FROM_UNKNOWNS`
+      unknowns): theta eliminated, K = A_uu + A_ut G applied without forming it
+      (:class:`~pdverify.solvers.iterative.CondensedOperator`), Jacobi-preconditioned CG
+      (:func:`~pdverify.solvers.iterative.solve_condensed`); where it does not apply
+      (constraint rows, or K not symmetric: :func:`~pdverify.solvers.policy.condensed_cg`)
+      ``nested-dissection`` instead, and ``solver_choice`` says why.
 
     Returns ``(x, info)``: ``x`` the augmented unknowns (displacements, then theta; the
     multipliers dropped); ``info`` the solver's diagnostics, with ``matrix_nnz`` (the
@@ -149,7 +155,22 @@ def solve_augmented(system, *, where: str, ordering: str = "COLAMD"):
     rhs = np.asarray(system.rhs, dtype=float)
     solver = policy.static_solver(system.solver, system.dim, system.dofs)
     B = None if system.B is None else sp.csr_matrix(system.B)
-    if solver == "direct":
+    fallback = None
+    if solver == "cg":
+        op = None if B is not None else CondensedOperator(A, rhs, s, system.fixed,
+                                                          system.values)
+        asymmetry = np.nan if op is None else op.asymmetry()
+        fallback = policy.condensed_cg(asymmetry, B is not None)
+        if fallback is None:
+            x, info = solve_condensed(op, where=where)
+            info["symmetry_defect"] = asymmetry
+            nnz = A.nnz
+        else:
+            solver = "nested-dissection"
+        del op                   # its blocks: a copy of A's size, not kept past the choice
+    if solver == "cg":
+        pass                     # solved above
+    elif solver == "direct":
         K, G = condensed(A, s)
         r = rhs[:n]
         if np.any(rhs[n:]):
@@ -194,7 +215,7 @@ def solve_augmented(system, *, where: str, ordering: str = "COLAMD"):
     info["matrix_nnz"] = int(nnz)
     info["static_solver"] = solver
     if system.solver == "auto":
-        info["solver_choice"] = policy.auto_note(solver, system.dofs)
+        info["solver_choice"] = policy.auto_note(solver, system.dofs, fallback)
     return x, info
 
 

@@ -232,18 +232,19 @@ class TwoLevelPreconditioner:
         return spla.LinearOperator(self.K.shape, matvec=self.apply, dtype=float)
 
 
-def cg_solve(K, f, precond: TwoLevelPreconditioner, *, where: str, rtol: float = CG_RTOL,
-             maxiter: int = 1000):
-    """CG on K u = f with ``precond``; returns ``(u, info)``.
+def cg_solve(K, f, precond, *, where: str, rtol: float = CG_RTOL, maxiter: int = 1000):
+    """CG on K u = f with ``precond`` (a :class:`TwoLevelPreconditioner` or a
+    :class:`JacobiPreconditioner`; ``K`` a sparse matrix or, e.g.
+    :class:`CondensedOperator`, anything with ``shape`` and ``@``); returns ``(u, info)``.
 
     ``info``: iterations, the relative residual ||K u - f|| / ||f||, the tolerance, setup
     and solve time, and ``solver_error_estimate``: the relative error left, estimated from
     the last step and the mean convergence factor rho as ||u_k - u_{k-1}|| rho / (1 - rho)
-    / ||u_k|| (a geometric tail). Non-convergence and non-finite values raise
-    :class:`NumericalError` naming ``where``.
+    / ||u_k|| (a geometric tail). Non-convergence (``maxiter`` reached: a stall) and
+    non-finite values raise :class:`NumericalError` naming ``where``.
     """
     f = np.asarray(f, dtype=float)
-    if not np.all(np.isfinite(f)) or not np.all(np.isfinite(K.data)):
+    if not np.all(np.isfinite(f)) or (sp.issparse(K) and not np.all(np.isfinite(K.data))):
         raise NumericalError(f"{where}: the system has non-finite entries")
     nf = float(np.linalg.norm(f))
     if nf == 0.0:
@@ -275,8 +276,10 @@ def cg_solve(K, f, precond: TwoLevelPreconditioner, *, where: str, rtol: float =
 
 
 def _cg_info(K, precond, iterations, res, err, solve_s, rtol):
+    label = getattr(precond, "label", None) or (
+        f"two-level smoothed aggregation (coarse {precond.coarse_size})")
     return {"unknowns": int(K.shape[0]), "relative_residual": float(res),
-            "solver": f"CG + two-level smoothed aggregation (coarse {precond.coarse_size})",
+            "solver": f"CG + {label}",
             "iterations": int(iterations), "rtol": float(rtol),
             "solver_error_estimate": float(err),
             "preconditioner_setup_s": float(precond.setup_s), "cg_solve_s": float(solve_s)}
@@ -300,3 +303,121 @@ def solver_error_warnings(diagnostics, metrics) -> list[str]:
         return []
     return [f"iterative solver error ~{est:.1e} is not below {SOLVER_ERROR_FRACTION:g} of the "
             f"method error rel_l2_error = {method:.1e}; use solver=direct"]
+
+
+# -- the condensed state-based system, applied without forming it -----------------------
+class JacobiPreconditioner:
+    """x = r / diag(K): the preconditioner of :func:`solve_condensed`. On the 3D box's
+    condensed LPS system (``none``) it was the fastest of scipy CG with Jacobi, with an
+    incomplete LU of the bond block A_uu and with pyamg's smoothed aggregation of A_uu
+    (rigid-body modes as near-null space), and of the multifrontal direct solve, at h =
+    0.05, 1/24, 1/30 and 1/36 (benchmarks/refine3d.py; under load, so CPU seconds compare
+    them: Jacobi 4.8 and 7.1 s of CPU for set-up and solve at h = 1/30 and 1/36, pyamg 5.4
+    and 8.1 s, records refine3d-2026-11-28-cpu-none-1-30 and -1-36; the multifrontal
+    solve 2.0 GB at 1/30 against CG's 0.9 GB, record
+    refine3d-2026-11-28-levels-0.05-to-1-36). A PD operator's high-frequency
+    spectrum is flat, and on these boxes (m = 3, at most 30 cells a side) the smooth modes
+    CG must still resolve are few: 91, 109, 137 iterations at h = 0.05, 1/24, 1/30 (~1/h)
+    cost less than pyamg's set-up and cycles (15-19 iterations). Its iterations grow as
+    1/h and pyamg's do not, so the gap narrows (12 % at 1/36): on boxes larger than the
+    report's, pyamg may become the better choice."""
+
+    label = "Jacobi"
+
+    def __init__(self, diag):
+        t0 = time.perf_counter()
+        diag = np.asarray(diag, dtype=float)
+        if np.any(diag <= 0) or not np.all(np.isfinite(diag)):
+            raise NumericalError("CG preconditioner: the stiffness has a non-positive diagonal "
+                                 "entry, so it is not symmetric positive definite")
+        self._inv = 1.0 / diag
+        self.setup_s = time.perf_counter() - t0
+
+    def operator(self):
+        n = self._inv.size
+        return spla.LinearOperator((n, n), matvec=lambda r: self._inv * r, dtype=float)
+
+
+class CondensedOperator(spla.LinearOperator):
+    """The condensed state-based stiffness K = A_uu + A_ut G of an augmented system
+    ``A = [[A_uu, A_ut], [G, -I]]`` (its last ``scalars`` unknowns theta = G u), on the
+    displacement unknowns left free by ``fixed``, applied as A_uu x + A_ut (G x): K couples
+    nodes two horizons apart (at h = 1/30 on the 3D box it would hold ~55 M non-zeros, the
+    augmented blocks 15 M), so it is never formed. ``rhs``: the augmented right-hand side
+    (zero on the scalars' rows, as :class:`~pdverify.pd.problem.LinearSystem` has it)."""
+
+    def __init__(self, A, rhs, scalars: int, fixed, values):
+        A = sp.csr_matrix(A)
+        n = A.shape[0] - int(scalars)
+        keep = np.ones(n, dtype=bool)
+        keep[np.asarray(fixed, dtype=int)] = False
+        self.free = np.flatnonzero(keep)
+        self.u0 = np.zeros(n)
+        self.u0[np.asarray(fixed, dtype=int)] = values
+        self._G_all = A[n:, :n].tocsr()
+        A_uu, A_ut = A[:n, :n], A[:n, n:]
+        rhs = np.asarray(rhs, dtype=float)
+        if np.any(rhs[n:]):
+            raise ValueError("the condensed operator needs a zero right-hand side on the "
+                             "scalars' rows (theta = G u)")
+        self.rhs = (rhs[:n] - A_uu @ self.u0 - A_ut @ (self._G_all @ self.u0))[self.free]
+        self._A = A_uu[self.free][:, self.free].tocsr()
+        self._At = A_ut[self.free].tocsr()
+        self._G = self._G_all[:, self.free].tocsr()
+        self.blocks_nnz = int(self._A.nnz + self._At.nnz + self._G.nnz)
+        super().__init__(float, (self.free.size, self.free.size))
+
+    def _matvec(self, x):
+        x = np.asarray(x, dtype=float).ravel()
+        return self._A @ x + self._At @ (self._G @ x)
+
+    def diagonal(self) -> np.ndarray:
+        """diag(K) exactly: diag(A_uu) + sum_k A_ut[i, k] G[k, i]."""
+        return (self._A.diagonal()
+                + np.asarray(self._At.multiply(self._G.T).sum(axis=1)).ravel())
+
+    def finite(self) -> bool:
+        return all(np.all(np.isfinite(M.data)) for M in (self._A, self._At, self._G))
+
+    def asymmetry(self) -> float:
+        """|b.Ka - a.Kb| / (|b| |Ka|) for two fixed random vectors: 0 for a symmetric K up
+        to the products' round-off (measured 1e-18 to 4e-17 on the 3D box's LPS systems),
+        2e-5 to 1e-4 for the energy method's (its factors are not symmetric per bond)."""
+        rng = np.random.default_rng(0)
+        a, b = rng.standard_normal(self.shape[0]), rng.standard_normal(self.shape[0])
+        Ka = self @ a
+        denom = float(np.linalg.norm(b) * np.linalg.norm(Ka))
+        return float(abs(b @ Ka - a @ (self @ b)) / denom) if denom > 0 else 0.0
+
+    def expand(self, u_free) -> np.ndarray:
+        """Every unknown of the augmented system: u (the prescribed values in place), then
+        theta = G u."""
+        u = self.u0.copy()
+        u[self.free] = u_free
+        return np.r_[u, self._G_all @ u]
+
+
+def solve_condensed(op: CondensedOperator, *, where: str):
+    """CG with the Jacobi preconditioner on a symmetric :class:`CondensedOperator` (the
+    caller has checked :meth:`~CondensedOperator.asymmetry`); returns the augmented
+    solution (:meth:`~CondensedOperator.expand`) and CG's diagnostics
+    (:func:`cg_solve`; a stall or a non-positive diagonal is a :class:`NumericalError`
+    naming ``where``), with ``symmetry_defect`` and ``operator_nnz`` (the non-zeros of
+    the blocks it applies)."""
+    if not op.finite():
+        raise NumericalError(f"{where}: the system has non-finite entries")
+    try:
+        precond = JacobiPreconditioner(op.diagonal())
+    except NumericalError as exc:
+        raise NumericalError(f"{where}: {exc}") from None
+    u, info = cg_solve(op, op.rhs, precond, where=where, maxiter=CONDENSED_CG_MAXITER)
+    info["solver"] += " on K = A_uu + A_ut G applied, not formed"
+    info["operator_nnz"] = op.blocks_nnz
+    return op.expand(u), info
+
+
+#: CG's iteration limit on the condensed systems: Jacobi-CG took 91, 109, 137, 165
+#: iterations on the 3D box at h = 0.05, 1/24, 1/30, 1/36 (~ 4.6 / h; record
+#: refine3d-2026-11-28-levels-0.05-to-1-36), so 2,000 is reached only by a stall (or a box
+#: ~ 400 cells long, far beyond any 2 GB run)
+CONDENSED_CG_MAXITER = 2000

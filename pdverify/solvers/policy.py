@@ -117,24 +117,58 @@ ND_FROM_UNKNOWNS = 1000
 ND3D_FROM_UNKNOWNS = 4000
 
 
+#: ... and from this many displacement unknowns in 3D, CG on the condensed K (applied, not
+#: formed; Jacobi-preconditioned, :func:`~pdverify.solvers.iterative.solve_condensed`) when K
+#: is symmetric (:func:`condensed_cg`), else nested dissection. The multifrontal solve
+#: reaches its end at h = 1/30 on the 3D box (20,250 unknowns: 2.0 GB, the 2 GB a run may
+#: take), where CG took 0.9 GB; CG is faster from h = 0.05 on (6,000 unknowns: 1 s against
+#: 16 s, under load), but the threshold sits above every 3D run of the report at h = 0.05
+#: (surface nodes: 9,000), so those keep their direct solutions bit for bit (record
+#: refine3d-2026-11-28-levels-0.05-to-1-36).
+CG3D_FROM_UNKNOWNS = 10000
+#: K counts as symmetric when |b.Ka - a.Kb| / (|b| |Ka|) of two random vectors is below
+#: this: round-off of the products gave 1e-18 to 4e-17 on the symmetric LPS systems of the
+#: 3D box, the energy method's non-symmetric K 2e-5 to 1e-4 (benchmarks/refine3d.py), so
+#: the line sits four orders above the one and seven below the other.
+SYMMETRY_TOL = 1e-12
+
+
 def static_solver(requested: str, dim: int, unknowns: int) -> str:
     """The solver a static state-based run uses: ``requested``, or for ``auto`` nested
     dissection from :data:`ND_FROM_UNKNOWNS` unknowns in 2D (11x faster than the direct
     solve at h = 0.01 with the float32 factor: commit aa3f0a1) and
     :data:`ND3D_FROM_UNKNOWNS` in 3D (2x faster and half the memory of the dense LU at h =
-    0.05: record solvers-2026-11-23-crossover3d). 1D: always direct."""
+    0.05: record solvers-2026-11-23-crossover3d), and ``cg`` from
+    :data:`CG3D_FROM_UNKNOWNS` in 3D (the front door falls back to nested dissection where
+    CG does not apply: :func:`condensed_cg`). 1D: always direct."""
     if requested != "auto":
         return requested
     if dim == 1:
         return "direct"
+    if dim == 3 and unknowns >= CG3D_FROM_UNKNOWNS:
+        return "cg"
     return ("nested-dissection" if unknowns >= (ND_FROM_UNKNOWNS if dim == 2
                                                  else ND3D_FROM_UNKNOWNS) else "direct")
 
 
-def auto_note(solver: str, unknowns: int) -> str:
-    """The ``solver_choice`` a run records when ``auto`` chose."""
+def condensed_cg(asymmetry: float, constraint_rows: bool) -> str | None:
+    """Why CG cannot solve a condensed state-based system that ``auto`` gave it (None: it
+    can): constraint rows (a saddle point, not SPD) or a K that is not symmetric
+    (``asymmetry`` above :data:`SYMMETRY_TOL`)."""
+    if constraint_rows:
+        return "constraint rows: a saddle-point system"
+    if not asymmetry <= SYMMETRY_TOL:
+        return f"K not symmetric (defect {asymmetry:.1e} > {SYMMETRY_TOL:g})"
+    return None
+
+
+def auto_note(solver: str, unknowns: int, fallback: str | None = None) -> str:
+    """The ``solver_choice`` a run records when ``auto`` chose (``fallback``: why CG, the
+    first choice, did not apply)."""
+    why = f"; cg does not apply: {fallback}" if fallback else ""
     return (f"auto: {solver} ({unknowns} unknowns; nested dissection from "
-            f"{ND_FROM_UNKNOWNS} in 2D, {ND3D_FROM_UNKNOWNS} in 3D)")
+            f"{ND_FROM_UNKNOWNS} in 2D, {ND3D_FROM_UNKNOWNS} in 3D, CG on a symmetric K "
+            f"from {CG3D_FROM_UNKNOWNS} in 3D{why})")
 
 
 # -- nested dissection: single or double precision, split or whole --------------------

@@ -111,3 +111,39 @@ def test_a_study_leaves_out_its_costly_methods():
     assert runs and not any(m in convergence.COSTLY_3D for _, m, _ in runs)
     assert any(m == "taylor-fictitious"
                for m, _ in get_scene("body3d-manufactured").report_cases())
+
+
+def test_methods_that_stop_early_are_fitted_over_the_levels_they_reach():
+    """body3d-manufactured's delta-refinement (issue 55): none, volume and pals run its five
+    levels (CG from h = 1/24), surface nodes stop at h = 0.05, energy, mirror nodes and
+    PDDO at 1/24 (the direct solver's reach) and say why; each rate is the least-squares
+    slope over the levels the method ran (here errors made exactly C h^p, so the fitted
+    rate is p)."""
+    from pdverify import convergence
+    from pdverify.results import RunResult
+    from pdverify.scenes import get_scene
+    scene = get_scene("body3d-manufactured")
+    st = next(s for s in convergence.STUDIES
+              if s.scene == "body3d-manufactured" and s.kind == "delta")
+    cases = [c for c in convergence.cases(["body3d-manufactured"]) if c[2] in st.levels]
+    per = {}
+    for _, method, level in cases:
+        per.setdefault(method, []).append(level["spacing"])
+    assert {m for m, hs in per.items() if len(hs) == 5} >= {"none", "volume", "pals"}
+    assert min(per["surface-nodes"]) == 0.05 and len(per["surface-nodes"]) == 3
+    for m in ("mirror-nodes", "pddo", "energy"):
+        assert min(per[m]) == 1 / 24 and len(per[m]) == 4, m
+    p = {"none": 0.7, "volume": 0.65, "surface-nodes": 2.0}
+    runs = [RunResult(scene=s, method=m, params=scene.resolve(m, lv), reference="analytic",
+                      metrics={"rel_l2_error": 0.5 * st.h(lv) ** p.get(m, 1.0)},
+                      timings={"total_s": 1.0})
+            for s, m, lv in cases]
+    entries = {e["method"]: e for e in convergence.collect(runs) if e["study"] == "delta"}
+    assert entries["none"]["rate"] == pytest.approx(0.7, rel=1e-12)
+    assert len(entries["none"]["levels"]) == 5 and not entries["none"]["note"]
+    # the successive pairs' rates: four for five levels, each p for an exact power law
+    assert entries["none"]["pair_rates"] == pytest.approx([0.7] * 4, rel=1e-12)
+    sn = entries["surface-nodes"]
+    assert len(sn["levels"]) == 3 and sn["rate"] == pytest.approx(2.0, rel=1e-12)
+    assert sn["note"].startswith("stops at h = 0.15: its system is not symmetric (no CG)")
+    assert entries["pddo"]["note"].startswith("stops at h = 0.125: not symmetric")

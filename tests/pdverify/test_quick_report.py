@@ -38,10 +38,10 @@ def _levels(kind, scene, quick):
 def test_the_3d_studies_of_the_quick_report_stay_at_six_cells_a_side_or_coarser():
     """body3d-manufactured's quick delta-refinement runs h = 0.1 and 1/12 (not 0.0625),
     its m-refinement (finer level h = 1/18) only in the full report; the full report's
-    levels are the study's own."""
+    levels are the study's own (five since issue 55: h = 1/24 and 1/30 appended)."""
     st, quick = _levels("delta", "body3d-manufactured", True)
     assert [lv["spacing"] for lv in quick] == [0.1, 1 / 12]
-    assert st.used_levels(False) == st.levels and len(st.levels) == 3
+    assert st.used_levels(False) == st.levels and len(st.levels) == 5
     st, quick = _levels("m", "body3d-manufactured", True)
     assert quick == () and len(st.used_levels(False)) == 2
     finest = min(o["spacing"] for s, _, o in plan(only=["body3d-manufactured"], quick=True)
