@@ -34,14 +34,6 @@ from ..quotes import used
 from . import influence_param, register, whole_cells
 from .shapes import ORDERING, ShapeScene, shape_errors
 
-#: why Taylor's fictitious nodes do not run on a 3D shape (``list``)
-TAYLOR_3D = ("on a 3D shape: not built (corrections.shape_fictitious fits its series along "
-             "the normal from the 2D parts' crossings, Shape.crossings of segments and arcs; "
-             "a 3D part would need the bond-surface intersections of planes, a mantle and a "
-             "sphere, and its 3D box form already costs 35-40 s and 2.1 GB at 2000 nodes, "
-             "past a 3D shape scene's budget)")
-
-
 def _sigma_z(sigma):
     return lambda x, n: np.c_[np.zeros(len(x)), np.zeros(len(x)), np.full(len(x), sigma)]
 
@@ -66,11 +58,6 @@ class Shape3DScene(ShapeScene):
         """The quick report's grid: the default (already the smallest that keeps a
         horizon inside the body's curved part, 1-3 s a run)."""
         return next(q.default for q in self.pd_params if q.name == "spacing")
-
-    def family_refusal(self, treatment):
-        if treatment.name == "taylor-fictitious":
-            return TAYLOR_3D
-        return super().family_refusal(treatment)
 
     def check_pd(self, where, method, p):
         lengths, _ = self.box(p)
