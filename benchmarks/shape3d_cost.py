@@ -10,6 +10,15 @@ fresh process: first with an empty FEM cache (a temporary ``PDVERIFY_CACHE_DIR``
 warm (the same cache), and records the wall time of each report and, per run, the
 run's total time and peak memory from its ``results.json``. The machine's load (the
 harness header) says how far the numbers are from an idle machine's.
+
+Measured 2026-11-28 under load (load average 14-18 on the 2 cores shared with five other
+sessions; record ``shape3d_cost-2026-11-28-default.json``): cold 88.6 s wall (runs 131 s
+summed; the FEM studies 14.6 s cylinder, 39.2 s cavity), warm 57.0 s wall (runs 80.5 s;
+PD runs 5.6-14.3 s each), every run's peak at most 0.59 GB. The same load scaled a
+reference run, body3d-traction's ``none`` (2.15 s in the full report of 674b0c4), to
+8.5-11.2 s, i.e. 4-5 times: alone the two scenes' warm runs would take ~16-20 s summed
+(~10 s wall on 2 workers) and the cold FEM studies ~12 s more. The quick report runs
+them at twice the spacing: 10 runs, 5.1 s critical path under the same load.
 """
 from __future__ import annotations
 
