@@ -11,6 +11,8 @@ Public API: one function per reference, each returning its converged, cached res
     crack_plate(**params)    -> CrackPlateResult      issue 54: centre crack (mode I)
     edge_crack_plate(**params) -> CrackPlateResult    issue 54: single edge crack (SENT)
     inclined_crack(**params) -> InclinedCrackResult   issue 54: inclined centre crack
+    cylinder_tension(**params) -> CylinderResult      issue 55: quarter cylinder, tension
+    cavity_block(**params)   -> CavityResult          issue 55: block with a spherical cavity
 
 Keyword arguments override the fields of the matching ``*Params`` dataclass;
 ``use_cache=False`` recomputes. The cache lives in ``$PDVERIFY_CACHE_DIR`` (default
@@ -18,7 +20,8 @@ Keyword arguments override the fields of the matching ``*Params`` dataclass;
 :class:`TensorElasticity` (assembly, condensation, reactions, energy), and
 :class:`FieldSolution` (evaluation at points, energy density, VTU export); on the
 domains that are not boxes, :class:`MeshElasticity` and :class:`MeshField` (isoparametric
-9-node quadrilaterals).
+9-node quadrilaterals); in 3D :class:`Solid3D` and :class:`TetField` (quadratic
+tetrahedra on mapped meshes).
 """
 
 __version__ = "0.1.0"
@@ -35,6 +38,9 @@ from .l_plate import LPlateParams, LPlateResult, l_plate  # noqa: E402
 from .mesh_elasticity import MeshElasticity  # noqa: E402
 from .mesh_field import MeshField  # noqa: E402
 from .plate import PlateParams, PlateResult, clamped_plate  # noqa: E402
+from .solid3d import Solid3D, TetField  # noqa: E402
+from .solid3d_refs import (CavityParams, CavityResult, CylinderParams, CylinderResult,  # noqa: E402
+                           cavity_block, cylinder_tension)
 from .results import ReferenceResult, RefinementRow  # noqa: E402
 from .tension_sheet import TensionSheetParams, TensionSheetResult, tension_sheet  # noqa: E402
 
@@ -48,16 +54,20 @@ REFERENCES = {
     "plate-crack": crack_plate,
     "plate-edge-crack": edge_crack_plate,
     "plate-inclined-crack": inclined_crack,
+    "cylinder3d-tension": cylinder_tension,
+    "block3d-cavity": cavity_block,
 }
 
 __all__ = [
     "__version__", "REFERENCES", "cache_dir", "cache_key",
     "clamped_plate", "tension_sheet", "clamped_sheet", "indentation", "hole_plate", "l_plate",
-    "crack_plate", "edge_crack_plate", "inclined_crack",
+    "crack_plate", "edge_crack_plate", "inclined_crack", "cylinder_tension", "cavity_block",
     "PlateParams", "TensionSheetParams", "ClampedSheetParams", "IndentationParams",
     "HolePlateParams", "LPlateParams", "CrackPlateParams", "InclinedCrackParams",
+    "CylinderParams", "CavityParams",
     "PlateResult", "TensionSheetResult", "ClampedSheetResult", "IndentationResult",
     "HolePlateResult", "LPlateResult", "CrackPlateResult", "InclinedCrackResult",
+    "CylinderResult", "CavityResult",
     "ReferenceResult", "RefinementRow", "Material", "TensorElasticity", "FieldSolution",
-    "MeshElasticity", "MeshField",
+    "MeshElasticity", "MeshField", "Solid3D", "TetField",
 ]

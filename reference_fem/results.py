@@ -11,9 +11,12 @@ import numpy as np
 
 from .field import FieldSolution
 from .mesh_field import MeshField
+from .solid3d import TetField
 
 #: the arrays of a MeshField, stored as ``<name>.<array>``
 _MESH_FIELD_ARRAYS = ("node_coords", "elements", "values", "box", "disks", "rects")
+#: the arrays of a TetField (3D), stored as ``<name>.<array>``
+_TET_FIELD_ARRAYS = ("node_coords", "elements", "values")
 
 
 @dataclass(frozen=True)
@@ -148,11 +151,11 @@ _ROW_TUPLES = ("refinement", "uniform_refinement")
 
 
 class MeshReferenceResult(ReferenceResult):
-    """A converged reference on a mapped mesh (its ``field`` a ``MeshField``), which also
-    gives the stress anywhere in the domain."""
+    """A converged reference on a mapped mesh (its ``field`` a ``MeshField``, or in 3D a
+    ``TetField``), which also gives the stress anywhere in the domain."""
 
     def stress(self, points: np.ndarray) -> np.ndarray:
-        """Cauchy stress (Pa) at points, shape (n, 2, 2)."""
+        """Cauchy stress (Pa) at points, shape (n, d, d)."""
         return self.field.stress(points)
 
 
@@ -170,6 +173,10 @@ def to_npz(result: ReferenceResult, path: Path) -> None:
             for a in _MESH_FIELD_ARRAYS:
                 arrays[f"{f.name}.{a}"] = np.asarray(getattr(v, a))
             meta[f.name] = {"__mesh_field__": True, "lam": v.lam, "mu": v.mu}
+        elif isinstance(v, TetField):
+            for a in _TET_FIELD_ARRAYS:
+                arrays[f"{f.name}.{a}"] = np.asarray(getattr(v, a))
+            meta[f.name] = {"__tet_field__": True, "lam": v.lam, "mu": v.mu}
         elif isinstance(v, np.ndarray):
             arrays[f.name] = v
             meta[f.name] = {"__array__": True}
@@ -213,6 +220,9 @@ def from_npz(path: Path, classes: dict) -> ReferenceResult:
         elif isinstance(v, dict) and "__mesh_field__" in v:
             kwargs[name] = MeshField(**{a: z[f"{name}.{a}"] for a in _MESH_FIELD_ARRAYS},
                                      lam=v["lam"], mu=v["mu"])
+        elif isinstance(v, dict) and "__tet_field__" in v:
+            kwargs[name] = TetField(*(z[f"{name}.{a}"] for a in _TET_FIELD_ARRAYS),
+                                    lam=v["lam"], mu=v["mu"])
         elif isinstance(v, dict) and "__array__" in v:
             kwargs[name] = z[name]
         elif name in _ROW_TUPLES:

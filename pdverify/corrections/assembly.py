@@ -37,11 +37,14 @@ def model_of(problem, grid, closure) -> StateBasedModel:
 
 def unknown_coords(model, nodes):
     """Coordinates of the unknowns: d displacement components of ``nodes``, then the
-    closure's nodal scalars (dilatations; PALS: two per node) of the real nodes."""
+    closure's nodal scalars (dilatations; PALS: two per node) of the real nodes, or of
+    every node of the grid where the closure keeps one per grid node (PALS on a shape's
+    lattice, whose void nodes carry decoupled scalars)."""
     g = model.grid
     x_int = g.x[g.interior_ids]
-    scalars = model.A_theta.shape[0] // len(x_int)
-    return np.r_[np.tile(nodes, (g.dim, 1)), np.tile(x_int, (scalars, 1))]
+    rows = model.A_theta.shape[0]
+    owners = g.x if rows % g.n_ext == 0 else x_int
+    return np.r_[np.tile(nodes, (g.dim, 1)), np.tile(owners, (rows // len(owners), 1))]
 
 
 def padded(rhs, K):

@@ -66,8 +66,10 @@ class BondMethod(Treatment):
 
     closure: BondClosure | None = None
     families: tuple[str, ...] = ("static-state",)
-    #: a closure changes bonds only; the uncorrected model's conditions serve any shape
+    #: a closure changes bonds only; the uncorrected model's conditions serve any shape,
+    #: 2D or 3D (``assemble_plain`` is the same in both)
     shapes: bool = True
+    shapes3d: bool = True
     #: ``checker(cells, params, where)``: refuses parameters before any work
     checker: ParamCheck | None = None
 

@@ -111,6 +111,10 @@ class Treatment:
     #: ``box_only``: why not, when it cannot (``list`` shows it on the shape scenes)
     shapes: bool = False
     box_only: str = ""
+    #: True when it can also assemble a 3D shape (``pdverify.pd.shapes3d``);
+    #: ``shapes3d_why``: why not, when it serves 2D shapes only
+    shapes3d: bool = False
+    shapes3d_why: str = ""
 
     def __post_init__(self):
         bad = [t for t in self.theories if t not in THEORIES]

@@ -5,8 +5,8 @@ Every PD model of pdverify is built here, from a description:
 - :class:`Body`: the box ``origin + [0, lengths]``, node ``spacing``, where the nodes sit
   (``placement``: cell centres or on the surface), the end cells' volumes
   (``boundary_volume``) and the ``thickness`` that multiplies volumes and face areas
-  (1D: the cross-section, 2D: the thickness, 3D: 1); or a 2D ``shape``
-  (``pdverify.pd.shapes``) cut from the lattice of that box, its nodes moved by
+  (1D: the cross-section, 2D: the thickness, 3D: 1); or a 2D or 3D ``shape``
+  (``pdverify.pd.shapes``, ``pdverify.pd.shapes3d``) cut from the lattice of that box, its nodes moved by
   ``jitter`` (a fraction of the spacing, seeded: :class:`~pdverify.pd.grid.ShapeGrid`);
 - the stencil (``pdverify.pd.bonds``: offsets and weights beta of one horizon);
 - the material: :class:`StateMaterial` (the linear state-based model: constants of energy

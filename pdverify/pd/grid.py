@@ -191,8 +191,9 @@ KIND_VOID = 2
 
 @dataclass
 class ShapeGrid(BoxGrid):
-    """The nodes of a 2D :class:`~pdverify.pd.shapes.Shape` cut from the uniform lattice of
-    its bounding box ``origin + [0, lengths]`` (cell-centred).
+    """The nodes of a 2D :class:`~pdverify.pd.shapes.Shape` or a 3D
+    :class:`~pdverify.pd.shapes3d.Shape3D` cut from the uniform lattice of its bounding box
+    ``origin + [0, lengths]`` (cell-centred).
 
     A node is real when its cell centre lies inside the shape; its volume is the part of
     its cell inside the shape (:meth:`Shape.fractions`; the slivers of cut cells whose
@@ -202,8 +203,8 @@ class ShapeGrid(BoxGrid):
     stencil bond of a real node ends on a real or fictitious node. The others are void
     (no bonds, ``KIND_VOID``).
 
-    ``jitter``: every real node moves by a seeded random vector, uniform in the square of
-    side ``jitter * spacing`` about its lattice point (``jitter_seed``); a node the move
+    ``jitter``: every real node moves by a seeded random vector, uniform in the square
+    (cube) of side ``jitter * spacing`` about its lattice point (``jitter_seed``); a node the move
     would take out of the shape stays at its lattice point (``jitter_kept`` counts them).
     The bond family stays the lattice's (the stencil's offsets, weights and cell volumes);
     the bonds' lengths and directions come from the moved positions
@@ -218,8 +219,9 @@ class ShapeGrid(BoxGrid):
         if self.placement != "cell-centred":
             raise ValueError("a shape is cut from a cell-centred lattice")
         super().__post_init__()
-        if self.dim != 2 or getattr(self.shape, "dim", None) != 2:
-            raise ValueError("shapes are 2D")
+        if self.dim not in (2, 3) or getattr(self.shape, "dim", None) != self.dim:
+            raise ValueError(f"a {self.dim}D box cuts a shape of its own dimension (2D or "
+                             f"3D), got a {getattr(self.shape, 'dim', None)}D shape")
         s = self.shape
         lattice = self.x.copy()
         inside = s.inside(lattice)
@@ -243,7 +245,7 @@ class ShapeGrid(BoxGrid):
         if self.jitter:
             rng = np.random.default_rng(self.jitter_seed)
             ids = self.interior_ids
-            move = rng.uniform(-0.5, 0.5, size=(ids.size, 2)) * self.jitter * self.spacing
+            move = rng.uniform(-0.5, 0.5, size=(ids.size, self.dim)) * self.jitter * self.spacing
             moved = lattice[ids] + move
             stays = ~s.inside(moved)
             moved[stays] = lattice[ids][stays]
@@ -255,9 +257,9 @@ class ShapeGrid(BoxGrid):
         """No box surface nodes: a shape's boundary is its parts (``Shape.samples``)."""
         self.faces = ()
         self.face_start = np.zeros(1, dtype=int)
-        self.surface_cell = np.zeros((0, 2), dtype=int)
-        self.surface_x = np.zeros((0, 2))
-        self.surface_normal = np.zeros((0, 2))
+        self.surface_cell = np.zeros((0, self.dim), dtype=int)
+        self.surface_x = np.zeros((0, self.dim))
+        self.surface_normal = np.zeros((0, self.dim))
         self.surface_face = np.zeros(0, dtype=int)
 
     def bond_vectors(self, a, b) -> np.ndarray:

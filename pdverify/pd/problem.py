@@ -128,7 +128,8 @@ class StaticProblem:
     where: str = "static problem"
     #: m of a complete neighbourhood (``StateBasedModel``'s ``complete_m``)
     complete_m: str = "stencil"
-    #: a 2D body that is not the box (``pdverify.pd.shapes``): ``lengths``/``origin`` are
+    #: a body that is not the box (2D: ``pdverify.pd.shapes``, 3D:
+    #: ``pdverify.pd.shapes3d``): ``lengths``/``origin`` are
     #: its bounding box, ``conditions`` are keyed by its boundary parts' names
     shape: object = None
     #: the real nodes' random displacement, a fraction of the spacing (shapes only)

@@ -49,6 +49,10 @@ class StaticStateScene(Scene):
         if self.has_shape and not getattr(treatment, "shapes", False):
             return (f"box faces only: {treatment.box_only}" if treatment.box_only else
                     "box faces only (the treatment does not declare shapes)")
+        if self.has_shape and self.dim == 3 and not getattr(treatment, "shapes3d", False):
+            why = getattr(treatment, "shapes3d_why", "")
+            return (f"on a 3D shape: {why}" if why else
+                    "2D shapes only (the treatment does not declare 3D shapes)")
         if treatment.whole_faces_only and not self._whole_faces():
             return (f"{treatment.scope or 'whole-face conditions only'}; this scene "
                     "prescribes a component on part of a face")
