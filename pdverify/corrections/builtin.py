@@ -193,6 +193,9 @@ def family_treatments() -> list[Treatment]:
                   "one runs along the local normal with derivatives from a least-squares "
                   "fit, arcs take the series' traction (surface_nodes."
                   "surface_nodes_on_shape: our generalisation)",
+            shapes3d_why="not built (surface_nodes.surface_nodes_on_shape places its "
+                         "surface nodes and fits on the 2D parts; a 3D part needs surface "
+                         "nodes on planes, a mantle and a sphere and 3D fits)",
             roles=(("wave-bar", Role(wave_extension, (WAVE_ORDER,), check_wave_order)),)),
         FamilyTreatment(
             "mirror-nodes", "seed 001 §5: a delta-thick fictitious layer whose nodes copy "
@@ -205,7 +208,10 @@ def family_treatments() -> list[Treatment]:
                   "point, the reflection across the local tangent and the traction "
                   "relation with the local normal (mirror_nodes.MirrorNodesOnShape: our "
                   "generalisation)",
-            build=_mirror, checker=_check_mirror, shapes=True),
+            build=_mirror, checker=_check_mirror, shapes=True,
+            shapes3d_why="not built (mirror_nodes.MirrorNodesOnShape reflects across the "
+                         "tangent lines of 2D parts; a 3D part needs the tangent planes of "
+                         "planes, a mantle and a sphere and 3D fits)"),
         FamilyTreatment(
             "pddo", "seed 001 §5: peridynamic differential operator (moment matrices exact "
             "for quadratics) for the boundary rows and the equilibrium within 2 delta, LPS "
@@ -214,7 +220,10 @@ def family_treatments() -> list[Treatment]:
             scope="state-based; the boundary row (Dirichlet or traction) is chosen per "
                   "boundary node; on a shape at each boundary node's points with the "
                   "part's local normal (pddo.pddo_shape_system: our generalisation)",
-            build=_pddo, shapes=True),
+            build=_pddo, shapes=True,
+            shapes3d_why="not built (pddo.pddo_shape_system takes the boundary rows at "
+                         "points of 2D parts; a 3D part needs them at points of planes, a "
+                         "mantle and a sphere)"),
     ]
 
 
