@@ -12,7 +12,8 @@ from dataclasses import dataclass
 
 from ..errors import InputError
 from ..params import Param, at_least
-from ..pd.problem import LOAD_POINTS, LinearSystem, StaticProblem
+from ..pd.problem import LOAD_POINTS, BondProblem, BondSystem, LinearSystem, StaticProblem
+from .bond_fictitious import assemble_bond_box, check_bond_box
 from .mirror_nodes import GRADIENT_AT, MIRROR_POINTS, NEUMANN_READINGS, assemble_mirror
 from .pddo import BULK_MODELS, assemble_pddo
 from .plain import assemble_plain
@@ -151,6 +152,29 @@ def _check_flux_order(nodes, params, where) -> None:
     _check_taylor((nodes,), params, where)
 
 
+def _bond_taylor(problem: BondProblem, params: Params) -> BondSystem:
+    """Taylor's role in the ``bond-box`` family (seed 000 §7: the bond-based form)."""
+    return assemble_bond_box(problem, params["order"], "real")
+
+
+def _bond_surface(problem: BondProblem, params: Params) -> BondSystem:
+    """The surface nodes' role in the ``bond-box`` family (seed 001 read for bond-based
+    PD: ``corrections.bond_fictitious``)."""
+    return assemble_bond_box(problem, params["order"], "surface")
+
+
+def _check_bond_surface(cells, p, where) -> None:
+    N = p["order"]
+    need = max(N + 1, 2 * ((N + 1) // 2) + 1)
+    for name, n in zip("xyz", cells):
+        if n < need:
+            raise InputError(f"{where}: {n} cells along {name}; order {N} needs at least "
+                             f"{need} for the Taylor stencils")
+
+
+BOTH = ("state-based", "bond-based")
+
+
 def family_treatments() -> list[Treatment]:
     return [
         FamilyTreatment(
@@ -163,7 +187,7 @@ def family_treatments() -> list[Treatment]:
             "extrapolation (1D series along the normal; corners by Eq. 69), Dirichlet and "
             "Neumann conditions via Lagrange multipliers (Eqs. 58, 60, 63)",
             "Scabbia, Zaccariotto, Galvanetto 2021 (seed 000)", params=(ORDER, CORNERS),
-            theories=STATE, dims=(1, 2, 3), families=FAMILY, footprint="fictitious",
+            theories=BOTH, dims=(1, 2, 3), families=FAMILY, footprint="fictitious",
             scope="state-based 1D, 2D and 3D (3D is our extension). 3D at the seed-001 "
                   "boxes' h = 0.05: 35-40 s and 2.1-2.2 GB (bordered system under nested "
                   "dissection, 6.1-6.5 M non-zeros); one flux row of each edge cell's "
@@ -172,19 +196,26 @@ def family_treatments() -> list[Treatment]:
                   "(10 x 5 x 5 cells) keeps 2 dependent constraint rows and fails as "
                   "near-singular. On a shape (not a box) the series runs along the local "
                   "normal with derivatives from a least-squares fit, the conditions at "
-                  "boundary points (corrections.shape_fictitious; corners unused)",
+                  "boundary points (corrections.shape_fictitious; corners unused). "
+                  "Bond-based (seed 000 §7): the 2D boxes that state their conditions at "
+                  "the surface (corrections.bond_fictitious)",
             build=_taylor, checker=_check_taylor, shapes=True,
-            roles=(("flux-bar", Role(_flux_order, (ORDER,), _check_flux_order)),)),
+            roles=(("flux-bar", Role(_flux_order, (ORDER,), _check_flux_order)),
+                   ("bond-box", Role(_bond_taylor, (ORDER,), check_bond_box)))),
         FamilyTreatment(
             "surface-nodes", "seeds 001/002: surface nodes carry the boundary conditions, "
             "fictitious layer by Taylor extrapolation about the nearest surface node",
             "Scabbia, Zaccariotto, Galvanetto 2023 (seed 001); seed 002",
-            params=(SURFACE_ORDER,), theories=STATE, families=FAMILY, footprint="surface",
+            params=(SURFACE_ORDER,), theories=BOTH, families=FAMILY, footprint="surface",
+            scope="state-based boxes and 1D waves; bond-based: the 2D boxes that state "
+                  "their conditions at the surface (corrections.bond_fictitious: what "
+                  "seed 001 leaves open for bond-based PD)",
             build=_surface, checker=_check_surface,
             box_only="its surface nodes sit at the centres of boundary cell faces and its "
                      "Taylor stencils run along lattice lines normal to a face (seed 001 "
                      "§3); a curved or cut boundary has neither",
-            roles=(("wave-bar", Role(wave_extension, (WAVE_ORDER,), check_wave_order)),)),
+            roles=(("wave-bar", Role(wave_extension, (WAVE_ORDER,), check_wave_order)),
+                   ("bond-box", Role(_bond_surface, (SURFACE_ORDER,), _check_bond_surface)))),
         FamilyTreatment(
             "mirror-nodes", "seed 001 §5: a delta-thick fictitious layer whose nodes copy "
             "mirror nodes inside the body (odd reflection for Dirichlet components, the "

@@ -18,6 +18,8 @@ grid, ``BondMethod``)     Closure``                                   ``pals``, 
                           (grid -> Closure) | None``                  the bar's grid
 ``clamped-sheet`` (role)  :class:`Clamp`: ``(ClampedBox, params) ->   ``virtual_nodes.clamp``
                           ClampedGrid``
+``bond-box`` (role)       :class:`BondBox`: ``(BondProblem, params)   ``bond_fictitious.
+                          -> BondSystem``                             assemble_bond_box``
 ========================  ==========================================  =====================
 
 Parameter checks share one signature, :class:`ParamCheck` ``(context, params, where)``,
@@ -41,7 +43,7 @@ import scipy.sparse as sp
 
 from ..pd.closure import Closure
 from ..pd.grid import BoxGrid
-from ..pd.problem import ClampedBox, LinearSystem, StaticProblem
+from ..pd.problem import BondProblem, BondSystem, ClampedBox, LinearSystem, StaticProblem
 
 #: a treatment's resolved parameters
 Params = Mapping[str, Any]
@@ -100,6 +102,15 @@ class Clamp(Protocol):
 
 
 @runtime_checkable
+class BondBox(Protocol):
+    """``bond-box``: a bond-based box's system from its conditions at the surface
+    (:class:`~pdverify.pd.problem.SurfaceConditions`), with the treatment's own grid,
+    unknowns and rows (``corrections.bond_fictitious``)."""
+
+    def __call__(self, problem: BondProblem, params: Params) -> BondSystem: ...
+
+
+@runtime_checkable
 class ParamCheck(Protocol):
     """Refuses parameters before any work (``InputError``, one line naming ``where``)."""
 
@@ -108,9 +119,9 @@ class ParamCheck(Protocol):
 
 #: the protocol of each family's role (``Role.build``)
 ROLE_PROTOCOLS: dict[str, type] = {"wave-bar": WaveExtension, "flux-bar": FluxClosure,
-                                   "clamped-sheet": Clamp}
+                                   "clamped-sheet": Clamp, "bond-box": BondBox}
 #: what ``Role.build`` may be: one of the role protocols
-RoleBuild = typing.Union[WaveExtension, FluxClosure, Clamp]
+RoleBuild = typing.Union[WaveExtension, FluxClosure, Clamp, BondBox]
 
 
 def conformance(fn, protocol: type) -> str | None:

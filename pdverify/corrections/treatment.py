@@ -52,6 +52,10 @@ if TYPE_CHECKING:       # the signatures each family takes (imported by the type
 
 THEORIES = ("bond-based", "state-based")
 ENTRY_POINT_GROUP = "pdverify.methods"
+#: families whose roles serve the scenes of one theory beside the scene's own family
+#: (``Scene.role_families``): a scene of that theory that does not list the family
+#: says why (``Scene.role_refusals``)
+ROLE_FAMILY_THEORY = {"bond-box": "bond-based"}
 #: the uncorrected baseline's name (``Treatment.baseline``; a scene that declares its own
 #: baseline run names it so)
 BASELINE = "none"
@@ -127,10 +131,19 @@ class Treatment:
         """Its :class:`Role` in ``family``, if it has one."""
         return next((r for f, r in self.roles if f == family), None)
 
+    def role_on(self, scene) -> Role | None:
+        """Its :class:`Role` on ``scene``: in the scene's family, else in the first of
+        the scene's further ``role_families`` it has one in."""
+        for family in (getattr(scene, "family", None), *getattr(scene, "role_families", ())):
+            role = self.role(family)
+            if role is not None:
+                return role
+        return None
+
     def params_for(self, scene) -> tuple[Param, ...]:
-        """Its parameters on ``scene``: its role's in the scene's family, the scene's
+        """Its parameters on ``scene``: its role's there (:meth:`role_on`), the scene's
         ``baseline_params`` for the baseline on a closure scene, else ``params``."""
-        role = self.role(getattr(scene, "family", None))
+        role = self.role_on(scene)
         if role is not None:
             return role.params
         if self.baseline and self._closure_scene(scene):
@@ -157,8 +170,8 @@ class Treatment:
         """``None`` when this treatment runs on ``scene``, else a one-line reason."""
         if self.name in {m.name for m in scene.methods}:
             return None                                  # the scene implements it itself
-        if self.role(getattr(scene, "family", None)) is not None:
-            return None                      # a role in the scene's problem family
+        if self.role_on(scene) is not None:
+            return None                      # a role in the scene's problem families
         if self.baseline and self._closure_scene(scene):
             return None                      # the uncorrected model of a closure scene
         if getattr(scene, "closed_to_treatments", None):
@@ -177,6 +190,12 @@ class Treatment:
         family = getattr(scene, "family", None)
         if self.families and family in self.families:
             return scene.family_refusal(self)
+        theory = getattr(scene, "model_theory", None)
+        for f, _ in self.roles:
+            if ROLE_FAMILY_THEORY.get(f) == theory:
+                return (getattr(scene, "role_refusals", {}).get(f)
+                        or f"its {f} role needs the scene's conditions stated at the body's "
+                           "surface; this scene states them on nodes only")
         if self.families:
             return (f"assembles {', '.join(self.families)} problems; this scene is "
                     f"{family or 'not a problem description yet'}"
