@@ -139,6 +139,8 @@ def _plane_rows(g, planes, n_cols_per_comp):
     h = 1.25 mm, 20 x 40 mm, its bordered system had a null vector (smallest singular
     value 1e-17 of the largest), a displacement balanced by reactions on the planes; the
     symmetric solution meets every line's row, so no exactness is lost."""
+    if not planes:
+        return []
     if g.dim != 2 or len(planes) > 2:
         raise ValueError("symmetry planes are taken in 2D, at most two")
     real = g.interior_ids
@@ -167,6 +169,21 @@ def _plane_rows(g, planes, n_cols_per_comp):
             raise ValueError(f"no node on or straddling the plane x_{axis} = 0")
         rows.append(r)
     return rows
+
+
+def energy_ratios(system, strain) -> np.ndarray:
+    """W_i / W_bulk at the real nodes of a ``bond-box`` system under u = strain . x at
+    its unknown nodes (the real nodes, then any surface nodes), its fictitious nodes by
+    its extrapolation (``pdverify.pd.work.work_density``)."""
+    from ..pd.work import work_density
+    model = system.model
+    g = model.grid
+    nodes = g.x[g.interior_ids]
+    if system.n_unknown > g.n_interior:
+        nodes = np.r_[nodes, g.surface_x]
+    field = (nodes @ np.asarray(strain, dtype=float).T).T.ravel()
+    W = work_density(model, strain, field)
+    return W[g.interior_ids] / model.bulk_work_density(strain)
 
 
 def check_bond_box(cells, p, where) -> None:
@@ -199,6 +216,15 @@ def assemble_bond_box(problem: BondProblem, order: int, anchor: str) -> BondBoxS
         closure = replace(closure, dilatation_map=None, weighted_volume="truncated")
         n_unk = ni + ns
     model = build_model(body, problem.stencil, problem.material, closure, grid=g)
+    counts = {"real_nodes": int(ni), "fictitious_nodes": int(g.n_ext - ni)}
+    if anchor == "surface":
+        counts["surface_nodes"] = int(ns)
+    if not sc.faces and not sc.planes:
+        # free all round and unsupported: the rigid motions are free, nothing to solve
+        # (the stiffness scenes give u at the unknowns); the model and its map only
+        return BondBoxSystem(model, np.zeros(d * g.n_ext), np.zeros(0, dtype=int),
+                             np.zeros(0), {}, A=model.displacement_map(), n_unknown=n_unk,
+                             counts=counts)
     # the crossings in the model's own bond numbering (it drops zero-weight offsets)
     flux = face_crossings(g, model.bond_a, model.bond_b)
     A = model.displacement_map()
@@ -274,10 +300,7 @@ def assemble_bond_box(problem: BondProblem, order: int, anchor: str) -> BondBoxS
     if B is not None:
         W = abs(B).tocsr()
         coords = np.r_[coords, (W @ coords) / np.asarray(W.sum(axis=1))]
-    counts = {"real_nodes": int(ni), "fictitious_nodes": int(g.n_ext - ni),
-              "constraints": int(n_rows), "unknowns": int(op.shape[0])}
-    if anchor == "surface":
-        counts["surface_nodes"] = int(ns)
+    counts.update(constraints=int(n_rows), unknowns=int(op.shape[0]))
     parts = {f.name: np.flatnonzero(~g.is_interior & (
         (g.index[:, f.axis] < 0) if f.side == 0
         else (g.index[:, f.axis] >= g.nodes_per_axis[f.axis]))) for f in box_faces(d)}
