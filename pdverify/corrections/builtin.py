@@ -21,7 +21,7 @@ from .protocols import GridClosure, ParamCheck, Params, StaticAssembly
 from .surface_nodes import MAX_ORDER, assemble_surface_nodes, check_wave_order, wave_extension
 from .taylor_fictitious import CORNER_RULES, assemble_taylor, fictitious_closure
 from .treatment import BASELINE, Role, Treatment
-from .virtual_nodes import check_layers, clamp
+from .virtual_nodes import check_layers, clamp, held_face
 
 FAMILY = ("static-state",)
 
@@ -224,6 +224,11 @@ def family_treatments() -> list[Treatment]:
             theories=STATE, families=FAMILY, footprint="fictitious",
             scope="state-based boxes; the mirror relation (Dirichlet or traction) is "
                   "chosen per boundary cell face",
+            theory_refusal="not wired for bond-based PD: it would need a bond-box role "
+                           "(its odd/even reflection map with the prescribed values' "
+                           "offset on bond_fictitious' grid) and a Neumann relation from "
+                           "the bond-based lattice's moduli (C11, C12 of the stencil), "
+                           "not the LPS constants it takes",
             build=_mirror, checker=_check_mirror,
             box_only="its mirror nodes are reflections across a plane face (seed 001 §5.2); "
                      "across a curved part the reflection needs the local normal and "
@@ -233,6 +238,10 @@ def family_treatments() -> list[Treatment]:
             "for quadratics) for the boundary rows and the equilibrium within 2 delta, LPS "
             "beyond", "Behera, Roy, Anicode, Madenci, Spencer 2022; seed 001 §5.3",
             params=PDDO_PARAMS, theories=STATE, families=FAMILY,
+            theory_refusal="not wired for bond-based PD: its equations beyond 2 delta are "
+                           "the LPS model's and its traction rows use the LPS constants "
+                           "(seed 001 §5.3); a bond-based form needs the bond-based bulk "
+                           "beyond and the lattice's moduli (C11, C12) in the rows",
             scope="state-based boxes; the boundary row (Dirichlet or traction) is chosen "
                   "per boundary node", build=_pddo,
             box_only="its boundary rows take each node's box face and that face's normal "
@@ -250,9 +259,18 @@ def hand_wired() -> list[Treatment]:
         Treatment("virtual-nodes", "seed 003 §4.1.2: buffer layers of thickness delta "
                   "outside the clamped edges, displaced rigidly (bond-based)",
                   "seed 003 §4.1.2", theories=("bond-based",), footprint="fictitious",
-                  roles=(("clamped-sheet", Role(clamp, (CORRECT_SIDES,), check_layers)),),
-                  scope="the clamped sheet only (rigid buffers need a clamped edge, which "
-                        "no other bond-based scene has)"),
+                  roles=(("clamped-sheet", Role(clamp, (CORRECT_SIDES,), check_layers)),
+                         ("held-face", Role(held_face))),
+                  scope="bond-based bodies with a face held in every component: the "
+                        "clamped sheet (its own grid, variants 2 and 4) and the held-face "
+                        "scenes (buffer rows beyond the held face, variant 2)",
+                  theory_refusal="bond-based (seed 003 §4.1.2: a rigid buffer beyond a "
+                                 "clamp, its nodes carrying no state of their own); an LPS "
+                                 "buffer node needs a dilatation and enters its neighbours' "
+                                 "m, which the paper does not give, and most state-based "
+                                 "scenes prescribe a varying field on a face (the plates) "
+                                 "or its normal component only (body3d), where no buffer "
+                                 "is rigid"),
         Treatment("fem", "classical-elasticity FEM reference (reference_fem)",
                   "scikit-fem", scope="the reference of the scenes whose reference is FEM"),
     ]

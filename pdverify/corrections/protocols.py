@@ -20,6 +20,8 @@ grid, ``BondMethod``)     Closure``                                   ``pals``, 
                           ClampedGrid``
 ``bond-box`` (role)       :class:`BondBox`: ``(BondProblem, params)   ``bond_fictitious.
                           -> BondSystem``                             assemble_bond_box``
+``held-face`` (role)      :class:`HeldFace`: ``(BondProblem, params)  ``virtual_nodes.
+                          -> BondProblem``                            held_face``
 ========================  ==========================================  =====================
 
 Parameter checks share one signature, :class:`ParamCheck` ``(context, params, where)``,
@@ -111,6 +113,14 @@ class BondBox(Protocol):
 
 
 @runtime_checkable
+class HeldFace(Protocol):
+    """``held-face``: the description with what the treatment adds beyond its held faces
+    (virtual nodes' rigid buffer rows, held as the face is)."""
+
+    def __call__(self, problem: BondProblem, params: Params) -> BondProblem: ...
+
+
+@runtime_checkable
 class ParamCheck(Protocol):
     """Refuses parameters before any work (``InputError``, one line naming ``where``)."""
 
@@ -119,9 +129,10 @@ class ParamCheck(Protocol):
 
 #: the protocol of each family's role (``Role.build``)
 ROLE_PROTOCOLS: dict[str, type] = {"wave-bar": WaveExtension, "flux-bar": FluxClosure,
-                                   "clamped-sheet": Clamp, "bond-box": BondBox}
+                                   "clamped-sheet": Clamp, "bond-box": BondBox,
+                                   "held-face": HeldFace}
 #: what ``Role.build`` may be: one of the role protocols
-RoleBuild = typing.Union[WaveExtension, FluxClosure, Clamp, BondBox]
+RoleBuild = typing.Union[WaveExtension, FluxClosure, Clamp, BondBox, HeldFace]
 
 
 def conformance(fn, protocol: type) -> str | None:

@@ -144,6 +144,10 @@ def _builtin() -> list[Treatment]:
                    "Mitchell, Silling and Littlewood, J. Mech. Mater. Struct. 10 (2015) "
                    "539-557; seed 001 §5.1; Peridigm pals.cxx", closure=pals_closure,
                    theories=("state-based",), dims=(2, 3),
+                   theory_refusal="a state-based constitutive model (its influence "
+                                  "functions weigh the dilatation and the deviatoric "
+                                  "extension); a bond-based model has neither term, so "
+                                  "there is nothing for them to weigh",
                    scope="2D/3D state-based (the matching deformations of a 1D bar leave "
                          "its influence functions undetermined)"),
         BondMethod("perifit", "operator-matching nodal weights of the perifit package, "

@@ -55,7 +55,13 @@ ENTRY_POINT_GROUP = "pdverify.methods"
 #: families whose roles serve the scenes of one theory beside the scene's own family
 #: (``Scene.role_families``): a scene of that theory that does not list the family
 #: says why (``Scene.role_refusals``)
-ROLE_FAMILY_THEORY = {"bond-box": "bond-based"}
+ROLE_FAMILY_THEORY = {"bond-box": "bond-based", "held-face": "bond-based"}
+#: the reason a scene of that theory that neither lists the family nor says why gets
+ROLE_DEFAULT_REFUSAL = {
+    "bond-box": "its bond-box role needs the scene's conditions stated at the body's "
+                "surface; this scene states them on nodes only",
+    "held-face": "its held-face role needs a face held in every component; this scene "
+                 "holds none"}
 #: the uncorrected baseline's name (``Treatment.baseline``; a scene that declares its own
 #: baseline run names it so)
 BASELINE = "none"
@@ -115,6 +121,8 @@ class Treatment:
     #: ``box_only``: why not, when it cannot (``list`` shows it on the shape scenes)
     shapes: bool = False
     box_only: str = ""
+    #: why not on a scene of a theory it does not take (one line; empty: "THEORY only")
+    theory_refusal: str = ""
 
     def __post_init__(self):
         bad = [t for t in self.theories if t not in THEORIES]
@@ -180,7 +188,8 @@ class Treatment:
             return self.scope or f"only on {', '.join(self.scenes)}"
         theory = getattr(scene, "model_theory", None)
         if theory is not None and theory not in self.theories:
-            return f"{'/'.join(self.theories)} only; this scene is {theory}"
+            return (self.theory_refusal
+                    or f"{'/'.join(self.theories)} only; this scene is {theory}")
         if scene.dim is not None and scene.dim not in self.dims:
             return (f"{'/'.join(map(str, self.dims))}D only; this scene is {scene.dim}D"
                     + (f" ({self.scope})" if self.scope else ""))
@@ -194,8 +203,7 @@ class Treatment:
         for f, _ in self.roles:
             if ROLE_FAMILY_THEORY.get(f) == theory:
                 return (getattr(scene, "role_refusals", {}).get(f)
-                        or f"its {f} role needs the scene's conditions stated at the body's "
-                           "surface; this scene states them on nodes only")
+                        or ROLE_DEFAULT_REFUSAL.get(f, f"the scene offers no {f} role"))
         if self.families:
             return (f"assembles {', '.join(self.families)} problems; this scene is "
                     f"{family or 'not a problem description yet'}"

@@ -26,6 +26,8 @@ from .fem_references import FemAndPD
 
 #: the family of the treatments that impose a bond-based box's conditions at its surface
 BOND_BOX = "bond-box"
+#: the family of the treatments that add a rigid buffer beyond a held face (virtual nodes)
+HELD_FACE = "held-face"
 
 MICROMODULI = ("constant", "conical")
 #: seed 003's node volumes (ERRATA) and the horizon quadrature that reproduces Tables 1-2

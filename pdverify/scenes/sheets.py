@@ -124,6 +124,8 @@ class TensionSheet(SheetScene):
     """
 
     id = "sheet2d-tension"
+    role_refusals = {"held-face": "no held face: the ends carry the traction, the sheet is "
+                                  "held only on its symmetry lines inside"}
     #: the numbers the docstring quotes from this report's runs (pdverify.quotes)
     doc_quotes = {f"{k[0]}_{s[0]}_{c}": Q(f"max_error_u{c}_pct", k,
                                          {**_T1_RUN, "load_sharing": s}, ".3g")

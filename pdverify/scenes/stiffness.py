@@ -223,6 +223,7 @@ class SheetStiffness(StiffnessScene):
     #: Taylor's fictitious nodes and the surface nodes complete its neighbourhoods
     #: (``corrections.bond_fictitious``; the rows of its traction-free faces unused)
     role_families = (BOND_BOX,)
+    role_refusals = {"held-face": "no conditions: every node is given u = eps . x"}
     title = "Sheet under homogeneous strain: nodal energy density against the bulk"
     seed = "003 §4.1.1"
     closure_theory = "bond-based"
@@ -466,6 +467,7 @@ class BondBoxStiffness(StiffnessScene):
     #: Taylor's fictitious nodes and the surface nodes complete its neighbourhoods
     #: (``corrections.bond_fictitious``; the rows of its traction-free faces unused)
     role_families = (BOND_BOX,)
+    role_refusals = {"held-face": "no conditions: every node is given u = eps . x"}
     title = "3D box under homogeneous strain, bond-based: nodal energy density against the bulk"
     seed = "001 §4.1 (bond-based: ours)"
     closure_theory = "bond-based"
