@@ -171,21 +171,6 @@ def _plane_rows(g, planes, n_cols_per_comp):
     return rows
 
 
-def energy_ratios(system, strain) -> np.ndarray:
-    """W_i / W_bulk at the real nodes of a ``bond-box`` system under u = strain . x at
-    its unknown nodes (the real nodes, then any surface nodes), its fictitious nodes by
-    its extrapolation (``pdverify.pd.work.work_density``)."""
-    from ..pd.work import work_density
-    model = system.model
-    g = model.grid
-    nodes = g.x[g.interior_ids]
-    if system.n_unknown > g.n_interior:
-        nodes = np.r_[nodes, g.surface_x]
-    field = (nodes @ np.asarray(strain, dtype=float).T).T.ravel()
-    W = work_density(model, strain, field)
-    return W[g.interior_ids] / model.bulk_work_density(strain)
-
-
 def check_bond_box(cells, p, where) -> None:
     """The extrapolation of order n needs more than 2 n nodes along every axis (seed 000
     App. D; the surface nodes' stencils need fewer)."""

@@ -112,6 +112,20 @@ def treatment_ratios(system, strain) -> np.ndarray:
     return W[g.interior_ids] / model.bulk_work_density(strain)
 
 
+def bond_box_ratios(system, strain) -> np.ndarray:
+    """W_i / W_bulk at the real nodes of a ``bond-box`` treatment's system under
+    u = strain . x at its unknown nodes (the real nodes, then any surface nodes), its
+    fictitious nodes by its extrapolation."""
+    model = system.model
+    g = model.grid
+    nodes = g.x[g.interior_ids]
+    if system.n_unknown > g.n_interior:
+        nodes = np.r_[nodes, g.surface_x]
+    field = (nodes @ np.asarray(strain, dtype=float).T).T.ravel()
+    W = work_density(model, strain, field)
+    return W[g.interior_ids] / model.bulk_work_density(strain)
+
+
 class StiffnessScene(Scene):
     """Shared machinery: subclasses build the model of a method (``build``). The
     bond-based ones describe their body and material once (:meth:`bond_problem`, a
@@ -172,14 +186,14 @@ class StiffnessScene(Scene):
         nodes; ``corrections.bond_fictitious``) on the bond-based box: its grid
         (cell-centred, the same spacing) and extrapolation, every face traction-free
         (the rows are built, not solved: u = strain . x is given at its unknown nodes)."""
-        from ..corrections.bond_fictitious import energy_ratios as box_ratios
         with timer.phase("setup"):
             problem = dataclasses.replace(
                 self.bond_problem(p, self.id),
                 surface=SurfaceConditions({}, lambda x: np.zeros_like(x)))
             system = t.build_for(BOND_BOX, problem, p)
         with timer.phase("solve"):
-            ratios = {name: box_ratios(system, eps) for name, eps in strain_states(self.dim)}
+            ratios = {name: bond_box_ratios(system, eps)
+                      for name, eps in strain_states(self.dim)}
         return self.measure_ratios(p, system.model, ratios, system.counts)
 
     def measure_ratios(self, p, model, ratios, counts=None) -> Outcome:
