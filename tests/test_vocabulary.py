@@ -48,7 +48,14 @@ def test_studies_unchanged_bit_for_bit():
     """Every study's levels, labels and refined lengths h (as float.hex) as at a694eb9,
     when convergence.py had four adapters of its own."""
     before = json.loads((DATA / "studies_a694eb9.json").read_text())
-    assert json.loads(json.dumps(studies())) == before
+    after = json.loads(json.dumps(studies()))
+    # the methods a study skips grew by issue 55's bond-box methods on the sheets (their
+    # cost, convergence.BOND_BOX_COST); every level, label and h is as it was
+    for row in after:
+        if row["scene"] in ("sheet2d-tension", "sheet2d-clamped"):
+            assert row["skip"][-2:] == ["taylor-fictitious", "surface-nodes"], row["scene"]
+            row["skip"] = row["skip"][:-2]
+    assert after == before
 
 
 #: the method x scene cells added since a694eb9 (issue 55: the seed methods across

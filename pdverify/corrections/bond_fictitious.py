@@ -44,6 +44,11 @@ system is not symmetric (the extrapolation rows enter the real equations and the
 rows are not the transpose of anything), so it goes to the sparse LU whatever the
 scene's ``solver`` says.
 
+At m = 2 the flux rows of a face are dependent (a checkerboard combination of the
+shear rows of the side faces: 4 dependent rows on the tension sheet's 20 x 40 cells) and
+the run fails as near-singular, a named failed run; at m = 4 (the quick grid) they
+have full rank.
+
 The scene's measurements see the displacements of every grid node (real and
 fictitious, :attr:`BondBoxSystem.A`) and the force through a face
 (:meth:`BondBoxSystem.face_force`: its boundary cell faces' fluxes).
