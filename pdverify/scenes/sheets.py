@@ -13,6 +13,7 @@ from ..pd.influence import bond_based_nu
 from ..pd.problem import BondProblem, FaceCondition, PartCondition, SurfaceConditions
 from . import Outcome, Published, register
 from .base import Discretisation
+from .bar1d import MACHINE_PRECISION, MACHINE_PRECISION_PCT
 from .bondfamily import BOND_BOX, PAPER, PD_COMMON, BondStaticScene, check_horizon_grid
 from ..quotes import Quote as Q
 
@@ -146,6 +147,14 @@ class TensionSheet(SheetScene):
     )
     published = (
         Published("max_error_pct", "closed form", "seed 003 §4.1.1", method="fem"),
+        # seed 000 §7: the Taylor method "can be successfully used also in bond-based
+        # models"; its exactness for a linear field (§5.1, Figs. 15-16) read on the
+        # sheet's uniform stress, against the lattice's own moduli
+        *(Published(f"max_error_u{c}_norm_pct", "machine precision",
+                    "seed 000 §7 (bond-based form) with §5.1's exactness (Figs. 15-16)",
+                    method="taylor-fictitious", where={"order": 1},
+                    bound=MACHINE_PRECISION_PCT, tolerance_source=MACHINE_PRECISION)
+          for c in ("x", "y")),
         Published("max_error_ux_pct", 82, "seed 003 Table 1", method="none",
                   where={**PAPER, **TABLE1_GRID}, deviation="003-table1",
                   reproduced=_table1("301", "540.5")),
