@@ -79,3 +79,27 @@ def test_fictitious_layer_restores_the_bulk_energy(scene_id, over, method):
     assert run.status == "ok", run.message
     assert run.metrics["surface_energy_error_pct"] < 1e-10
     assert run.metrics["energy_ratio_min"] > 1 - 1e-12
+
+
+def test_held_face_adds_held_buffer_rows_below_the_indentation_block():
+    """Virtual nodes' held-face role: delta / h rows below the held bottom, every node of
+    them and of the bottom row held (u = 0), the block's other nodes as before; a
+    description that holds no face in every component is refused."""
+    from pdverify.pd.problem import PartCondition, assemble_bonds
+    scene = get_scene("block2d-indentation")
+    p = scene.resolve("virtual-nodes", {"spacing": 0.001, "horizon": 0.006})
+    t = treatments()["virtual-nodes"]
+    before = scene.bond_problem(p, "test")
+    after = t.build_for("held-face", before, p)
+    rows = round(p["horizon"] / p["spacing"])
+    assert after.body.lengths[1] == pytest.approx(before.body.lengths[1] + rows * p["spacing"])
+    system = assemble_bonds(after)
+    x = system.model.grid.x
+    n = x.shape[0]
+    held = np.unique(system.fixed % n)
+    want = np.flatnonzero(x[:, 1] <= -p["height"] + 1e-9 * p["spacing"])
+    assert np.array_equal(held, want)
+    assert want.size == (rows + 1) * round(p["width"] / p["spacing"] + 1)
+    with pytest.raises(ValueError, match="no face held"):
+        t.build_for("held-face", type(before)(**{**before.__dict__, "conditions": {
+            "y-": PartCondition({1: 0.0})}}), p)
