@@ -12,7 +12,8 @@ from dataclasses import dataclass
 
 from ..errors import InputError
 from ..params import Param, at_least
-from ..pd.problem import LOAD_POINTS, LinearSystem, StaticProblem
+from ..pd.problem import LOAD_POINTS, BondProblem, BondSystem, LinearSystem, StaticProblem
+from .bond_fictitious import assemble_bond_box, check_bond_box
 from .mirror_nodes import GRADIENT_AT, MIRROR_POINTS, NEUMANN_READINGS, assemble_mirror
 from .pddo import BULK_MODELS, assemble_pddo
 from .plain import assemble_plain
@@ -20,7 +21,7 @@ from .protocols import GridClosure, ParamCheck, Params, StaticAssembly
 from .surface_nodes import MAX_ORDER, assemble_surface_nodes, check_wave_order, wave_extension
 from .taylor_fictitious import CORNER_RULES, assemble_taylor, fictitious_closure
 from .treatment import BASELINE, Role, Treatment
-from .virtual_nodes import check_layers, clamp
+from .virtual_nodes import check_layers, clamp, held_face
 
 FAMILY = ("static-state",)
 
@@ -151,6 +152,29 @@ def _check_flux_order(nodes, params, where) -> None:
     _check_taylor((nodes,), params, where)
 
 
+def _bond_taylor(problem: BondProblem, params: Params) -> BondSystem:
+    """Taylor's role in the ``bond-box`` family (seed 000 §7: the bond-based form)."""
+    return assemble_bond_box(problem, params["order"], "real")
+
+
+def _bond_surface(problem: BondProblem, params: Params) -> BondSystem:
+    """The surface nodes' role in the ``bond-box`` family (seed 001 read for bond-based
+    PD: ``corrections.bond_fictitious``)."""
+    return assemble_bond_box(problem, params["order"], "surface")
+
+
+def _check_bond_surface(cells, p, where) -> None:
+    N = p["order"]
+    need = max(N + 1, 2 * ((N + 1) // 2) + 1)
+    for name, n in zip("xyz", cells):
+        if n < need:
+            raise InputError(f"{where}: {n} cells along {name}; order {N} needs at least "
+                             f"{need} for the Taylor stencils")
+
+
+BOTH = ("state-based", "bond-based")
+
+
 def family_treatments() -> list[Treatment]:
     return [
         FamilyTreatment(
@@ -164,7 +188,7 @@ def family_treatments() -> list[Treatment]:
             "extrapolation (1D series along the normal; corners by Eq. 69), Dirichlet and "
             "Neumann conditions via Lagrange multipliers (Eqs. 58, 60, 63)",
             "Scabbia, Zaccariotto, Galvanetto 2021 (seed 000)", params=(ORDER, CORNERS),
-            theories=STATE, dims=(1, 2, 3), families=FAMILY, footprint="fictitious",
+            theories=BOTH, dims=(1, 2, 3), families=FAMILY, footprint="fictitious",
             scope="state-based 1D, 2D and 3D (3D is our extension). 3D at the seed-001 "
                   "boxes' h = 0.05: 35-40 s and 2.1-2.2 GB (bordered system under nested "
                   "dissection, 6.1-6.5 M non-zeros); one flux row of each edge cell's "
@@ -173,7 +197,9 @@ def family_treatments() -> list[Treatment]:
                   "(10 x 5 x 5 cells) keeps 2 dependent constraint rows and fails as "
                   "near-singular. On a shape (not a box) the series runs along the local "
                   "normal with derivatives from a least-squares fit, the conditions at "
-                  "boundary points (corrections.shape_fictitious; corners unused)",
+                  "boundary points (corrections.shape_fictitious; corners unused). "
+                  "Bond-based (seed 000 §7): the 2D boxes that state their conditions at "
+                  "the surface (corrections.bond_fictitious)",
             build=_taylor, checker=_check_taylor, shapes=True,
             shapes3d_why="not built (corrections.shape_fictitious fits its series along "
                          "the normal from the 2D parts' crossings, Shape.crossings of "
@@ -181,22 +207,26 @@ def family_treatments() -> list[Treatment]:
                          "intersections of planes, a mantle and a sphere, and its 3D box "
                          "form already costs 35-40 s and 2.1 GB at 2000 nodes, past a 3D "
                          "shape scene's budget)",
-            roles=(("flux-bar", Role(_flux_order, (ORDER,), _check_flux_order)),)),
+            roles=(("flux-bar", Role(_flux_order, (ORDER,), _check_flux_order)),
+                   ("bond-box", Role(_bond_taylor, (ORDER,), check_bond_box)))),
         FamilyTreatment(
             "surface-nodes", "seeds 001/002: surface nodes carry the boundary conditions, "
             "fictitious layer by Taylor extrapolation about the nearest surface node",
             "Scabbia, Zaccariotto, Galvanetto 2023 (seed 001); seed 002",
-            params=(SURFACE_ORDER,), theories=STATE, families=FAMILY, footprint="surface",
+            params=(SURFACE_ORDER,), theories=BOTH, families=FAMILY, footprint="surface",
             build=_surface, checker=_check_surface, shapes=True,
-            scope="state-based boxes and shapes; on a shape the surface nodes sit at "
-                  "the boundary nodes' points on each part, the series about the nearest "
+            scope="state-based boxes, shapes and 1D waves; on a shape the surface nodes sit "
+                  "at the boundary nodes' points on each part, the series about the nearest "
                   "one runs along the local normal with derivatives from a least-squares "
                   "fit, arcs take the series' traction (surface_nodes."
-                  "surface_nodes_on_shape: our generalisation)",
+                  "surface_nodes_on_shape: our generalisation); bond-based: the 2D boxes "
+                  "that state their conditions at the surface (corrections.bond_fictitious: "
+                  "what seed 001 leaves open for bond-based PD)",
             shapes3d_why="not built (surface_nodes.surface_nodes_on_shape places its "
                          "surface nodes and fits on the 2D parts; a 3D part needs surface "
                          "nodes on planes, a mantle and a sphere and 3D fits)",
-            roles=(("wave-bar", Role(wave_extension, (WAVE_ORDER,), check_wave_order)),)),
+            roles=(("wave-bar", Role(wave_extension, (WAVE_ORDER,), check_wave_order)),
+                   ("bond-box", Role(_bond_surface, (SURFACE_ORDER,), _check_bond_surface)))),
         FamilyTreatment(
             "mirror-nodes", "seed 001 §5: a delta-thick fictitious layer whose nodes copy "
             "mirror nodes inside the body (odd reflection for Dirichlet components, the "
@@ -208,6 +238,11 @@ def family_treatments() -> list[Treatment]:
                   "point, the reflection across the local tangent and the traction "
                   "relation with the local normal (mirror_nodes.MirrorNodesOnShape: our "
                   "generalisation)",
+            theory_refusal="not wired for bond-based PD: it would need a bond-box role "
+                           "(its odd/even reflection map with the prescribed values' "
+                           "offset on bond_fictitious' grid) and a Neumann relation from "
+                           "the bond-based lattice's moduli (C11, C12 of the stencil), "
+                           "not the LPS constants it takes",
             build=_mirror, checker=_check_mirror, shapes=True,
             shapes3d_why="not built (mirror_nodes.MirrorNodesOnShape reflects across the "
                          "tangent lines of 2D parts; a 3D part needs the tangent planes of "
@@ -217,6 +252,10 @@ def family_treatments() -> list[Treatment]:
             "for quadratics) for the boundary rows and the equilibrium within 2 delta, LPS "
             "beyond", "Behera, Roy, Anicode, Madenci, Spencer 2022; seed 001 §5.3",
             params=PDDO_PARAMS, theories=STATE, families=FAMILY,
+            theory_refusal="not wired for bond-based PD: its equations beyond 2 delta are "
+                           "the LPS model's and its traction rows use the LPS constants "
+                           "(seed 001 §5.3); a bond-based form needs the bond-based bulk "
+                           "beyond and the lattice's moduli (C11, C12) in the rows",
             scope="state-based; the boundary row (Dirichlet or traction) is chosen per "
                   "boundary node; on a shape at each boundary node's points with the "
                   "part's local normal (pddo.pddo_shape_system: our generalisation)",
@@ -237,9 +276,18 @@ def hand_wired() -> list[Treatment]:
         Treatment("virtual-nodes", "seed 003 §4.1.2: buffer layers of thickness delta "
                   "outside the clamped edges, displaced rigidly (bond-based)",
                   "seed 003 §4.1.2", theories=("bond-based",), footprint="fictitious",
-                  roles=(("clamped-sheet", Role(clamp, (CORRECT_SIDES,), check_layers)),),
-                  scope="the clamped sheet only (rigid buffers need a clamped edge, which "
-                        "no other bond-based scene has)"),
+                  roles=(("clamped-sheet", Role(clamp, (CORRECT_SIDES,), check_layers)),
+                         ("held-face", Role(held_face))),
+                  scope="bond-based bodies with a face held in every component: the "
+                        "clamped sheet (its own grid, variants 2 and 4) and the held-face "
+                        "scenes (buffer rows beyond the held face, variant 2)",
+                  theory_refusal="bond-based (seed 003 §4.1.2: a rigid buffer beyond a "
+                                 "clamp, its nodes carrying no state of their own); an LPS "
+                                 "buffer node needs a dilatation and enters its neighbours' "
+                                 "m, which the paper does not give, and most state-based "
+                                 "scenes prescribe a varying field on a face (the plates) "
+                                 "or its normal component only (body3d), where no buffer "
+                                 "is rigid"),
         Treatment("fem", "classical-elasticity FEM reference (reference_fem)",
                   "scikit-fem", scope="the reference of the scenes whose reference is FEM"),
     ]

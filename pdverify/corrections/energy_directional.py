@@ -1,4 +1,5 @@
-"""Directional energy surface correction for bond-based PD (seed 003 §3, Eqs. 12-14)."""
+"""Directional energy surface correction for bond-based PD (seed 003 §3, Eqs. 12-14), and
+its reading for state-based (LPS) models (:func:`box_factors`)."""
 from __future__ import annotations
 
 import numpy as np
@@ -40,14 +41,18 @@ def directional_factor(x, e, lower, upper, horizon, influence, dim, axes=None) -
         return influence.radial_ratio(dim, d, horizon)
 
 
-def directional_closure(grid, lower, upper, horizon, influence, axes=None) -> Closure:
+def directional_closure(grid, lower, upper, horizon, influence, axes=None,
+                        moment: int | None = None) -> Closure:
     """The ``energy-directional`` closure: bond a-b gets (phi(x_a, n) + phi(x_b, -n)) / 2
-    (Eq. 2 applied at both ends, ERRATA), the faces of ``axes`` of the box counted."""
+    (Eq. 2 applied at both ends, ERRATA), the faces of ``axes`` of the box counted;
+    ``moment``: the power of xi in Eq. 14's integrals (default the dimension D, the
+    bond-based node energy; D + 1 for a state-based model, :func:`box_factors`)."""
     lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+    D = grid.dim if moment is None else moment
 
     def bond_factor(a, b, n):
-        fa = directional_factor(grid.x[a], n, lower, upper, horizon, influence, grid.dim, axes)
-        fb = directional_factor(grid.x[b], -n, lower, upper, horizon, influence, grid.dim, axes)
+        fa = directional_factor(grid.x[a], n, lower, upper, horizon, influence, D, axes)
+        fb = directional_factor(grid.x[b], -n, lower, upper, horizon, influence, D, axes)
         return 0.5 * (fa + fb)
 
     return Closure(bond_factor=bond_factor)
@@ -62,11 +67,26 @@ def box_factors(model) -> np.ndarray:
     under a homogeneous strain is (1/4) s^2 int c(xi) xi^D dxi per direction (the bond
     energy c s^2 |xi| / 2, halved to each end, times the shell xi^(D-1)), which is the
     paper's 2D ratio for D = 2 and the same argument in 1D and 3D (our extension).
+
+    State-based (LPS) models (our reading; seed 003 is bond-based): the factor multiplies
+    each bond's influence omega beta, so it enters the weighted volume m, the dilatation
+    theta and the force state alike (``Closure.geometric_factor``). Under a homogeneous
+    strain eps, m, theta's sum and the deviatoric energy each take, direction by
+    direction, int omega(xi) xi^(D+1) dxi (the bond's omega |xi|^2 s^2, s = n.eps.n, over
+    the shell xi^(D-1)), so Eq. 14's ratio is taken with xi^(D+1): the role of c(xi) xi^D
+    is played by omega(xi) xi^(D+1). A node whose truncated directions are all restored
+    gets the complete m, the bulk dilatation tr(eps) and the bulk energy; like
+    the paper's, the factor is exact only where a direction's missing part is a whole
+    radial interval (a ray leaving the box), not for bonds whose partial volume the
+    quadrature cuts.
     """
+    from ..pd.statebased import StateBasedModel
     g = model.grid
     lower = np.asarray(g.origin, dtype=float)
     upper = lower + np.asarray(g.lengths, dtype=float)
-    closure = directional_closure(g, lower, upper, model.horizon, model.influence)
+    moment = g.dim + 1 if isinstance(model, StateBasedModel) else g.dim
+    closure = directional_closure(g, lower, upper, model.horizon, model.influence,
+                                  moment=moment)
     return closure.bond_factor(model.bond_a, model.bond_b, model.bond_n)
 
 

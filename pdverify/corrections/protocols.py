@@ -18,6 +18,10 @@ grid, ``BondMethod``)     Closure``                                   ``pals``, 
                           (grid -> Closure) | None``                  the bar's grid
 ``clamped-sheet`` (role)  :class:`Clamp`: ``(ClampedBox, params) ->   ``virtual_nodes.clamp``
                           ClampedGrid``
+``bond-box`` (role)       :class:`BondBox`: ``(BondProblem, params)   ``bond_fictitious.
+                          -> BondSystem``                             assemble_bond_box``
+``held-face`` (role)      :class:`HeldFace`: ``(BondProblem, params)  ``virtual_nodes.
+                          -> BondProblem``                            held_face``
 ========================  ==========================================  =====================
 
 Parameter checks share one signature, :class:`ParamCheck` ``(context, params, where)``,
@@ -41,7 +45,7 @@ import scipy.sparse as sp
 
 from ..pd.closure import Closure
 from ..pd.grid import BoxGrid
-from ..pd.problem import ClampedBox, LinearSystem, StaticProblem
+from ..pd.problem import BondProblem, BondSystem, ClampedBox, LinearSystem, StaticProblem
 
 #: a treatment's resolved parameters
 Params = Mapping[str, Any]
@@ -100,6 +104,23 @@ class Clamp(Protocol):
 
 
 @runtime_checkable
+class BondBox(Protocol):
+    """``bond-box``: a bond-based box's system from its conditions at the surface
+    (:class:`~pdverify.pd.problem.SurfaceConditions`), with the treatment's own grid,
+    unknowns and rows (``corrections.bond_fictitious``)."""
+
+    def __call__(self, problem: BondProblem, params: Params) -> BondSystem: ...
+
+
+@runtime_checkable
+class HeldFace(Protocol):
+    """``held-face``: the description with what the treatment adds beyond its held faces
+    (virtual nodes' rigid buffer rows, held as the face is)."""
+
+    def __call__(self, problem: BondProblem, params: Params) -> BondProblem: ...
+
+
+@runtime_checkable
 class ParamCheck(Protocol):
     """Refuses parameters before any work (``InputError``, one line naming ``where``)."""
 
@@ -108,9 +129,10 @@ class ParamCheck(Protocol):
 
 #: the protocol of each family's role (``Role.build``)
 ROLE_PROTOCOLS: dict[str, type] = {"wave-bar": WaveExtension, "flux-bar": FluxClosure,
-                                   "clamped-sheet": Clamp}
+                                   "clamped-sheet": Clamp, "bond-box": BondBox,
+                                   "held-face": HeldFace}
 #: what ``Role.build`` may be: one of the role protocols
-RoleBuild = typing.Union[WaveExtension, FluxClosure, Clamp]
+RoleBuild = typing.Union[WaveExtension, FluxClosure, Clamp, BondBox, HeldFace]
 
 
 def conformance(fn, protocol: type) -> str | None:

@@ -129,9 +129,14 @@ def _builtin() -> list[Treatment]:
                    "to its truncated part along the bond direction, on the scene's box "
                    "(bond-based; the seed-003 scenes wire it to their own boxes)",
                    "Ritter, Wohlmuth et al. (seed 003), Eqs. 2, 12-14",
-                   closure=energy_directional_closure, theories=("bond-based",),
-                   scope="bond-based box scenes (Eq. 14's ratio with xi^D: the paper's 2D, "
-                         "our 1D and 3D)"),
+                   closure=energy_directional_closure, shapes=False,
+                   scope="box scenes (Eq. 14's ratio with xi^D: the paper's 2D, our 1D and "
+                         "3D; state-based, our reading: the factor on each bond's influence, "
+                         "so in m, the dilatation and the force state, with xi^(D+1))",
+                   box_only="Eq. 14's ray distance a is taken to the scene's box faces "
+                            "(the grid's bounding box); a hole or a notch is not one of "
+                            "them, so a bond there would be restored against the wrong "
+                            "missing length"),
         BondMethod("volume", "volume correction 2 V0 / (V_i + V_j) on the bond force (V the "
                    "discrete horizon volume of each end)",
                    "Le and Bobaru 2018; PeriLab, PeriPy, pypd", closure=volume_closure),
@@ -141,6 +146,10 @@ def _builtin() -> list[Treatment]:
                    "Mitchell, Silling and Littlewood, J. Mech. Mater. Struct. 10 (2015) "
                    "539-557; seed 001 §5.1; Peridigm pals.cxx", closure=pals_closure,
                    theories=("state-based",), dims=(2, 3),
+                   theory_refusal="a state-based constitutive model (its influence "
+                                  "functions weigh the dilatation and the deviatoric "
+                                  "extension); a bond-based model has neither term, so "
+                                  "there is nothing for them to weigh",
                    scope="2D/3D state-based (the matching deformations of a 1D bar leave "
                          "its influence functions undetermined)"),
         BondMethod("perifit", "operator-matching nodal weights of the perifit package, "

@@ -52,6 +52,16 @@ if TYPE_CHECKING:       # the signatures each family takes (imported by the type
 
 THEORIES = ("bond-based", "state-based")
 ENTRY_POINT_GROUP = "pdverify.methods"
+#: families whose roles serve the scenes of one theory beside the scene's own family
+#: (``Scene.role_families``): a scene of that theory that does not list the family
+#: says why (``Scene.role_refusals``)
+ROLE_FAMILY_THEORY = {"bond-box": "bond-based", "held-face": "bond-based"}
+#: the reason a scene of that theory that neither lists the family nor says why gets
+ROLE_DEFAULT_REFUSAL = {
+    "bond-box": "its bond-box role needs the scene's conditions stated at the body's "
+                "surface; this scene states them on nodes only",
+    "held-face": "its held-face role needs a face held in every component; this scene "
+                 "holds none"}
 #: the uncorrected baseline's name (``Treatment.baseline``; a scene that declares its own
 #: baseline run names it so)
 BASELINE = "none"
@@ -115,6 +125,8 @@ class Treatment:
     #: ``shapes3d_why``: why not, when it serves 2D shapes only
     shapes3d: bool = False
     shapes3d_why: str = ""
+    #: why not on a scene of a theory it does not take (one line; empty: "THEORY only")
+    theory_refusal: str = ""
 
     def __post_init__(self):
         bad = [t for t in self.theories if t not in THEORIES]
@@ -131,10 +143,19 @@ class Treatment:
         """Its :class:`Role` in ``family``, if it has one."""
         return next((r for f, r in self.roles if f == family), None)
 
+    def role_on(self, scene) -> Role | None:
+        """Its :class:`Role` on ``scene``: in the scene's family, else in the first of
+        the scene's further ``role_families`` it has one in."""
+        for family in (getattr(scene, "family", None), *getattr(scene, "role_families", ())):
+            role = self.role(family)
+            if role is not None:
+                return role
+        return None
+
     def params_for(self, scene) -> tuple[Param, ...]:
-        """Its parameters on ``scene``: its role's in the scene's family, the scene's
+        """Its parameters on ``scene``: its role's there (:meth:`role_on`), the scene's
         ``baseline_params`` for the baseline on a closure scene, else ``params``."""
-        role = self.role(getattr(scene, "family", None))
+        role = self.role_on(scene)
         if role is not None:
             return role.params
         if self.baseline and self._closure_scene(scene):
@@ -161,8 +182,8 @@ class Treatment:
         """``None`` when this treatment runs on ``scene``, else a one-line reason."""
         if self.name in {m.name for m in scene.methods}:
             return None                                  # the scene implements it itself
-        if self.role(getattr(scene, "family", None)) is not None:
-            return None                      # a role in the scene's problem family
+        if self.role_on(scene) is not None:
+            return None                      # a role in the scene's problem families
         if self.baseline and self._closure_scene(scene):
             return None                      # the uncorrected model of a closure scene
         if getattr(scene, "closed_to_treatments", None):
@@ -171,7 +192,8 @@ class Treatment:
             return self.scope or f"only on {', '.join(self.scenes)}"
         theory = getattr(scene, "model_theory", None)
         if theory is not None and theory not in self.theories:
-            return f"{'/'.join(self.theories)} only; this scene is {theory}"
+            return (self.theory_refusal
+                    or f"{'/'.join(self.theories)} only; this scene is {theory}")
         if scene.dim is not None and scene.dim not in self.dims:
             return (f"{'/'.join(map(str, self.dims))}D only; this scene is {scene.dim}D"
                     + (f" ({self.scope})" if self.scope else ""))
@@ -181,6 +203,11 @@ class Treatment:
         family = getattr(scene, "family", None)
         if self.families and family in self.families:
             return scene.family_refusal(self)
+        theory = getattr(scene, "model_theory", None)
+        for f, _ in self.roles:
+            if ROLE_FAMILY_THEORY.get(f) == theory:
+                return (getattr(scene, "role_refusals", {}).get(f)
+                        or ROLE_DEFAULT_REFUSAL.get(f, f"the scene offers no {f} role"))
         if self.families:
             return (f"assembles {', '.join(self.families)} problems; this scene is "
                     f"{family or 'not a problem description yet'}"

@@ -284,6 +284,22 @@ class PartCondition:
     force: Callable[[np.ndarray], np.ndarray] | None = None
 
 
+@dataclass(frozen=True)
+class SurfaceConditions:
+    """A bond-based box's conditions stated at its surface, for the treatments that
+    impose them there (fictitious or surface nodes, the ``bond-box`` family): the body
+    laid out cell-centred (whole cells, the surface half a spacing beyond the outermost
+    nodes) and ``faces[name] = FaceCondition(prescribed=(k, ...), traction=...)`` as in
+    :class:`StaticProblem` (whole faces; faces not listed are traction-free), the
+    prescribed components taking ``value(x) -> (n, d)`` at the boundary points, and
+    ``planes = ((axis, k), ...)``: u_k = 0 on the plane x_axis = 0 inside the body (a
+    symmetry line; on a cell-centred grid the mean of the two nodes straddling it)."""
+
+    faces: Mapping[str, FaceCondition]
+    value: Callable[[np.ndarray], np.ndarray]
+    planes: tuple = ()
+
+
 @dataclass
 class BondProblem:
     """A static bond-based problem as a scene states it once, the twin of
@@ -315,6 +331,9 @@ class BondProblem:
     family: str | None = None
     loads: str = ""
     supports: str = ""
+    #: the same conditions stated at the body's surface (:class:`SurfaceConditions`),
+    #: for the ``bond-box`` treatments; None: the scene states them on nodes only
+    surface: SurfaceConditions | None = None
 
     def __post_init__(self):
         faces = face_names(len(self.body.lengths))

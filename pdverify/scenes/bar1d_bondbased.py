@@ -134,6 +134,12 @@ class BondBarScene(Scene):
     seed = "004"
     dim = 1
     closure_theory = "bond-based"
+    role_refusals = {
+        "bond-box": "not wired: the bar's loads and holds are seed 004's point forces on "
+                    "its end points and held points, whose end-bond factors it measures "
+                    "(Tables 12-13); the 1D bars stated at their surface are the "
+                    "state-based bar1d-traction/-uniform-load (Taylor, surface nodes)",
+        "held-face": "no held face: both end points carry the end forces"}
 
     def discretisation(self, p):
         """``nodes`` points over ``length`` (Delta = length / (nodes - 1)), delta =
@@ -532,6 +538,8 @@ class Constraints(BondBarScene):
     """
 
     id = "bar1d-constraints"
+    role_refusals = {**BondBarScene.role_refusals, "held-face": (
+        "its held points are seed 004's own constraint variants: bar (c), points 1..m held over one horizon, is the rigid buffer virtual nodes add, run as the scene's own bar")}
     title = "Symmetry and constraint variants of a bar in tension (Fig. 3)"
     seed = "004 §6.2"
     reference = "analytic"
@@ -706,6 +714,8 @@ class Vibration(BondBarScene):
     """
 
     id = "bar1d-vibration"
+    role_refusals = {**BondBarScene.role_refusals, "held-face": (
+        "its held points are seed 004's own constraint variants: constraint=end-points (points 1..4 held over one horizon) is the rigid buffer virtual nodes add, run as the scene's own case")}
     #: the numbers the docstring quotes from this report's runs (pdverify.quotes)
     doc_quotes = {k: Q(metric, "homogenized", {"constraint": "mid", "horizon_ratio": 4.0,
                                                "nodes": 201}, ".3g")

@@ -333,6 +333,13 @@ class Scene:
     #: why no treatment beyond the scene's own ``methods`` applies (one line), e.g. a
     #: reference that is the uncorrected model's own; None: the registry decides
     closed_to_treatments: str | None = None
+    #: further problem families whose treatments' roles serve the scene beside its
+    #: ``family`` (``bond-box``: a bond-based box whose description states its
+    #: conditions at the surface too, :class:`~pdverify.pd.problem.SurfaceConditions`)
+    role_families: tuple[str, ...] = ()
+    #: why a family of :data:`~pdverify.corrections.treatment.ROLE_FAMILY_THEORY` of the
+    #: scene's theory is not among its ``role_families`` (family -> one line)
+    role_refusals: Mapping[str, str] = {}
 
     # -- methods ----------------------------------------------------------------------
     @property

@@ -24,6 +24,11 @@ from ..solvers.policy import AUTO_ITERATIVE_UNKNOWNS, SPD_LATTICE_SOLVERS
 from .base import Outcome, whole_cells
 from .fem_references import FemAndPD
 
+#: the family of the treatments that impose a bond-based box's conditions at its surface
+BOND_BOX = "bond-box"
+#: the family of the treatments that add a rigid buffer beyond a held face (virtual nodes)
+HELD_FACE = "held-face"
+
 MICROMODULI = ("constant", "conical")
 #: seed 003's node volumes (ERRATA) and the horizon quadrature that reproduces Tables 1-2
 PD_COMMON = (
@@ -71,6 +76,10 @@ class BondStaticScene(FemAndPD):
         uncorrected one for the baseline and a peer)."""
         problem = self.bond_problem(p, where)
         t = self.offered().get(method)
+        if (problem.surface is not None and t is not None
+                and t.role(problem.family) is None and t.role(BOND_BOX) is not None):
+            # conditions at the surface: the treatment's own grid, unknowns and rows
+            return problem, t.build_for(BOND_BOX, problem, p)
         if problem.family is not None and t is not None and t.role(problem.family):
             box = problem.clamped_box()
             grid, closure, low, high = t.build_for(problem.family, box, p)
@@ -89,7 +98,9 @@ class BondStaticScene(FemAndPD):
         t = self.offered().get(method)
         peer = getattr(t, "peer_solve_bonds", None)
         with timer.phase("solve"):
-            if peer is not None:       # another code solves it (pdverify.peers)
+            if hasattr(system, "solve"):   # a bond-box system: its own bordered solve
+                u, info = system.solve(where)
+            elif peer is not None:       # another code solves it (pdverify.peers)
                 u, info, peer_metrics, trouble = peer(self, p, problem, system, where,
                                                       solve_none)
             else:

@@ -121,12 +121,12 @@ class FemAndPD(FemReference):
     @property
     def all_methods(self):
         """``fem``, then the offered treatments; a treatment with a role in the scene's
-        family takes ``pd_params`` beside its role's (the baseline and the closures
+        family (or its ``role_families``) takes ``pd_params`` beside its role's (the baseline and the closures
         have them through ``baseline_params``)."""
         own = tuple(self.methods)
         offered = self.offered()
         return own + tuple(
-            MethodSpec(m.name, (self.pd_params if (offered[m.name].role(self.family)
+            MethodSpec(m.name, (self.pd_params if (offered[m.name].role_on(self)
                                                    or getattr(offered[m.name], "peer", False))
                                 else ()) + m.params)
             for m in Scene.all_methods.fget(self)[len(own):])

@@ -9,7 +9,7 @@ when its cell centre lies inside, its volume the part of its cell inside, sample
 of the family that can serve a 3D body that is not a box run on it: ``none`` and the
 bond/closure methods (``energy``, ``volume``, ``pals``); ``list`` says why the others do
 not (Taylor's fictitious nodes along the normal are 2D on shapes; surface nodes, mirror
-nodes and PDDO are box-only).
+nodes and PDDO serve the 2D shapes only).
 
 Choices common to both (the issue is silent): octants by symmetry, on the PD side too
 (the symmetry planes are roller parts, a prescribed normal component on the real nodes
@@ -32,7 +32,7 @@ from ..pd.shapes3d import cavity_octant, quarter_cylinder
 from ..quotes import Quote as Q
 from ..quotes import used
 from . import influence_param, register, whole_cells
-from .shapes import ORDERING, ShapeScene, shape_errors
+from .shapes import ORDERING, ShapeScene
 
 def _sigma_z(sigma):
     return lambda x, n: np.c_[np.zeros(len(x)), np.zeros(len(x)), np.full(len(x), sigma)]

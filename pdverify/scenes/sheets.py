@@ -10,10 +10,11 @@ from ..params import Param, horizon_param, m_ratio_param, spacing_param
 from ..pd import get_influence
 from ..pd.build import Body, BondMaterial
 from ..pd.influence import bond_based_nu
-from ..pd.problem import BondProblem, PartCondition
+from ..pd.problem import BondProblem, FaceCondition, PartCondition, SurfaceConditions
 from . import Outcome, Published, register
 from .base import Discretisation
-from .bondfamily import PAPER, PD_COMMON, BondStaticScene, check_horizon_grid
+from .bar1d import MACHINE_PRECISION, MACHINE_PRECISION_PCT
+from .bondfamily import BOND_BOX, PAPER, PD_COMMON, BondStaticScene, check_horizon_grid
 from ..quotes import Quote as Q
 
 #: the grids and loads of the papers' tables (the published values stand beside these only,
@@ -45,6 +46,9 @@ class SheetScene(BondStaticScene):
     params' split)."""
 
     figure = "sheets"
+    #: Taylor's fictitious nodes and the surface nodes take the conditions at the
+    #: sheet's surface (``BondProblem.surface``, ``corrections.bond_fictitious``)
+    role_families = (BOND_BOX,)
 
     def check_pd(self, where, method, p):
         nu = bond_based_nu(2, "stress")
@@ -58,8 +62,14 @@ class SheetScene(BondStaticScene):
         t = self.offered().get(method)
         if getattr(t, "peer", False):
             t.check((), p, where)
+        if t is not None and t.role(BOND_BOX) is not None and t.role(self.family) is None:
+            t.check_for(BOND_BOX, self.cells(p), p, where)
 
     def check_sheet(self, where, method, p):
+        raise NotImplementedError
+
+    def cells(self, p) -> tuple[int, ...]:
+        """Cells per axis of the sheet laid out cell-centred (the ``bond-box`` grid)."""
         raise NotImplementedError
 
 
@@ -115,6 +125,8 @@ class TensionSheet(SheetScene):
     """
 
     id = "sheet2d-tension"
+    role_refusals = {"held-face": "no held face: the ends carry the traction, the sheet is "
+                                  "held only on its symmetry lines inside"}
     #: the numbers the docstring quotes from this report's runs (pdverify.quotes)
     doc_quotes = {f"{k[0]}_{s[0]}_{c}": Q(f"max_error_u{c}_pct", k,
                                          {**_T1_RUN, "load_sharing": s}, ".3g")
@@ -135,6 +147,14 @@ class TensionSheet(SheetScene):
     )
     published = (
         Published("max_error_pct", "closed form", "seed 003 §4.1.1", method="fem"),
+        # seed 000 §7: the Taylor method "can be successfully used also in bond-based
+        # models"; its exactness for a linear field (§5.1, Figs. 15-16) read on the
+        # sheet's uniform stress, against the lattice's own moduli
+        *(Published(f"max_error_u{c}_norm_pct", "machine precision",
+                    "seed 000 §7 (bond-based form) with §5.1's exactness (Figs. 15-16)",
+                    method="taylor-fictitious", where={"order": 1},
+                    bound=MACHINE_PRECISION_PCT, tolerance_source=MACHINE_PRECISION)
+          for c in ("x", "y")),
         Published("max_error_ux_pct", 82, "seed 003 Table 1", method="none",
                   where={**PAPER, **TABLE1_GRID}, deviation="003-table1",
                   reproduced=_table1("301", "540.5")),
@@ -182,7 +202,12 @@ class TensionSheet(SheetScene):
         for h in self.m_sweep:
             if h != 0.001:
                 out += [(m, {"spacing": h}) for m in ("none", "energy-directional")]
-        return out
+        # seed 000 §7's and seed 001's methods read for bond-based PD, default case only
+        return out + [(m, {}) for m in ("taylor-fictitious", "surface-nodes")
+                      if m in self.offered()]
+
+    def cells(self, p):
+        return (round(p["width"] / p["spacing"]), round(p["length"] / p["spacing"]))
 
     def bond_problem(self, p, where):
         W, H, h, delta = p["width"], p["length"], p["spacing"], p["horizon"]
@@ -209,6 +234,12 @@ class TensionSheet(SheetScene):
             p["E"], bond_based_nu(2, "stress"), "plane-stress",
             parts={"symmetry-x": lambda x: np.isclose(x[:, 0], 0.0),
                    "symmetry-y": lambda x: np.isclose(x[:, 1], 0.0)},
+            # at the surface: the traction sigma on the ends' cell faces (the sheet's
+            # whole width), the same symmetry lines
+            surface=SurfaceConditions(
+                {"y-": FaceCondition(traction=_end_traction(sigma)),
+                 "y+": FaceCondition(traction=_end_traction(sigma))},
+                lambda x: np.zeros((len(x), 2)), planes=((0, 0), (1, 1))),
             loads=(f"the end force traction x width x thickness = {sigma * W * t:.6g} N on "
                    f"each end y = +-length/2, shared among that end's nodes {share} "
                    "(nodal forces in y, outward)"),
@@ -220,8 +251,9 @@ class TensionSheet(SheetScene):
         W, H, h, delta, sigma = (p["width"], p["length"], p["spacing"], p["horizon"],
                                  p["traction"])
         model = system.model
-        n, xg = model.grid.n_ext, model.grid.x
-        U = np.asarray(x).reshape(2, n).T
+        real = model.grid.interior_ids        # every node but a treatment's fictitious ones
+        n, xg = model.grid.n_ext, model.grid.x[real]
+        U = np.asarray(x).reshape(2, n).T[real]
         E_star, nu_star = lattice_moduli(model)
         metrics = {}
         refs = {"": (E_star, nu_star), "_continuum": (p["E"], bond_based_nu(2, "stress"))}
@@ -241,8 +273,25 @@ class TensionSheet(SheetScene):
         fields = {"x": xg, "u": U, "u_ref": u_ref, "error": err, "spacing": h,
                   "horizon": delta, "lengths": (W, H)}
         size = {"nodes": int(n), "dofs": int(2 * n - system.fixed.size),
-                "bonds": model.n_bonds(), "stiffness_nnz": int(model.K.nnz)}
+                "bonds": model.n_bonds(), "stiffness_nnz": int(model.K.nnz),
+                **_bond_box_size(system)}
         return Outcome(metrics=metrics, size=size, fields=fields, diagnostics=info)
+
+
+def _end_traction(sigma):
+    """The outward normal traction sigma on a face y = const: t = sigma n_y e_y."""
+    def traction(x, normal):
+        t = np.zeros((len(x), 2))
+        t[:, 1] = sigma * normal[:, 1]
+        return t
+    return traction
+
+
+def _bond_box_size(system) -> dict:
+    """A ``bond-box`` system's unknowns and node counts (its grid adds fictitious nodes
+    and its unknowns multipliers, so the plain grid's ``dofs`` does not say them)."""
+    counts = getattr(system, "counts", None)
+    return {} if not counts else {"dofs": counts["unknowns"], **counts}
 
 
 def lattice_moduli(model) -> tuple[float, float]:
@@ -363,9 +412,15 @@ class ClampedSheet(SheetScene):
         check_horizon_grid(where, (("side", L),), delta / p["m_ratio"], delta, "horizon/m_ratio")
         self.treatment(method).check_for(self.family, None, p, where)
 
+    def cells(self, p):
+        n = round(p["side_factor"] * p["m_ratio"])
+        return (n, n)
+
     def cases(self, quick=False):
         out = [("fem", {}), ("none", {}), ("energy-directional", {}), ("virtual-nodes", {}),
                ("virtual-nodes", {"correct_sides": True})]
+        # seed 000 §7's and seed 001's methods read for bond-based PD
+        out += [(m, {}) for m in ("taylor-fictitious", "surface-nodes") if m in self.offered()]
         if quick:
             return out
         pv = {"quadrature": "partial-volume"}
@@ -391,6 +446,11 @@ class ClampedSheet(SheetScene):
             delta, {"y+": PartCondition({0: 0.0, 1: uy}),
                     "y-": PartCondition({0: 0.0, 1: -uy})},
             p["E"], bond_based_nu(2, "stress"), "plane-stress", family=self.family,
+            # at the surface: the clamped edges y = +-L/2 themselves (u_x = 0,
+            # u_y = strain y there), the sides traction-free
+            surface=SurfaceConditions(
+                {"y-": FaceCondition(prescribed=(0, 1)), "y+": FaceCondition(prescribed=(0, 1))},
+                lambda x: np.stack([np.zeros(len(x)), p["strain"] * x[:, 1]], axis=1)),
             loads="none: the sheet is driven by its clamped rows alone",
             supports=(f"the outermost rows y = +-L/2 clamped: u_x = 0 and u_y = +-strain "
                       f"L / 2 = +-{uy:.6g} m (nodes lie on the sheet's surface); the "
@@ -413,9 +473,13 @@ class ClampedSheet(SheetScene):
         grid = model.grid
         n = grid.n_ext
         u = np.asarray(x)
-        reaction = system.K @ u - system.rhs
-        stress = float(reaction[n + top].sum()) / (L * t) / 1e6
-        sample = np.flatnonzero(np.abs(grid.x[:, 1]) <= L / 2 + 1e-12 * L)
+        if hasattr(system, "face_force"):    # a bond-box system: the flux through y = L/2
+            stress = float(system.face_force("y+")[1]) / (L * t) / 1e6
+        else:
+            reaction = system.K @ u - system.rhs
+            stress = float(reaction[n + top].sum()) / (L * t) / 1e6
+        sample = np.flatnonzero((np.abs(grid.x[:, 1]) <= L / 2 + 1e-12 * L)
+                                & grid.is_interior)
         U = u.reshape(2, n).T
         xs = grid.x[sample]
         u_ref = ref.evaluate(xs)
@@ -431,8 +495,9 @@ class ClampedSheet(SheetScene):
         }
         fields = {"x": xs, "u": U[sample], "u_ref": u_ref, "error": err, "spacing": h,
                   "horizon": delta, "lengths": (L, L),
-                  "energy": model.strain_energy_density(u)[sample],
+                  # (a bond-box model maps its own unknowns to the grid's nodes)
+                  "energy": model.strain_energy_density(getattr(system, "unknowns", u))[sample],
                   "energy_ref": ref.strain_energy_density(xs)}
         size = {"nodes": int(n), "dofs": int(2 * n - system.fixed.size),
-                "bonds": model.n_bonds()}
+                "bonds": model.n_bonds(), **_bond_box_size(system)}
         return Outcome(metrics=metrics, size=size, fields=fields, diagnostics=info)

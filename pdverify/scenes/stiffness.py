@@ -27,6 +27,7 @@ all nodes, ``energy_ratio_min`` / ``_max`` the extremes of W_i / W_bulk. The set
 """
 from __future__ import annotations
 
+import dataclasses
 import itertools
 
 import numpy as np
@@ -38,11 +39,13 @@ from ..pd import (StateBasedConstants, bond_micromodulus, build_stencil, get_inf
                   state_based_stencil)
 from ..pd.build import Body, BondMaterial, StateMaterial, build_model
 from ..pd.influence import INFLUENCES, bond_based_nu
-from ..pd.problem import BondProblem, FaceCondition, StaticProblem, assemble_bonds, face_names
+from ..pd.problem import (BondProblem, FaceCondition, StaticProblem, SurfaceConditions,
+                          assemble_bonds, face_names)
 from ..pd.work import uniaxial, work_density
 from ..quotes import Quote as Q
 from . import MethodSpec, Outcome, Published, Scene, register, whole_cells
 from ..corrections.treatment import BASELINE
+from .bondfamily import BOND_BOX
 from .family import StaticStateScene
 
 AXES = "xyz"
@@ -109,6 +112,20 @@ def treatment_ratios(system, strain) -> np.ndarray:
     return W[g.interior_ids] / model.bulk_work_density(strain)
 
 
+def bond_box_ratios(system, strain) -> np.ndarray:
+    """W_i / W_bulk at the real nodes of a ``bond-box`` treatment's system under
+    u = strain . x at its unknown nodes (the real nodes, then any surface nodes), its
+    fictitious nodes by its extrapolation."""
+    model = system.model
+    g = model.grid
+    nodes = g.x[g.interior_ids]
+    if system.n_unknown > g.n_interior:
+        nodes = np.r_[nodes, g.surface_x]
+    field = (nodes @ np.asarray(strain, dtype=float).T).T.ravel()
+    W = work_density(model, strain, field)
+    return W[g.interior_ids] / model.bulk_work_density(strain)
+
+
 class StiffnessScene(Scene):
     """Shared machinery: subclasses build the model of a method (``build``). The
     bond-based ones describe their body and material once (:meth:`bond_problem`, a
@@ -138,11 +155,14 @@ class StiffnessScene(Scene):
         return p["m_ratio"] * p["spacing"]
 
     def check(self, method, p):
-        whole_cells(f"{self.id} --method {method}", p["spacing"],
-                    [(f"l_{a}", L) for a, L in zip(AXES, self.lengths(p))])
+        where = f"{self.id} --method {method}"
+        whole_cells(where, p["spacing"], [(f"l_{a}", L) for a, L in zip(AXES, self.lengths(p))])
         t = self.offered().get(method)
         if getattr(t, "peer", False):
-            t.check((), p, f"{self.id} --method {method}")
+            t.check((), p, where)
+        if t is not None and BOND_BOX in self.role_families and t.role(BOND_BOX) is not None:
+            t.check_for(BOND_BOX, tuple(round(L / p["spacing"]) for L in self.lengths(p)),
+                        p, where)
 
     def estimate(self, method, p):
         """Bond arrays and the model's sparse operators: ~ (d + 4) entries a bond."""
@@ -155,6 +175,8 @@ class StiffnessScene(Scene):
 
     def solve(self, method, p, timer):
         t = self.offered().get(method)
+        if t is not None and t.role(BOND_BOX) is not None:
+            return self._solve_bond_box(t, p, timer)
         peer = getattr(t, "peer_energies", None)
         with timer.phase("setup"):
             model = self.build(method, p, self.bond_closure(method, p))
@@ -169,6 +191,21 @@ class StiffnessScene(Scene):
         with timer.phase("solve"):
             ratios = energy_ratios(model)
         return self.measure_ratios(p, model, ratios)
+
+    def _solve_bond_box(self, t, p, timer) -> Outcome:
+        """A treatment of the ``bond-box`` family (Taylor's fictitious nodes, the surface
+        nodes; ``corrections.bond_fictitious``) on the bond-based box: its grid
+        (cell-centred, the same spacing) and extrapolation, every face traction-free
+        (the rows are built, not solved: u = strain . x is given at its unknown nodes)."""
+        with timer.phase("setup"):
+            problem = dataclasses.replace(
+                self.bond_problem(p, self.id),
+                surface=SurfaceConditions({}, lambda x: np.zeros_like(x)))
+            system = t.build_for(BOND_BOX, problem, p)
+        with timer.phase("solve"):
+            ratios = {name: bond_box_ratios(system, eps)
+                      for name, eps in strain_states(self.dim)}
+        return self.measure_ratios(p, system.model, ratios, system.counts)
 
     def measure_ratios(self, p, model, ratios, counts=None) -> Outcome:
         """Metrics and fields of the energy ratios W_i / W_bulk of the real nodes."""
@@ -208,6 +245,10 @@ class SheetStiffness(StiffnessScene):
     """
 
     id = "stiffness2d-sheet"
+    #: Taylor's fictitious nodes and the surface nodes complete its neighbourhoods
+    #: (``corrections.bond_fictitious``; the rows of its traction-free faces unused)
+    role_families = (BOND_BOX,)
+    role_refusals = {"held-face": "no conditions: every node is given u = eps . x"}
     title = "Sheet under homogeneous strain: nodal energy density against the bulk"
     seed = "003 §4.1.1"
     closure_theory = "bond-based"
@@ -448,6 +489,10 @@ class BondBoxStiffness(StiffnessScene):
     """
 
     id = "stiffness3d-box-bond"
+    #: Taylor's fictitious nodes and the surface nodes complete its neighbourhoods
+    #: (``corrections.bond_fictitious``; the rows of its traction-free faces unused)
+    role_families = (BOND_BOX,)
+    role_refusals = {"held-face": "no conditions: every node is given u = eps . x"}
     title = "3D box under homogeneous strain, bond-based: nodal energy density against the bulk"
     seed = "001 §4.1 (bond-based: ours)"
     closure_theory = "bond-based"

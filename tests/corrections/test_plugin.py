@@ -100,7 +100,8 @@ def test_without_the_plugin_the_method_is_bad_input():
     r = subprocess.run([sys.executable, "-m", "pdverify", "run", "stiffness2d-sheet",
                         "--method", "demo-uniform"], capture_output=True, text=True)
     assert r.returncode == 2
-    assert "not supported by this scene; allowed: none, energy, energy-directional" in r.stderr
+    assert ("not supported by this scene; allowed: none, taylor-fictitious, surface-nodes, "
+            "energy, energy-directional" in r.stderr)
     assert "demo-uniform" not in r.stderr.split("allowed:", 1)[1]
 
 

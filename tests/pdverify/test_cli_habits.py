@@ -112,7 +112,7 @@ def test_list_scene_shows_units_methods_and_why_not(capsys):
     assert "    spacing=0.02 m: " in out
     assert "    nu=0.3: " in out                 # dimensionless: no unit
     assert "    surface-nodes  - " in out and "        order=1: " in out
-    assert "not offered here" in out and "virtual-nodes: bond-based only" in out
+    assert "not offered here" in out and "virtual-nodes: bond-based (seed 003" in out
     assert "homogenized: 1D bond-based bars only (seed 004 derives its factors" in out
     assert "bar1d-traction" not in out           # one scene only
 

@@ -32,9 +32,9 @@ CASES = [
     ("unknown-scene", ["run", "no-such-scene"], {}, "unknown scene"),
     ("unknown-method", ["run", "bar1d-traction", "--method", "nope"], {},
      "not supported by this scene; allowed: none"),
-    ("method-not-on-scene", ["run", "stiffness3d-box", "--method", "energy-directional"], {},
-     "stiffness3d-box: method 'energy-directional' is not supported by this scene; allowed: "
-     "none, taylor-fictitious, surface-nodes, mirror-nodes, energy, volume"),
+    ("method-not-on-scene", ["run", "stiffness3d-box", "--method", "virtual-nodes"], {},
+     "stiffness3d-box: method 'virtual-nodes' is not supported by this scene; allowed: "
+     "none, taylor-fictitious, surface-nodes, mirror-nodes, energy, energy-directional, volume"),
     ("unknown-command", ["frobnicate"], {}, "invalid choice"),
     ("unknown-flag", ["run", "bar1d-traction", "--fast"], {}, "unrecognized"),
     # ---------------------------------------------------------------- run: --set syntax

@@ -87,7 +87,8 @@ BAD_INPUT = [
     (("sheet2d-clamped", "--method", "none", "--set", "m_ratio=6.3"), "must divide"),
     (("sheet2d-clamped", "--method", "none", "--set", "micromodulus=cubic"),
      "allowed: constant, conical"),
-    (("sheet2d-tension", "--method", "virtual-nodes"), "allowed: fem, none, energy, energy-directional"),
+    (("sheet2d-tension", "--method", "virtual-nodes"),
+     "allowed: fem, none, taylor-fictitious, surface-nodes, energy, energy-directional"),
     (("sheet2d-clamped", "--method", "energy-directional", "--set", "nu=0.3"), "nu = 1/3"),
 ]
 

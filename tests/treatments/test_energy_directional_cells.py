@@ -20,12 +20,36 @@ NEW_CELLS = ("bar1d-homogenization", "bar1d-constraints", "bar1d-vibration",
              "stiffness3d-box-bond")
 
 
-def test_the_method_serves_every_bond_based_box_scene_and_no_state_based_one():
+def test_the_method_serves_every_box_scene_and_no_shape():
+    """Bond-based boxes (seed 003) and, in our reading (issue 55), the state-based ones;
+    the shapes refuse it: Eq. 14's ray distance runs to the box faces."""
     t = treatments()["energy-directional"]
-    for sid in NEW_CELLS + ("sheet2d-tension", "stiffness2d-sheet"):
+    for sid in NEW_CELLS + ("sheet2d-tension", "stiffness2d-sheet", "plate2d-clamped",
+                            "body3d-traction", "bar1d-traction"):
         assert t.why_not(get_scene(sid)) is None, sid
-    reason = t.why_not(get_scene("plate2d-clamped"))
-    assert reason and "bond-based only" in reason
+    for sid in ("plate-hole", "plate-l"):
+        reason = t.why_not(get_scene(sid))
+        assert reason and "box faces" in reason, sid
+
+
+def test_state_based_factor_takes_xi_to_the_d_plus_1():
+    """On an LPS model the factor is Eq. 14's ratio with omega xi^(D+1) (the LPS
+    energy's radial weight, ``box_factors``), not the bond-based xi^D: exactly as
+    ``directional_closure(moment=D + 1)`` gives it, and unlike ``moment=D``."""
+    from pdverify.corrections.energy_directional import box_factors
+    from pdverify.pd import StateBasedConstants, StateBasedModel
+    from pdverify.pd.statebased import state_based_stencil
+    W, H, h, m = 0.02, 0.01, 0.001, 3.0
+    inf = get_influence("gaussian")
+    grid = BoxGrid((W, H), (0.0, 0.0), h)
+    stencil = state_based_stencil(2, m, h, inf, "partial-volume")
+    model = StateBasedModel(grid, stencil, StateBasedConstants("plane-strain", 1.0, 0.25), inf)
+    got = box_factors(model)
+    for D, same in ((3, True), (2, False)):
+        want = directional_closure(grid, (0.0, 0.0), (W, H), model.horizon, inf,
+                                   moment=D).bond_factor(model.bond_a, model.bond_b,
+                                                         model.bond_n)
+        assert np.allclose(got, want, rtol=ULP_RTOL, atol=0) is same, D
 
 
 def test_box_factors_equal_the_seed_003_wiring_on_a_2d_sheet():
