@@ -28,7 +28,9 @@ def test_the_list_offers_the_node_adding_methods_on_the_shapes():
                          capture_output=True, text=True, check=True).stdout
     for name in ("surface-nodes", "mirror-nodes", "pddo"):
         assert f"\n    {name}  - " in out, name
-    assert "box faces only" not in out
+        assert f"\n    {name}: box faces only" not in out, name
+    # the one box-only method left there: seed 003's ray distances to the box faces
+    assert "\n    energy-directional: box faces only: Eq. 14's ray distance" in out
     assert "jitter=0" in out
 
 
