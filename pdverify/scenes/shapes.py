@@ -117,10 +117,11 @@ class ShapeScene(FemStaticStateScene):
         return tuple(np.subtract(s.upper, s.lower)), tuple(s.lower)
 
     def check_pd(self, where, method, p):
+        """The grid and the material (2D and 3D shapes; a 3D body has no thickness)."""
         lengths, _ = self.box(p)
-        whole_cells(where, p["spacing"], [(f"l_{a}", L) for a, L in zip("xy", lengths)])
+        whole_cells(where, p["spacing"], [(f"l_{a}", L) for a, L in zip("xyz", lengths)])
         for name in ("E", "thickness", "traction"):
-            if not (np.isfinite(p[name]) and p[name] > 0):
+            if name in p and not (np.isfinite(p[name]) and p[name] > 0):
                 raise InputError(f"{where}: {name}={p[name]!r} must be a finite number > 0")
         if not -1.0 < p["nu"] < 0.5:
             raise InputError(f"{where}: nu={p['nu']!r} must be in (-1, 0.5)")

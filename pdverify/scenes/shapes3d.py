@@ -24,14 +24,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError
 from ..params import Param, grid_params
 from ..pd import QUADRATURES, StateBasedConstants, get_influence, state_based_stencil
 from ..pd.problem import FaceCondition, StaticProblem
 from ..pd.shapes3d import cavity_octant, quarter_cylinder
 from ..quotes import Quote as Q
 from ..quotes import used
-from . import influence_param, register, whole_cells
+from . import influence_param, register
 from .shapes import ORDERING, ShapeScene
 
 def _sigma_z(sigma):
@@ -60,15 +59,6 @@ class Shape3DScene(ShapeScene):
         cylinder's radius and twice the cavity's, so every method still runs, but its
         errors are not the scene's findings)."""
         return 2 * next(q.default for q in self.pd_params if q.name == "spacing")
-
-    def check_pd(self, where, method, p):
-        lengths, _ = self.box(p)
-        whole_cells(where, p["spacing"], [(f"l_{a}", L) for a, L in zip("xyz", lengths)])
-        for name in ("E", "traction"):
-            if not (np.isfinite(p[name]) and p[name] > 0):
-                raise InputError(f"{where}: {name}={p[name]!r} must be a finite number > 0")
-        if not -1.0 < p["nu"] < 0.5:
-            raise InputError(f"{where}: nu={p['nu']!r} must be in (-1, 0.5)")
 
     def problem(self, p, where):
         inf = get_influence(p["influence"])
