@@ -174,6 +174,8 @@ def family_treatments() -> list[Treatment]:
                   "normal with derivatives from a least-squares fit, the conditions at "
                   "boundary points (corrections.shape_fictitious; corners unused)",
             build=_taylor, checker=_check_taylor, shapes=True,
+            static_only="its conditions are Lagrange constraint rows, so the dynamics "
+                        "would be a differential-algebraic system",
             roles=(("flux-bar", Role(_flux_order, (ORDER,), _check_flux_order)),)),
         FamilyTreatment(
             "surface-nodes", "seeds 001/002: surface nodes carry the boundary conditions, "
@@ -194,6 +196,8 @@ def family_treatments() -> list[Treatment]:
             scope="state-based boxes; the mirror relation (Dirichlet or traction) is "
                   "chosen per boundary cell face",
             build=_mirror, checker=_check_mirror,
+            static_only="its fictitious nodes carry an affine offset of the prescribed "
+                        "values, fixed at assembly",
             box_only="its mirror nodes are reflections across a plane face (seed 001 §5.2); "
                      "across a curved part the reflection needs the local normal and "
                      "curvature, which this implementation does not take"),
@@ -204,6 +208,8 @@ def family_treatments() -> list[Treatment]:
             params=PDDO_PARAMS, theories=STATE, families=FAMILY,
             scope="state-based boxes; the boundary row (Dirichlet or traction) is chosen "
                   "per boundary node", build=_pddo,
+            static_only="its boundary rows on the outer node layer are algebraic "
+                        "equations, not a mass's equation of motion",
             box_only="its boundary rows take each node's box face and that face's normal "
                      "(seed 001 §5.3); a curved part's normal turns within a horizon"),
     ]

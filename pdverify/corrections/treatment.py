@@ -111,6 +111,10 @@ class Treatment:
     #: ``box_only``: why not, when it cannot (``list`` shows it on the shape scenes)
     shapes: bool = False
     box_only: str = ""
+    #: why its static system does not carry over into the family's dynamic mode
+    #: (M u'' + K u = f(t): every free unknown a mass, the prescribed ones eliminated;
+    #: ``pdverify.scenes.waves``), e.g. constraint rows; empty: it carries over
+    static_only: str = ""
 
     def __post_init__(self):
         bad = [t for t in self.theories if t not in THEORIES]
