@@ -275,8 +275,8 @@ class ManufacturedWave(StaticStateScene):
                  ("none", {**disc, "integrator": "newmark"}),
                  ("none", {**disc, "time_function": "quadratic"}),
                  ("none", {**disc, "time_function": "quadratic", "integrator": "newmark"})]
-                + [(m, dict(over)) for m in ("energy", "volume", "surface-nodes")]
-                + [(m, dict(disc)) for m in ("energy", "volume", "surface-nodes")])
+                + [(m, dict(over)) for m in ("energy", "volume", "pals", "surface-nodes")]
+                + [(m, dict(disc)) for m in ("energy", "volume", "pals", "surface-nodes")])
 
 
 def _wave_params(lengths, spacing):
