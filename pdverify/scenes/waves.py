@@ -18,8 +18,6 @@ import math
 
 import numpy as np
 
-from manufactured.engine import solution as manufactured_solution
-
 from .. import budget
 from ..errors import NumericalError
 from ..params import Param, at_least, grid_params, material_params, open_interval, positive
@@ -133,7 +131,9 @@ class ManufacturedWave(StaticStateScene):
     # ----------------------------------------------------------------- the field
     def manufactured(self, p):
         """The continuum PD fields of P (``manufactured.engine``: the infinite-body body
-        force b = -L P of the run's state-based model, influence and horizon)."""
+        force b = -L P of the run's state-based model, influence and horizon). Imported
+        here: sympy stays out of the commands that run nothing (``list``)."""
+        from manufactured.engine import solution as manufactured_solution
         return manufactured_solution(
             [f"A*({c})" for c in self.field], model="state-based", dim=self.dim,
             horizon=p["m_ratio"] * p["spacing"], E=p["E"], nu=p["nu"],
