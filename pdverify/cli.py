@@ -113,8 +113,8 @@ def build_parser() -> argparse.ArgumentParser:
                           "--only, so that neither replaces the full report)")
     rep.add_argument("--quick", action="store_true",
                      help="smaller sweeps of the expensive scenes")
-    rep.add_argument("--only", nargs="+", default=None, metavar="SCENE",
-                     help="run only these scenes (each once)")
+    rep.add_argument("--only", nargs="+", action="extend", default=None, metavar="SCENE",
+                     help="run only these scenes (each once; repeated --only add up)")
     rep.add_argument("--method", nargs="+", default=None, metavar="M", dest="methods",
                      help="run only these methods (on the selected scenes)")
     rep.add_argument("--failed", action="store_true",

@@ -201,6 +201,8 @@ def family_treatments() -> list[Treatment]:
                   "Bond-based (seed 000 §7): the 2D boxes that state their conditions at "
                   "the surface (corrections.bond_fictitious)",
             build=_taylor, checker=_check_taylor, shapes=True,
+            static_only="its conditions are Lagrange constraint rows, so the dynamics "
+                        "would be a differential-algebraic system",
             shapes3d_why="not built (corrections.shape_fictitious fits its series along "
                          "the normal from the 2D parts' crossings, Shape.crossings of "
                          "segments and arcs; a 3D part would need the bond-surface "
@@ -244,6 +246,8 @@ def family_treatments() -> list[Treatment]:
                            "the bond-based lattice's moduli (C11, C12 of the stencil), "
                            "not the LPS constants it takes",
             build=_mirror, checker=_check_mirror, shapes=True,
+            static_only="its fictitious nodes carry an affine offset of the prescribed "
+                        "values, fixed at assembly",
             shapes3d_why="not built (mirror_nodes.MirrorNodesOnShape reflects across the "
                          "tangent lines of 2D parts; a 3D part needs the tangent planes of "
                          "planes, a mantle and a sphere and 3D fits)"),
@@ -260,6 +264,8 @@ def family_treatments() -> list[Treatment]:
                   "boundary node; on a shape at each boundary node's points with the "
                   "part's local normal (pddo.pddo_shape_system: our generalisation)",
             build=_pddo, shapes=True,
+            static_only="its boundary rows on the outer node layer are algebraic "
+                        "equations, not a mass's equation of motion",
             shapes3d_why="not built (pddo.pddo_shape_system takes the boundary rows at "
                          "points of 2D parts; a 3D part needs them at points of planes, a "
                          "mantle and a sphere)"),

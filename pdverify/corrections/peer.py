@@ -141,6 +141,7 @@ class PeerTreatment(Treatment):
     checks) and solves it with the peer (``peer_solve``)."""
 
     peer: bool = True
+    static_only: str = "the peer code solves the static system in one call"
 
     def report_runs(self, scene, quick) -> list[dict]:
         over = REPORT_RUNS.get(scene.id)

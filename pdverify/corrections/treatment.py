@@ -127,6 +127,10 @@ class Treatment:
     shapes3d_why: str = ""
     #: why not on a scene of a theory it does not take (one line; empty: "THEORY only")
     theory_refusal: str = ""
+    #: why its static system does not carry over into the family's dynamic mode
+    #: (M u'' + K u = f(t): every free unknown a mass, the prescribed ones eliminated;
+    #: ``pdverify.scenes.waves``), e.g. constraint rows; empty: it carries over
+    static_only: str = ""
 
     def __post_init__(self):
         bad = [t for t in self.theories if t not in THEORIES]
