@@ -261,6 +261,12 @@ class Indentation(BondStaticScene):
         ExpectedFailure("the linear lattice folds under the indenter at 1 mm (a bond "
                         "inverted), as seed 003 §4.2 expects of small-displacement PD",
                         method="none", where={"kinematics": "linear", "spacing": 0.00025}),
+        ExpectedFailure("the buffer rows below the held bottom do not stiffen the surface "
+                        "under the indenter: at the quick grid the lattice loses definiteness "
+                        "at 1.7 mm as the uncorrected one does at 1.8 mm (the quick report of "
+                        "2026-11-28; at half the paper's spacing it reaches 2 mm)",
+                        method="virtual-nodes", where={**PAPER, "kinematics": "nonlinear",
+                                                        "spacing": 0.001, "horizon": 0.006}),
         *(ExpectedFailure("the peers' bond corrections stall at 1.0-1.1 mm at the paper's "
                           "grid, the bond under the indenter at 15 % of its length (our "
                           "finding, deviations)", method=m,

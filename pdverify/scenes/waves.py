@@ -356,7 +356,7 @@ class Wave2DManufactured(ManufacturedWave):
     Findings at the defaults (not tuned): with the discrete operator every carried
     treatment is exact to round-off for the quadratic motion, and the
     fitted rates of both integrators are 2 within a few hundredths in 2D (the 3D base
-    pair is steeper, the finer pairs 2.00); with the continuum operator the uncorrected
+    pair is steeper, the finer pairs at the asymptotic rate); with the continuum operator the uncorrected
     model's error is several times the surface nodes', most of it within a horizon of the
     surface, and ``energy``, ``volume`` and ``pals`` do not lower it (their factors
     correct the stiffness of a homogeneous strain, not this field's boundary data).
