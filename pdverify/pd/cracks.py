@@ -92,17 +92,8 @@ def williams_field(x, tip, direction, coefficients, E, nu, plane) -> np.ndarray:
     """The displacement (n, 2) of the mode I series ``coefficients`` = (a_1, a_2, ...)
     about ``tip``, the crack running from the tip along -``direction`` (a unit vector
     along the crack line, pointing ahead of the tip)."""
-    x = np.asarray(x, float)
-    e = np.asarray(direction, float) / np.linalg.norm(direction)
-    nrm = np.array([-e[1], e[0]])
-    d = x - np.asarray(tip, float)
-    s, t = d @ e, d @ nrm
-    r, th = np.hypot(s, t), np.arctan2(t, s)
-    ul = np.zeros((len(x), 2))
-    for n, a in enumerate(coefficients, start=1):
-        ul[:, 0] += a * williams_ux(r, th, n, E, nu, plane)
-        ul[:, 1] += a * williams_uy(r, th, n, E, nu, plane)
-    return ul[:, :1] * e + ul[:, 1:] * nrm
+    return williams_mixed_field(x, tip, direction, coefficients, (), E, nu, plane,
+                                translation=None)
 
 
 @dataclass(frozen=True)
@@ -218,7 +209,7 @@ def williams_mixed_field(x, tip, direction, mode1, mode2, E, nu, plane,
                          translation=(0.0, 0.0)) -> np.ndarray:
     """The displacement (n, 2) of the series ``mode1`` = (a_1, a_2, ...) and ``mode2`` =
     (b_1, b_2, ...) about ``tip`` (the crack behind it along -``direction``), plus a
-    rigid ``translation``."""
+    rigid ``translation`` (None: none added)."""
     x = np.asarray(x, float)
     e = np.asarray(direction, float) / np.linalg.norm(direction)
     nrm = np.array([-e[1], e[0]])
@@ -233,7 +224,8 @@ def williams_mixed_field(x, tip, direction, mode1, mode2, E, nu, plane,
         wx, wy = williams_mode2(r, th, n, E, nu, plane)
         ul[:, 0] += b * wx
         ul[:, 1] += b * wy
-    return ul[:, :1] * e + ul[:, 1:] * nrm + np.asarray(translation, float)
+    out = ul[:, :1] * e + ul[:, 1:] * nrm
+    return out if translation is None else out + np.asarray(translation, float)
 
 
 @dataclass(frozen=True)

@@ -166,11 +166,14 @@ class CrackScene(ShapeScene):
     #: scene says
     delta_sweep = ()
 
+    #: the FEM reference's fields fixed at its defaults (not parameters of ``fem``)
+    fem_fixed = _FEM_FIXED
+
     @property
     def methods(self):
         (fem,) = FemAndPD.methods.fget(self)
         return (MethodSpec(fem.name, tuple(q for q in fem.params
-                                           if q.name not in _FEM_FIXED)),)
+                                           if q.name not in self.fem_fixed)),)
 
     @property
     def table_metrics(self):

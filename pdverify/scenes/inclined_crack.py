@@ -17,9 +17,7 @@ from ..errors import InputError
 from ..pd.cracks import fit_k_mixed
 from ..pd.shapes import Crack
 from . import register, whole_cells
-from .base import MethodSpec
 from .cracks import TIP_ZONE, CrackPlate, plate_outline
-from .fem_references import FemAndPD
 from .shapes import ShapeScene
 
 #: the K fit's outer radius as a fraction of min(a, the distance from the tip to the
@@ -103,12 +101,7 @@ class InclinedCrackPlate(CrackPlate):
     headline = "k_error_pct"
     delta_sweep = ()
     quick_spacing = 1 / 30
-
-    @property
-    def methods(self):
-        (fem,) = FemAndPD.methods.fget(self)
-        return (MethodSpec(fem.name, tuple(q for q in fem.params
-                                           if q.name not in _FEM_FIXED)),)
+    fem_fixed = _FEM_FIXED
 
     @property
     def table_metrics(self):
