@@ -355,28 +355,14 @@ def run(model: Model, setting: str, folder: str, *, where: str,
     """Write the deck into ``folder`` (an empty folder pdverify made), run LAMMPS there
     and read its displacements back. LAMMPS's own failures are NumericalError naming
     ``where`` and LAMMPS's ERROR line."""
-    exe, why = locate()
-    if exe is None:
-        raise InputError(f"{where}: {why}")
-    for name, text in deck(model, setting, title=where).items():
-        with open(os.path.join(folder, name), "w", encoding="utf-8") as fh:
-            fh.write(text)
-    try:
-        proc = subprocess.run(
-            [*exe.argv, "-in", "in.lammps", "-log", "log.lammps", "-screen", "none",
-             "-nocite"], cwd=folder, env=exe.env, capture_output=True, text=True,
-            timeout=timeout, stdin=subprocess.DEVNULL)
-    except subprocess.TimeoutExpired:
-        raise NumericalError(f"{where}: LAMMPS did not finish within {timeout:g} s") from None
-    except OSError as exc:
-        raise NumericalError(f"{where}: LAMMPS ({exe.where}) could not start: {exc}") from None
-    log = _read(os.path.join(folder, "log.lammps"))
+    proc, log, executable = _launch(deck(model, setting, title=where), folder, where,
+                                    timeout)
     if proc.returncode != 0 or not os.path.exists(os.path.join(folder, "displaced.dump")):
         error = next((ln.strip() for ln in (log + proc.stdout + proc.stderr).splitlines()
                       if ln.startswith("ERROR")), f"exit status {proc.returncode}")
         raise NumericalError(f"{where}: LAMMPS failed: {error[:300]}")
     info = parse_log(log)
-    info.update({"executable": exe.where, "setting": setting, "pair_style": model.pair})
+    info.update({"executable": executable, "setting": setting, "pair_style": model.pair})
     dump = np.loadtxt(os.path.join(folder, "displaced.dump"), skiprows=9, ndmin=2)
     ids = dump[:, 0].astype(int)
     if len(ids) != len(model.x) or np.any(np.sort(ids) != np.arange(1, len(ids) + 1)):
@@ -479,22 +465,8 @@ def energies(model: Model, setting: str, strains, folder: str, *, where: str,
     ``strains`` at unit scale (rows: states; LAMMPS's at :data:`STRAIN_SCALE`, divided by
     its square), run in ``folder`` (an empty folder pdverify made); ``info`` holds the
     version and the damage LAMMPS reported (any lost bond is a failed run)."""
-    exe, why = locate()
-    if exe is None:
-        raise InputError(f"{where}: {why}")
-    for name, text in energy_deck(model, setting, strains, title=where).items():
-        with open(os.path.join(folder, name), "w", encoding="utf-8") as fh:
-            fh.write(text)
-    try:
-        proc = subprocess.run(
-            [*exe.argv, "-in", "in.lammps", "-log", "log.lammps", "-screen", "none",
-             "-nocite"], cwd=folder, env=exe.env, capture_output=True, text=True,
-            timeout=timeout, stdin=subprocess.DEVNULL)
-    except subprocess.TimeoutExpired:
-        raise NumericalError(f"{where}: LAMMPS did not finish within {timeout:g} s") from None
-    except OSError as exc:
-        raise NumericalError(f"{where}: LAMMPS ({exe.where}) could not start: {exc}") from None
-    log = _read(os.path.join(folder, "log.lammps"))
+    proc, log, executable = _launch(energy_deck(model, setting, strains, title=where),
+                                    folder, where, timeout)
     dumps = [os.path.join(folder, f"state{s}.dump") for s in range(len(strains))]
     if proc.returncode != 0 or not all(os.path.exists(p) for p in dumps):
         error = next((ln.strip() for ln in (log + proc.stdout + proc.stderr).splitlines()
@@ -503,7 +475,7 @@ def energies(model: Model, setting: str, strains, folder: str, *, where: str,
     info = {k: v for k, v in parse_log(log).items() if k == "version"}
     lost = [float(ln.split()[1]) for ln in log.splitlines()
             if ln.startswith("pdverify-lost-bonds-")]
-    info.update({"executable": exe.where, "setting": setting, "pair_style": model.pair,
+    info.update({"executable": executable, "setting": setting, "pair_style": model.pair,
                  "strain_scale": STRAIN_SCALE, "damage_sum": float(sum(lost))})
     W = np.empty((len(strains), len(model.x)))
     for s, path in enumerate(dumps):
@@ -516,3 +488,26 @@ def energies(model: Model, setting: str, strains, folder: str, *, where: str,
     if not np.all(np.isfinite(W)):
         raise NumericalError(f"{where}: LAMMPS's energies hold non-finite numbers")
     return W, info
+
+
+def _launch(files: dict, folder: str, where: str, timeout: float):
+    """Write the deck ``files`` into ``folder`` and run LAMMPS there on ``in.lammps``:
+    ``(proc, log, executable)``: the finished process, its log's text and where the
+    executable is. LAMMPS missing is bad input; a run past ``timeout`` or one that cannot
+    start is numerical trouble, named."""
+    exe, why = locate()
+    if exe is None:
+        raise InputError(f"{where}: {why}")
+    for name, text in files.items():
+        with open(os.path.join(folder, name), "w", encoding="utf-8") as fh:
+            fh.write(text)
+    try:
+        proc = subprocess.run(
+            [*exe.argv, "-in", "in.lammps", "-log", "log.lammps", "-screen", "none",
+             "-nocite"], cwd=folder, env=exe.env, capture_output=True, text=True,
+            timeout=timeout, stdin=subprocess.DEVNULL)
+    except subprocess.TimeoutExpired:
+        raise NumericalError(f"{where}: LAMMPS did not finish within {timeout:g} s") from None
+    except OSError as exc:
+        raise NumericalError(f"{where}: LAMMPS ({exe.where}) could not start: {exc}") from None
+    return proc, _read(os.path.join(folder, "log.lammps")), exe.where
