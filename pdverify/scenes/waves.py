@@ -163,7 +163,10 @@ class ManufacturedWave(StaticStateScene):
         # on these lattices (measured at m = 3: PDDO's 1.3 the smallest); every level
         # halves the step
         steps = budget.step_count(p["periods"] * p["period"] * cells / (1.3 * p["dt_factor"]))
-        total = steps * (2 ** p["time_levels"] - 1)
+        # in floats: an extreme time_levels must give inf (refused by the budget), not a
+        # Python integer of 2^levels bits (10^18 levels took the whole memory)
+        levels = p["time_levels"]
+        total = steps * (2.0 ** levels - 1 if levels < 1024 else math.inf)
         return base + budget.Estimate(
             0.0, f"~{total:.3g} time steps: periods={p['periods']:g} x period="
             f"{p['period']:g} transit times at dt_factor={p['dt_factor']:g} of the limit, "
