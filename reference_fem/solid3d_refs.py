@@ -199,29 +199,41 @@ def cylinder_samples(p) -> np.ndarray:
     return x[np.hypot(x[:, 0], x[:, 1]) < p.radius]
 
 
-def compute_cylinder(p: CylinderParams) -> CylinderResult:
-    t_start = time.perf_counter()
-    pts = cylinder_samples(p)
+def _refine(p, solve, top, pts, extra_of):
+    """The study both references run: per level ``solve(p, cells)``, the quantity u_z at
+    ``top``, the field at ``pts`` and ``extra_of(fld)``, with the changes against the level
+    before. Returns the rows and the finest level's field, setup and solve seconds."""
     rows, prev_q, prev = [], None, None
     for level in range(p.levels):
-        model, fld, ts, tv = solve_cylinder(p, p.cells + level)
-        q = float(fld.evaluate(np.array([[0.0, 0.0, p.length]]))[0, 2])
+        model, fld, ts, tv = solve(p, p.cells + level)
+        q = float(fld.evaluate(np.array([top]))[0, 2])
         sample = fld.evaluate(pts)
-        x = np.concatenate([pts, fld.node_coords])
-        exact = cylinder_closed_form(x, p.E, p.nu, p.traction)
-        err = float(100 * np.max(np.abs(fld.evaluate(x) - exact)) / np.max(np.abs(exact)))
-        extra = {"closed_form_error_pct": err}
+        extra = extra_of(fld)
         if prev is not None:
             extra["field_change_pct"] = field_change_pct(sample, prev)
         rows.append(RefinementRow(level=level, dofs=model.N, h_min=model.min_edge(), quantity=q,
                                   change_pct=change_pct(q, prev_q), setup_s=ts, solve_s=tv,
                                   extra=extra))
         prev_q, prev = q, sample
+    return rows, fld, ts, tv
+
+
+def compute_cylinder(p: CylinderParams) -> CylinderResult:
+    t_start = time.perf_counter()
+    pts = cylinder_samples(p)
+
+    def closed_form(fld):
+        x = np.concatenate([pts, fld.node_coords])
+        exact = cylinder_closed_form(x, p.E, p.nu, p.traction)
+        return {"closed_form_error_pct": float(100 * np.max(np.abs(fld.evaluate(x) - exact))
+                                               / np.max(np.abs(exact)))}
+    rows, fld, ts, tv = _refine(p, solve_cylinder, (0.0, 0.0, p.length), pts, closed_form)
+    q = rows[-1].quantity
     return CylinderResult(
         reference=CYLINDER, params=_p.as_dict(p), quantity_name="u_z at (0, 0, L) (m)",
         quantity=q, refinement=tuple(rows), refinement_change_pct=rows[-1].change_pct,
         setup_s=ts, solve_s=tv, study_s=time.perf_counter() - t_start, field=fld,
-        uz_top=q, closed_form_error_pct=err,
+        uz_top=q, closed_form_error_pct=rows[-1].extra["closed_form_error_pct"],
         field_change_pct=rows[-1].extra.get("field_change_pct", float("nan")))
 
 
@@ -348,18 +360,9 @@ def cavity_samples(p) -> np.ndarray:
 def compute_cavity(p: CavityParams) -> CavityResult:
     t_start = time.perf_counter()
     pts = cavity_samples(p)
-    rows, prev_q, prev = [], None, None
-    for level in range(p.levels):
-        model, fld, ts, tv = solve_cavity(p, p.cells + level)
-        q = float(fld.evaluate(np.array([[0.0, 0.0, p.width]]))[0, 2])
-        sample = fld.evaluate(pts)
-        extra = {"scf": cavity_scf(fld, p.radius, p.traction)}
-        if prev is not None:
-            extra["field_change_pct"] = field_change_pct(sample, prev)
-        rows.append(RefinementRow(level=level, dofs=model.N, h_min=model.min_edge(), quantity=q,
-                                  change_pct=change_pct(q, prev_q), setup_s=ts, solve_s=tv,
-                                  extra=extra))
-        prev_q, prev = q, sample
+    rows, fld, ts, tv = _refine(p, solve_cavity, (0.0, 0.0, p.width), pts,
+                                lambda fld: {"scf": cavity_scf(fld, p.radius, p.traction)})
+    q = rows[-1].quantity
     return CavityResult(
         reference=CAVITY, params=_p.as_dict(p), quantity_name="u_z at (0, 0, W) (m)",
         quantity=q, refinement=tuple(rows), refinement_change_pct=rows[-1].change_pct,
