@@ -143,21 +143,25 @@ def _plane_rows(g, planes, n_cols_per_comp):
     the surface nodes' unsymmetric system: with the tension sheet's two planes at
     h = 1.25 mm, 20 x 40 mm, its bordered system had a null vector (smallest singular
     value 1e-17 of the largest), a displacement balanced by reactions on the planes; the
-    symmetric solution meets every line's row, so no exactness is lost."""
+    symmetric solution meets every line's row, so no exactness is lost. In 1D (a bar
+    in tension, ``planes = ((0, 0),)``) the plane is a point and its one row removes
+    the translation."""
     if not planes:
         return []
-    if g.dim != 2 or len(planes) > 2:
-        raise ValueError("symmetry planes are taken in 2D, at most two")
+    if not ((g.dim == 2 and len(planes) <= 2) or (g.dim == 1 and len(planes) == 1)):
+        raise ValueError("symmetry planes are taken in 2D (at most two) or 1D (one)")
     real = g.interior_ids
     idx, x, h = g.index[real], g.x[real], g.spacing
     rows = []
     for which, (axis, k) in enumerate(planes):
         on = np.flatnonzero(np.abs(x[:, axis]) < 1e-9 * h)
         below = np.flatnonzero(np.abs(x[:, axis] + 0.5 * h) < 1e-9 * h)
-        other = 1 - axis
-        ends = (lambda ids: ids[np.isin(x[ids, other], [x[ids, other].min(), x[ids, other].max()]
-                                        if which == 0 else [x[ids, other].min()])])
-        on, below = ends(on) if on.size else on, ends(below) if below.size else below
+        if g.dim == 2:
+            other = 1 - axis
+            ends = (lambda ids: ids[np.isin(x[ids, other],
+                                            [x[ids, other].min(), x[ids, other].max()]
+                                            if which == 0 else [x[ids, other].min()])])
+            on, below = ends(on) if on.size else on, ends(below) if below.size else below
         if on.size:
             r = sp.csr_matrix((np.ones(on.size), (np.arange(on.size), k * n_cols_per_comp + on)),
                               shape=(on.size, g.dim * n_cols_per_comp))

@@ -1,7 +1,7 @@
 """Seed 004: 1D bond-based bars, triangular micromodulus: homogenisation, constraints, vibration."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from fractions import Fraction
 from typing import Callable
 
@@ -20,13 +20,16 @@ from ..params import Param, at_least, positive, youngs_modulus
 from ..pd import build_stencil, get_influence
 from ..pd.bar1d import bar_micromodulus, micromodulus_factor, split_horizon_ratio
 from ..pd.build import Body, BondMaterial
-from ..pd.problem import BondProblem, BondSystem, PartCondition, assemble_bonds
+from ..pd.problem import (BondProblem, BondSystem, FaceCondition, PartCondition,
+                          SurfaceConditions, assemble_bonds)
 from ..solvers.explicit import central_difference
 from ..solvers.modal import exact_stability_limit, min_angular_frequency
 from ..solvers.front import solve_constrained
 from ..quotes import Quote as Q
 from . import Outcome, Published, Scene, register
 from .base import Discretisation, truncation_problem
+from .bar1d import MACHINE_PRECISION, MACHINE_PRECISION_PCT
+from .bondfamily import BOND_BOX
 
 
 #: Cross-section A [m^2]. It cancels in every metric (c1 ~ 1/A, forces ~ A); kept so that
@@ -129,17 +132,64 @@ class BondBarScene(Scene):
     ``none``'s parameters; the scene's metrics and load stay as they are. Each scene
     then solves the system its own way (statically determinate cuts, Lagrange rows for
     the held points, explicit dynamics).
+
+    The static bars whose load is a surface traction in the continuum (the end force
+    sigma A over the area A: ``bar1d-homogenization``, bars (a) and (b) of
+    ``bar1d-constraints``) state it at their surface too (:meth:`surface_bar`, a
+    :class:`~pdverify.pd.problem.SurfaceConditions`), for the ``bond-box`` treatments:
+    seed 000 §7's Taylor fictitious nodes and seed 001's surface nodes read for
+    bond-based PD (:mod:`pdverify.corrections.bond_fictitious`). Their body is the bar
+    between its end points, [x_1, x_N] = ``length``, laid out cell-centred with the
+    scene's Delta: N - 1 real nodes at the cells' centres (every one a whole cell), the
+    surface at x_1 and x_N, a fictitious layer of one horizon beyond it; the traction
+    sigma (outward) on a loaded end, u = 0 at a held end's surface point, and u = 0 at
+    the plane x = 0 of a symmetric bar (the midpoint held: the mean of the two nodes
+    straddling it). The end weights do not exist there (every real node carries a
+    whole cell), so ``end_weight=half`` is refused for them.
     """
 
     seed = "004"
     dim = 1
     closure_theory = "bond-based"
-    role_refusals = {
-        "bond-box": "not wired: the bar's loads and holds are seed 004's point forces on "
-                    "its end points and held points, whose end-bond factors it measures "
-                    "(Tables 12-13); the 1D bars stated at their surface are the "
-                    "state-based bar1d-traction/-uniform-load (Taylor, surface nodes)",
-        "held-face": "no held face: both end points carry the end forces"}
+    role_refusals = {"held-face": "no held face: both end points carry the end forces"}
+
+    def bond_box(self, method):
+        """The treatment of ``method`` where it serves the bar by its ``bond-box`` role
+        (None: the bar's own closure runs it)."""
+        t = self.offered().get(method)
+        if t is None or BOND_BOX not in self.role_families or t.role(BOND_BOX) is None:
+            return None
+        return t
+
+    def bond_box_cells(self, p) -> int:
+        """Cells of the smallest bar the scene lays out for a ``bond-box`` treatment."""
+        return p["nodes"] - 1
+
+    def surface_bar(self, p, cells, spacing, origin, faces, planes=()) -> BondProblem:
+        """The bar [origin, origin + cells Delta] with ``faces`` (``x-``, ``x+``:
+        :class:`~pdverify.pd.problem.FaceCondition`) stated at its surface and u = 0 on
+        the ``planes`` (``((0, 0),)``: at x = 0), for the ``bond-box`` treatments (the
+        class docstring); its material, stencil and c1 are :meth:`bar_problem`'s."""
+        problem = self.bar_problem(p, cells + 1, spacing)
+        return replace(problem, body=replace(problem.body, origin=(float(origin),)),
+                       surface=SurfaceConditions(dict(faces),
+                                                 lambda x: np.zeros((len(x), 1)),
+                                                 planes=tuple(planes)))
+
+    @staticmethod
+    def end_traction(p) -> FaceCondition:
+        """The end stress sigma as an outward traction, t = sigma n, on an end face."""
+        sigma = float(p["stress"])
+        return FaceCondition(traction=lambda x, normal: sigma * np.asarray(normal, dtype=float))
+
+    def solve_surface_bar(self, t, problem, p, where):
+        """``(x, u, system, info)`` of ``problem`` under the ``bond-box`` treatment
+        ``t``: its real nodes' positions (ascending) and displacements."""
+        system = t.build_for(BOND_BOX, problem, p)
+        u, info = system.solve(where)
+        g = system.model.grid
+        real = g.interior_ids[np.argsort(g.x[g.interior_ids, 0])]
+        return g.x[real, 0], u[real], system, info
 
     def discretisation(self, p):
         """``nodes`` points over ``length`` (Delta = length / (nodes - 1)), delta =
@@ -162,6 +212,14 @@ class BondBarScene(Scene):
         if t is not None:
             from ..corrections.registry import plugin_call
             plugin_call(t, "check", t.check, (p["nodes"],), p, where)
+        box = self.bond_box(method)
+        if box is not None:
+            if p["end_weight"] != "full":
+                raise InputError(f"{where}: end_weight={p['end_weight']} is not allowed; the "
+                                 "fictitious-node layout gives every real node a whole cell "
+                                 "of the bar between its end points (no end element to "
+                                 "weigh): end_weight=full only")
+            box.check_for(BOND_BOX, (self.bond_box_cells(p),), p, where)
         peer = self.offered().get(method)
         if getattr(peer, "peer", False):
             peer.check_bar(p, where)
@@ -350,9 +408,25 @@ class Homogenization(BondBarScene):
     asking for them is bad input. §7's remark on the constant micromodulus (the classical
     limit only with full-weight ends, from its ref. [1]) does not reproduce in either
     calibration: finding ``004-constant-limit`` (``pdverify.deviations``).
+
+    ``taylor-fictitious`` and ``surface-nodes`` (seed 000 §7, seed 001 read for
+    bond-based PD; :class:`BondBarScene`): the end force sigma A is the traction sigma
+    on the bar's end faces x_1, x_N (the surface of the body between the end points,
+    N - 1 cells of Delta), the translation removed at the plane x = 0 (the centre).
+    ``strain_factor`` is then the strain between the outermost real nodes, x_1 + Delta/2
+    and x_N - Delta/2, over sigma/E; ``max_error_pct`` and ``rel_l2_error`` over the
+    real nodes. Seed 000 §7's claim, read as its §5.1 exactness: an order-n
+    extrapolation reproduces the linear field on the layer, so with the discrete
+    calibration (the bulk lattice's modulus is E) u = sigma x / E solves every real
+    equation and both flux rows: f = 1 and the error at round-off for every N
+    ({{taylor}} % at N = 9, where ``none`` has f = 1.2178540), without any factor. No
+    sweep over N is run for them (f = 1 at every N is that claim).
     """
 
     id = "bar1d-homogenization"
+    role_families = (BOND_BOX,)
+    #: the numbers the docstring quotes from this report's runs (pdverify.quotes)
+    doc_quotes = {"taylor": Q("max_error_pct", "taylor-fictitious", {"nodes": 9}, ".2g")}
     #: typed numbers that look like ours on purpose (pdverify.quotes): Table 12's 1.043
     doc_typed = ("1.043",)
     title = "Bar in uniaxial tension: end-bond homogenisation (triangular micromodulus)"
@@ -388,6 +462,13 @@ class Homogenization(BondBarScene):
         Published("strain_factor_limit", "1 for full-weight ends only", "seed 004 §7 (its "
                   "ref. [1])", method="none", where=CONSTANT_LIMIT,
                   deviation="004-constant-limit"),
+        # seed 000 §7: the Taylor method "can be successfully used also in bond-based
+        # models"; its exactness for a linear field (§5.1, Figs. 15-16) read on the bar's
+        # uniform stress (the discrete calibration: the lattice's modulus is E)
+        Published("max_error_pct", "machine precision",
+                  "seed 000 §7 (bond-based form) with §5.1's exactness (Figs. 15-16)",
+                  method="taylor-fictitious", where={"calibration": "discrete"},
+                  bound=MACHINE_PRECISION_PCT, tolerance_source=MACHINE_PRECISION),
     )
 
     table12 = TABLE12
@@ -429,6 +510,11 @@ class Homogenization(BondBarScene):
             out += [("none", {"horizon_ratio": ratio, "nodes": 2 * int(ratio) + 1})
                     for _table, rows in MICROMODULUS_TABLES for ratio, _ in rows
                     if ratio not in covered]
+        # seed 000 §7's and seed 001's methods read for bond-based PD: Table 12's default
+        # bar (delta = 4 Delta, N = 9) and, in the full report, the sweep's largest N
+        for method in ("taylor-fictitious", "surface-nodes"):
+            if method in self.offered():
+                out += [(method, {"nodes": n}) for n in ((9,) if quick else (9, 1001))]
         return out
 
     def end_loaded_problem(self, p, nodes, spacing) -> BondProblem:
@@ -463,9 +549,36 @@ class Homogenization(BondBarScene):
             "end_load_C": p["E"] / (model.c * AREA * model.spacing ** 2
                                     * (0.5 if p["end_weight"] == "half" else 1.0))}
 
+    def solve_bond_box(self, t, method, p, timer) -> Outcome:
+        """The end-loaded bar under a ``bond-box`` treatment (the class docstring)."""
+        N, L = p["nodes"], p["length"]
+        with timer.phase("setup"):
+            end = self.end_traction(p)
+            problem = self.surface_bar(p, N - 1, L / (N - 1), -0.5 * L,
+                                       {"x-": end, "x+": end}, planes=((0, 0),))
+        with timer.phase("solve"):
+            x, u, system, info = self.solve_surface_bar(t, problem, p, f"{self.id}/{method}")
+        model = system.model
+        u_cl = p["stress"] / p["E"] * x
+        f = float((u[-1] - u[0]) / (x[-1] - x[0]) * p["E"] / p["stress"])
+        metrics = {"strain_factor": f, "max_error_pct": max_error_of_peak_pct(u, u_cl),
+                   "rel_l2_error": rel_l2_error(u, u_cl), **self.model_metrics(p, model)}
+        counts = system.counts
+        size = {"nodes": counts["real_nodes"], "dofs": counts["unknowns"],
+                "bonds": model.n_bonds(), **counts}
+        # the force through the loaded end (its boundary cell face's flux) over sigma A:
+        # the flux row the solve imposed, a check on it
+        info = {**info, "end_flux_over_load": float(system.face_force("x+")[0]
+                                                    / (p["stress"] * AREA)), "c1": model.c}
+        return Outcome(metrics=metrics, size=size, fields={"x": x, "u": u, "u_ref": u_cl},
+                       diagnostics=info)
+
     def solve(self, method, p, timer):
         N = p["nodes"]
         t = self.offered().get(method)
+        box = self.bond_box(method)
+        if box is not None:
+            return self.solve_bond_box(box, method, p, timer)
         peer = getattr(t, "peer_solve_bar", None)
         with timer.phase("setup"):
             problem = self.end_loaded_problem(p, N, p["length"] / (N - 1))
