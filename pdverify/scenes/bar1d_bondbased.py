@@ -648,11 +648,32 @@ class Constraints(BondBarScene):
 
     Defaults are the paper's: delta = 4 Delta, full-weight end elements, E = 1, sigma = 1,
     N_a = 17 (so N_b = 9, N_c = 12). Unstated and chosen: length 2 (Table 13, case a).
+
+    ``taylor-fictitious`` and ``surface-nodes`` (seed 000 §7, seed 001 read for
+    bond-based PD; :class:`BondBarScene`) run the two bars the continuum states: (a) the
+    bar between its end points x = -+(N_a - 1) Delta / 2 (N_a - 1 cells) with the
+    traction sigma on both end faces and u = 0 at its plane of symmetry x = 0 (the held
+    midpoint; the mean of the two nodes straddling it), and (b) its right half [0, (N_a
+    - 1) Delta / 2] with u = 0 at the surface point x = 0 (Eq. 58: the extrapolated
+    value there, or the surface node's own) and the traction at x = (N_a - 1) Delta / 2.
+    Their real nodes coincide on x > 0, where ``half_vs_full_max_diff`` compares them.
+    Bar (c) is not run for them: its points 1..m held over one horizon are seed 004's
+    discrete variant of the same continuum condition u(0) = 0; stated at the surface it
+    is bar (b) (the m - 1 held points to the left of x = 0 lie outside the body, in its
+    fictitious layer, whose values the extrapolation sets), so
+    ``horizon_constraint_vs_full_max_diff``, ``error_c_pct`` and ``c_closer_than_b`` are
+    the bar's own methods' metrics. Seed 000 §7's claim, read as §5.1's exactness: the
+    linear field solves both bars, so (b) is the half of (a) and both are classical to
+    round-off ({{taylor_half}} and {{taylor_error}} % for Taylor here).
     """
 
     id = "bar1d-constraints"
+    role_families = (BOND_BOX,)
     role_refusals = {**BondBarScene.role_refusals, "held-face": (
         "its held points are seed 004's own constraint variants: bar (c), points 1..m held over one horizon, is the rigid buffer virtual nodes add, run as the scene's own bar")}
+    #: the numbers the docstring quotes from this report's runs (pdverify.quotes)
+    doc_quotes = {"taylor_half": Q("half_vs_full_max_diff", "taylor-fictitious", {}, ".2g"),
+                  "taylor_error": Q("max_error_pct", "taylor-fictitious", {}, ".2g")}
     title = "Symmetry and constraint variants of a bar in tension (Fig. 3)"
     seed = "004 §6.2"
     reference = "analytic"
@@ -679,10 +700,57 @@ class Constraints(BondBarScene):
                   exact=True, kind="read off a figure", role="claim"),
         Published("horizon_constraint_vs_full_max_diff", "non-zero", "seed 004 §6.2 and Fig. 3",
                   method="homogenized", bound=1e-12, check="above", tolerance_source=NONZERO),
+        # seed 000 §7 (the bond-based form) with §5.1's exactness for a linear field: bar
+        # (a) classical to round-off (the discrete calibration: the lattice's modulus is E)
+        Published("max_error_pct", "machine precision",
+                  "seed 000 §7 (bond-based form) with §5.1's exactness (Figs. 15-16)",
+                  method="taylor-fictitious", where={"calibration": "discrete"},
+                  bound=MACHINE_PRECISION_PCT, tolerance_source=MACHINE_PRECISION),
     )
 
     def min_nodes(self, m):
         return 4 * m + 1  # the halves have (N_a + 1)/2 >= 2m + 1 points
+
+    def bond_box_cells(self, p) -> int:
+        return (p["nodes"] + 1) // 2 - 1          # the half bar (b)
+
+    def solve_bond_box(self, t, method, p, timer) -> Outcome:
+        """Bars (a) and (b) under a ``bond-box`` treatment (the class docstring)."""
+        n_a = p["nodes"]
+        n_b = (n_a + 1) // 2
+        spacing = p["length"] / (n_a - 1)
+        end = self.end_traction(p)
+        with timer.phase("setup"):
+            problems = {
+                "a": self.surface_bar(p, n_a - 1, spacing, -0.5 * (n_a - 1) * spacing,
+                                      {"x-": end, "x+": end}, planes=((0, 0),)),
+                "b": self.surface_bar(p, n_b - 1, spacing, 0.0,
+                                      {"x-": FaceCondition(prescribed=(0,)), "x+": end})}
+        x, u, info, systems = {}, {}, {}, {}
+        with timer.phase("solve"):
+            for k, problem in problems.items():
+                x[k], u[k], systems[k], info[k] = self.solve_surface_bar(
+                    t, problem, p, f"{self.id}/{method} bar ({k})")
+        right = x["a"] > 0.0
+        if not np.allclose(x["a"][right], x["b"], rtol=0.0, atol=1e-9 * spacing):
+            raise NumericalError(f"{self.id}/{method}: bars (a) and (b) do not share their "
+                                 "real nodes on x > 0")
+        scale = np.max(np.abs(u["a"]))
+        s_E = p["stress"] / p["E"]
+        metrics = {
+            "half_vs_full_max_diff": float(np.max(np.abs(u["b"] - u["a"][right])) / scale),
+            "max_error_pct": max_error_of_peak_pct(u["a"], s_E * x["a"]),
+            "rel_l2_error": rel_l2_error(u["a"], s_E * x["a"]),
+            "error_b_pct": max_error_of_peak_pct(u["b"], s_E * x["b"]),
+        }
+        fields = {f"{name}_{k}": d[k] for k in x for name, d in (("x", x), ("u", u))}
+        fields["stress_over_E"] = s_E
+        size = {"nodes": sum(s.counts["real_nodes"] for s in systems.values()),
+                "dofs": sum(s.counts["unknowns"] for s in systems.values()),
+                "bonds": sum(s.model.n_bonds() for s in systems.values())}
+        diagnostics = {f"bar_{k}_{key}": v for k in info for key, v in info[k].items()
+                       if isinstance(v, (int, float)) and not isinstance(v, bool)}
+        return Outcome(metrics=metrics, size=size, fields=fields, diagnostics=diagnostics)
 
     def estimate(self, method, p):
         one = super().estimate(method, p)  # bars a, b (half of a), c (b plus a horizon)
@@ -718,6 +786,9 @@ class Constraints(BondBarScene):
             "c": (n_c, list(range(m)), 0.0, -(m - 1) * spacing),
         }
         t = self.offered().get(method)
+        box = self.bond_box(method)
+        if box is not None:
+            return self.solve_bond_box(box, method, p, timer)
         peer = getattr(t, "peer_solve_bar", None)
         with timer.phase("setup"):
             problems = {k: self.bar_problem(p, n, spacing, *self.conditions(held, left, force))
