@@ -84,7 +84,9 @@ ADDED_CELLS = (
     | {(sid, m) for sid in ("sheet2d-clamped", "sheet2d-tension", "stiffness2d-sheet",
                             "stiffness3d-box-bond")
        for m in ("taylor-fictitious", "surface-nodes")}
-    | {("block2d-indentation", "virtual-nodes")})
+    | {("block2d-indentation", "virtual-nodes")}
+    | {(sid, m) for sid in ("bar1d-homogenization", "bar1d-constraints")
+       for m in ("taylor-fictitious", "surface-nodes")})
 
 
 def test_parameter_surface_unchanged():

@@ -898,7 +898,15 @@ class Vibration(BondBarScene):
     """
 
     id = "bar1d-vibration"
-    role_refusals = {**BondBarScene.role_refusals, "held-face": (
+    role_refusals = {**BondBarScene.role_refusals, "bond-box": (
+        "a dynamic run of conditions that are algebraic rows: Taylor's held end and free "
+        "end are Lagrange rows on the real nodes (seed 000 Eq. 63, a static method, §2), so "
+        "M u'' + K u = B^T lambda, B u = 0 is an index-3 differential-algebraic system whose "
+        "multipliers act as forces PD's equation of motion does not have; the surface "
+        "nodes' free end is a massless node whose equation is the flux row (seed 002 moves "
+        "only prescribed surface nodes), an index-1 one (condensed, an ODE with a "
+        "non-symmetric stiffness no seed states); the scene's explicit central "
+        "differences step M u'' = f(u) with a mass on every unknown"), "held-face": (
         "its held points are seed 004's own constraint variants: constraint=end-points (points 1..4 held over one horizon) is the rigid buffer virtual nodes add, run as the scene's own case")}
     #: the numbers the docstring quotes from this report's runs (pdverify.quotes)
     doc_quotes = {k: Q(metric, "homogenized", {"constraint": "mid", "horizon_ratio": 4.0,
