@@ -1,6 +1,8 @@
 """Seed 000's Taylor fictitious nodes and seed 001's surface nodes on a bond-based box:
 the ``bond-box`` family (the bond-based scenes that state their conditions at the body's
-surface, :class:`~pdverify.pd.problem.SurfaceConditions`).
+surface, :class:`~pdverify.pd.problem.SurfaceConditions`: the 2D sheets and stiffness
+boxes, the 3D stiffness box, and in 1D seed 004's static bars, whose end force is the
+traction sigma on the end faces and whose held midpoint is the symmetry point x = 0).
 
 Both treatments lay the body out cell-centred (every real node carries its whole cell,
 the surface half a spacing beyond the outermost nodes: the scene's box with the spacing

@@ -198,8 +198,8 @@ def family_treatments() -> list[Treatment]:
                   "near-singular. On a shape (not a box) the series runs along the local "
                   "normal with derivatives from a least-squares fit, the conditions at "
                   "boundary points (corrections.shape_fictitious; corners unused). "
-                  "Bond-based (seed 000 §7): the 2D boxes that state their conditions at "
-                  "the surface (corrections.bond_fictitious)",
+                  "Bond-based (seed 000 §7): the 2D boxes and seed 004's static bars that "
+                  "state their conditions at the surface (corrections.bond_fictitious)",
             build=_taylor, checker=_check_taylor, shapes=True,
             static_only="its conditions are Lagrange constraint rows, so the dynamics "
                         "would be a differential-algebraic system",
@@ -222,7 +222,8 @@ def family_treatments() -> list[Treatment]:
                   "one runs along the local normal with derivatives from a least-squares "
                   "fit, arcs take the series' traction (surface_nodes."
                   "surface_nodes_on_shape: our generalisation); bond-based: the 2D boxes "
-                  "that state their conditions at the surface (corrections.bond_fictitious: "
+                  "and seed 004's static bars that state their conditions at the surface "
+                  "(corrections.bond_fictitious: "
                   "what seed 001 leaves open for bond-based PD)",
             shapes3d_why="not built (surface_nodes.surface_nodes_on_shape places its "
                          "surface nodes and fits on the 2D parts; a 3D part needs surface "
