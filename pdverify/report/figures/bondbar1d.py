@@ -104,8 +104,8 @@ def constraint_figures(scene, results, folder):
                 ax.plot(f[f"x_{k}"], f[f"u_{k}"], markers.get(r.method, "d") + "-", ms=4,
                         lw=0.8, mfc="none", color=palette.colour(r.method), label=r.method)
         # bar (a)'s nodes that bar (b) shares: x >= 0 (its midpoint on), x > 0 (cell-centred)
-        shared = np.isin(np.round(f["x_a"] / np.max(np.abs(f["x_a"])), 9),
-                         np.round(f["x_b"] / np.max(np.abs(f["x_a"])), 9))
+        gap = np.abs(f["x_a"][:, None] - f["x_b"][None, :]).min(axis=1)
+        shared = gap <= 1e-9 * np.max(np.abs(f["x_a"]))
         half = f["u_a"][shared]
         scale = np.max(np.abs(f["u_a"]))
         mk = markers.get(r.method, "d")
