@@ -418,15 +418,13 @@ class Homogenization(BondBarScene):
     real nodes. Seed 000 §7's claim, read as its §5.1 exactness: an order-n
     extrapolation reproduces the linear field on the layer, so with the discrete
     calibration (the bulk lattice's modulus is E) u = sigma x / E solves every real
-    equation and both flux rows: f = 1 and the error at round-off for every N
-    ({{taylor}} % at N = 9, where ``none`` has f = 1.2178540), without any factor. No
-    sweep over N is run for them (f = 1 at every N is that claim).
+    equation and both flux rows: f = 1 and the error at round-off for every N (at N = 9,
+    where ``none`` has Table 12's f(9)), without any factor. No sweep over N is run for
+    them (f = 1 at every N is that claim).
     """
 
     id = "bar1d-homogenization"
     role_families = (BOND_BOX,)
-    #: the numbers the docstring quotes from this report's runs (pdverify.quotes)
-    doc_quotes = {"taylor": Q("max_error_pct", "taylor-fictitious", {"nodes": 9}, ".2g")}
     #: typed numbers that look like ours on purpose (pdverify.quotes): Table 12's 1.043
     doc_typed = ("1.043",)
     title = "Bar in uniaxial tension: end-bond homogenisation (triangular micromodulus)"
@@ -664,16 +662,13 @@ class Constraints(BondBarScene):
     ``horizon_constraint_vs_full_max_diff``, ``error_c_pct`` and ``c_closer_than_b`` are
     the bar's own methods' metrics. Seed 000 §7's claim, read as §5.1's exactness: the
     linear field solves both bars, so (b) is the half of (a) and both are classical to
-    round-off ({{taylor_half}} and {{taylor_error}} % for Taylor here).
+    round-off.
     """
 
     id = "bar1d-constraints"
     role_families = (BOND_BOX,)
     role_refusals = {**BondBarScene.role_refusals, "held-face": (
         "its held points are seed 004's own constraint variants: bar (c), points 1..m held over one horizon, is the rigid buffer virtual nodes add, run as the scene's own bar")}
-    #: the numbers the docstring quotes from this report's runs (pdverify.quotes)
-    doc_quotes = {"taylor_half": Q("half_vs_full_max_diff", "taylor-fictitious", {}, ".2g"),
-                  "taylor_error": Q("max_error_pct", "taylor-fictitious", {}, ".2g")}
     title = "Symmetry and constraint variants of a bar in tension (Fig. 3)"
     seed = "004 §6.2"
     reference = "analytic"

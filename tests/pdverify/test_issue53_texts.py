@@ -124,7 +124,9 @@ def test_section_6_2_statements_attach_to_the_uncorrected_and_homogenised_bars_o
     scene = get_scene("bar1d-constraints")
     for method in scene.offered():
         params = scene.resolve(method, {})
-        metrics = {p.metric for p in scene.published if p.applies(method, params)}
+        # seed 004's statements; seed 000 §7's claim on Taylor's bars (issue 55) is its own
+        metrics = {p.metric for p in scene.published if p.applies(method, params)
+                   and p.source.startswith("seed 004")}
         assert bool(metrics) == (method in ("none", "homogenized")), (method, metrics)
         if metrics:
             assert "horizon_constraint_vs_full_max_diff" in metrics
