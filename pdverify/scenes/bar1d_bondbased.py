@@ -135,10 +135,13 @@ class BondBarScene(Scene):
     dim = 1
     closure_theory = "bond-based"
     role_refusals = {
-        "bond-box": "not wired: the bar's loads and holds are seed 004's point forces on "
-                    "its end points and held points, whose end-bond factors it measures "
-                    "(Tables 12-13); the 1D bars stated at their surface are the "
-                    "state-based bar1d-traction/-uniform-load (Taylor, surface nodes)",
+        "bond-box": "its question is seed 004's: what end-bond factors do to a bar whose "
+                    "load is a point force on its end points (half-volume nodes on the "
+                    "bar's ends) and whose holds are held points (Tables 12-13); a "
+                    "treatment that states the conditions at the surface replaces those "
+                    "points' equations by a traction or a value at a face, which leaves "
+                    "no point force and no held point to measure (a 1D bar under an end "
+                    "traction is bar1d-traction, where Taylor and surface nodes run)",
         "held-face": "no held face: both end points carry the end forces"}
 
     def discretisation(self, p):

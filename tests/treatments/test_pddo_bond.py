@@ -142,3 +142,55 @@ def test_continuum_moduli_miss_the_bond_based_bulk():
     u, _ = system.solve("test")
     want = exact(g.x)
     assert np.max(np.abs(u.reshape(2, n).T - want)) > 1e3 * ROUND_OFF * np.max(np.abs(want))
+
+
+# ----------------------------------------------------------------------- on the scenes
+from pdverify.corrections.registry import treatments  # noqa: E402
+from pdverify.scenes import get_scene  # noqa: E402
+
+#: the tension sheet's small grid of tests/treatments/test_bond_fictitious.py (16 x 32
+#: cells at m = 4) and its round-off bound on the affine field (4e-9 % of the largest
+#: |u| of a component: condition ~2e5 times eps; measured here 4e-12 .. 8e-12 %)
+SMALL = {"width": 0.02, "length": 0.04, "spacing": 0.00125}
+ROUND_OFF_PCT = 4e-9
+
+
+def test_affine_field_is_exact_on_the_tension_sheet():
+    """The uniform stress against the lattice's own moduli (the scene's reference): the
+    PDDO rows' tensor is the lattice's, so the affine field is a solution to round-off
+    (the uncorrected sheet misses it by > 1 %, tests/treatments/test_bond_fictitious.py)."""
+    run = get_scene("sheet2d-tension").run("pddo", SMALL)
+    assert run.status == "ok", run.message
+    assert run.metrics["max_error_ux_norm_pct"] < ROUND_OFF_PCT
+    assert run.metrics["max_error_uy_norm_pct"] < ROUND_OFF_PCT
+    assert run.size["fictitious_nodes"] == 0 and run.size["constraints"] == 3
+
+
+def test_clamped_sheet_stress_is_the_traction_through_the_clamped_face():
+    """The tensile stress of the PDDO run is the PDDO traction integrated over y = L/2.
+    The PDDO system has no row of the body's balance (its traction rows hold at boundary
+    points), so the two clamps' forces cancel by the sheet's symmetry about y = 0, to the
+    solve's round-off; the sides carry the corner cells' x-traction (their x-rows are the
+    clamp's Dirichlet rows: measured 2.9 % of the clamp force at m = 6), equal and
+    opposite by the symmetry about x = 0."""
+    scene = get_scene("sheet2d-clamped")
+    p = scene.resolve("pddo", {})
+    _, system = scene.bond_system("pddo", p, "test")
+    system.solve("test")
+    top, bottom = system.face_force("y+"), system.face_force("y-")
+    left, right = system.face_force("x-"), system.face_force("x+")
+    assert top[1] > 0
+    # a relative 1e-9: the solve's round-off (residual ~1e-16, condition < 1e5) with margin
+    assert abs(left[0] + right[0]) < 1e-9 * abs(top[1])
+    assert abs(top[1] + bottom[1]) < 1e-9 * abs(top[1])
+
+
+def test_refusals_on_the_bond_based_scenes_are_mathematics():
+    """Every bond-based scene PDDO does not serve says why without 'not wired'."""
+    t = treatments()["pddo"]
+    for sid in ("bar1d-homogenization", "bar1d-constraints", "bar1d-vibration",
+                "block2d-indentation", "stiffness2d-sheet", "stiffness3d-box-bond"):
+        why = t.why_not(get_scene(sid))
+        assert why is not None and "not wired" not in why, (sid, why)
+    for sid in ("sheet2d-tension", "sheet2d-clamped"):
+        assert t.why_not(get_scene(sid)) is None, sid
