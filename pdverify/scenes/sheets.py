@@ -46,8 +46,9 @@ class SheetScene(BondStaticScene):
     params' split)."""
 
     figure = "sheets"
-    #: Taylor's fictitious nodes and the surface nodes take the conditions at the
-    #: sheet's surface (``BondProblem.surface``, ``corrections.bond_fictitious``)
+    #: Taylor's fictitious nodes, the surface nodes and PDDO take the conditions at the
+    #: sheet's surface (``BondProblem.surface``, ``corrections.bond_fictitious``,
+    #: ``corrections.pddo_bond``)
     role_families = (BOND_BOX,)
 
     def check_pd(self, where, method, p):
@@ -475,7 +476,8 @@ class ClampedSheet(SheetScene):
         grid = model.grid
         n = grid.n_ext
         u = np.asarray(x)
-        if hasattr(system, "face_force"):    # a bond-box system: the flux through y = L/2
+        if hasattr(system, "face_force"):    # a bond-box system: the force through y = L/2
+            # (the boundary cell faces' fluxes; PDDO: its traction over them)
             stress = float(system.face_force("y+")[1]) / (L * t) / 1e6
         else:
             reaction = system.K @ u - system.rhs
