@@ -58,6 +58,13 @@ def test_lattice_tensor_is_the_models_energy_under_a_homogeneous_strain(box):
     # total symmetry (pairwise central forces: Cauchy's relations), C12 = C44
     assert np.allclose(C, C.transpose(0, 2, 1, 3), rtol=0, atol=1e-15 * C.max())
     assert C[0, 0, 1, 1] == pytest.approx(C[0, 1, 0, 1], rel=1e-14)
+    if d == 2 and body.thickness == 1.0:
+        # the tension sheet's plane-stress E*, nu* (sheets.lattice_moduli, its reference)
+        from pdverify.scenes.sheets import lattice_moduli
+        E_star, nu_star = lattice_moduli(model)
+        C11, C12 = C[0, 0, 0, 0], C[0, 0, 1, 1]
+        assert C11 - C12 ** 2 / C11 == pytest.approx(E_star, rel=1e-14)
+        assert C12 / C11 == pytest.approx(nu_star, rel=1e-14)
 
 
 def _quadratic(d, C, scale=1e-3):
