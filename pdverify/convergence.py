@@ -167,14 +167,16 @@ STOP_3D = (
 )
 
 
-#: Taylor's fictitious nodes and the surface nodes on the bond-based sheets (issue 55,
-#: ``corrections.bond_fictitious``): the scenes' own cases run them at the default grid.
+#: Taylor's fictitious nodes, the surface nodes and PDDO on the bond-based sheets (issue
+#: 55, ``corrections.bond_fictitious``, ``corrections.pddo_bond``): the scenes' own cases run them at the default grid.
 #: On the tension sheet they are exact at every level (an affine field: no rate to fit)
 #: and at m = 2 near-singular (the flux rows' checkerboard dependency); on the clamped
 #: sheet the finest levels took 13-25 s a run under load (side 12, m = 12) and the
 #: tension sheet's h = 0.625 mm 81 and 228 s and 2.2 GB (report of 2026-11-28, /tmp):
-#: more than the issue's time for all its cells
-BOND_BOX_COST = ("taylor-fictitious", "surface-nodes")
+#: more than the issue's time for all its cells. PDDO's bond-based form
+#: (``corrections.pddo_bond``) likewise: exact on the tension sheet, 7.6 and 9.9 s a run
+#: under load at the clamped sheet's finest levels (m = 12; side 12)
+BOND_BOX_COST = ("taylor-fictitious", "surface-nodes", "pddo")
 
 
 def _m(scene, kind, levels, skip=(), quick=None):

@@ -59,8 +59,9 @@ def test_studies_unchanged_bit_for_bit():
     # cost, convergence.BOND_BOX_COST); every level, label and h is as it was
     for row in after:
         if row["scene"] in ("sheet2d-tension", "sheet2d-clamped"):
-            assert row["skip"][-2:] == ["taylor-fictitious", "surface-nodes"], row["scene"]
-            row["skip"] = row["skip"][:-2]
+            assert row["skip"][-3:] == ["taylor-fictitious", "surface-nodes", "pddo"], \
+                row["scene"]
+            row["skip"] = row["skip"][:-3]
     assert len(after) == len(before)
     for old, new in zip(before, after):
         if (old["scene"], old["kind"]) in EXTENDED:
@@ -84,9 +85,10 @@ ADDED_CELLS = (
     | {(sid, m) for sid in ("sheet2d-clamped", "sheet2d-tension", "stiffness2d-sheet",
                             "stiffness3d-box-bond")
        for m in ("taylor-fictitious", "surface-nodes")}
+    | {(sid, "pddo") for sid in ("sheet2d-clamped", "sheet2d-tension")}
     | {("block2d-indentation", "virtual-nodes")}
     | {(sid, m) for sid in ("bar1d-homogenization", "bar1d-constraints")
-       for m in ("taylor-fictitious", "surface-nodes")})
+       for m in ("taylor-fictitious", "surface-nodes", "pddo")})
 
 
 def test_parameter_surface_unchanged():

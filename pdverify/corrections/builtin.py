@@ -16,6 +16,7 @@ from ..pd.problem import LOAD_POINTS, BondProblem, BondSystem, LinearSystem, Sta
 from .bond_fictitious import assemble_bond_box, check_bond_box
 from .mirror_nodes import GRADIENT_AT, MIRROR_POINTS, NEUMANN_READINGS, assemble_mirror
 from .pddo import BULK_MODELS, assemble_pddo
+from .pddo_bond import assemble_bond_pddo
 from .plain import assemble_plain
 from .protocols import GridClosure, ParamCheck, Params, StaticAssembly
 from .surface_nodes import MAX_ORDER, assemble_surface_nodes, check_wave_order, wave_extension
@@ -172,6 +173,12 @@ def _check_bond_surface(cells, p, where) -> None:
                              f"{need} for the Taylor stencils")
 
 
+def _bond_pddo(problem: BondProblem, params: Params) -> BondSystem:
+    """PDDO's role in the ``bond-box`` family (seed 001 §5.3 read for bond-based PD:
+    ``corrections.pddo_bond``)."""
+    return assemble_bond_pddo(problem)
+
+
 BOTH = ("state-based", "bond-based")
 
 
@@ -256,20 +263,20 @@ def family_treatments() -> list[Treatment]:
             "pddo", "seed 001 §5: peridynamic differential operator (moment matrices exact "
             "for quadratics) for the boundary rows and the equilibrium within 2 delta, LPS "
             "beyond", "Behera, Roy, Anicode, Madenci, Spencer 2022; seed 001 §5.3",
-            params=PDDO_PARAMS, theories=STATE, families=FAMILY,
-            theory_refusal="not wired for bond-based PD: its equations beyond 2 delta are "
-                           "the LPS model's and its traction rows use the LPS constants "
-                           "(seed 001 §5.3); a bond-based form needs the bond-based bulk "
-                           "beyond and the lattice's moduli (C11, C12) in the rows",
+            params=PDDO_PARAMS, theories=BOTH, families=FAMILY,
             scope="state-based; the boundary row (Dirichlet or traction) is chosen per "
                   "boundary node; on a shape at each boundary node's points with the "
-                  "part's local normal (pddo.pddo_shape_system: our generalisation)",
+                  "part's local normal (pddo.pddo_shape_system: our generalisation). "
+                  "Bond-based: the 2D and 3D boxes that state their conditions at the "
+                  "surface, the rows with the lattice's own elasticity tensor and the "
+                  "bond-based equations beyond 2 delta (corrections.pddo_bond)",
             build=_pddo, shapes=True,
             static_only="its boundary rows on the outer node layer are algebraic "
                         "equations, not a mass's equation of motion",
             shapes3d_why="not built (pddo.pddo_shape_system takes the boundary rows at "
                          "points of 2D parts; a 3D part needs them at points of planes, a "
-                         "mantle and a sphere)"),
+                         "mantle and a sphere)",
+            roles=(("bond-box", Role(_bond_pddo)),)),
     ]
 
 

@@ -39,6 +39,10 @@ subdomains, not a port:
 
 The system is square and nonsymmetric (direct sparse LU). A node whose moment matrix is
 singular to 1e-12 (too few neighbours in some direction) is a failed run naming it.
+
+The bond-based form (the same operators and boundary rows, the lattice's own elasticity
+tensor in them and the bond-based equations beyond 2 delta) is
+:mod:`~pdverify.corrections.pddo_bond`.
 """
 from __future__ import annotations
 

@@ -186,8 +186,9 @@ class Treatment:
         """``None`` when this treatment runs on ``scene``, else a one-line reason."""
         if self.name in {m.name for m in scene.methods}:
             return None                                  # the scene implements it itself
-        if self.role_on(scene) is not None:
-            return None                      # a role in the scene's problem families
+        if self.role_on(scene) is not None:  # a role in the scene's problem families,
+            refusal = getattr(scene, "role_refusal", None)   # unless the scene says why
+            return None if refusal is None else refusal(self)   # not (None: it runs)
         if self.baseline and self._closure_scene(scene):
             return None                      # the uncorrected model of a closure scene
         if getattr(scene, "closed_to_treatments", None):

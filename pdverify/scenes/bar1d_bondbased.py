@@ -900,7 +900,9 @@ class Vibration(BondBarScene):
         "multipliers act as forces PD's equation of motion does not have; the surface "
         "nodes' free end is a massless node whose equation is the flux row (seed 002 moves "
         "only prescribed surface nodes), an index-1 one (condensed, an ODE with a "
-        "non-symmetric stiffness no seed states); the scene's explicit central "
+        "non-symmetric stiffness no seed states); PDDO's boundary rows replace the end "
+        "nodes' equations of motion by algebraic rows (a traction or a value at the end "
+        "face), index-1 too; the scene's explicit central "
         "differences step M u'' = f(u) with a mass on every unknown"), "held-face": (
         "its held points are seed 004's own constraint variants: constraint=end-points (points 1..4 held over one horizon) is the rigid buffer virtual nodes add, run as the scene's own case")}
     #: the numbers the docstring quotes from this report's runs (pdverify.quotes)

@@ -374,6 +374,11 @@ class Scene:
         """Why a treatment of this scene's family cannot serve it (None: it can)."""
         return None
 
+    def role_refusal(self, treatment) -> str | None:
+        """Why a treatment with a role in one of this scene's families cannot serve it
+        nonetheless (None: it can), e.g. a stiffness box's treatments that add no node."""
+        return None
+
     def _with_defaults(self, params, method: str) -> tuple[Param, ...]:
         """``params`` with this scene's :attr:`treatment_defaults` applied to those that
         declare ``scene_default``; a default a parameter does not allow is bad input."""

@@ -46,8 +46,9 @@ class SheetScene(BondStaticScene):
     params' split)."""
 
     figure = "sheets"
-    #: Taylor's fictitious nodes and the surface nodes take the conditions at the
-    #: sheet's surface (``BondProblem.surface``, ``corrections.bond_fictitious``)
+    #: Taylor's fictitious nodes, the surface nodes and PDDO take the conditions at the
+    #: sheet's surface (``BondProblem.surface``, ``corrections.bond_fictitious``,
+    #: ``corrections.pddo_bond``)
     role_families = (BOND_BOX,)
 
     def check_pd(self, where, method, p):
@@ -202,8 +203,9 @@ class TensionSheet(SheetScene):
         for h in self.m_sweep:
             if h != 0.001:
                 out += [(m, {"spacing": h}) for m in ("none", "energy-directional")]
-        # seed 000 §7's and seed 001's methods read for bond-based PD, default case only
-        return out + [(m, {}) for m in ("taylor-fictitious", "surface-nodes")
+        # seed 000 §7's and seed 001's methods (§3, §5.3's PDDO) read for bond-based PD,
+        # default case only
+        return out + [(m, {}) for m in ("taylor-fictitious", "surface-nodes", "pddo")
                       if m in self.offered()]
 
     def cells(self, p):
@@ -419,8 +421,9 @@ class ClampedSheet(SheetScene):
     def cases(self, quick=False):
         out = [("fem", {}), ("none", {}), ("energy-directional", {}), ("virtual-nodes", {}),
                ("virtual-nodes", {"correct_sides": True})]
-        # seed 000 §7's and seed 001's methods read for bond-based PD
-        out += [(m, {}) for m in ("taylor-fictitious", "surface-nodes") if m in self.offered()]
+        # seed 000 §7's and seed 001's methods (§3, §5.3's PDDO) read for bond-based PD
+        out += [(m, {}) for m in ("taylor-fictitious", "surface-nodes", "pddo")
+                if m in self.offered()]
         if quick:
             return out
         pv = {"quadrature": "partial-volume"}
@@ -473,7 +476,8 @@ class ClampedSheet(SheetScene):
         grid = model.grid
         n = grid.n_ext
         u = np.asarray(x)
-        if hasattr(system, "face_force"):    # a bond-box system: the flux through y = L/2
+        if hasattr(system, "face_force"):    # a bond-box system: the force through y = L/2
+            # (the boundary cell faces' fluxes; PDDO: its traction over them)
             stress = float(system.face_force("y+")[1]) / (L * t) / 1e6
         else:
             reaction = system.K @ u - system.rhs

@@ -279,6 +279,11 @@ class SheetStiffness(StiffnessScene):
                            reproduced=(({}, "3.26", "deviations 003-anisotropy-measure; "
                                         "tests/pdverify/test_issue53_texts.py"),)))
 
+    def role_refusal(self, treatment):
+        """A ``bond-box`` treatment that adds no node (PDDO) leaves every node's bonds:
+        :data:`NO_EXTRA_NODES`."""
+        return NO_EXTRA_NODES if treatment.footprint == "plain" else None
+
     def measure_ratios(self, p, model, ratios, counts=None) -> Outcome:
         """:meth:`StiffnessScene.measure_ratios` and the Cauchy reading of the bulk's
         anisotropy (:func:`cauchy_anisotropy_pct`, bond-based in 2D only)."""
@@ -505,6 +510,11 @@ class BondBoxStiffness(StiffnessScene):
               choices=("constant", "conical")),
         Param("quadrature", "full-cells", "horizon quadrature: whole cells (perifit's view) "
               "or exact partial volumes", choices=("full-cells", "partial-volume")))
+
+    def role_refusal(self, treatment):
+        """A ``bond-box`` treatment that adds no node (PDDO) leaves every node's bonds:
+        :data:`NO_EXTRA_NODES`."""
+        return NO_EXTRA_NODES if treatment.footprint == "plain" else None
 
     def lengths(self, p):
         return box_lengths(p)
