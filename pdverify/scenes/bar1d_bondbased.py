@@ -135,10 +135,13 @@ class BondBarScene(Scene):
     dim = 1
     closure_theory = "bond-based"
     role_refusals = {
-        "bond-box": "not wired: the bar's loads and holds are seed 004's point forces on "
-                    "its end points and held points, whose end-bond factors it measures "
-                    "(Tables 12-13); the 1D bars stated at their surface are the "
-                    "state-based bar1d-traction/-uniform-load (Taylor, surface nodes)",
+        "bond-box": "its loads and holds are seed 004's point forces on its end points "
+                    "and held points (nodes on the bar's ends), whose end-bond factors it "
+                    "measures (Tables 12-13): no traction or displacement is stated at a "
+                    "surface, so flux rows, surface nodes or mirror reflections have no "
+                    "condition to impose, and with one the bar would be another problem "
+                    "than the one its metrics check; the 1D bars stated at their surface "
+                    "are the state-based bar1d-traction/-uniform-load",
         "held-face": "no held face: both end points carry the end forces"}
 
     def discretisation(self, p):

@@ -202,8 +202,9 @@ class TensionSheet(SheetScene):
         for h in self.m_sweep:
             if h != 0.001:
                 out += [(m, {"spacing": h}) for m in ("none", "energy-directional")]
-        # seed 000 §7's and seed 001's methods read for bond-based PD, default case only
-        return out + [(m, {}) for m in ("taylor-fictitious", "surface-nodes")
+        # seed 000 §7's and seed 001's methods read for bond-based PD (seed 001 §5.2's
+        # mirror nodes with the lattice's moduli), default case only
+        return out + [(m, {}) for m in ("taylor-fictitious", "surface-nodes", "mirror-nodes")
                       if m in self.offered()]
 
     def cells(self, p):
@@ -419,8 +420,10 @@ class ClampedSheet(SheetScene):
     def cases(self, quick=False):
         out = [("fem", {}), ("none", {}), ("energy-directional", {}), ("virtual-nodes", {}),
                ("virtual-nodes", {"correct_sides": True})]
-        # seed 000 §7's and seed 001's methods read for bond-based PD
-        out += [(m, {}) for m in ("taylor-fictitious", "surface-nodes") if m in self.offered()]
+        # seed 000 §7's and seed 001's methods read for bond-based PD (and seed 001 §5.2's
+        # mirror nodes)
+        out += [(m, {}) for m in ("taylor-fictitious", "surface-nodes", "mirror-nodes")
+                if m in self.offered()]
         if quick:
             return out
         pv = {"quadrature": "partial-volume"}
