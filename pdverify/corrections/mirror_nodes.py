@@ -1,5 +1,8 @@
 """The mirror node method (MNM; Zhao, Jafarzadeh, Chen and Bobaru 2020, engrXiv
-10.31224/osf.io/7z8qr; seed 001 §5.2) on a box of cell-centred nodes, state-based.
+10.31224/osf.io/7z8qr; seed 001 §5.2) on a box of cell-centred nodes, state-based; on
+the 2D shapes along the local normal (:class:`MirrorNodesOnShape`); on the bond-based
+boxes that state their conditions at the surface (:func:`assemble_mirror_bond_box`: the
+same relations with the bond-based lattice's moduli, :func:`bond_lattice_moduli`).
 
 Seed 001 describes the method in words only, and the original was written for
 diffusion. What we implement, and which parts are our reading (a guess where marked):
