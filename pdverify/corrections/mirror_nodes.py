@@ -630,7 +630,14 @@ def assemble_mirror_bond_box(problem, neumann: str = "full-traction",
     (straight faces; the ``corrected`` mirror point everywhere), so the real nodes'
     neighbourhoods are the bulk lattice's and the field is a solution to round-off: the
     tension sheet's uniform stress against the lattice's moduli, the stiffness boxes'
-    homogeneous strains with ``corrected`` (``tests/treatments/test_mirror_bond.py``)."""
+    homogeneous strains with ``corrected`` (``tests/treatments/test_mirror_bond.py``).
+    With the method's ``nearest`` mirror node a prescribed face is exact only where the
+    mirror point is a node: not at the boxes' edges and corners, where the stiffness
+    boxes' surface energy misses by a few per cent (as on the state-based boxes). What a
+    non-affine field shows: the traction-free condition is the first-order even
+    reflection, not a flux row as Taylor's, so on the clamped sheet each free side
+    carries a normal force through its boundary cell faces (7.7 kN against the clamp's
+    196 kN; the four faces' forces still balance to round-off, the test above)."""
     sc = problem.surface
     if sc is None:
         raise ValueError("the problem states no surface conditions")
