@@ -10,8 +10,6 @@ from __future__ import annotations
 import functools
 from dataclasses import dataclass
 
-import numpy as np
-
 from ..errors import InputError
 from ..params import Param, at_least
 from ..pd.problem import LOAD_POINTS, BondProblem, BondSystem, LinearSystem, StaticProblem
@@ -186,8 +184,9 @@ def _bond_mirror(problem: BondProblem, params: Params) -> BondSystem:
 def _check_bond_mirror(cells, p, where) -> None:
     """The mirror point of the layer's outermost fictitious node lies ceil(m) cells
     inside the face; a body thinner than that along an axis has no node there."""
+    import math
     m = p["m_ratio"] if "m_ratio" in p else p["horizon"] / p["spacing"]
-    reach = int(np.ceil(m - 1e-9))
+    reach = math.ceil(m - 1e-9)     # the layer's cells (a rounding of m's product: 1e-9)
     for name, n in zip("xyz", cells):
         if n < reach:
             raise InputError(f"{where}: {n} cells along {name}; the mirror nodes of a layer "
