@@ -176,7 +176,9 @@ STOP_3D = (
 #: more than the issue's time for all its cells. PDDO's bond-based form
 #: (``corrections.pddo_bond``) likewise: exact on the tension sheet, 7.6 and 9.9 s a run
 #: under load at the clamped sheet's finest levels (m = 12; side 12)
-BOND_BOX_COST = ("taylor-fictitious", "surface-nodes", "pddo")
+#: The mirror nodes' bond-box runs the same unsymmetric LU on the same grids (one layer,
+#: no surface nodes): skipped alike
+BOND_BOX_COST = ("taylor-fictitious", "surface-nodes", "pddo", "mirror-nodes")
 
 
 def _m(scene, kind, levels, skip=(), quick=None):

@@ -14,7 +14,8 @@ from ..errors import InputError
 from ..params import Param, at_least
 from ..pd.problem import LOAD_POINTS, BondProblem, BondSystem, LinearSystem, StaticProblem
 from .bond_fictitious import assemble_bond_box, check_bond_box
-from .mirror_nodes import GRADIENT_AT, MIRROR_POINTS, NEUMANN_READINGS, assemble_mirror
+from .mirror_nodes import (GRADIENT_AT, MIRROR_POINTS, NEUMANN_READINGS, assemble_mirror,
+                           assemble_mirror_bond_box)
 from .pddo import BULK_MODELS, assemble_pddo
 from .pddo_bond import assemble_bond_pddo
 from .plain import assemble_plain
@@ -179,6 +180,28 @@ def _bond_pddo(problem: BondProblem, params: Params) -> BondSystem:
     return assemble_bond_pddo(problem)
 
 
+def _bond_mirror(problem: BondProblem, params: Params) -> BondSystem:
+    """The mirror nodes' role in the ``bond-box`` family (seed 001 §5.2 read for
+    bond-based PD, the traction relation with the lattice's C11, C12, C66:
+    ``corrections.mirror_nodes.assemble_mirror_bond_box``)."""
+    return assemble_mirror_bond_box(problem, params["neumann"], params["mirror_point"],
+                                    params.get("gradient_at", "mirror"))
+
+
+def _check_bond_mirror(cells, p, where) -> None:
+    """The mirror point of the layer's outermost fictitious node lies ceil(m) cells
+    inside the face; a body thinner than that along an axis has no node there."""
+    import math
+    m = next((p[k] for k in ("m_ratio", "horizon_ratio") if k in p), None)
+    if m is None:
+        m = p["horizon"] / p["spacing"]
+    reach = math.ceil(m - 1e-9)     # the layer's cells (a rounding of m's product: 1e-9)
+    for name, n in zip("xyz", cells):
+        if n < reach:
+            raise InputError(f"{where}: {n} cells along {name}; the mirror nodes of a layer "
+                             f"{reach} cells thick need at least {reach}")
+
+
 BOTH = ("state-based", "bond-based")
 
 
@@ -242,23 +265,21 @@ def family_treatments() -> list[Treatment]:
             "mirror nodes inside the body (odd reflection for Dirichlet components, the "
             "traction through the Neumann relation)",
             "Zhao, Jafarzadeh, Chen, Bobaru 2020; seed 001 §5.2", params=MIRROR_PARAMS,
-            theories=STATE, families=FAMILY, footprint="fictitious",
+            theories=BOTH, families=FAMILY, footprint="fictitious",
             scope="state-based; the mirror relation (Dirichlet or traction) is chosen "
                   "per boundary cell face, on a shape per fictitious node at its closest "
                   "point, the reflection across the local tangent and the traction "
                   "relation with the local normal (mirror_nodes.MirrorNodesOnShape: our "
-                  "generalisation)",
-            theory_refusal="not wired for bond-based PD: it would need a bond-box role "
-                           "(its odd/even reflection map with the prescribed values' "
-                           "offset on bond_fictitious' grid) and a Neumann relation from "
-                           "the bond-based lattice's moduli (C11, C12 of the stencil), "
-                           "not the LPS constants it takes",
+                  "generalisation); bond-based: the boxes that state their conditions at "
+                  "the surface, the traction relation with the lattice's C11, C12, C66 "
+                  "(mirror_nodes.assemble_mirror_bond_box: our reading)",
             build=_mirror, checker=_check_mirror, shapes=True,
             static_only="its fictitious nodes carry an affine offset of the prescribed "
                         "values, fixed at assembly",
             shapes3d_why="not built (mirror_nodes.MirrorNodesOnShape reflects across the "
                          "tangent lines of 2D parts; a 3D part needs the tangent planes of "
-                         "planes, a mantle and a sphere and 3D fits)"),
+                         "planes, a mantle and a sphere and 3D fits)",
+            roles=(("bond-box", Role(_bond_mirror, MIRROR_PARAMS, _check_bond_mirror)),)),
         FamilyTreatment(
             "pddo", "seed 001 §5: peridynamic differential operator (moment matrices exact "
             "for quadratics) for the boundary rows and the equilibrium within 2 delta, LPS "

@@ -1,5 +1,8 @@
 """The mirror node method (MNM; Zhao, Jafarzadeh, Chen and Bobaru 2020, engrXiv
-10.31224/osf.io/7z8qr; seed 001 §5.2) on a box of cell-centred nodes, state-based.
+10.31224/osf.io/7z8qr; seed 001 §5.2) on a box of cell-centred nodes, state-based; on
+the 2D shapes along the local normal (:class:`MirrorNodesOnShape`); on the bond-based
+boxes that state their conditions at the surface (:func:`assemble_mirror_bond_box`: the
+same relations with the bond-based lattice's moduli, :func:`bond_lattice_moduli`).
 
 Seed 001 describes the method in words only, and the original was written for
 diffusion. What we implement, and which parts are our reading (a guess where marked):
@@ -64,12 +67,18 @@ plate2d-plane-strain):
 """
 from __future__ import annotations
 
+from dataclasses import dataclass, replace
+
 import numpy as np
 import scipy.sparse as sp
 
+from ..pd.build import build_model
 from ..pd.closure import Closure, real_identity
 from ..pd.problem import Face, LinearSystem, box_faces
 from .assembly import model_of, padded, traction_of, unknown_coords
+from .bond_fictitious import BondBoxSystem, _plane_rows, bond_force_matrix
+from .surface_nodes import crossing_bonds, face_crossings
+from .taylor_fictitious import _surface_flux
 
 
 def peridynamic_gradient(grid, stencil) -> np.ndarray:
@@ -148,7 +157,9 @@ class MirrorNodes:
     :class:`~pdverify.pd.faces.Face`), with ``exact(x) -> (n, d)`` giving the prescribed
     values g; ``traction(x, normal, face) -> (n, d)`` the applied traction of each face
     (``face``: a :class:`~pdverify.pd.faces.Face`; zero on free faces); ``moduli`` =
-    (lambda, mu) of the material; ``neumann``: how a traction becomes the gradient of
+    (lambda, mu) of an isotropic material, or (C11, C12, C66) of a cubic one (the
+    bond-based lattice's, :func:`bond_lattice_moduli`: C11 in lambda + 2 mu's place,
+    C12 in lambda's, C66 in mu's); ``neumann``: how a traction becomes the gradient of
     the Neumann relation (:data:`NEUMANN_READINGS`); ``mirror_point``: the nearest node
     as it is, or with its mismatch corrected by its gradient, or taken as sitting at the
     mirror point (:data:`MIRROR_POINTS`); ``gradient_at``: the cell whose central
@@ -179,7 +190,14 @@ class MirrorNodes:
         # the step of the Neumann relation: x_f - x_m, or x_f - x* when the mirror node
         # is taken as sitting at the mirror point x* (then wrong by x* - x_m near corners)
         step = x - (star if mirror_point == "at-mirror-point" else g.x[mirror])
-        lam, mu = moduli
+        # (lambda, mu) of an isotropic material, or (C11, C12, C66) of a cubic one (the
+        # bond-based lattice: bond_lattice_moduli); lambda + 2 mu, lambda, mu play C11,
+        # C12, C66 in the traction relation
+        if len(moduli) == 3:
+            c11, lam, mu = moduli
+        else:
+            lam, mu = moduli
+            c11 = lam + 2 * mu
         tol = 1e-9 * h
         nf = fict.size
         faces = box_faces(d)
@@ -236,11 +254,11 @@ class MirrorNodes:
             for k in range(d):
                 w = step[:, b]                       # D_kb enters with (x_f - x_m)_b
                 if k == b:   # sigma_bb = (lam + 2 mu) u_b,b + lam sum_j u_j,j = s t_b
-                    const[:, k] += np.where(on_b, w * sgn * tr[:, b] / (lam + 2 * mu), 0.0)
+                    const[:, k] += np.where(on_b, w * sgn * tr[:, b] / c11, 0.0)
                     if full:
                         for j in range(d):
                             if j != b:
-                                fd(on_b, k, j, j, -w * lam / (lam + 2 * mu))
+                                fd(on_b, k, j, j, -w * lam / c11)
                 else:        # sigma_kb = mu (u_k,b + u_b,k) = s t_k
                     const[:, k] += np.where(on_b, w * sgn * tr[:, k] / mu, 0.0)
                     if full:
@@ -519,3 +537,166 @@ def assemble_mirror(problem, neumann: str, mirror_point: str,
                         scalars=scalars,
                         counts=getattr(mirror, "counts", None)
                         or {"fictitious_nodes": int(g.n_ext - g.n_interior)}, offset=U_c)
+
+
+# ------------------------------------------------------------------ bond-based boxes (bond-box)
+def bond_lattice_moduli(stencil, c, influence, horizon, spacing) -> tuple[float, float, float]:
+    """(C11, C12, C66) of the bond-based lattice in the bulk (a complete neighbourhood),
+    the moduli of the mirror nodes' traction relation on a bond-based box.
+
+    Derivation. A bond of the stencil's offset k (length r = |k| h, unit n, weight
+    beta_k, cell volume V = h^d) under the homogeneous strain eps stretches by
+    e = r n.eps.n and carries the force density c omega(r) e / r V on each end; half of
+    its energy c omega(r) e^2 / (2 r) V goes to each end, so a bulk node's energy
+    density is W = (c / 4) sum_k omega(r) r beta_k V (n.eps.n)^2 = C_abcd eps_ab eps_cd / 2
+    with C_abcd = (c / 2) sum_k w_k n_a n_b n_c n_d, w_k = omega(r) r beta_k V: fully
+    symmetric in its four indices (central pairwise forces), so C12 = C_xxyy equals
+    C66 = C_xyxy (the Cauchy relation), and the square or cubic stencil gives cubic
+    symmetry: C11 = C_xxxx = C_yyyy (= C_zzzz), C12 = C_xxyy = C_xxzz = C_yyzz. The
+    traction on a face of normal e_b is then sigma_bb = C11 u_b,b + C12 sum_(j != b)
+    u_j,j and sigma_kb = C66 (u_k,b + u_b,k), the relation :class:`MirrorNodes` takes
+    with (lambda + 2 mu, lambda, mu) -> (C11, C12, C66). It is not the continuum's:
+    C11 = 3 C12 (isotropy) only in the limit of a fine stencil (3.3 % off at m = 6, whole
+    cells; ``stiffness2d-sheet``'s ``bulk_anisotropy_c11_3c12_pct``). The same sums as
+    the tension sheet's reference moduli (``scenes.sheets.lattice_moduli``); tested
+    against the model's own energy density under homogeneous strains
+    (``tests/treatments/test_mirror_bond.py``)."""
+    offsets = np.asarray(stencil.offsets, dtype=float)
+    length = np.linalg.norm(offsets, axis=1)
+    r, n = length * spacing, offsets / length[:, None]
+    w = influence.omega(r, horizon) * r * np.asarray(stencil.beta) * spacing ** offsets.shape[1]
+    c11 = 0.5 * c * np.sum(w * n[:, 0] ** 4)
+    # a 1D bar has no transverse component: sigma = C11 u' alone
+    c12 = 0.5 * c * np.sum(w * n[:, 0] ** 2 * n[:, 1] ** 2) if n.shape[1] > 1 else 0.0
+    return float(c11), float(c12), float(c12)
+
+
+@dataclass
+class MirrorBondBoxSystem(BondBoxSystem):
+    """A ``bond-box`` system whose grid displacements are affine in its unknowns,
+    ``A x + offset`` (the mirror relations' constants: the prescribed values' 2 g and the
+    tractions' terms); the model's unknowns are every grid node (identity map), so
+    :attr:`unknowns` after a solve is the whole grid's displacement and ``face_rows``
+    act on it. The equations (``op``, ``op_rhs``, ``face_rows``) are built on the first
+    solve (``rows``): the stiffness boxes only apply the relations."""
+
+    offset: np.ndarray = None
+    rows: object = None
+
+    def _built(self):
+        if self.op is None and self.rows is not None:
+            self.op, self.op_rhs, self.face_rows, self.coords, more = self.rows()
+            self.counts.update(more)
+
+    def solve(self, where: str):
+        self._built()
+        u, info = super().solve(where)
+        self.unknowns = u + self.offset
+        return self.unknowns, info
+
+    def face_force(self, face: str) -> np.ndarray:
+        self._built()
+        return super().face_force(face)
+
+    def grid_displacement(self, x_real) -> np.ndarray:
+        """Every grid node's displacement when the real nodes carry ``x_real``
+        (component-major): the relations applied, no solve."""
+        return self.A @ np.asarray(x_real, dtype=float) + self.offset
+
+
+def assemble_mirror_bond_box(problem, neumann: str = "full-traction",
+                             mirror_point: str = "nearest", gradient_at: str = "mirror"):
+    """Seed 001 §5.2's mirror nodes on a bond-based box (the ``bond-box`` family: a
+    :class:`~pdverify.pd.problem.BondProblem` with its conditions stated at the surface,
+    :class:`~pdverify.pd.problem.SurfaceConditions`); our reading for bond-based PD.
+
+    The grid is ``bond_fictitious``' (cell-centred, whole cells, a fictitious layer of the
+    stencil's reach; the bonds with a real end and the fictitious pairs crossing a
+    boundary cell face). The fictitious displacements are :class:`MirrorNodes`' relations
+    on it, face by face as on the state-based boxes: a prescribed component by the odd
+    reflection about the boundary value, u_f = 2 g(x_B) - u_m; every other one (a
+    traction or free face) by the even reflection with the Neumann step, u_f = u_m +
+    (x_f - x_m) . G with G from the face's traction through the bond-based lattice's own
+    moduli (:func:`bond_lattice_moduli`: C11, C12, C66 of the stencil, not the LPS
+    constants). The unknowns are the real displacements, the equations the real nodes'
+    equilibrium with the relations' constants (2 g and the traction terms) on the
+    right-hand side: the loads and the prescribed values enter through the relations
+    only, as on the state-based boxes. A scene's symmetry planes
+    (``SurfaceConditions.planes``) are constraint rows by Lagrange multipliers, as for
+    Taylor's and the surface nodes' (``bond_fictitious._plane_rows``). The square system
+    is not symmetric (the reflections enter the real equations) and goes to the sparse LU.
+
+    Exactness: the relations reproduce an affine field whose tractions are the faces'
+    (and whose values are the prescribed ones) wherever the mirror point is a node
+    (straight faces; the ``corrected`` mirror point everywhere), so the real nodes'
+    neighbourhoods are the bulk lattice's and the field is a solution to round-off: the
+    tension sheet's uniform stress against the lattice's moduli, the stiffness boxes'
+    homogeneous strains with ``corrected`` (``tests/treatments/test_mirror_bond.py``).
+    With the method's ``nearest`` mirror node a prescribed face is exact only where the
+    mirror point is a node: not at the boxes' edges and corners, where the stiffness
+    boxes' surface energy misses by a few per cent (as on the state-based boxes). What a
+    non-affine field shows: the traction-free condition is the first-order even
+    reflection, not a flux row as Taylor's, so on the clamped sheet each free side
+    carries a normal force through its boundary cell faces (7.7 kN against the clamp's
+    196 kN; the four faces' forces still balance to round-off, the test above)."""
+    sc = problem.surface
+    if sc is None:
+        raise ValueError("the problem states no surface conditions")
+    body = replace(problem.body, placement="cell-centred", boundary_volume="partial")
+    g = body.grid(problem.stencil.reach)
+    d, ni, ne, ns = g.dim, g.n_interior, g.n_ext, g.n_surface
+    keep, _ = crossing_bonds(g, problem.stencil)
+    # the model's unknowns: every grid node (the relations are affine, not linear)
+    model = build_model(body, problem.stencil, problem.material,
+                        Closure(keep=keep, displacement_map=sp.identity(ne, format="csr"),
+                                n_unknown_nodes=ne), grid=g)
+    moduli = bond_lattice_moduli(problem.stencil, model.c, model.influence, model.horizon,
+                                 g.spacing)
+    faces = dict(sc.faces)
+
+    def traction(x, normal, face):
+        cond = faces.get(Face.named(face).name)
+        if cond is None or cond.traction is None:
+            return np.zeros_like(x)
+        return cond.traction(x, normal)
+
+    mirror = MirrorNodes(g, problem.stencil,
+                         [(name, k) for name, cond in faces.items() for k in cond.prescribed],
+                         sc.value, traction, moduli, neumann=neumann,
+                         mirror_point=mirror_point, gradient_at=gradient_at)
+    A = mirror.displacement_map()                         # d n_ext x d ni
+    offset = mirror.constant_displacements().T.ravel()    # component-major
+
+    def rows():
+        """The real nodes' equilibrium with the relations' constants on the right, the
+        plane rows bordered, the boundary cell faces' flux rows; the coordinates of the
+        unknowns (nested dissection) and their counts."""
+        K_real = model.K[model.real_rows()]
+        K = (K_real @ A).tocsr()
+        rhs = -(K_real @ offset)
+        planes = _plane_rows(g, sc.planes, ni)
+        if planes:
+            B = sp.vstack(planes).tocsr()
+            # the plane rows to the stiffness's scale, as bond_fictitious does
+            scale = abs(K).max() / np.maximum(abs(B).max(axis=1).toarray().ravel(), 1e-300)
+            B = (sp.diags(scale) @ B).tocsr()
+            op = sp.bmat([[K, B.T], [B, None]], format="csc")
+            op_rhs = np.r_[rhs, np.zeros(B.shape[0])]
+        else:
+            B, op, op_rhs = None, K.tocsc(), rhs
+        coords = np.tile(g.x[g.interior_ids], (d, 1))
+        if B is not None:
+            W = abs(B).tocsr()
+            coords = np.r_[coords, (W @ coords) / np.asarray(W.sum(axis=1))]
+        flux = face_crossings(g, model.bond_a, model.bond_b)
+        face_rows = (_surface_flux(model, flux, ns) @ bond_force_matrix(model)).tocsr()
+        return op, op_rhs, face_rows, coords, {
+            "constraints": 0 if B is None else int(B.shape[0]), "unknowns": int(op.shape[0])}
+
+    counts = {"real_nodes": int(ni), "fictitious_nodes": int(ne - ni)}
+    parts = {f.name: np.flatnonzero(~g.is_interior & (
+        (g.index[:, f.axis] < 0) if f.side == 0
+        else (g.index[:, f.axis] >= g.nodes_per_axis[f.axis]))) for f in box_faces(d)}
+    return MirrorBondBoxSystem(
+        model, np.zeros(d * ne), np.zeros(0, dtype=int), np.zeros(0), parts, A=A,
+        n_unknown=ni, counts=counts, offset=offset, rows=rows)

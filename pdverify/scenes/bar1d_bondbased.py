@@ -903,7 +903,10 @@ class Vibration(BondBarScene):
         "non-symmetric stiffness no seed states); PDDO's boundary rows replace the end "
         "nodes' equations of motion by algebraic rows (a traction or a value at the end "
         "face), index-1 too; the scene's explicit central "
-        "differences step M u'' = f(u) with a mass on every unknown"), "held-face": (
+        "differences step M u'' = f(u) with a mass on every unknown. The mirror nodes keep "
+        "a mass on every real node, but their reflection map makes the stiffness "
+        "non-symmetric (as the condensed surface nodes' is), whose stable step and energy "
+        "no seed states: not built"), "held-face": (
         "its held points are seed 004's own constraint variants: constraint=end-points (points 1..4 held over one horizon) is the rigid buffer virtual nodes add, run as the scene's own case")}
     #: the numbers the docstring quotes from this report's runs (pdverify.quotes)
     doc_quotes = {k: Q(metric, "homogenized", {"constraint": "mid", "horizon_ratio": 4.0,

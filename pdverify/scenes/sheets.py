@@ -203,9 +203,10 @@ class TensionSheet(SheetScene):
         for h in self.m_sweep:
             if h != 0.001:
                 out += [(m, {"spacing": h}) for m in ("none", "energy-directional")]
-        # seed 000 §7's and seed 001's methods (§3, §5.3's PDDO) read for bond-based PD,
+        # seed 000 §7's and seed 001's methods (§3, §5.2's mirror nodes, §5.3's PDDO) read for bond-based PD,
         # default case only
-        return out + [(m, {}) for m in ("taylor-fictitious", "surface-nodes", "pddo")
+        return out + [(m, {}) for m in ("taylor-fictitious", "surface-nodes", "pddo",
+                                            "mirror-nodes")
                       if m in self.offered()]
 
     def cells(self, p):
@@ -421,8 +422,9 @@ class ClampedSheet(SheetScene):
     def cases(self, quick=False):
         out = [("fem", {}), ("none", {}), ("energy-directional", {}), ("virtual-nodes", {}),
                ("virtual-nodes", {"correct_sides": True})]
-        # seed 000 §7's and seed 001's methods (§3, §5.3's PDDO) read for bond-based PD
-        out += [(m, {}) for m in ("taylor-fictitious", "surface-nodes", "pddo")
+        # seed 000 §7's and seed 001's methods (§3, §5.2's mirror nodes, §5.3's PDDO) read for bond-based PD
+        out += [(m, {}) for m in ("taylor-fictitious", "surface-nodes", "pddo",
+                                            "mirror-nodes")
                 if m in self.offered()]
         if quick:
             return out

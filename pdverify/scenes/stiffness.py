@@ -202,9 +202,35 @@ class StiffnessScene(Scene):
                 self.bond_problem(p, self.id),
                 surface=SurfaceConditions({}, lambda x: np.zeros_like(x)))
             system = t.build_for(BOND_BOX, problem, p)
+        if hasattr(system, "grid_displacement"):
+            return self._solve_bond_box_prescribed(t, p, problem, timer)
         with timer.phase("solve"):
             ratios = {name: bond_box_ratios(system, eps)
                       for name, eps in strain_states(self.dim)}
+        return self.measure_ratios(p, system.model, ratios, system.counts)
+
+    def _solve_bond_box_prescribed(self, t, p, problem, timer) -> Outcome:
+        """A ``bond-box`` treatment whose fictitious nodes depend on the conditions (the
+        mirror nodes: odd reflections about prescribed values, even ones with a
+        traction step; ``system.grid_displacement``): per strain state the box with
+        every component of every face prescribed at u = strain . x, as the state-based
+        stiffness boxes assemble theirs (``_StateStiffness``); the real nodes carry
+        u = strain . x and the fictitious nodes follow the relations (no solve)."""
+        ratios, system = {}, None
+        for name, eps in strain_states(self.dim):
+            with timer.phase("setup"):
+                every = FaceCondition(prescribed=tuple(range(self.dim)))
+                system = t.build_for(BOND_BOX, dataclasses.replace(
+                    problem, surface=SurfaceConditions(
+                        {face: every for face in face_names(self.dim)},
+                        lambda x, eps=eps: x @ eps.T)), p)
+            with timer.phase("solve"):
+                model = system.model
+                g = model.grid
+                field = system.grid_displacement(
+                    (g.x[g.interior_ids] @ np.asarray(eps, dtype=float).T).T.ravel())
+                ratios[name] = (work_density(model, eps, field)[g.interior_ids]
+                                / model.bulk_work_density(eps))
         return self.measure_ratios(p, system.model, ratios, system.counts)
 
     def measure_ratios(self, p, model, ratios, counts=None) -> Outcome:

@@ -68,24 +68,27 @@ def test_bad_input_is_one_line(over, words):
         get_scene("bar1d-homogenization").resolve("taylor-fictitious", over)
 
 
-@pytest.mark.parametrize("method", METHODS + ("pddo",))
+@pytest.mark.parametrize("method", METHODS + ("pddo", "mirror-nodes"))
 def test_vibration_refusal_is_the_mathematical_reason(method):
     why = treatments()[method].why_not(get_scene("bar1d-vibration"))
     assert why is not None and "not wired" not in why
-    assert "index-1" in why
-    if method != "pddo":
+    assert ("index-1" if method != "mirror-nodes" else "non-symmetric") in why
+    if method in METHODS:
         assert "differential-algebraic" in why
 
 
+@pytest.mark.parametrize("method", ["pddo", "mirror-nodes"])
 @pytest.mark.parametrize("scene, metric", [("bar1d-homogenization", "strain_factor"),
                                            ("bar1d-constraints", "half_vs_full_max_diff")])
-def test_pddo_on_the_bars_is_classical(scene, metric):
+def test_pddo_and_mirror_nodes_on_the_bars_are_classical(method, scene, metric):
     """PDDO's bond-based form (pdverify.corrections.pddo_bond: exact for quadratic fields
-    with the lattice's own tensor) on the same bars adds no node and meets the linear
-    field to round-off, the load through the end face included."""
-    run = get_scene(scene).run("pddo", {})
+    with the lattice's own tensor; it adds no node) and the mirror nodes' (affine fields
+    exact with the lattice's C11: corrections.mirror_nodes.bond_lattice_moduli, C12 = 0
+    in 1D) on the same bars meet the linear field to round-off."""
+    run = get_scene(scene).run(method, {})
     assert run.status == "ok", run.message
     target = 1.0 if metric == "strain_factor" else 0.0
     assert abs(run.metrics[metric] - target) < ROUND_OFF
     assert run.metrics["max_error_pct"] < MACHINE_PRECISION_PCT
-    assert run.size.get("fictitious_nodes", 0) == 0
+    if method == "pddo":
+        assert run.size.get("fictitious_nodes", 0) == 0

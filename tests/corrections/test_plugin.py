@@ -101,7 +101,7 @@ def test_without_the_plugin_the_method_is_bad_input():
                         "--method", "demo-uniform"], capture_output=True, text=True)
     assert r.returncode == 2
     assert ("not supported by this scene; allowed: none, taylor-fictitious, surface-nodes, "
-            "energy, energy-directional" in r.stderr)
+            "mirror-nodes, energy, energy-directional" in r.stderr)
     assert "demo-uniform" not in r.stderr.split("allowed:", 1)[1]
 
 
