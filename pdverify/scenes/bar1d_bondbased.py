@@ -410,7 +410,8 @@ class Homogenization(BondBarScene):
     calibration: finding ``004-constant-limit`` (``pdverify.deviations``).
 
     ``taylor-fictitious`` and ``surface-nodes`` (seed 000 §7, seed 001 read for
-    bond-based PD; :class:`BondBarScene`): the end force sigma A is the traction sigma
+    bond-based PD; :class:`BondBarScene`; ``mirror-nodes`` and ``pddo``, seed 001 §5's
+    bond-based forms with the lattice's C11, on the same bars): the end force sigma A is the traction sigma
     on the bar's end faces x_1, x_N (the surface of the body between the end points,
     N - 1 cells of Delta), the translation removed at the plane x = 0 (the centre).
     ``strain_factor`` is then the strain between the outermost real nodes, x_1 + Delta/2
@@ -510,7 +511,7 @@ class Homogenization(BondBarScene):
                     if ratio not in covered]
         # seed 000 §7's and seed 001's methods read for bond-based PD: Table 12's default
         # bar (delta = 4 Delta, N = 9) and, in the full report, the sweep's largest N
-        for method in ("taylor-fictitious", "surface-nodes"):
+        for method in ("taylor-fictitious", "surface-nodes", "mirror-nodes", "pddo"):
             if method in self.offered():
                 out += [(method, {"nodes": n}) for n in ((9,) if quick else (9, 1001))]
         return out
@@ -648,7 +649,8 @@ class Constraints(BondBarScene):
     N_a = 17 (so N_b = 9, N_c = 12). Unstated and chosen: length 2 (Table 13, case a).
 
     ``taylor-fictitious`` and ``surface-nodes`` (seed 000 §7, seed 001 read for
-    bond-based PD; :class:`BondBarScene`) run the two bars the continuum states: (a) the
+    bond-based PD; :class:`BondBarScene`; ``mirror-nodes`` and ``pddo``, seed 001 §5's
+    bond-based forms with the lattice's C11, on the same bars) run the two bars the continuum states: (a) the
     bar between its end points x = -+(N_a - 1) Delta / 2 (N_a - 1 cells) with the
     traction sigma on both end faces and u = 0 at its plane of symmetry x = 0 (the held
     midpoint; the mean of the two nodes straddling it), and (b) its right half [0, (N_a
