@@ -1,5 +1,10 @@
 """Directional energy surface correction for bond-based PD (seed 003 §3, Eqs. 12-14), and
-its reading for state-based (LPS) models (:func:`box_factors`)."""
+its reading for state-based (LPS) models (:func:`box_factors`).
+
+Eq. (14)'s ray distance a is the slab form on a box (:func:`ray_distance`) and, on a body
+that is not a box (a grid cut from a shape: a hole, a notch, a crack, a 3D curved face),
+the first crossing of the ray with any of the shape's parts, the crack faces included
+(``pdverify.pd.rays.exit_distance``; equal to the slab form on a box, tested)."""
 from __future__ import annotations
 
 import numpy as np
@@ -29,30 +34,41 @@ def ray_distance(x, e, lower, upper, axes=None) -> np.ndarray:
     return t
 
 
-def directional_factor(x, e, lower, upper, horizon, influence, dim, axes=None) -> np.ndarray:
+def directional_factor(x, e, lower, upper, horizon, influence, dim, axes=None,
+                       shape=None) -> np.ndarray:
     """phi(x, e) of Eq. (14): int_0^delta c xi^D dxi / int_0^d c xi^D dxi, d = min(a, delta).
 
     For a constant micromodulus this is (delta / d)^(D + 1); for any other registered one
     the integral ratio (ERRATA: the power law is exact only for a constant c). Directions
-    that leave the body at once (d = 0) have no bonds; they get phi = inf.
+    that leave the body at once (d = 0) have no bonds; they get phi = inf. ``shape``: a
+    is the ray's first crossing of the shape's boundary (``pdverify.pd.rays``; ``lower``,
+    ``upper`` and ``axes`` are then unused), else the box's slab form.
     """
-    d = np.minimum(ray_distance(x, e, lower, upper, axes), horizon)
+    if shape is not None:
+        from ..pd.rays import exit_distance
+        a = exit_distance(shape, x, e)
+    else:
+        a = ray_distance(x, e, lower, upper, axes)
+    d = np.minimum(a, horizon)
     with np.errstate(divide="ignore"):
         return influence.radial_ratio(dim, d, horizon)
 
 
 def directional_closure(grid, lower, upper, horizon, influence, axes=None,
-                        moment: int | None = None) -> Closure:
+                        moment: int | None = None, shape=None) -> Closure:
     """The ``energy-directional`` closure: bond a-b gets (phi(x_a, n) + phi(x_b, -n)) / 2
-    (Eq. 2 applied at both ends, ERRATA), the faces of ``axes`` of the box counted;
-    ``moment``: the power of xi in Eq. 14's integrals (default the dimension D, the
-    bond-based node energy; D + 1 for a state-based model, :func:`box_factors`)."""
+    (Eq. 2 applied at both ends, ERRATA), the faces of ``axes`` of the box counted, or
+    every part of ``shape`` when one is given (:func:`directional_factor`); ``moment``:
+    the power of xi in Eq. 14's integrals (default the dimension D, the bond-based node
+    energy; D + 1 for a state-based model, :func:`box_factors`)."""
     lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
     D = grid.dim if moment is None else moment
 
     def bond_factor(a, b, n):
-        fa = directional_factor(grid.x[a], n, lower, upper, horizon, influence, D, axes)
-        fb = directional_factor(grid.x[b], -n, lower, upper, horizon, influence, D, axes)
+        fa = directional_factor(grid.x[a], n, lower, upper, horizon, influence, D, axes,
+                                shape)
+        fb = directional_factor(grid.x[b], -n, lower, upper, horizon, influence, D, axes,
+                                shape)
         return 0.5 * (fa + fb)
 
     return Closure(bond_factor=bond_factor)
@@ -61,7 +77,11 @@ def directional_closure(grid, lower, upper, horizon, influence, axes=None,
 def box_factors(model) -> np.ndarray:
     """The bond factors of :func:`directional_closure` on the model's own box (the grid's
     ``origin + [0, lengths]``, every face counted), from the built model's bonds: the
-    ``energy-directional`` bond method of the registry on any bond-based box scene.
+    ``energy-directional`` bond method of the registry on any bond-based box scene. On a
+    grid cut from a shape (``ShapeGrid.shape``: a hole, a notch, cracks, a 3D curved
+    body) the ray distance runs to the shape's own parts instead of the lattice's box
+    (``pdverify.pd.rays``; issue 55), the crack faces included: a bond beside a crack is
+    restored against the length its ray keeps before the slit.
 
     The ratio of Eq. (14) is taken with xi^D in D dimensions: a bond-based node's energy
     under a homogeneous strain is (1/4) s^2 int c(xi) xi^D dxi per direction (the bond
@@ -86,7 +106,7 @@ def box_factors(model) -> np.ndarray:
     upper = lower + np.asarray(g.lengths, dtype=float)
     moment = g.dim + 1 if isinstance(model, StateBasedModel) else g.dim
     closure = directional_closure(g, lower, upper, model.horizon, model.influence,
-                                  moment=moment)
+                                  moment=moment, shape=getattr(g, "shape", None))
     return closure.bond_factor(model.bond_a, model.bond_b, model.bond_n)
 
 
