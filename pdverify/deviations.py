@@ -587,6 +587,21 @@ DEVIATIONS = (
               "scenes/cracks.py EdgeCrackPlate, pd/cracks.py fit_k, "
               "reference_fem/crack_plate.py edge_crack_plate",
               summary="Ours: the whole SENT strip, K by the opening fit"),
+    Deviation(("plate-hole", "plate-l", "plate-crack", "plate-edge-crack",
+               "plate-inclined-crack", "cylinder3d-tension", "block3d-cavity"), "choice",
+              "Ours, not a paper's: seed 003's energy-directional on bodies that are not "
+              "boxes (seed 003 takes Eq. 14's a to a rectangle's sides): a is the distance "
+              "along the bond from the node to the first boundary part its ray meets, a "
+              "crack face included (a ray through a crack's tip passes round it, as the "
+              "bonds there do); equal to the box's slab form on a box. Where the ray leaves "
+              "the body and re-enters it within the horizon (a chord across the hole, the "
+              "notch of the L seen from the other arm) the model keeps the bonds beyond the "
+              "gap, so the direction holds more than [0, a] and Eq. 14 restores too much "
+              "there. These scenes are state-based: the factor is our reading of it for LPS "
+              "(on each bond's influence, with xi^(D+1)), as on the state-based boxes.",
+              "pd/rays.py, corrections/energy_directional.py; tests/shapes/test_rays.py, "
+              "tests/treatments/test_energy_directional_cells.py",
+              summary="Ours: seed 003's ray distance to the first part the ray meets"),
     Deviation(("plate-l",), "finding",
               "Taylor along the normal was worse than the uncorrected model at the re-entrant "
               "corner (rel L2 about 1.5 times none's at h = 0.025, order 2; the report of "
