@@ -594,10 +594,11 @@ DEVIATIONS = (
               "along the bond from the node to the first boundary part its ray meets, a "
               "crack face included (a ray through a crack's tip passes round it, as the "
               "bonds there do); equal to the box's slab form on a box. Where the ray leaves "
-              "the body and re-enters it within the horizon (a chord across the hole, the "
-              "notch of the L seen from the other arm) the model keeps the bonds beyond the "
-              "gap, so the direction holds more than [0, a] and Eq. 14 restores too much "
-              "there. These scenes are state-based: the factor is our reading of it for LPS "
+              "the body and re-enters it within the horizon (the notch of the L seen from "
+              "the other arm) the model keeps the bonds across the gap, so Eq. 14's "
+              "denominator is its integral over the parts of the horizon in the body (up to "
+              "a crack's slit); the first crossing alone gave the L's notch-bridging bonds "
+              "factors up to about 96 at h = 0.025 m. These scenes are state-based: the factor is our reading of it for LPS "
               "(on each bond's influence, with xi^(D+1)), as on the state-based boxes.",
               "pd/rays.py, corrections/energy_directional.py; tests/shapes/test_rays.py, "
               "tests/treatments/test_energy_directional_cells.py",

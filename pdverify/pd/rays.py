@@ -31,10 +31,12 @@ face's offset by the direction's component, formed in another order: tested).
 
 What the first crossing means for Eq. 14: the direction's material is taken to be the
 radial interval [0, a]. Where the ray leaves the body and re-enters it within the
-horizon (a chord across a hole, the notch of an L seen from the other arm), the model
-keeps the bonds beyond the gap (only a crack cuts bonds), so the direction holds more
-than [0, a] and Eq. 14 restores too much there, as seed 003's own factor does for any
-direction whose missing part is not one radial interval.
+horizon (a chord across a notch, the L seen from its other arm) the model keeps the
+bonds beyond the gap, so the direction holds more than [0, a]: :func:`inside_intervals`
+gives the parts of the ray's horizon in the body (up to a crack's slit, which ends it),
+from which ``corrections.energy_directional.directional_factor`` takes Eq. 14's
+denominator there. A bond of the partial-volume quadrature longer than the horizon is
+not on the ray's horizon (as on a box, the factor counts [0, delta] only).
 """
 from __future__ import annotations
 
@@ -61,19 +63,34 @@ def _segment(q: Segment, x, e):
     w = a - x
     t = _cross(w, E) / den
     u = _cross(w, e) / den
-    return _first(t, ok & (t > 0) & (u >= -END) & (u <= 1 + END))
+    return _first(t, ok & (t > 0) & (u >= -END) & (u <= 1 + END))[:, None]
+
+
+def _roots(f, e, radius):
+    """The two roots t of |f + t e|^2 = radius^2 (rows) and where they are real and
+    distinct."""
+    A = np.einsum("ij,ij->i", e, e)
+    ok = A > 0
+    A = np.where(ok, A, 1.0)
+    bq = np.einsum("ij,ij->i", f, e) / A
+    cq = (np.einsum("ij,ij->i", f, f) - radius ** 2) / A
+    disc = bq * bq - cq
+    real = ok & (disc > 0)
+    root = np.sqrt(np.where(real, disc, 0.0))
+    return (-bq - root, -bq + root), real
 
 
 def _arc(q: Arc, x, e):
-    (t0, t1), real = _roots(x - np.asarray(q.centre, float), e, q.radius)
-    best = np.full(len(x), np.inf)
+    c = np.asarray(q.centre, float)
+    (t0, t1), real = _roots(x - c, e, q.radius)
+    out = []
     for t in (t0, t1):
-        p = x + t[:, None] * e - np.asarray(q.centre, float)
+        p = x + t[:, None] * e - c
         th = np.arctan2(p[:, 1], p[:, 0])
         th = q.theta0 - END + np.mod(th - q.theta0 + END, 2 * np.pi)
         on = (th >= q.theta0 - END) & (th <= q.theta1 + END)
-        best = np.minimum(best, _first(t, real & (t > 0) & on))
-    return best
+        out.append(_first(t, real & (t > 0) & on))
+    return np.stack(out, axis=1)
 
 
 def _crack(c, x, e):
@@ -110,47 +127,35 @@ def _planar(q, x, e):
         tol = END * W
         inside = ((s >= -tol) & (s <= W + tol) & (v >= -tol) & (v <= W + tol)
                   & (s * s + v * v >= a * a * (1 - END)))
-    return _first(t, ok & (t > 0) & inside)
-
-
-def _roots(f, e, radius):
-    """The two roots t of |f + t e|^2 = radius^2 (rows) and where they are real and
-    distinct."""
-    A = np.einsum("ij,ij->i", e, e)
-    ok = A > 0
-    A = np.where(ok, A, 1.0)
-    bq = np.einsum("ij,ij->i", f, e) / A
-    cq = (np.einsum("ij,ij->i", f, f) - radius ** 2) / A
-    disc = bq * bq - cq
-    real = ok & (disc > 0)
-    root = np.sqrt(np.where(real, disc, 0.0))
-    return (-bq - root, -bq + root), real
+    return _first(t, ok & (t > 0) & inside)[:, None]
 
 
 def _mantle(q, x, e):
     (t0, t1), real = _roots(x[:, :2], e[:, :2], q.radius)
-    best = np.full(len(x), np.inf)
+    out = []
     for t in (t0, t1):
         p = x + t[:, None] * e
         th = np.arctan2(p[:, 1], p[:, 0])
         th = -END + np.mod(th + END, 2 * np.pi)
         on = ((th >= -END) & (th <= q.theta1 + END) & (p[:, 2] >= -END * q.length)
               & (p[:, 2] <= q.length * (1 + END)))
-        best = np.minimum(best, _first(t, real & (t > 0) & on))
-    return best
+        out.append(_first(t, real & (t > 0) & on))
+    return np.stack(out, axis=1)
 
 
 def _sphere_octant(q, x, e):
     (t0, t1), real = _roots(x, e, q.radius)
-    best = np.full(len(x), np.inf)
+    out = []
     for t in (t0, t1):
         p = x + t[:, None] * e
         on = np.all(p >= -END * q.radius, axis=1)
-        best = np.minimum(best, _first(t, real & (t > 0) & on))
-    return best
+        out.append(_first(t, real & (t > 0) & on))
+    return np.stack(out, axis=1)
 
 
-def _part_distance(q, x, e):
+def _part_roots(q, x, e):
+    """(n, k): every crossing t > 0 of the ray with the part (k = 1 or 2), inf where
+    none."""
     from .shapes3d import Mantle, Planar, SphereOctant
     if isinstance(q, Segment):
         return _segment(q, x, e)
@@ -166,19 +171,51 @@ def _part_distance(q, x, e):
                     f"({type(q).__name__})")
 
 
+def _rows(x, e):
+    x = np.atleast_2d(np.asarray(x, dtype=float))
+    e = np.atleast_2d(np.asarray(e, dtype=float))
+    return x, np.broadcast_to(e, x.shape)
+
+
+def _crack_stop(shape, x, e) -> np.ndarray:
+    """The first crossing of a crack's slit along each ray (inf where none)."""
+    stop = np.full(len(x), np.inf)
+    for c in getattr(shape, "cracks", ()):
+        if c.length:
+            stop = np.minimum(stop, _crack(c, x, e))
+    return stop
+
+
+def _outline_roots(shape, x, e) -> np.ndarray:
+    """(n, K): the crossings of every part but the crack faces."""
+    roots = [_part_roots(q, x, e) for q in shape.parts if not isinstance(q, CrackFace)]
+    return np.concatenate(roots, axis=1) if roots else np.full((len(x), 1), np.inf)
+
+
 def exit_distance(shape, x, e) -> np.ndarray:
     """The smallest t > 0 with x + t e on a part of ``shape`` (module docstring), row by
     row; ``inf`` where the ray meets no part. ``x`` (n, D): points inside the body;
     ``e`` (n, D): directions (unit, for t to be a distance)."""
-    x = np.atleast_2d(np.asarray(x, dtype=float))
-    e = np.atleast_2d(np.asarray(e, dtype=float))
-    e = np.broadcast_to(e, x.shape)
-    best = np.full(len(x), np.inf)
-    for q in shape.parts:
-        if isinstance(q, CrackFace):
-            continue                      # both faces at once, from the crack (below)
-        best = np.minimum(best, _part_distance(q, x, e))
-    for c in getattr(shape, "cracks", ()):
-        if c.length:
-            best = np.minimum(best, _crack(c, x, e))
-    return best
+    x, e = _rows(x, e)
+    return np.minimum(_outline_roots(shape, x, e).min(axis=1), _crack_stop(shape, x, e))
+
+
+def inside_intervals(shape, x, e, reach: float):
+    """The parts of each ray's [0, ``reach``] (a horizon) inside the body and reachable
+    from its point: ``(edges, inside)``, ``edges`` (n, K + 2) the sorted crossings with
+    the parts, 0 first and the ray's end last, ``inside`` (n, K + 1) whether the
+    interval between two edges lies in the body (its midpoint inside, the interval not
+    empty). A crack's slit ends the ray there (the model cuts every bond across it, so
+    nothing beyond it is the point's); a hole or a notch does not (the model keeps the
+    bonds across a gap in the body, so the material beyond it is the point's again).
+    Vectorised; a loop over the parts."""
+    x, e = _rows(x, e)
+    stop = np.minimum(_crack_stop(shape, x, e), float(reach))
+    roots = np.sort(np.minimum(_outline_roots(shape, x, e), stop[:, None]), axis=1)
+    edges = np.concatenate([np.zeros((len(x), 1)), roots, stop[:, None]], axis=1)
+    lo, hi = edges[:, :-1], edges[:, 1:]
+    full = hi > lo
+    mid = x[:, None, :] + (0.5 * (lo + hi))[:, :, None] * e[:, None, :]
+    inside = np.zeros(lo.shape, dtype=bool)
+    inside[full] = shape.inside(mid[full])
+    return edges, inside

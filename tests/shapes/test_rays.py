@@ -206,3 +206,54 @@ def test_every_part_kind_is_known():
     odd = replace(s, parts=s.parts + (Odd(),))
     with pytest.raises(TypeError, match="odd"):
         exit_distance(odd, [[0.5, 0.5]], [[1.0, 0.0]])
+
+
+def test_a_ray_across_the_notch_counts_the_material_beyond_it():
+    """From (0.45, 0.56) in the L's upper arm along (1, -1)/sqrt 2 the ray leaves the body
+    through x = 1/2 at a = 0.05 sqrt 2 and enters the lower arm through y = 1/2 at
+    b = 0.06 sqrt 2; the model keeps the bonds across the notch, so Eq. 14's denominator
+    is the integral over [0, a] and [b, delta] (``directional_factor``; constant omega,
+    xi^3: delta^4 / (a^4 + delta^4 - b^4)), not the first crossing's (delta / a)^4. A
+    crack ends the ray instead (nothing past its slit is the point's)."""
+    from pdverify.corrections.energy_directional import directional_factor
+    from pdverify.pd.rays import inside_intervals
+    s, delta = l_shape(1.0), 0.2
+    x, e = np.array([[0.45, 0.56]]), np.array([[1.0, -1.0]]) / np.sqrt(2)
+    a, b = 0.05 * np.sqrt(2), 0.06 * np.sqrt(2)
+    edges, inside = inside_intervals(s, x, e, delta)
+    kept = [(lo, hi) for lo, hi, i in zip(edges[0, :-1], edges[0, 1:], inside[0]) if i]
+    assert np.allclose(kept, [(0, a), (b, delta)], rtol=0, atol=CLOSED)
+    inf = get_influence("constant")
+    phi = directional_factor(x, e, None, None, delta, inf, 3, shape=s)
+    # the closed form and the code's partial moments: round-off of fourth powers
+    np.testing.assert_allclose(phi, delta ** 4 / (a ** 4 + delta ** 4 - b ** 4), rtol=1e-12)
+    assert phi[0] < 0.5 * (delta / a) ** 4
+    cracked = s.with_cracks(Crack("c", (0.75, 0.4), (0.75, 0.2)))
+    x2, e2 = np.array([[0.7, 0.3]]), np.array([[1.0, 0.0]])
+    edges, inside = inside_intervals(cracked, x2, e2, delta)
+    assert edges[0, -1] == pytest.approx(0.05) and inside[0, 0] and not inside[0, 1:].any()
+
+
+@pytest.mark.parametrize("scene_id", SHAPE_SCENES)
+def test_the_kept_bonds_end_before_their_rays_leave_the_body(scene_id):
+    """The rays and the model's bond choice agree: on every shape scene's default model
+    no kept bond reaches past either end's first crossing (a bond a crack cuts is
+    dropped, one round a tip is kept and its ray passes the tip), except, on the L, the
+    bonds that bridge the notch (the model keeps them), exactly those with a point
+    outside the body."""
+    from pdverify.corrections.assembly import model_of
+    scene = get_scene(scene_id)
+    p = scene.resolve("none", {})
+    problem = scene.problem(p, scene_id)
+    model = model_of(problem, problem.body.grid(0), None)
+    x, a, b, n = model.grid.x, model.bond_a, model.bond_b, model.bond_n
+    length = np.linalg.norm(x[b] - x[a], axis=1)
+    past = ((exit_distance(problem.shape, x[a], n) < length * (1 - 1e-12))
+            | (exit_distance(problem.shape, x[b], -n) < length * (1 - 1e-12)))
+    if scene_id != "plate-l":
+        assert not past.any(), np.flatnonzero(past)[:5]
+        return
+    u = np.linspace(0, 1, 101)[1:-1]
+    pts = x[a][:, None, :] + u[None, :, None] * (x[b] - x[a])[:, None, :]
+    outside = ~problem.shape.inside(pts.reshape(-1, 2)).reshape(len(a), -1).all(axis=1)
+    assert past.any() and np.array_equal(past, outside)
