@@ -4,7 +4,9 @@ its reading for state-based (LPS) models (:func:`box_factors`).
 Eq. (14)'s ray distance a is the slab form on a box (:func:`ray_distance`) and, on a body
 that is not a box (a grid cut from a shape: a hole, a notch, a crack, a 3D curved face),
 the first crossing of the ray with any of the shape's parts, the crack faces included
-(``pdverify.pd.rays.exit_distance``; equal to the slab form on a box, tested)."""
+(``pdverify.pd.rays.exit_distance``; equal to the slab form on a box, tested); a ray
+that enters the body again within the horizon (a notch's chord) takes Eq. 14's
+denominator over the parts of its horizon in the body (:func:`directional_factor`)."""
 from __future__ import annotations
 
 import numpy as np
