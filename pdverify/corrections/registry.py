@@ -126,17 +126,17 @@ def _builtin() -> list[Treatment]:
                    closure=energy_closure),
         BondMethod("energy-directional", "seed 003: bond stiffness times (phi(x, e) + "
                    "phi(x', -e))/2, phi the Eq. (14) ratio of the horizon's radial integral "
-                   "to its truncated part along the bond direction, on the scene's box "
-                   "(bond-based; the seed-003 scenes wire it to their own boxes)",
+                   "to its truncated part along the bond direction, the ray run to the "
+                   "scene's box or, on a shape, to the first of its parts it meets, crack "
+                   "faces included (bond-based; the seed-003 scenes wire it to their own "
+                   "boxes)",
                    "Ritter, Wohlmuth et al. (seed 003), Eqs. 2, 12-14",
-                   closure=energy_directional_closure, shapes=False,
-                   scope="box scenes (Eq. 14's ratio with xi^D: the paper's 2D, our 1D and "
-                         "3D; state-based, our reading: the factor on each bond's influence, "
-                         "so in m, the dilatation and the force state, with xi^(D+1))",
-                   box_only="Eq. 14's ray distance a is taken to the scene's box faces "
-                            "(the grid's bounding box); a hole or a notch is not one of "
-                            "them, so a bond there would be restored against the wrong "
-                            "missing length"),
+                   closure=energy_directional_closure,
+                   scope="box and shape scenes (Eq. 14's ratio with xi^D: the paper's 2D, "
+                         "our 1D and 3D; on a shape the ray distance to the first part the "
+                         "ray meets, pdverify/pd/rays.py; state-based, our reading: the "
+                         "factor on each bond's influence, so in m, the dilatation and the "
+                         "force state, with xi^(D+1))"),
         BondMethod("volume", "volume correction 2 V0 / (V_i + V_j) on the bond force (V the "
                    "discrete horizon volume of each end)",
                    "Le and Bobaru 2018; PeriLab, PeriPy, pypd", closure=volume_closure),

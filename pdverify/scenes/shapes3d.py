@@ -7,9 +7,10 @@ the body is cut from the uniform cell-centred lattice of its bounding box (a nod
 when its cell centre lies inside, its volume the part of its cell inside, sampled on an
 8 x 8 x 8 sub-grid), conditions are keyed by the shape's named parts, and the treatments
 of the family that can serve a 3D body that is not a box run on it: ``none`` and the
-bond/closure methods (``energy``, ``volume``, ``pals``); ``list`` says why the others do
-not (Taylor's fictitious nodes along the normal are 2D on shapes; surface nodes, mirror
-nodes and PDDO serve the 2D shapes only).
+bond/closure methods (``energy``, ``volume``, ``pals``, ``energy-directional`` with
+Eq. 14's ray distance to the first part the ray meets, ``pdverify.pd.rays``); ``list``
+says why the others do not (Taylor's fictitious nodes along the normal are 2D on
+shapes; surface nodes, mirror nodes and PDDO serve the 2D shapes only).
 
 Choices common to both (the issue is silent): octants by symmetry, on the PD side too
 (the symmetry planes are roller parts, a prescribed normal component on the real nodes

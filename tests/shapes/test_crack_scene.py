@@ -79,13 +79,14 @@ def test_the_list_shows_why_the_node_adding_treatments_and_the_peer_do_not_run(s
                "shapes" in out, method
     assert "peer:lammps: its code builds its own bonds from the node positions" in out
     offered = set(get_scene(scene_id).offered())
-    assert offered == {"none", "energy", "volume", "pals"}
+    assert offered == {"none", "energy", "volume", "pals", "energy-directional"}
 
 
 def test_the_cases_are_every_method_at_the_defaults_and_the_quick_grid():
     scene = get_scene("plate-crack")
     cases = scene.cases()
-    assert {m for m, _ in cases} == {"fem", "none", "energy", "volume", "pals"}
+    assert {m for m, _ in cases} == {"fem", "none", "energy", "volume", "pals",
+                                     "energy-directional"}
     assert all(q == {} for _, q in cases)
     quick = scene.cases(quick=True)
     assert {m for m, _ in quick} == {m for m, _ in cases}
@@ -130,7 +131,7 @@ def test_the_edge_crack_scene_shares_the_centre_cracks_builder_and_refines_k():
         1.0, 1.0, 0.5, 0.025, 3.0)
     assert edge.reference_params(p)["height"] == 1.0
     cases = edge.cases()
-    methods = {"none", "energy", "volume", "pals"}
+    methods = {"none", "energy", "volume", "pals", "energy-directional"}
     assert {m for m, _ in cases} == methods | {"fem"}
     assert sorted({q.get("spacing", 0.025) for m, q in cases if m != "fem"}) == sorted(
         (1 / 60, 0.025, 1 / 30))

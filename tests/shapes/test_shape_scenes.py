@@ -20,7 +20,7 @@ def test_every_treatment_that_can_serve_a_shape_runs_there(scene_id):
     scene = get_scene(scene_id)
     offered = set(scene.offered())
     assert {"none", "taylor-fictitious", "energy", "volume", "pals", "surface-nodes",
-            "mirror-nodes", "pddo"} <= offered
+            "mirror-nodes", "pddo", "energy-directional"} <= offered
 
 
 def test_the_list_offers_the_node_adding_methods_on_the_shapes():
@@ -29,8 +29,9 @@ def test_the_list_offers_the_node_adding_methods_on_the_shapes():
     for name in ("surface-nodes", "mirror-nodes", "pddo"):
         assert f"\n    {name}  - " in out, name
         assert f"\n    {name}: box faces only" not in out, name
-    # the one box-only method left there: seed 003's ray distances to the box faces
-    assert "\n    energy-directional: box faces only: Eq. 14's ray distance" in out
+    # seed 003's correction too: its ray distance runs to the shape's parts (issue 55)
+    assert "\n    energy-directional  - " in out
+    assert "box faces only" not in out
     assert "jitter=0" in out
 
 
