@@ -236,21 +236,18 @@ def family_treatments() -> list[Treatment]:
             "Zhao, Jafarzadeh, Chen, Bobaru 2020; seed 001 §5.2", params=MIRROR_PARAMS,
             theories=STATE, families=FAMILY, footprint="fictitious",
             scope="state-based; the mirror relation (Dirichlet or traction) is chosen "
-                  "per boundary cell face, on a shape per fictitious node at its closest "
-                  "point, the reflection across the local tangent and the traction "
-                  "relation with the local normal (mirror_nodes.MirrorNodesOnShape: our "
-                  "generalisation)",
+                  "per boundary cell face, on a shape (2D or 3D) per fictitious node at "
+                  "its closest point, the reflection across the local tangent line or "
+                  "plane and the traction relation with the local normal "
+                  "(mirror_nodes.MirrorNodesOnShape: our generalisation)",
             theory_refusal="not wired for bond-based PD: it would need a bond-box role "
                            "(its odd/even reflection map with the prescribed values' "
                            "offset on bond_fictitious' grid) and a Neumann relation from "
                            "the bond-based lattice's moduli (C11, C12 of the stencil), "
                            "not the LPS constants it takes",
-            build=_mirror, checker=_check_mirror, shapes=True,
+            build=_mirror, checker=_check_mirror, shapes=True, shapes3d=True,
             static_only="its fictitious nodes carry an affine offset of the prescribed "
-                        "values, fixed at assembly",
-            shapes3d_why="not built (mirror_nodes.MirrorNodesOnShape reflects across the "
-                         "tangent lines of 2D parts; a 3D part needs the tangent planes of "
-                         "planes, a mantle and a sphere and 3D fits)"),
+                        "values, fixed at assembly"),
         FamilyTreatment(
             "pddo", "seed 001 §5: peridynamic differential operator (moment matrices exact "
             "for quadratics) for the boundary rows and the equilibrium within 2 delta, LPS "

@@ -57,14 +57,23 @@ from ..pd.closure import Closure
 WEIGHT_LENGTH = 1.0
 
 
-def exponents(order: int) -> np.ndarray:
-    """(M, 2) exponents (i, j) of the monomials x^i y^j with i + j <= order."""
-    return np.array([(i, t - i) for t in range(order + 1) for i in range(t, -1, -1)])
+def exponents(order: int, dim: int = 2) -> np.ndarray:
+    """(M, dim) exponents of the monomials of total degree <= order: in 2D (i, j) of
+    x^i y^j, in 3D (i, j, k) of x^i y^j z^k, by degree, x's power falling first."""
+    if dim == 2:
+        return np.array([(i, t - i) for t in range(order + 1) for i in range(t, -1, -1)])
+    return np.array([(i, j, t - i - j) for t in range(order + 1)
+                     for i in range(t, -1, -1) for j in range(t - i, -1, -1)]).reshape(-1, 3)
 
 
-def neighbours(order: int) -> int:
-    """Real nodes a fit of ``order`` takes: twice the monomials (one node for order 0)."""
-    return 1 if order == 0 else (order + 1) * (order + 2)
+def neighbours(order: int, dim: int = 2) -> int:
+    """Real nodes a fit of ``order`` takes: twice the monomials in 2D, three times in 3D
+    (one node for order 0). In 3D twice is too few: beside a plane of cell faces the 20
+    nearest nodes of a quadratic fit lie on two lattice planes along the normal, so x
+    and x^2 cannot be told apart (rank 9 of 10); the 30 nearest reach the third plane."""
+    if order == 0:
+        return 1
+    return (order + 1) * (order + 2) if dim == 2 else len(exponents(order, 3)) * 3
 
 
 def _vander(z, E):
@@ -75,12 +84,14 @@ def _vander(z, E):
 def fit(x_real, centres, targets, order: int, h: float, gradient: bool = False):
     """Least-squares weights of the order-``order`` fit about each centre, over its
     ``neighbours(order)`` nearest real nodes: ``(nodes (F, k), value weights at targets
-    (F, k))``, and with ``gradient`` the weights of d/dx, d/dy there (F, 2, k)."""
-    k = min(neighbours(order), len(x_real))
+    (F, k))``, and with ``gradient`` the weights of d/dx, d/dy (, d/dz) there (F, dim,
+    k). 2D or 3D by the points' columns."""
+    dim = x_real.shape[1]
+    k = min(neighbours(order, dim), len(x_real))
     _, nodes = cKDTree(x_real).query(centres, k=k)
     nodes = nodes.reshape(len(centres), k)
-    E = exponents(order)
-    z = (x_real[nodes] - centres[:, None, :]) / h                 # (F, k, 2)
+    E = exponents(order, dim)
+    z = (x_real[nodes] - centres[:, None, :]) / h                 # (F, k, dim)
     # weighted by the distance to the centre (WEIGHT_LENGTH spacings), so that nearby
     # centres sharing their nodes still get their own fit (equal rows would be singular)
     sw = np.exp(-0.5 * np.sum(z * z, axis=-1) / WEIGHT_LENGTH ** 2)[..., None]
@@ -90,7 +101,7 @@ def fit(x_real, centres, targets, order: int, h: float, gradient: bool = False):
     if not gradient:
         return nodes, value
     out = []
-    for axis in (0, 1):
+    for axis in range(dim):
         dE = E.copy()
         c = dE[:, axis].astype(float)
         dE[:, axis] = np.maximum(dE[:, axis] - 1, 0)

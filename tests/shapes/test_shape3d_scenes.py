@@ -16,12 +16,13 @@ SCENES = ("cylinder3d-tension", "block3d-cavity")
 def test_the_closures_run_and_taylor_and_the_box_methods_say_why_not(scene_id):
     scene = get_scene(scene_id)
     offered = set(scene.offered())
-    assert {"none", "energy", "volume", "pals"} <= offered
+    assert {"none", "energy", "volume", "pals", "mirror-nodes"} <= offered
     from pdverify.corrections.registry import from_name
     assert from_name("taylor-fictitious").why_not(scene).startswith("on a 3D shape: not built")
-    for name in ("surface-nodes", "mirror-nodes", "pddo"):     # 2D shapes only (issue 55)
+    for name in ("surface-nodes", "pddo"):     # 2D shapes only (issue 55)
         assert from_name(name).why_not(scene).startswith("on a 3D shape: not built ("), name
-    assert {m for m, _ in scene.cases()} == {"fem", "none", "energy", "volume", "pals"}
+    assert {m for m, _ in scene.cases()} == {"fem", "none", "energy", "volume", "pals",
+                                             "mirror-nodes"}
 
 
 def test_the_list_shows_the_refusal():
