@@ -216,17 +216,15 @@ def family_treatments() -> list[Treatment]:
             "fictitious layer by Taylor extrapolation about the nearest surface node",
             "Scabbia, Zaccariotto, Galvanetto 2023 (seed 001); seed 002",
             params=(SURFACE_ORDER,), theories=BOTH, families=FAMILY, footprint="surface",
-            build=_surface, checker=_check_surface, shapes=True,
+            build=_surface, checker=_check_surface, shapes=True, shapes3d=True,
             scope="state-based boxes, shapes and 1D waves; on a shape the surface nodes sit "
                   "at the boundary nodes' points on each part, the series about the nearest "
                   "one runs along the local normal with derivatives from a least-squares "
-                  "fit, arcs take the series' traction (surface_nodes."
-                  "surface_nodes_on_shape: our generalisation); bond-based: the 2D boxes "
-                  "that state their conditions at the surface (corrections.bond_fictitious: "
-                  "what seed 001 leaves open for bond-based PD)",
-            shapes3d_why="not built (surface_nodes.surface_nodes_on_shape places its "
-                         "surface nodes and fits on the 2D parts; a 3D part needs surface "
-                         "nodes on planes, a mantle and a sphere and 3D fits)",
+                  "fit, arcs take the series' traction, on a 3D shape every part does "
+                  "(surface_nodes.surface_nodes_on_shape: our generalisation); bond-based: "
+                  "the 2D boxes that state their conditions at the surface "
+                  "(corrections.bond_fictitious: what seed 001 leaves open for bond-based "
+                  "PD)",
             roles=(("wave-bar", Role(wave_extension, (WAVE_ORDER,), check_wave_order)),
                    ("bond-box", Role(_bond_surface, (SURFACE_ORDER,), _check_bond_surface)))),
         FamilyTreatment(

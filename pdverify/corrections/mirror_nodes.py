@@ -343,7 +343,7 @@ class MirrorNodesOnShape(MirrorNodes):
     gradient H on the tangent plane (P = I - n n^T) and the normal derivative a = n
     (t.n - lam tr T) / (lam + 2 mu) + P t / mu - P T^T n, the unique a with sigma(G) n
     = t (the 2D formula is its case P = tau tau^T); ``normal-only``: T = 0. The fits are
-    3D quadratics over the 30 nearest real nodes (``shape_fictitious.neighbours``).
+    3D quadratics over the 40 nearest real nodes (``shape_fictitious.neighbours``).
     Exactness kept: the affine field with ``corrected`` and ``full-traction`` to
     round-off on the quarter cylinder and the cavity octant, every part prescribed or
     loaded by the field's traction (tests/shapes/test_shape3d_methods.py); the method's

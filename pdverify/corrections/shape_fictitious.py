@@ -67,13 +67,41 @@ def exponents(order: int, dim: int = 2) -> np.ndarray:
 
 
 def neighbours(order: int, dim: int = 2) -> int:
-    """Real nodes a fit of ``order`` takes: twice the monomials in 2D, three times in 3D
-    (one node for order 0). In 3D twice is too few: beside a plane of cell faces the 20
-    nearest nodes of a quadratic fit lie on two lattice planes along the normal, so x
-    and x^2 cannot be told apart (rank 9 of 10); the 30 nearest reach the third plane."""
+    """Real nodes a fit of ``order`` takes: twice the monomials in 2D (one node for order
+    0); in 3D four times (orders 1, 2: 16, 40 nodes) and five times for order 3 (100).
+    Twice is too few in 3D: beside a plane of cell faces the 20 nearest nodes of a
+    quadratic fit about a node lie on two lattice planes along the normal, so x and x^2
+    cannot be told apart (rank 9 of 10). Measured on both 3D shapes at their test grids
+    (h = 1/8, 1/10), about every fictitious node's closest point, every boundary point
+    and every real node: 30 and 80 nodes still leave rank-deficient fits of order 2 and
+    3 (957 and 813 centres on the cavity octant), 40 and 100 none (smallest relative
+    singular value 7.7e-3 and 4.9e-4); :func:`fit` refuses a rank-deficient 3D fit."""
     if order == 0:
         return 1
-    return (order + 1) * (order + 2) if dim == 2 else len(exponents(order, 3)) * 3
+    if dim == 2:
+        return (order + 1) * (order + 2)
+    return len(exponents(order, 3)) * (4 if order <= 2 else 5)
+
+
+#: smallest singular value of a 3D fit's weighted Vandermonde matrix, relative to its
+#: largest, below which the fit is refused (round-off scale; the fits of the 3D shapes
+#: measure 4.9e-4 or more at neighbours(order, 3), rank-deficient ones below 1e-15)
+RANK_TOLERANCE = 1e-10
+
+
+def _full_rank(A, order):
+    """Refuse a batch of 3D fits whose weighted Vandermonde matrices ``A`` (F, k, M) are
+    rank deficient: pinv would return a minimum-norm fit that does not reproduce the
+    polynomials of its order (a silent wrong extension)."""
+    from ..errors import NumericalError
+    sv = np.linalg.svd(A, compute_uv=False)
+    ratio = sv[:, -1] / np.maximum(sv[:, 0], np.finfo(float).tiny)
+    bad = int(np.sum(ratio < RANK_TOLERANCE))
+    if bad:
+        raise NumericalError(f"{bad} of {len(A)} least-squares fits of order {order} over "
+                             f"their {A.shape[1]} nearest real nodes are rank deficient "
+                             f"(smallest relative singular value {ratio.min():.1e} < "
+                             f"{RANK_TOLERANCE:g}): the nodes do not span the polynomials")
 
 
 def _vander(z, E):
@@ -95,7 +123,10 @@ def fit(x_real, centres, targets, order: int, h: float, gradient: bool = False):
     # weighted by the distance to the centre (WEIGHT_LENGTH spacings), so that nearby
     # centres sharing their nodes still get their own fit (equal rows would be singular)
     sw = np.exp(-0.5 * np.sum(z * z, axis=-1) / WEIGHT_LENGTH ** 2)[..., None]
-    pinv = np.linalg.pinv(sw * _vander(z, E)) * np.swapaxes(sw, 1, 2)   # (F, M, k)
+    A = sw * _vander(z, E)
+    if dim == 3:
+        _full_rank(A, order)
+    pinv = np.linalg.pinv(A) * np.swapaxes(sw, 1, 2)                  # (F, M, k)
     zt = (targets - centres) / h
     value = np.einsum("fm,fmk->fk", _vander(zt, E), pinv)
     if not gradient:
@@ -119,14 +150,19 @@ def centred_fit(x_real, centres, centre_cols, targets, order: int, h: float,
     weights at targets (F, k + 1))``, the centre's column first, and with ``gradient``
     the weights of d/dx, d/dy there (F, 2, k + 1). Exact for every polynomial of degree
     <= order; the series passes through the centre's value (seed 001's Taylor series
-    about the surface node, its derivatives from a fit instead of lattice lines)."""
-    k = min(neighbours(order), len(x_real))
+    about the surface node, its derivatives from a fit instead of lattice lines).
+    2D or 3D by the points' columns (then d/dz too)."""
+    dim = x_real.shape[1]
+    k = min(neighbours(order, dim), len(x_real))
     _, nodes = cKDTree(x_real).query(centres, k=k)
     nodes = nodes.reshape(len(centres), k)
-    E = exponents(order)[1:]                                       # no constant term
+    E = exponents(order, dim)[1:]                                  # no constant term
     z = (x_real[nodes] - centres[:, None, :]) / h
     sw = np.exp(-0.5 * np.sum(z * z, axis=-1) / WEIGHT_LENGTH ** 2)[..., None]
-    pinv = np.linalg.pinv(sw * _vander(z, E)) * np.swapaxes(sw, 1, 2)   # (F, M - 1, k)
+    A = sw * _vander(z, E)
+    if dim == 3:
+        _full_rank(A, order)
+    pinv = np.linalg.pinv(A) * np.swapaxes(sw, 1, 2)                  # (F, M - 1, k)
     cols = np.c_[np.asarray(centre_cols)[:, None], nodes]
     zt = (targets - centres) / h
 
@@ -137,7 +173,7 @@ def centred_fit(x_real, centres, centre_cols, targets, order: int, h: float,
     if not gradient:
         return cols, value
     out = []
-    for axis in (0, 1):
+    for axis in range(dim):
         dE = E.copy()
         c = dE[:, axis].astype(float)
         dE[:, axis] = np.maximum(dE[:, axis] - 1, 0)
@@ -183,7 +219,8 @@ def boundary_points(g, shape, samples):
     key = node * len(shape.parts) + part
     keys, inv = np.unique(key, return_inverse=True)
     wsum = np.bincount(inv, W)
-    mean = np.c_[np.bincount(inv, W * P[:, 0]), np.bincount(inv, W * P[:, 1])] / wsum[:, None]
+    mean = np.stack([np.bincount(inv, W * P[:, i]) for i in range(P.shape[1])],
+                    axis=1) / wsum[:, None]
     kpart = keys % len(shape.parts)
     pts, nrm = np.zeros_like(mean), np.zeros_like(mean)
     for k, q in enumerate(shape.parts):
@@ -299,9 +336,9 @@ def condition_rows(model, problem, order: int, samples):
 
 
 def prescribed(problem, part) -> np.ndarray:
-    """(n, 2): whether the part of each point prescribes each component."""
+    """(n, d): whether the part of each point prescribes each component."""
     names = problem.shape.part_names
-    out = np.zeros((len(part), 2), dtype=bool)
+    out = np.zeros((len(part), problem.shape.dim), dtype=bool)
     for name, cond in problem.conditions.items():
         for k in cond.prescribed:
             out[:, k] |= part == names.index(name)
@@ -359,6 +396,24 @@ def free_rows(model, problem, samples, points, nodes, grad, n_cols):
     return out
 
 
+def traction_rows_3d(problem, points, nodes, grad, n_cols):
+    """:func:`free_rows` on a 3D shape: every boundary point whose part does not
+    prescribe component k has the row of the fit's traction sigma(grad u_fit) n equal
+    to the applied one (zero on a free part), on plane and curved parts alike (a 3D
+    force flux through a point's patch of a part would need the bonds' crossings of
+    planes, a mantle and a sphere, which ``Shape3D`` does not compute)."""
+    pts, nrm, part, _ = points
+    lam, mu = problem.constants.moduli()
+    t = _traction_at(problem, pts, nrm, part, problem.shape.part_names)
+    pres = prescribed(problem, part)
+    out = []
+    for k in range(3):
+        free = np.flatnonzero(~pres[:, k])
+        out.append([(free, _traction_rows(nodes[free], grad[free], nrm[free], k, lam, mu,
+                                          n_cols), t[free, k])] if free.size else [])
+    return out
+
+
 def _params(shape, x, xpart):
     """Arc length on its part of each point of ``x``."""
     out = np.zeros(len(x))
@@ -407,17 +462,20 @@ def stretches(shape, pts, part, s_samples, spart, group, s_all, xpart, h) -> sp.
 
 def _traction_rows(nodes, grad, nrm, k, lam, mu, n_cols):
     """Rows of the traction component k, sigma(grad u_fit) n with the continuum moduli
-    (plane: t_k = lam (div u) n_k + mu sum_l (d_l u_k + d_k u_l) n_l), over the fit's
-    nodes' displacements."""
+    (plane or 3D: t_k = lam (div u) n_k + mu sum_l (d_l u_k + d_k u_l) n_l), over the
+    fit's nodes' displacements (d ``n_cols`` columns, d = 2 or 3 by ``nrm``)."""
     blocks = []
-    F = len(nodes)
-    for a in range(2):          # the displacement component the row weighs
+    F, d = len(nodes), nrm.shape[1]
+    for a in range(d):          # the displacement component the row weighs
         c = lam * nrm[:, k][:, None] * grad[:, a]
         c = c + mu * nrm[:, a][:, None] * grad[:, k]
         if a == k:
             c = c + mu * np.einsum("fl,flk->fk", nrm, grad)
-        blocks.append(_rows(nodes, c, F, 2 * n_cols, col_offset=a * n_cols))
-    return (blocks[0] + blocks[1]).tocsr()
+        blocks.append(_rows(nodes, c, F, d * n_cols, col_offset=a * n_cols))
+    out = blocks[0] + blocks[1]
+    for extra in blocks[2:]:
+        out = out + extra
+    return out.tocsr()
 
 
 def _traction_at(problem, x, n, xpart, names):

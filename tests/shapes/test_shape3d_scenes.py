@@ -16,13 +16,15 @@ SCENES = ("cylinder3d-tension", "block3d-cavity")
 def test_the_closures_run_and_taylor_and_the_box_methods_say_why_not(scene_id):
     scene = get_scene(scene_id)
     offered = set(scene.offered())
-    assert {"none", "energy", "volume", "pals", "mirror-nodes"} <= offered
+    assert {"none", "energy", "volume", "pals", "mirror-nodes", "surface-nodes"} <= offered
     from pdverify.corrections.registry import from_name
     assert from_name("taylor-fictitious").why_not(scene).startswith("on a 3D shape: not built")
-    for name in ("surface-nodes", "pddo"):     # 2D shapes only (issue 55)
-        assert from_name(name).why_not(scene).startswith("on a 3D shape: not built ("), name
-    assert {m for m, _ in scene.cases()} == {"fem", "none", "energy", "volume", "pals",
-                                             "mirror-nodes"}
+    assert from_name("pddo").why_not(scene).startswith("on a 3D shape: not built (")
+    cases = scene.cases()
+    assert {m for m, _ in cases} == {"fem", "none", "energy", "volume", "pals",
+                                     "mirror-nodes", "surface-nodes"}
+    # surface nodes at order 1 only (the scenes' share of the report's time)
+    assert [q.get("order") for m, q in cases if m == "surface-nodes"] == [1]
 
 
 def test_the_list_shows_the_refusal():
