@@ -72,7 +72,7 @@ def test_studies_unchanged_bit_for_bit():
 
 
 #: the method x scene cells added since a694eb9 (issue 55): the node-adding methods on the
-#: 2D shapes (their parameters are the box scenes') and the seed methods across theories;
+#: 2D and 3D shapes (their parameters are the box scenes') and the seed methods across theories;
 #: each is a new method of a scene, every cell of a694eb9 stays as it was
 ADDED_CELLS = (
     {(sid, m) for sid in ("plate-hole", "plate-l")
@@ -84,7 +84,9 @@ ADDED_CELLS = (
     | {(sid, m) for sid in ("sheet2d-clamped", "sheet2d-tension", "stiffness2d-sheet",
                             "stiffness3d-box-bond")
        for m in ("taylor-fictitious", "surface-nodes")}
-    | {("block2d-indentation", "virtual-nodes")})
+    | {("block2d-indentation", "virtual-nodes")}
+    | {(sid, m) for sid in ("cylinder3d-tension", "block3d-cavity")
+       for m in ("mirror-nodes", "surface-nodes", "pddo")})
 
 
 def test_parameter_surface_unchanged():

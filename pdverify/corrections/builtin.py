@@ -256,14 +256,12 @@ def family_treatments() -> list[Treatment]:
                            "(seed 001 §5.3); a bond-based form needs the bond-based bulk "
                            "beyond and the lattice's moduli (C11, C12) in the rows",
             scope="state-based; the boundary row (Dirichlet or traction) is chosen per "
-                  "boundary node; on a shape at each boundary node's points with the "
-                  "part's local normal (pddo.pddo_shape_system: our generalisation)",
-            build=_pddo, shapes=True,
+                  "boundary node; on a shape (2D or 3D) at each boundary node's points "
+                  "with the part's local normal (pddo.pddo_shape_system: our "
+                  "generalisation)",
+            build=_pddo, shapes=True, shapes3d=True,
             static_only="its boundary rows on the outer node layer are algebraic "
-                        "equations, not a mass's equation of motion",
-            shapes3d_why="not built (pddo.pddo_shape_system takes the boundary rows at "
-                         "points of 2D parts; a 3D part needs them at points of planes, a "
-                         "mantle and a sphere)"),
+                        "equations, not a mass's equation of motion"),
     ]
 
 
