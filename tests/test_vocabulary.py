@@ -86,7 +86,7 @@ ADDED_CELLS = (
        for m in ("taylor-fictitious", "surface-nodes")}
     | {("block2d-indentation", "virtual-nodes")}
     | {(sid, m) for sid in ("cylinder3d-tension", "block3d-cavity")
-       for m in ("mirror-nodes", "surface-nodes", "pddo")})
+       for m in ("mirror-nodes", "surface-nodes", "pddo", "taylor-fictitious")})
 
 
 def test_parameter_surface_unchanged():

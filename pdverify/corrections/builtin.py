@@ -197,18 +197,15 @@ def family_treatments() -> list[Treatment]:
                   "(10 x 5 x 5 cells) keeps 2 dependent constraint rows and fails as "
                   "near-singular. On a shape (not a box) the series runs along the local "
                   "normal with derivatives from a least-squares fit, the conditions at "
-                  "boundary points (corrections.shape_fictitious; corners unused). "
+                  "boundary points (corrections.shape_fictitious; corners unused; on a 3D "
+                  "shape every part not prescribing a component takes the fit's "
+                  "traction row, and grids whose condition rows outnumber the unknowns "
+                  "fail as singular, named). "
                   "Bond-based (seed 000 §7): the 2D boxes that state their conditions at "
                   "the surface (corrections.bond_fictitious)",
-            build=_taylor, checker=_check_taylor, shapes=True,
+            build=_taylor, checker=_check_taylor, shapes=True, shapes3d=True,
             static_only="its conditions are Lagrange constraint rows, so the dynamics "
                         "would be a differential-algebraic system",
-            shapes3d_why="not built (corrections.shape_fictitious fits its series along "
-                         "the normal from the 2D parts' crossings, Shape.crossings of "
-                         "segments and arcs; a 3D part would need the bond-surface "
-                         "intersections of planes, a mantle and a sphere, and its 3D box "
-                         "form already costs 35-40 s and 2.1 GB at 2000 nodes, past a 3D "
-                         "shape scene's budget)",
             roles=(("flux-bar", Role(_flux_order, (ORDER,), _check_flux_order)),
                    ("bond-box", Role(_bond_taylor, (ORDER,), check_bond_box)))),
         FamilyTreatment(

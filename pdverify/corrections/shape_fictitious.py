@@ -40,6 +40,18 @@ cut boundary has no such lines, and a jittered node set no lattice at all, so he
   sigma(grad u_fit) n of the fit's gradient with the continuum moduli of the PD
   constants, equal to the applied traction (zero on a free part).
 
+On a 3D shape (``pdverify.pd.shapes3d``; issue 55) the same with 3D fits
+(:func:`neighbours`: 16, 40, 100 real nodes for orders 1, 2, 3; a rank-deficient fit is
+refused, :func:`_full_rank`), the boundary points on planes, the mantle and the sphere,
+and on every part not prescribing a component the fit's traction row (plane parts too:
+the force flux through a 3D patch needs the bonds' crossings of the parts, which
+``Shape3D`` does not compute; :func:`traction_rows_3d`); no fictitious-fictitious bonds
+(:func:`real_keep`) and no bridging test (``Shape3D`` has no ``hides``: the quarter
+cylinder is convex; on the cavity octant such bonds, if any, keep their node's value).
+Exactness kept: order n reproduces the polynomials of degree <= n as in 2D
+(tests/shapes/test_shape3d_methods.py). A grid whose condition rows outnumber the
+displacement unknowns (the quarter cylinder at h = 1/8) fails by name.
+
 Vectorised: the neighbours by one k-d tree query, the fits as one batched pseudo-inverse
 (points x neighbours x monomials); no loop over nodes.
 """
@@ -202,7 +214,9 @@ def normal_closure(g, shape, order: int, stencil=None) -> Closure:
     nodes, w = fit(x_real, p, g.x[fict], order - 1, h)
     A_T = (eye + _rows(nodes, w, g.n_ext, ni, fict)).tocsr()
     keep = shadow = None
-    if stencil is not None:
+    if stencil is not None and g.dim == 3:
+        keep = real_keep(g, stencil)       # 3D: no crossings, no bridging test
+    elif stencil is not None:
         keep = crossing_keep(g, shape, stencil)
         shadow = shadow_rows(g, shape, stencil, keep, order)
     info = {"fictitious_nodes": int(fict.size),
@@ -228,6 +242,15 @@ def boundary_points(g, shape, samples):
         if on.any():
             pts[on], nrm[on] = q.closest(mean[on])
     return pts, nrm, kpart, keys // len(shape.parts), inv
+
+
+def real_keep(g, stencil):
+    """The bonds of a 3D shape's closure: every stencil pair with a real end and no void
+    end (its conditions are traction rows, so no fictitious-fictitious bond carries a
+    flux; ``Shape3D`` has no crossings)."""
+    from ..pd.bonds import bond_pairs
+    a, b, _ = bond_pairs(g.ext_shape, stencil.offsets[stencil.half])
+    return (g.is_interior[a] | g.is_interior[b]) & ~g.is_void[a] & ~g.is_void[b]
 
 
 def crossing_keep(g, shape, stencil):
@@ -316,18 +339,20 @@ def condition_rows(model, problem, order: int, samples):
     resultant over that stretch, or on an arc the fit's traction (:func:`_traction_rows`)
     equal to the applied traction (zero on a free part)."""
     g, shape = model.grid, problem.shape
-    ni, h = g.n_interior, g.spacing
+    ni, h, d = g.n_interior, g.spacing, g.dim
     x_real = g.x[g.interior_ids]
     pts, nrm, part, _, group = boundary_points(g, shape, samples)
     nodes, value, grad = fit(x_real, pts, pts, order, h, gradient=True)
     exact = problem.exact(pts)
     pres = prescribed(problem, part)
-    free = free_rows(model, problem, samples, (pts, nrm, part, group), nodes, grad, ni)
+    points = (pts, nrm, part, group)
+    free = (free_rows(model, problem, samples, points, nodes, grad, ni) if d == 2
+            else traction_rows_3d(problem, points, nodes, grad, ni))
     rows, vals = [], []
-    for k in range(2):
+    for k in range(d):
         if pres[:, k].any():
             sel = np.flatnonzero(pres[:, k])
-            rows.append(_rows(nodes[sel], value[sel], sel.size, 2 * ni, col_offset=k * ni))
+            rows.append(_rows(nodes[sel], value[sel], sel.size, d * ni, col_offset=k * ni))
             vals.append(exact[sel, k])
         for _, R, c in free[k]:
             rows.append(R)
