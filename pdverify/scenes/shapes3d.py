@@ -32,6 +32,7 @@ from ..pd.shapes3d import cavity_octant, quarter_cylinder
 from ..quotes import Quote as Q
 from ..quotes import used
 from . import influence_param, register
+from .base import ExpectedFailure
 from .shapes import ORDERING, ShapeScene
 
 def _sigma_z(sigma):
@@ -81,15 +82,24 @@ class Shape3DScene(ShapeScene):
             self.conditions(p), exact=value, solver=self.fixed_solver,
             ordering=ORDERING, where=where, shape=self.shape(p))
 
+    @property
+    def expected_failures(self):
+        """Taylor's fictitious nodes at the quick grid: a documented failure (its
+        condition rows outnumber the displacement unknowns there, a singular bordered
+        system; the run names it, ``taylor_fictitious._taylor_on_shape``)."""
+        return (ExpectedFailure(
+            "at the quick grid Taylor's condition rows at the boundary points outnumber "
+            "the displacement unknowns (390 on 312 on the quarter cylinder at h = 1/8): a "
+            "singular bordered system, named; the default grid runs",
+            method="taylor-fictitious", where={"spacing": self.quick_spacing}),)
+
     def cases(self, quick=False):
         """The FEM reference and :meth:`default_cases`; the quick report at
-        :attr:`quick_spacing`, without Taylor's fictitious nodes: there its condition rows
-        outnumber the displacement unknowns (390 on 312 on the quarter cylinder at
-        h = 1/8), a singular bordered system."""
+        :attr:`quick_spacing` (Taylor's run there fails as expected:
+        :attr:`expected_failures`)."""
         runs = self.default_cases()
         if quick:
-            return [("fem", {})] + [(m, {**q, "spacing": self.quick_spacing}) for m, q in runs
-                                    if m != "taylor-fictitious"]
+            return [("fem", {})] + [(m, {**q, "spacing": self.quick_spacing}) for m, q in runs]
         return [("fem", {})] + runs
 
 #: the node-adding treatments' runs (issue 55): their quote keys and parameters
