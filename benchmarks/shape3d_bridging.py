@@ -1,8 +1,9 @@
-"""How many bonds of block3d-cavity's fictitious layer would bridge the cavity (issue 55):
-the 3D node-adding treatments have no bridging test (``Shape3D`` has no ``hides``), so a
+"""How many bonds of block3d-cavity's fictitious layer bridge the cavity (issue 55): a
 real node bonded to a fictitious node whose closest boundary point lies on a plane part
-reads that node's value even where it sees the point only through the cavity (the 2D
-shapes give such a bond a value of its own, ``Closure.shadow``). This counts them.
+that it sees only through the cavity; the node-adding treatments give such a bond a
+value of its own (``Closure.shadow``, found by ``Shape3D.hides``). This counts them
+independently of ``Shape3D.hides`` (the segment against the ball, in closed form) and
+is the check of its count (``bridging_bonds`` of the runs: 49 at h = 0.1).
 
 Plain script (no test runner):
 

@@ -46,9 +46,10 @@ refused, :func:`_full_rank`), the boundary points on planes, the mantle and the 
 and on every part not prescribing a component the fit's traction row (plane parts too:
 the force flux through a 3D patch needs the bonds' crossings of the parts, which
 ``Shape3D`` does not compute; :func:`traction_rows_3d`); no fictitious-fictitious bonds
-(:func:`real_keep`) and no bridging test (``Shape3D`` has no ``hides``: the quarter
-cylinder is convex; on the cavity octant 49 of 93 624 real-fictitious bonds at h = 0.1
-bridge the cavity and keep their node's value, ``benchmarks/shape3d_bridging.py``).
+(:func:`real_keep`); bridging bonds as in 2D (``Shape3D.hides``, exact crossings): none
+on the convex quarter cylinder, 49 of 93 624 real-fictitious bonds at h = 0.1 on the
+cavity octant, through the cavity (``benchmarks/shape3d_bridging.py``); they leave
+block3d-cavity's Taylor errors unchanged to four digits.
 Exactness kept: order n reproduces the polynomials of degree <= n as in 2D
 (tests/shapes/test_shape3d_methods.py). A grid whose condition rows outnumber the
 displacement unknowns (the quarter cylinder at h = 1/8) fails by name.
@@ -215,10 +216,9 @@ def normal_closure(g, shape, order: int, stencil=None) -> Closure:
     nodes, w = fit(x_real, p, g.x[fict], order - 1, h)
     A_T = (eye + _rows(nodes, w, g.n_ext, ni, fict)).tocsr()
     keep = shadow = None
-    if stencil is not None and g.dim == 3:
-        keep = real_keep(g, stencil)       # 3D: no crossings, no bridging test
-    elif stencil is not None:
-        keep = crossing_keep(g, shape, stencil)
+    if stencil is not None:
+        # 3D: no fictitious-fictitious flux bonds (no crossings in Shape3D)
+        keep = real_keep(g, stencil) if g.dim == 3 else crossing_keep(g, shape, stencil)
         shadow = shadow_rows(g, shape, stencil, keep, order)
     info = {"fictitious_nodes": int(fict.size),
             "bridging_bonds": 0 if shadow is None else int(shadow[0].size)}

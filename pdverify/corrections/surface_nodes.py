@@ -372,8 +372,9 @@ def surface_nodes_on_shape(problem, order: int) -> LinearSystem:
     the series' traction row, planes included (seed 001's force flux through a 3D
     patch would need the bonds' crossings of planes, a mantle and a sphere, which
     ``Shape3D`` does not compute; on a plane of cell faces the flux row and the traction
-    row agree for fields the lattice's moduli reproduce). No bridging test (``Shape3D``
-    has no ``hides``; see ``mirror_nodes.MirrorNodesOnShape``). Exactness kept on the
+    row agree for fields the lattice's moduli reproduce). Bridging bonds as in 2D
+    (``Shape3D.hides``; ``mirror_nodes.MirrorNodesOnShape`` gives the count). Exactness
+    kept on the
     quarter cylinder and the cavity octant (tests/shapes/test_shape3d_methods.py): order
     1 the affine field on partial volumes, order 2 the quadratic one with its body force
     on the moment-corrected stencil, ``x-`` prescribed and the rest under tractions
@@ -408,12 +409,10 @@ def surface_nodes_on_shape(problem, order: int) -> LinearSystem:
     A_U = (real_identity(g, nu_) + _place(U, fict, g.n_ext)).tocsr()
     A_T = (real_identity(g) + _place(T, fict, g.n_ext)).tocsr()
     a, b, _ = bond_pairs(g.ext_shape, st.offsets[st.half])
-    if d == 2:
-        keep = crossing_keep(g, shape, st)
-        pairs, real, far = bridging(g, shape, a, b, uncut(g, a, b, keep))
-    else:   # 3D: the bonds with a real end, no bridging test (docstring)
-        keep = (g.is_interior[a] | g.is_interior[b]) & ~g.is_void[a] & ~g.is_void[b]
-        pairs = np.zeros(0, dtype=int)
+    # 3D: the bonds with a real end (no fictitious-fictitious flux bonds; docstring)
+    keep = (crossing_keep(g, shape, st) if d == 2
+            else (g.is_interior[a] | g.is_interior[b]) & ~g.is_void[a] & ~g.is_void[b])
+    pairs, real, far = bridging(g, shape, a, b, uncut(g, a, b, keep))
     shadow = None
     if pairs.size:
         shadow = (pairs, *extension(g.x[far], seen_points(g, shape, real, far)[0]))
