@@ -73,8 +73,8 @@ def test_studies_unchanged_bit_for_bit():
 
 
 #: the method x scene cells added since a694eb9 (issue 55): the node-adding methods on the
-#: 2D shapes (their parameters are the box scenes'), the seed methods across theories and
-#: seed 003's correction on the shapes (its ray distance to the shape's parts);
+#: 2D and 3D shapes (their parameters are the box scenes'), the seed methods across theories
+#: and seed 003's correction on the shapes (its ray distance to the shape's parts);
 #: each is a new method of a scene, every cell of a694eb9 stays as it was
 ADDED_CELLS = (
     {(sid, m) for sid in ("plate-hole", "plate-l")
@@ -92,7 +92,9 @@ ADDED_CELLS = (
        for m in ("taylor-fictitious", "surface-nodes", "pddo", "mirror-nodes")}
     | {(sid, "energy-directional") for sid in (
         "plate-hole", "plate-l", "plate-crack", "plate-edge-crack", "plate-inclined-crack",
-        "cylinder3d-tension", "block3d-cavity")})
+        "cylinder3d-tension", "block3d-cavity")}
+    | {(sid, m) for sid in ("cylinder3d-tension", "block3d-cavity")
+       for m in ("mirror-nodes", "surface-nodes", "pddo", "taylor-fictitious")})
 
 
 def test_parameter_surface_unchanged():

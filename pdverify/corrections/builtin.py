@@ -227,18 +227,15 @@ def family_treatments() -> list[Treatment]:
                   "(10 x 5 x 5 cells) keeps 2 dependent constraint rows and fails as "
                   "near-singular. On a shape (not a box) the series runs along the local "
                   "normal with derivatives from a least-squares fit, the conditions at "
-                  "boundary points (corrections.shape_fictitious; corners unused). "
+                  "boundary points (corrections.shape_fictitious; corners unused; on a 3D "
+                  "shape every part not prescribing a component takes the fit's "
+                  "traction row, and grids whose condition rows outnumber the unknowns "
+                  "fail as singular, named). "
                   "Bond-based (seed 000 §7): the 2D boxes and seed 004's static bars that "
                   "state their conditions at the surface (corrections.bond_fictitious)",
-            build=_taylor, checker=_check_taylor, shapes=True,
+            build=_taylor, checker=_check_taylor, shapes=True, shapes3d=True,
             static_only="its conditions are Lagrange constraint rows, so the dynamics "
                         "would be a differential-algebraic system",
-            shapes3d_why="not built (corrections.shape_fictitious fits its series along "
-                         "the normal from the 2D parts' crossings, Shape.crossings of "
-                         "segments and arcs; a 3D part would need the bond-surface "
-                         "intersections of planes, a mantle and a sphere, and its 3D box "
-                         "form already costs 35-40 s and 2.1 GB at 2000 nodes, past a 3D "
-                         "shape scene's budget)",
             roles=(("flux-bar", Role(_flux_order, (ORDER,), _check_flux_order)),
                    ("bond-box", Role(_bond_taylor, (ORDER,), check_bond_box)))),
         FamilyTreatment(
@@ -246,18 +243,15 @@ def family_treatments() -> list[Treatment]:
             "fictitious layer by Taylor extrapolation about the nearest surface node",
             "Scabbia, Zaccariotto, Galvanetto 2023 (seed 001); seed 002",
             params=(SURFACE_ORDER,), theories=BOTH, families=FAMILY, footprint="surface",
-            build=_surface, checker=_check_surface, shapes=True,
+            build=_surface, checker=_check_surface, shapes=True, shapes3d=True,
             scope="state-based boxes, shapes and 1D waves; on a shape the surface nodes sit "
                   "at the boundary nodes' points on each part, the series about the nearest "
                   "one runs along the local normal with derivatives from a least-squares "
-                  "fit, arcs take the series' traction (surface_nodes."
-                  "surface_nodes_on_shape: our generalisation); bond-based: the 2D boxes "
-                  "and seed 004's static bars that state their conditions at the surface "
-                  "(corrections.bond_fictitious: "
-                  "what seed 001 leaves open for bond-based PD)",
-            shapes3d_why="not built (surface_nodes.surface_nodes_on_shape places its "
-                         "surface nodes and fits on the 2D parts; a 3D part needs surface "
-                         "nodes on planes, a mantle and a sphere and 3D fits)",
+                  "fit, arcs take the series' traction, on a 3D shape every part does "
+                  "(surface_nodes.surface_nodes_on_shape: our generalisation); bond-based: "
+                  "the 2D boxes and seed 004's static bars that state their conditions at "
+                  "the surface (corrections.bond_fictitious: what seed 001 leaves open for "
+                  "bond-based PD)",
             roles=(("wave-bar", Role(wave_extension, (WAVE_ORDER,), check_wave_order)),
                    ("bond-box", Role(_bond_surface, (SURFACE_ORDER,), _check_bond_surface)))),
         FamilyTreatment(
@@ -267,18 +261,16 @@ def family_treatments() -> list[Treatment]:
             "Zhao, Jafarzadeh, Chen, Bobaru 2020; seed 001 §5.2", params=MIRROR_PARAMS,
             theories=BOTH, families=FAMILY, footprint="fictitious",
             scope="state-based; the mirror relation (Dirichlet or traction) is chosen "
-                  "per boundary cell face, on a shape per fictitious node at its closest "
-                  "point, the reflection across the local tangent and the traction "
-                  "relation with the local normal (mirror_nodes.MirrorNodesOnShape: our "
-                  "generalisation); bond-based: the boxes that state their conditions at "
-                  "the surface, the traction relation with the lattice's C11, C12, C66 "
+                  "per boundary cell face, on a shape (2D or 3D) per fictitious node at "
+                  "its closest point, the reflection across the local tangent line or "
+                  "plane and the traction relation with the local normal "
+                  "(mirror_nodes.MirrorNodesOnShape: our generalisation); bond-based: the "
+                  "boxes and seed 004's static bars that state their conditions at the "
+                  "surface, the traction relation with the lattice's C11, C12, C66 "
                   "(mirror_nodes.assemble_mirror_bond_box: our reading)",
-            build=_mirror, checker=_check_mirror, shapes=True,
+            build=_mirror, checker=_check_mirror, shapes=True, shapes3d=True,
             static_only="its fictitious nodes carry an affine offset of the prescribed "
                         "values, fixed at assembly",
-            shapes3d_why="not built (mirror_nodes.MirrorNodesOnShape reflects across the "
-                         "tangent lines of 2D parts; a 3D part needs the tangent planes of "
-                         "planes, a mantle and a sphere and 3D fits)",
             roles=(("bond-box", Role(_bond_mirror, MIRROR_PARAMS, _check_bond_mirror)),)),
         FamilyTreatment(
             "pddo", "seed 001 §5: peridynamic differential operator (moment matrices exact "
@@ -286,17 +278,15 @@ def family_treatments() -> list[Treatment]:
             "beyond", "Behera, Roy, Anicode, Madenci, Spencer 2022; seed 001 §5.3",
             params=PDDO_PARAMS, theories=BOTH, families=FAMILY,
             scope="state-based; the boundary row (Dirichlet or traction) is chosen per "
-                  "boundary node; on a shape at each boundary node's points with the "
-                  "part's local normal (pddo.pddo_shape_system: our generalisation). "
-                  "Bond-based: the 2D and 3D boxes that state their conditions at the "
-                  "surface, the rows with the lattice's own elasticity tensor and the "
-                  "bond-based equations beyond 2 delta (corrections.pddo_bond)",
-            build=_pddo, shapes=True,
+                  "boundary node; on a shape (2D or 3D) at each boundary node's points "
+                  "with the part's local normal (pddo.pddo_shape_system: our "
+                  "generalisation). Bond-based: the 2D and 3D boxes and seed 004's static "
+                  "bars that state their conditions at the surface, the rows with the "
+                  "lattice's own elasticity tensor and the bond-based equations beyond 2 "
+                  "delta (corrections.pddo_bond)",
+            build=_pddo, shapes=True, shapes3d=True,
             static_only="its boundary rows on the outer node layer are algebraic "
                         "equations, not a mass's equation of motion",
-            shapes3d_why="not built (pddo.pddo_shape_system takes the boundary rows at "
-                         "points of 2D parts; a 3D part needs them at points of planes, a "
-                         "mantle and a sphere)",
             roles=(("bond-box", Role(_bond_pddo)),)),
     ]
 

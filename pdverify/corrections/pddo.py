@@ -284,7 +284,7 @@ def choose_points(pnode, ppart, nrm, problem, d):
 
 
 def pddo_shape_system(model, problem, body_load, bulk_model="lps"):
-    """PDDO's boundary layer on a shape (issue 55; our generalisation of seed 001 §5.3's
+    """PDDO's boundary layer on a 2D or 3D shape (issue 55; our generalisation of seed 001 §5.3's
     box rows): ``(A, rhs, counts)`` as :func:`pddo_system`.
 
     - outer nodes: the real nodes the boundary samples belong to
@@ -309,7 +309,13 @@ def pddo_shape_system(model, problem, body_load, bulk_model="lps"):
     field with its constant body force; the bulk's LPS rows for an affine field always,
     for a quadratic one on a stencil whose complete neighbourhoods are exact for it (the
     moment-corrected weights). Tested on the hole and the L
-    (tests/shapes/test_shape_methods.py)."""
+    (tests/shapes/test_shape_methods.py).
+
+    On a 3D shape (``pdverify.pd.shapes3d``) the same construction unchanged (every step
+    above is written for d dimensions: 3D moment matrices of the ten monomials to
+    second order, boundary points on planes, the mantle and the sphere with their
+    normals); the same exactness, tested on the quarter cylinder and the cavity octant
+    (tests/shapes/test_shape3d_methods.py)."""
     from .shape_fictitious import boundary_points
     if bulk_model not in BULK_MODELS:
         raise ValueError(f"bulk_model={bulk_model!r}; allowed: {', '.join(BULK_MODELS)}")

@@ -40,6 +40,20 @@ cut boundary has no such lines, and a jittered node set no lattice at all, so he
   sigma(grad u_fit) n of the fit's gradient with the continuum moduli of the PD
   constants, equal to the applied traction (zero on a free part).
 
+On a 3D shape (``pdverify.pd.shapes3d``; issue 55) the same with 3D fits
+(:func:`neighbours`: 16, 40, 100 real nodes for orders 1, 2, 3; a rank-deficient fit is
+refused, :func:`_full_rank`), the boundary points on planes, the mantle and the sphere,
+and on every part not prescribing a component the fit's traction row (plane parts too:
+the force flux through a 3D patch needs the bonds' crossings of the parts, which
+``Shape3D`` does not compute; :func:`traction_rows_3d`); no fictitious-fictitious bonds
+(:func:`real_keep`); bridging bonds as in 2D (``Shape3D.hides``, exact crossings): none
+on the convex quarter cylinder, 49 of 93 624 real-fictitious bonds at h = 0.1 on the
+cavity octant, through the cavity (``benchmarks/shape3d_bridging.py``); they leave
+block3d-cavity's Taylor errors unchanged to four digits.
+Exactness kept: order n reproduces the polynomials of degree <= n as in 2D
+(tests/shapes/test_shape3d_methods.py). A grid whose condition rows outnumber the
+displacement unknowns (the quarter cylinder at h = 1/8) fails by name.
+
 Vectorised: the neighbours by one k-d tree query, the fits as one batched pseudo-inverse
 (points x neighbours x monomials); no loop over nodes.
 """
@@ -57,14 +71,51 @@ from ..pd.closure import Closure
 WEIGHT_LENGTH = 1.0
 
 
-def exponents(order: int) -> np.ndarray:
-    """(M, 2) exponents (i, j) of the monomials x^i y^j with i + j <= order."""
-    return np.array([(i, t - i) for t in range(order + 1) for i in range(t, -1, -1)])
+def exponents(order: int, dim: int = 2) -> np.ndarray:
+    """(M, dim) exponents of the monomials of total degree <= order: in 2D (i, j) of
+    x^i y^j, in 3D (i, j, k) of x^i y^j z^k, by degree, x's power falling first."""
+    if dim == 2:
+        return np.array([(i, t - i) for t in range(order + 1) for i in range(t, -1, -1)])
+    return np.array([(i, j, t - i - j) for t in range(order + 1)
+                     for i in range(t, -1, -1) for j in range(t - i, -1, -1)]).reshape(-1, 3)
 
 
-def neighbours(order: int) -> int:
-    """Real nodes a fit of ``order`` takes: twice the monomials (one node for order 0)."""
-    return 1 if order == 0 else (order + 1) * (order + 2)
+def neighbours(order: int, dim: int = 2) -> int:
+    """Real nodes a fit of ``order`` takes: twice the monomials in 2D (one node for order
+    0); in 3D four times (orders 1, 2: 16, 40 nodes) and five times for order 3 (100).
+    Twice is too few in 3D: beside a plane of cell faces the 20 nearest nodes of a
+    quadratic fit about a node lie on two lattice planes along the normal, so x and x^2
+    cannot be told apart (rank 9 of 10). Measured on both 3D shapes at their test grids
+    (h = 1/8, 1/10), about every fictitious node's closest point, every boundary point
+    and every real node: 30 and 80 nodes still leave rank-deficient fits of order 2 and
+    3 (957 and 813 centres on the cavity octant), 40 and 100 none (smallest relative
+    singular value 7.7e-3 and 4.9e-4); :func:`fit` refuses a rank-deficient 3D fit."""
+    if order == 0:
+        return 1
+    if dim == 2:
+        return (order + 1) * (order + 2)
+    return len(exponents(order, 3)) * (4 if order <= 2 else 5)
+
+
+#: smallest singular value of a 3D fit's weighted Vandermonde matrix, relative to its
+#: largest, below which the fit is refused (round-off scale; the fits of the 3D shapes
+#: measure 4.9e-4 or more at neighbours(order, 3), rank-deficient ones below 1e-15)
+RANK_TOLERANCE = 1e-10
+
+
+def _full_rank(A, order):
+    """Refuse a batch of 3D fits whose weighted Vandermonde matrices ``A`` (F, k, M) are
+    rank deficient: pinv would return a minimum-norm fit that does not reproduce the
+    polynomials of its order (a silent wrong extension)."""
+    from ..errors import NumericalError
+    sv = np.linalg.svd(A, compute_uv=False)
+    ratio = sv[:, -1] / np.maximum(sv[:, 0], np.finfo(float).tiny)
+    bad = int(np.sum(ratio < RANK_TOLERANCE))
+    if bad:
+        raise NumericalError(f"{bad} of {len(A)} least-squares fits of order {order} over "
+                             f"their {A.shape[1]} nearest real nodes are rank deficient "
+                             f"(smallest relative singular value {ratio.min():.1e} < "
+                             f"{RANK_TOLERANCE:g}): the nodes do not span the polynomials")
 
 
 def _vander(z, E):
@@ -75,22 +126,27 @@ def _vander(z, E):
 def fit(x_real, centres, targets, order: int, h: float, gradient: bool = False):
     """Least-squares weights of the order-``order`` fit about each centre, over its
     ``neighbours(order)`` nearest real nodes: ``(nodes (F, k), value weights at targets
-    (F, k))``, and with ``gradient`` the weights of d/dx, d/dy there (F, 2, k)."""
-    k = min(neighbours(order), len(x_real))
+    (F, k))``, and with ``gradient`` the weights of d/dx, d/dy (, d/dz) there (F, dim,
+    k). 2D or 3D by the points' columns."""
+    dim = x_real.shape[1]
+    k = min(neighbours(order, dim), len(x_real))
     _, nodes = cKDTree(x_real).query(centres, k=k)
     nodes = nodes.reshape(len(centres), k)
-    E = exponents(order)
-    z = (x_real[nodes] - centres[:, None, :]) / h                 # (F, k, 2)
+    E = exponents(order, dim)
+    z = (x_real[nodes] - centres[:, None, :]) / h                 # (F, k, dim)
     # weighted by the distance to the centre (WEIGHT_LENGTH spacings), so that nearby
     # centres sharing their nodes still get their own fit (equal rows would be singular)
     sw = np.exp(-0.5 * np.sum(z * z, axis=-1) / WEIGHT_LENGTH ** 2)[..., None]
-    pinv = np.linalg.pinv(sw * _vander(z, E)) * np.swapaxes(sw, 1, 2)   # (F, M, k)
+    A = sw * _vander(z, E)
+    if dim == 3:
+        _full_rank(A, order)
+    pinv = np.linalg.pinv(A) * np.swapaxes(sw, 1, 2)                  # (F, M, k)
     zt = (targets - centres) / h
     value = np.einsum("fm,fmk->fk", _vander(zt, E), pinv)
     if not gradient:
         return nodes, value
     out = []
-    for axis in (0, 1):
+    for axis in range(dim):
         dE = E.copy()
         c = dE[:, axis].astype(float)
         dE[:, axis] = np.maximum(dE[:, axis] - 1, 0)
@@ -108,14 +164,19 @@ def centred_fit(x_real, centres, centre_cols, targets, order: int, h: float,
     weights at targets (F, k + 1))``, the centre's column first, and with ``gradient``
     the weights of d/dx, d/dy there (F, 2, k + 1). Exact for every polynomial of degree
     <= order; the series passes through the centre's value (seed 001's Taylor series
-    about the surface node, its derivatives from a fit instead of lattice lines)."""
-    k = min(neighbours(order), len(x_real))
+    about the surface node, its derivatives from a fit instead of lattice lines).
+    2D or 3D by the points' columns (then d/dz too)."""
+    dim = x_real.shape[1]
+    k = min(neighbours(order, dim), len(x_real))
     _, nodes = cKDTree(x_real).query(centres, k=k)
     nodes = nodes.reshape(len(centres), k)
-    E = exponents(order)[1:]                                       # no constant term
+    E = exponents(order, dim)[1:]                                  # no constant term
     z = (x_real[nodes] - centres[:, None, :]) / h
     sw = np.exp(-0.5 * np.sum(z * z, axis=-1) / WEIGHT_LENGTH ** 2)[..., None]
-    pinv = np.linalg.pinv(sw * _vander(z, E)) * np.swapaxes(sw, 1, 2)   # (F, M - 1, k)
+    A = sw * _vander(z, E)
+    if dim == 3:
+        _full_rank(A, order)
+    pinv = np.linalg.pinv(A) * np.swapaxes(sw, 1, 2)                  # (F, M - 1, k)
     cols = np.c_[np.asarray(centre_cols)[:, None], nodes]
     zt = (targets - centres) / h
 
@@ -126,7 +187,7 @@ def centred_fit(x_real, centres, centre_cols, targets, order: int, h: float,
     if not gradient:
         return cols, value
     out = []
-    for axis in (0, 1):
+    for axis in range(dim):
         dE = E.copy()
         c = dE[:, axis].astype(float)
         dE[:, axis] = np.maximum(dE[:, axis] - 1, 0)
@@ -156,7 +217,8 @@ def normal_closure(g, shape, order: int, stencil=None) -> Closure:
     A_T = (eye + _rows(nodes, w, g.n_ext, ni, fict)).tocsr()
     keep = shadow = None
     if stencil is not None:
-        keep = crossing_keep(g, shape, stencil)
+        # 3D: no fictitious-fictitious flux bonds (no crossings in Shape3D)
+        keep = real_keep(g, stencil) if g.dim == 3 else crossing_keep(g, shape, stencil)
         shadow = shadow_rows(g, shape, stencil, keep, order)
     info = {"fictitious_nodes": int(fict.size),
             "bridging_bonds": 0 if shadow is None else int(shadow[0].size)}
@@ -172,7 +234,8 @@ def boundary_points(g, shape, samples):
     key = node * len(shape.parts) + part
     keys, inv = np.unique(key, return_inverse=True)
     wsum = np.bincount(inv, W)
-    mean = np.c_[np.bincount(inv, W * P[:, 0]), np.bincount(inv, W * P[:, 1])] / wsum[:, None]
+    mean = np.stack([np.bincount(inv, W * P[:, i]) for i in range(P.shape[1])],
+                    axis=1) / wsum[:, None]
     kpart = keys % len(shape.parts)
     pts, nrm = np.zeros_like(mean), np.zeros_like(mean)
     for k, q in enumerate(shape.parts):
@@ -180,6 +243,15 @@ def boundary_points(g, shape, samples):
         if on.any():
             pts[on], nrm[on] = q.closest(mean[on])
     return pts, nrm, kpart, keys // len(shape.parts), inv
+
+
+def real_keep(g, stencil):
+    """The bonds of a 3D shape's closure: every stencil pair with a real end and no void
+    end (its conditions are traction rows, so no fictitious-fictitious bond carries a
+    flux; ``Shape3D`` has no crossings)."""
+    from ..pd.bonds import bond_pairs
+    a, b, _ = bond_pairs(g.ext_shape, stencil.offsets[stencil.half])
+    return (g.is_interior[a] | g.is_interior[b]) & ~g.is_void[a] & ~g.is_void[b]
 
 
 def crossing_keep(g, shape, stencil):
@@ -268,18 +340,20 @@ def condition_rows(model, problem, order: int, samples):
     resultant over that stretch, or on an arc the fit's traction (:func:`_traction_rows`)
     equal to the applied traction (zero on a free part)."""
     g, shape = model.grid, problem.shape
-    ni, h = g.n_interior, g.spacing
+    ni, h, d = g.n_interior, g.spacing, g.dim
     x_real = g.x[g.interior_ids]
     pts, nrm, part, _, group = boundary_points(g, shape, samples)
     nodes, value, grad = fit(x_real, pts, pts, order, h, gradient=True)
     exact = problem.exact(pts)
     pres = prescribed(problem, part)
-    free = free_rows(model, problem, samples, (pts, nrm, part, group), nodes, grad, ni)
+    points = (pts, nrm, part, group)
+    free = (free_rows(model, problem, samples, points, nodes, grad, ni) if d == 2
+            else traction_rows_3d(problem, points, nodes, grad, ni))
     rows, vals = [], []
-    for k in range(2):
+    for k in range(d):
         if pres[:, k].any():
             sel = np.flatnonzero(pres[:, k])
-            rows.append(_rows(nodes[sel], value[sel], sel.size, 2 * ni, col_offset=k * ni))
+            rows.append(_rows(nodes[sel], value[sel], sel.size, d * ni, col_offset=k * ni))
             vals.append(exact[sel, k])
         for _, R, c in free[k]:
             rows.append(R)
@@ -288,9 +362,9 @@ def condition_rows(model, problem, order: int, samples):
 
 
 def prescribed(problem, part) -> np.ndarray:
-    """(n, 2): whether the part of each point prescribes each component."""
+    """(n, d): whether the part of each point prescribes each component."""
     names = problem.shape.part_names
-    out = np.zeros((len(part), 2), dtype=bool)
+    out = np.zeros((len(part), problem.shape.dim), dtype=bool)
     for name, cond in problem.conditions.items():
         for k in cond.prescribed:
             out[:, k] |= part == names.index(name)
@@ -348,6 +422,24 @@ def free_rows(model, problem, samples, points, nodes, grad, n_cols):
     return out
 
 
+def traction_rows_3d(problem, points, nodes, grad, n_cols):
+    """:func:`free_rows` on a 3D shape: every boundary point whose part does not
+    prescribe component k has the row of the fit's traction sigma(grad u_fit) n equal
+    to the applied one (zero on a free part), on plane and curved parts alike (a 3D
+    force flux through a point's patch of a part would need the bonds' crossings of
+    planes, a mantle and a sphere, which ``Shape3D`` does not compute)."""
+    pts, nrm, part, _ = points
+    lam, mu = problem.constants.moduli()
+    t = _traction_at(problem, pts, nrm, part, problem.shape.part_names)
+    pres = prescribed(problem, part)
+    out = []
+    for k in range(3):
+        free = np.flatnonzero(~pres[:, k])
+        out.append([(free, _traction_rows(nodes[free], grad[free], nrm[free], k, lam, mu,
+                                          n_cols), t[free, k])] if free.size else [])
+    return out
+
+
 def _params(shape, x, xpart):
     """Arc length on its part of each point of ``x``."""
     out = np.zeros(len(x))
@@ -396,17 +488,20 @@ def stretches(shape, pts, part, s_samples, spart, group, s_all, xpart, h) -> sp.
 
 def _traction_rows(nodes, grad, nrm, k, lam, mu, n_cols):
     """Rows of the traction component k, sigma(grad u_fit) n with the continuum moduli
-    (plane: t_k = lam (div u) n_k + mu sum_l (d_l u_k + d_k u_l) n_l), over the fit's
-    nodes' displacements."""
+    (plane or 3D: t_k = lam (div u) n_k + mu sum_l (d_l u_k + d_k u_l) n_l), over the
+    fit's nodes' displacements (d ``n_cols`` columns, d = 2 or 3 by ``nrm``)."""
     blocks = []
-    F = len(nodes)
-    for a in range(2):          # the displacement component the row weighs
+    F, d = len(nodes), nrm.shape[1]
+    for a in range(d):          # the displacement component the row weighs
         c = lam * nrm[:, k][:, None] * grad[:, a]
         c = c + mu * nrm[:, a][:, None] * grad[:, k]
         if a == k:
             c = c + mu * np.einsum("fl,flk->fk", nrm, grad)
-        blocks.append(_rows(nodes, c, F, 2 * n_cols, col_offset=a * n_cols))
-    return (blocks[0] + blocks[1]).tocsr()
+        blocks.append(_rows(nodes, c, F, d * n_cols, col_offset=a * n_cols))
+    out = blocks[0] + blocks[1]
+    for extra in blocks[2:]:
+        out = out + extra
+    return out.tocsr()
 
 
 def _traction_at(problem, x, n, xpart, names):

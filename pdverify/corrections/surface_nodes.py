@@ -335,7 +335,7 @@ ORDERING_ON_SHAPE = "COLAMD"
 
 
 def surface_nodes_on_shape(problem, order: int) -> LinearSystem:
-    """Seed 001's surface node method on a 2D shape (issue 55; our generalisation, say
+    """Seed 001's surface node method on a 2D or 3D shape (issue 55; our generalisation, say
     "seed 001 along the normal"):
 
     - surface nodes: one per (boundary node, part) pair, at the boundary point of the
@@ -363,19 +363,35 @@ def surface_nodes_on_shape(problem, order: int) -> LinearSystem:
     polynomial field of degree <= N with its body force when the real nodes' complete
     neighbourhoods do (affine: any stencil; quadratic: the moment-corrected one), with
     every part prescribed, and under tractions where the lattice's moduli are the
-    continuum's (the moment-corrected stencil), as the Taylor extension on shapes."""
+    continuum's (the moment-corrected stencil), as the Taylor extension on shapes.
+
+    On a 3D shape (``pdverify.pd.shapes3d``; our generalisation again) the same with
+    3D fits (``shape_fictitious.neighbours``: 16, 40 and 100 real nodes for orders 1, 2,
+    3; a rank-deficient fit is refused) and surface nodes at the boundary nodes' points
+    on planes, the mantle and the sphere; every part not prescribing a component takes
+    the series' traction row, planes included (seed 001's force flux through a 3D
+    patch would need the bonds' crossings of planes, a mantle and a sphere, which
+    ``Shape3D`` does not compute; on a plane of cell faces the flux row and the traction
+    row agree for fields the lattice's moduli reproduce). Bridging bonds as in 2D
+    (``Shape3D.hides``; ``mirror_nodes.MirrorNodesOnShape`` gives the count). Exactness
+    kept on the
+    quarter cylinder and the cavity octant (tests/shapes/test_shape3d_methods.py): order
+    1 the affine field on partial volumes, order 2 the quadratic one with its body force
+    on the moment-corrected stencil, ``x-`` prescribed and the rest under tractions
+    (with traction rows everywhere the partial-volume stencil's moduli do not enter)."""
     from scipy.spatial import cKDTree
 
     from ..pd.closure import uncut
     from .assembly import boundary_nodes, shape_counts
     from .shape_fictitious import (_rows, boundary_points, bridging, centred_fit,
-                                   crossing_keep, fit, free_rows, prescribed, seen_points)
+                                   crossing_keep, fit, free_rows, prescribed, seen_points,
+                                   traction_rows_3d)
     g = problem.body.grid(problem.stencil.reach)
     g.node_volume[g.interior_ids] = g.volume      # as the Taylor extension on shapes
     shape, st = problem.shape, problem.stencil
     samples = boundary_nodes(g, shape)
     pts, nrm, part, _, group = boundary_points(g, shape, samples)
-    ni, ns, h, d = g.n_interior, len(pts), g.spacing, 2
+    ni, ns, h, d = g.n_interior, len(pts), g.spacing, g.dim
     nu_ = ni + ns
     x_real = g.x[g.interior_ids]
     tree = cKDTree(pts)
@@ -392,8 +408,10 @@ def surface_nodes_on_shape(problem, order: int) -> LinearSystem:
     U, T = extension(g.x[fict], shape.closest(g.x[fict])[0])
     A_U = (real_identity(g, nu_) + _place(U, fict, g.n_ext)).tocsr()
     A_T = (real_identity(g) + _place(T, fict, g.n_ext)).tocsr()
-    keep = crossing_keep(g, shape, st)
     a, b, _ = bond_pairs(g.ext_shape, st.offsets[st.half])
+    # 3D: the bonds with a real end (no fictitious-fictitious flux bonds; docstring)
+    keep = (crossing_keep(g, shape, st) if d == 2
+            else (g.is_interior[a] | g.is_interior[b]) & ~g.is_void[a] & ~g.is_void[b])
     pairs, real, far = bridging(g, shape, a, b, uncut(g, a, b, keep))
     shadow = None
     if pairs.size:
@@ -407,8 +425,10 @@ def surface_nodes_on_shape(problem, order: int) -> LinearSystem:
     rows, extra = [], K.shape[1] - d * nu_
     rhs = np.zeros((nu_, d))
     rhs[:ni] = problem.body_load(x_real, model.node_volume[g.interior_ids][:, None])
-    for k, blocks in enumerate(free_rows(model, problem, samples, (pts, nrm, part, group),
-                                         cols, grad, nu_)):
+    points = (pts, nrm, part, group)
+    free = (free_rows(model, problem, samples, points, cols, grad, nu_) if d == 2
+            else traction_rows_3d(problem, points, cols, grad, nu_))
+    for k, blocks in enumerate(free):
         for ids, R, c in blocks:
             R = sp.hstack([R, sp.csr_matrix((R.shape[0], extra))]).tocoo()
             rows.append(sp.csr_matrix((R.data, (k * nu_ + ni + ids[R.row], R.col)),

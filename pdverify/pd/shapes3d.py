@@ -70,6 +70,24 @@ def _pieces(length, h):
 REGIONS = ("rect", "quarter-disk", "square-minus-disk")
 
 
+def _roots_on(x, p, c, d, radius, on_part):
+    """(n, 2) roots t in (0, 1) of |c + t d| = radius whose points x + t (p - x) lie on
+    the part (``on_part``), NaN elsewhere."""
+    A = np.einsum("ij,ij->i", d, d)
+    B = 2 * np.einsum("ij,ij->i", c, d)
+    C = np.einsum("ij,ij->i", c, c) - radius * radius
+    disc = B * B - 4 * A * C
+    ok = (A > 0) & (disc > 0)
+    root = np.sqrt(np.where(ok, disc, 0.0))
+    A = np.where(ok, A, 1.0)
+    out = np.full((len(x), 2), np.nan)
+    for k, t in enumerate(((-B - root) / (2 * A), (-B + root) / (2 * A))):
+        q = x + t[:, None] * (p - x)
+        good = ok & (t > 0) & (t < 1) & on_part(q)
+        out[good, k] = t[good]
+    return out
+
+
 @dataclass(frozen=True)
 class Planar:
     """A plane part (module docstring): ``region`` with its sizes ``size`` (rect: (A, B);
@@ -118,6 +136,20 @@ class Planar:
         st = self.local(np.c_[r @ e1, r @ e2])
         p = o + st[:, :1] * e1 + st[:, 1:] * e2
         return p, np.broadcast_to(np.asarray(self.normal, float), p.shape).copy()
+
+    def crosses(self, x, p) -> np.ndarray:
+        """Parameters t in (0, 1) where the segments x -> p cross the region (NaN where
+        they do not; a segment in the plane does not cross it)."""
+        o, e1, e2 = self._frame()
+        nrm = np.asarray(self.normal, float)
+        d = p - x
+        den = d @ nrm
+        ok = np.abs(den) > 0
+        t = np.where(ok, ((o - x) @ nrm) / np.where(ok, den, 1.0), np.nan)
+        at = x + np.nan_to_num(t)[:, None] * d - o
+        st = np.c_[at @ e1, at @ e2]
+        inside = np.linalg.norm(self.local(st) - st, axis=1) <= 1e-12 * max(self.size)
+        return np.where(ok & inside & (t > 0) & (t < 1), t, np.nan)
 
     @property
     def area(self) -> float:
@@ -177,6 +209,13 @@ class Mantle:
         p[:, 2] = np.clip(x[:, 2], 0.0, self.length)
         return p, e
 
+    def crosses(self, x, p) -> np.ndarray:
+        """(n, 2) parameters t in (0, 1) where the segments x -> p cross the mantle
+        (NaN where not; two roots of |x_xy + t d_xy| = R)."""
+        return _roots_on(x, p, x[:, :2], (p - x)[:, :2], self.radius, lambda q: (
+            (np.mod(np.arctan2(q[:, 1], q[:, 0]), 2 * np.pi) <= self.theta1 + 1e-12)
+            & (q[:, 2] >= 0) & (q[:, 2] <= self.length)))
+
     @property
     def area(self) -> float:
         return float(self.radius * self.theta1 * self.length)
@@ -204,6 +243,12 @@ class SphereOctant:
         e = np.where((r > 0)[:, None], q / np.where(r > 0, r, 1.0)[:, None],
                      np.array([1.0, 0.0, 0.0]))
         return self.radius * e, -e
+
+    def crosses(self, x, p) -> np.ndarray:
+        """(n, 2) parameters t in (0, 1) where the segments x -> p cross the sphere's
+        octant (NaN where not)."""
+        return _roots_on(x, p, x, p - x, self.radius,
+                         lambda q: np.all(q >= -1e-12 * self.radius, axis=1))
 
     @property
     def area(self) -> float:
@@ -257,6 +302,24 @@ class Shape3D:
             best = np.where(better, dist, best)
             P[better], N[better], part[better] = p[better], n[better], k
         return P, N, best, part
+
+    def hides(self, x, p, part) -> np.ndarray:
+        """Which boundary points ``p`` (rows, on the parts ``part``) the points ``x`` do
+        not see through the body: the segment x -> p crosses a part other than p's own
+        farther than 1e-9 |x - p| from p (it passes through the body's exterior, as a
+        segment through the cavity does), as ``pdverify.pd.shapes.Shape.hides`` in 2D.
+        Exact crossings (planes, the mantle's and the sphere's quadratics)."""
+        x, p = np.asarray(x, dtype=float), np.asarray(p, dtype=float)
+        part = np.asarray(part)
+        out = np.zeros(len(x), dtype=bool)
+        gap = 1e-9
+        for k, q in enumerate(self.parts):
+            other = np.flatnonzero(part != k)
+            if other.size == 0:
+                continue
+            t = np.asarray(q.crosses(x[other], p[other])).reshape(other.size, -1)
+            out[other[np.any(t < 1 - gap, axis=1)]] = True
+        return out
 
     def sdf(self, x) -> np.ndarray:
         """Signed distance to the boundary, negative inside."""

@@ -6,11 +6,12 @@ Both are ``static-state`` descriptions with a 3D ``shape`` (``pdverify.pd.shapes
 the body is cut from the uniform cell-centred lattice of its bounding box (a node is real
 when its cell centre lies inside, its volume the part of its cell inside, sampled on an
 8 x 8 x 8 sub-grid), conditions are keyed by the shape's named parts, and the treatments
-of the family that can serve a 3D body that is not a box run on it: ``none`` and the
-bond/closure methods (``energy``, ``volume``, ``pals``, ``energy-directional`` with
-Eq. 14's ray distance to the first part the ray meets, ``pdverify.pd.rays``); ``list``
-says why the others do not (Taylor's fictitious nodes along the normal are 2D on
-shapes; surface nodes, mirror nodes and PDDO serve the 2D shapes only).
+of the family run on it: ``none``, the bond/closure methods (``energy``, ``volume``,
+``pals``, ``energy-directional`` with Eq. 14's ray distance to the first part the ray
+meets, ``pdverify.pd.rays``) and the node-adding ones along the local normal in 3D
+(``mirror-nodes``, ``surface-nodes``, ``taylor-fictitious``, ``pddo``: our
+generalisations, each stated and tested for exactness in its module; the ordered ones at
+order 1, see :meth:`Shape3DScene.default_cases`).
 
 Choices common to both (the issue is silent): octants by symmetry, on the PD side too
 (the symmetry planes are roller parts, a prescribed normal component on the real nodes
@@ -32,6 +33,7 @@ from ..pd.shapes3d import cavity_octant, quarter_cylinder
 from ..quotes import Quote as Q
 from ..quotes import used
 from . import influence_param, register
+from .base import ExpectedFailure
 from .shapes import ORDERING, ShapeScene
 
 def _sigma_z(sigma):
@@ -61,6 +63,13 @@ class Shape3DScene(ShapeScene):
         errors are not the scene's findings)."""
         return 2 * next(q.default for q in self.pd_params if q.name == "spacing")
 
+    def default_cases(self):
+        """Every treatment offered here at the default grid, a Taylor order at 1 only
+        (Taylor's fictitious nodes and surface nodes: orders 2 and 3 take 1.2-2 times
+        order 1's time, past the scenes' share of the report; ``run --set order=2``
+        runs them)."""
+        return [(m, q) for m, q in super().default_cases() if q.get("order") in (None, 1)]
+
     def problem(self, p, where):
         inf = get_influence(p["influence"])
         lengths, origin = self.box(p)
@@ -75,10 +84,19 @@ class Shape3DScene(ShapeScene):
             ordering=ORDERING, where=where, shape=self.shape(p))
 
     def cases(self, quick=False):
+        """The FEM reference and :meth:`default_cases`; the quick report at
+        :attr:`quick_spacing` (Taylor's run there fails as expected: each scene's
+        ``expected_failures``)."""
         runs = self.default_cases()
         if quick:
             return [("fem", {})] + [(m, {**q, "spacing": self.quick_spacing}) for m, q in runs]
         return [("fem", {})] + runs
+
+#: why Taylor's run fails at the 3D shape scenes' quick grids (their ``expected_failures``)
+QUICK_TAYLOR = ("at the quick grid Taylor's condition rows at the boundary points outnumber "
+                "the displacement unknowns (390 on 312 on the quarter cylinder at h = 1/8, "
+                "459 on 372 on the cavity octant at h = 0.2): a singular bordered system, "
+                "named by the run; the default grid runs")
 
 
 @register
@@ -123,6 +141,14 @@ class CylinderTension(Shape3DScene):
     12.6 % at those three). First order in h, as a surface
     layer one horizon thick on a fixed m predicts; the h = 1/24 runs took 19-24 s each
     under load.
+
+    The node-adding treatments along the normal (issue 55) reproduce the field to
+    round-off: mirror nodes {{mirror_max}} %, surface nodes (order one) {{surface_max}} %,
+    Taylor (order one) {{taylor_max}} %, PDDO {{pddo_max}} % (max error). Each is exact
+    for affine fields here: the mantle is free, where the mirror node's traction
+    relation holds with any mirror node (its step is x_f - x_m), and the roller planes
+    lie on cell faces, where the mirror point is a node. On this scene that checks
+    their 3D forms; it does not rank them (``block3d-cavity`` does).
     """
 
     id = "cylinder3d-tension"
@@ -144,7 +170,15 @@ class CylinderTension(Shape3DScene):
            for k in ("none", "energy", "volume", "pals")
            for m, metric, fmt in (("max", "max_error_pct", ".3g"),
                                   ("l2", "rel_l2_error", ".2g"),
-                                  ("mantle", "mantle_max_error_pct", ".3g"))}})
+                                  ("mantle", "mantle_max_error_pct", ".3g"))},
+        **{f"{k}_max": Q("max_error_pct", method, {"spacing": 0.0625, "m_ratio": 3.0, **w},
+                         ".2g")
+           for k, method, w in (("mirror", "mirror-nodes", {}),
+                                ("surface", "surface-nodes", {"order": 1}),
+                                ("taylor", "taylor-fictitious", {"order": 1}),
+                                ("pddo", "pddo", {}))}})
+    expected_failures = (ExpectedFailure(QUICK_TAYLOR, method="taylor-fictitious",
+                                         where={"spacing": 0.125}),)
 
     def shape(self, p):
         return quarter_cylinder(p["radius"], p["length"])
@@ -187,12 +221,24 @@ class BlockCavity(Shape3DScene):
     (rel L2 {{none_l2}}; near the cavity {{none_cavity}} %), energy {{energy_max}} %
     ({{energy_l2}}), volume {{volume_max}} % ({{volume_l2}}), PALS {{pals_max}} %
     ({{pals_l2}}). The uncorrected model's largest error lies at the edge where the two
-    outer free faces meet (x = y = W), not at the cavity; near the cavity no treatment
+    outer free faces meet (x = y = W), not at the cavity; near the cavity no bond method
     beats the uncorrected model (energy {{energy_cavity}} %, volume {{volume_cavity}} %),
-    and PALS, the best in rel L2, has its largest error there ({{pals_cavity}} %). With
-    a = delta every node near the cavity sees it across most of its horizon; why the
-    corrections gain nothing there is not chased (one grid only: h = 1/12 would take
-    4-8 s a run under load, past the scene's share of the report).
+    and PALS, the best bond method in rel L2, has its largest error there
+    ({{pals_cavity}} %). With a = delta every node near the cavity sees it across most of
+    its horizon; why the bond corrections gain nothing there is not chased (one grid
+    only: h = 1/12 would take 4-8 s a run under load, past the scene's share of the
+    report).
+
+    The node-adding treatments along the normal (issue 55): PDDO has the smallest rel L2
+    of all, {{pddo_l2}} (max {{pddo_max}} %, near the cavity {{pddo_cavity}} %, in the
+    interior {{pddo_interior}} %); surface nodes (order one) {{surface_l2}} (max
+    {{surface_max}} %, near the cavity {{surface_cavity}} %); mirror nodes {{mirror_l2}}
+    (max {{mirror_max}} %), with the smallest error near the cavity of every treatment,
+    {{mirror_cavity}} %; Taylor (order one) {{taylor_l2}}, whose largest error,
+    {{taylor_max}} %, exceeds the uncorrected model's, {{taylor_cavity}} % near the
+    cavity (not chased). Their 3D forms are exact for affine fields on this body
+    (``tests/shapes/test_shape3d_methods.py``), so what they miss here is the
+    non-affine field about the cavity on a grid whose cavity is one horizon in radius.
     """
 
     id = "block3d-cavity"
@@ -213,7 +259,18 @@ class BlockCavity(Shape3DScene):
            for k in ("none", "energy", "volume", "pals")
            for m, metric, fmt in (("max", "max_error_pct", ".3g"),
                                   ("l2", "rel_l2_error", ".2g"),
-                                  ("cavity", "cavity_max_error_pct", ".3g"))}})
+                                  ("cavity", "cavity_max_error_pct", ".3g"))},
+        **{f"{k}_{m}": Q(metric, method, {"spacing": 0.1, "m_ratio": 3.0, **w}, fmt)
+           for k, method, w in (("mirror", "mirror-nodes", {}),
+                                ("surface", "surface-nodes", {"order": 1}),
+                                ("taylor", "taylor-fictitious", {"order": 1}),
+                                ("pddo", "pddo", {}))
+           for m, metric, fmt in (("max", "max_error_pct", ".3g"),
+                                  ("l2", "rel_l2_error", ".2g"),
+                                  ("cavity", "cavity_max_error_pct", ".3g"),
+                                  ("interior", "interior_max_error_pct", ".2g"))}})
+    expected_failures = (ExpectedFailure(QUICK_TAYLOR, method="taylor-fictitious",
+                                         where={"spacing": 0.2}),)
 
     def shape(self, p):
         return cavity_octant(p["width"], p["radius"])

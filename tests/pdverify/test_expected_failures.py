@@ -78,8 +78,9 @@ def test_the_indentation_findings_are_documented():
     assert [m for m, _ in expected] == nones + ["energy", "volume"] + peers
     assert all(e.method != "energy-directional" for e in scene.expected_failures)
     # and the 3D Taylor run on body3d-manufactured's quick box (dependent constraint rows)
-    assert {s.id for s in all_scenes() if s.expected_failures} == {"block2d-indentation",
-                                                                   "body3d-manufactured"}
+    # and on the 3D shapes' quick grids (more condition rows than unknowns; issue 55)
+    assert {s.id for s in all_scenes() if s.expected_failures} == {
+        "block2d-indentation", "body3d-manufactured", "cylinder3d-tension", "block3d-cavity"}
 
 
 # -- shown as expected while the report runs, in its log and in its summary (issue 52) --------

@@ -114,3 +114,25 @@ def test_samples_integrate_each_part_area(which):
         assert abs(W[on].sum() - q.area) < 1e-8 * q.area, q.name
         assert np.all(_on_part(s, k, P[on]) < 1e-14)
     np.testing.assert_allclose(np.linalg.norm(N, axis=1), 1.0, atol=1e-15)
+
+
+def test_a_segment_through_the_cavity_is_hidden_and_none_in_the_cylinder():
+    """``Shape3D.hides``: from a real node above the cavity's pole the rim point of the
+    x- plane's disk is seen only through the cavity (hidden); a point of the same plane
+    beside the node, a point of the outer face, and any boundary point of the convex
+    quarter cylinder are seen (the crossing at p itself does not count)."""
+    import numpy as np
+
+    from pdverify.pd.shapes3d import cavity_octant, quarter_cylinder
+    cav = cavity_octant(1.0, 0.3)
+    names = cav.part_names
+    x = np.array([[0.05, 0.05, 0.35]] * 3)
+    r = 0.3 / np.sqrt(2)
+    p = np.array([[0.0, r, r], [0.0, 0.05, 0.35], [1.0, 0.05, 0.35]])
+    part = np.array([names.index("x-"), names.index("x-"), names.index("x+")])
+    assert cav.hides(x, p, part).tolist() == [True, False, False]
+    cyl = quarter_cylinder(0.5, 1.0)
+    rng = np.random.default_rng(0)
+    inner = rng.uniform([0.0, 0.0, 0.0], [0.35, 0.35, 1.0], size=(200, 3))
+    P, _, _, k = cyl.closest(rng.uniform(-0.2, 1.2, size=(200, 3)))
+    assert not cyl.hides(inner, P, k).any()
