@@ -150,9 +150,10 @@ def normal_closure(g, shape, order: int, stencil=None) -> Closure:
     fict = np.flatnonzero(g.kind == 1)
     p = shape.closest(g.x[fict])[0]
     eye = sp.csr_matrix((np.ones(ni), (g.interior_ids, np.arange(ni))), shape=(g.n_ext, ni))
-    nodes, w = fit(x_real, p, g.x[fict], order, h)
+    reach = (g.layers + 3) * h
+    nodes, w = sided_fit(shape, x_real, p, g.x[fict], order, h, reach)
     A_U = (eye + _rows(nodes, w, g.n_ext, ni, fict)).tocsr()
-    nodes, w = fit(x_real, p, g.x[fict], order - 1, h)
+    nodes, w = sided_fit(shape, x_real, p, g.x[fict], order - 1, h, reach)
     A_T = (eye + _rows(nodes, w, g.n_ext, ni, fict)).tocsr()
     keep = shadow = ghosts = None
     if stencil is not None:
@@ -165,6 +166,31 @@ def normal_closure(g, shape, order: int, stencil=None) -> Closure:
         info["crack_ghost_bonds"] = int(ghosts[0].size)
     return Closure(keep=keep, weighted_volume="complete", displacement_map=A_U,
                    dilatation_map=A_T, shadow=shadow, ghosts=ghosts, info=info)
+
+
+def sided_fit(shape, x_real, centres, targets, order: int, h: float, reach: float,
+              owners=None):
+    """:func:`fit` of the fictitious nodes ``targets``, those within ``reach`` of a
+    crack (beside an edge crack's mouth) over the real nodes on one side of its line
+    only, the side of ``owners`` (default: the targets themselves; a bond's real end
+    for its own value of the node): a fit there over both sides' nodes would bond the
+    faces' nodes to values read across the open mouth. Without a crack, :func:`fit`
+    itself."""
+    nodes, w = fit(x_real, centres, targets, order, h)
+    owners = targets if owners is None else owners
+    for c in getattr(shape, "cracks", ()):
+        if not c.length:
+            continue
+        q, _ = c.faces[0].closest(targets)
+        near = np.linalg.norm(targets - q, axis=1) <= reach
+        plus = c.side(owners)
+        for face in c.faces:
+            sel = np.flatnonzero(near & (plus == face.plus))
+            if sel.size:
+                side = np.flatnonzero(face_side(face, x_real))
+                n_k, w_k = fit(x_real[side], centres[sel], targets[sel], order, h)
+                nodes[sel], w[sel] = side[n_k], w_k
+    return nodes, w
 
 
 def face_side(face, x) -> np.ndarray:
@@ -299,9 +325,17 @@ def shadow_rows(g, shape, stencil, keep, order: int):
     ni, h = g.n_interior, g.spacing
     x_real = g.x[g.interior_ids]
     p, _ = seen_points(g, shape, real, fict)
-    nodes, w = fit(x_real, p, g.x[fict], order, h)
+    reach = (g.layers + 3) * h
+    across = np.zeros(pairs.size, dtype=bool)
+    for c in getattr(shape, "cracks", ()):
+        if c.length:     # a bond past an edge crack's mouth: the node's own point, and
+            q, _ = c.faces[0].closest(g.x[fict])     # the fit from the real end's side
+            across |= ((np.linalg.norm(g.x[fict] - q, axis=1) <= reach)
+                       & (c.side(g.x[real]) != c.side(g.x[fict])))
+    p[across] = shape.closest(g.x[fict[across]])[0]
+    nodes, w = sided_fit(shape, x_real, p, g.x[fict], order, h, reach, g.x[real])
     U = _rows(nodes, w, pairs.size, ni)
-    nodes, w = fit(x_real, p, g.x[fict], order - 1, h)
+    nodes, w = sided_fit(shape, x_real, p, g.x[fict], order - 1, h, reach, g.x[real])
     return pairs, U, _rows(nodes, w, pairs.size, ni)
 
 

@@ -121,6 +121,10 @@ def _pull(traction: float):
 #: reference's stated choices)
 _FEM_FIXED = ("kind", "j_radii", "fit_window")
 
+#: the treatments that add nodes and serve crack faces (one-sided: the fictitious nodes
+#: of a face across the slit are fitted from its own side, ``Closure.ghosts``)
+FACE_TREATMENTS = ("taylor-fictitious",)
+
 #: why the treatments that add nodes do not run here
 _NO_CRACK_FACES = (
     "crack faces are not served yet: the node-adding treatments on shapes "
@@ -194,7 +198,8 @@ class CrackScene(ShapeScene):
         if getattr(treatment, "peer", False):
             return ("its code builds its own bonds from the node positions, so it would "
                     "bond across the crack; crack faces are not served yet")
-        if not (treatment.kind == "closure" or getattr(treatment, "baseline", False)):
+        if not (treatment.kind == "closure" or getattr(treatment, "baseline", False)
+                or getattr(treatment, "name", None) in FACE_TREATMENTS):
             return _NO_CRACK_FACES
         return None
 
