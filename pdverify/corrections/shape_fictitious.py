@@ -28,6 +28,26 @@ cut boundary has no such lines, and a jittered node set no lattice at all, so he
   arc no bond changes; on plate-hole 6 bonds do at h = 0.05 and 1/30 (none at 0.025):
   beside the arc's end on a symmetry plane, where a fictitious node below the plane has
   that end as its closest point and a real node sees it only through the hole;
+- crack faces (issue 54; ``pdverify.pd.shapes.Crack``): a slit has no outside, so its
+  fictitious nodes are not lattice nodes but copies, one per bond a crack cuts and per
+  end of it (:func:`crack_ghosts`, ``Closure.ghosts``): from each end a one-sided bond
+  to a fictitious node at the other end's place, fitted as above about that place's
+  closest point on the end's own face, over the real nodes on the end's side of the
+  crack's line only (a ghost of the upper face lies among the lower face's nodes, but
+  reads the upper field). The cut bond itself stays cut; a ghost has no equation and
+  no share in the other node's dilatation. At the tip: ghosts exist only for the bonds
+  the crack cuts, so the faces' fictitious nodes stop at the tip (a ghost ahead of it
+  is fitted about the tip point); the nodes ahead of the tip keep their real bonds,
+  the bonds round the tip stay real (not cut, no ghost), and a bond through the tip
+  point counts half in each face's force flux (``CrackFace.crossings``). Beside an
+  edge crack's mouth the lattice's fictitious nodes and the bonds to them across the
+  crack's line are fitted from one side (:func:`sided_fit`). A face along a lattice
+  axis takes the force-flux rows below; one at an angle to the lattice the fit's
+  traction (the flux through its stretches is a lattice count, :func:`lattice_flux`),
+  its fit one-sided (:func:`one_sided_fits`). Exact for the polynomials of the order
+  at every node, the tip zone included, and one-sided (``tests/shapes/
+  test_crack_faces.py``: a field different on the two sides is reproduced outside
+  the ligament's zone, and a fit over both sides misses it);
 - the conditions at boundary points by Lagrange multipliers (seed 000 Eq. 63): one point
   per boundary node and part (the mean of the part's boundary samples that belong to the
   node, ``assembly.boundary_nodes``, moved onto the part). A prescribed component's
