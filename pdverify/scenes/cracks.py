@@ -22,7 +22,7 @@ from ..errors import InputError
 from ..metrics import rel_l2_error
 from ..pd.cracks import fit_k, opening_pairs
 from ..pd.problem import FaceCondition
-from ..pd.shapes import Crack, polygon
+from ..pd.shapes import Crack, CrackFace, polygon
 from . import register, whole_cells
 from .base import MethodSpec
 from .fem_references import FemAndPD
@@ -31,6 +31,11 @@ from .shapes import ShapeScene, shape_errors
 #: the tip zone left out of the field metrics and of the K fit, in horizons: the nonlocal
 #: zone where a PD tip and LEFM cannot agree (``pdverify.pd.cracks``, fit_k's tip_zone)
 TIP_ZONE = 2.0
+
+#: the outer radius of the ring about the tips, in horizons, whose largest error is the
+#: field near the tip outside the nonlocal zone (``near_tip_max_error_pct``: r in
+#: [TIP_ZONE, NEAR_TIP) horizons of any tip)
+NEAR_TIP = 5.0
 
 
 def plate_outline(width: float, height: float, spacing: float):
@@ -155,7 +160,10 @@ class CrackScene(ShapeScene):
     ``k_handbook`` (the reference's K from J and Tada's), ``opening_error_pct`` (the
     rows nearest the crack behind the fitted tip at r >= 2 horizons), and the field
     errors (``shape_errors``) over the nodes outside the tip zone of every tip,
-    ``tip_zone_nodes`` the nodes left out. Fields beside the error maps: the fitted
+    ``tip_zone_nodes`` the nodes left out; among those, ``near_tip_max_error_pct`` over
+    the ring r in [2, 5) horizons of any tip (the tip's field outside the nonlocal zone)
+    and ``faces_max_error_pct`` over the nodes within a horizon of a crack face whose
+    closest part it is. Fields beside the error maps: the fitted
     tip, the tip zone's radius and the opening profiles (PD and FEM) of the nearest
     rows behind the fitted tip, every r (the figures' data).
     """
@@ -247,9 +255,18 @@ class CrackScene(ShapeScene):
         _, err = shape_errors(x_int, u, u_ref, problem.shape, delta)
         tip_dist = np.min([np.hypot(*(x_int - np.asarray(t)).T) for t in tip_points], axis=0)
         away = tip_dist >= TIP_ZONE * delta
-        metrics, _ = shape_errors(x_int[away], u[away], u_ref[away], problem.shape, delta)
+        metrics, err_away = shape_errors(x_int[away], u[away], u_ref[away], problem.shape,
+                                         delta)
         metrics["rel_l2_error"] = rel_l2_error(u[away], u_ref[away])
         metrics["tip_zone_nodes"] = int(np.count_nonzero(~away))
+        # the tip's field outside the nonlocal zone and the faces' (same scale as the
+        # errors above: max |u_FEM| outside the tip zone)
+        ring = tip_dist[away] < NEAR_TIP * delta
+        _, _, dist, part = problem.shape.closest(x_int[away])
+        faces = np.flatnonzero([isinstance(q, CrackFace) for q in problem.shape.parts])
+        on_face = (dist < delta) & np.isin(part, faces)
+        metrics["near_tip_max_error_pct"] = float(err_away[ring].max())
+        metrics["faces_max_error_pct"] = float(err_away[on_face].max())
         return x_int, u, u_ref, err, metrics
 
     def measure(self, p, problem, system, x, info):

@@ -179,3 +179,20 @@ def test_the_edge_scenes_fem_checks_name_the_edge_reference(tmp_path):
                         "--method", "fem", "--set", "cells=1"], capture_output=True, text=True)
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
     assert "plate-edge-crack --method fem: plate-edge-crack: cells must be 2..64" in r.stderr
+
+
+def test_taylor_runs_on_the_edge_crack_with_the_tip_and_face_errors(tmp_path):
+    """Taylor's one-sided fictitious nodes run on a crack scene (order 1, the quick
+    grid); the errors near the tip (the ring of 2 to 5 horizons) and along the faces are
+    parts of the errors outside the tip zone, on its scale."""
+    out = tmp_path / "t.json"
+    r = subprocess.run([sys.executable, "-m", "pdverify", "run", "plate-edge-crack",
+                        "--method", "taylor-fictitious", "--set", "order=1",
+                        "--set", f"spacing={1 / 30!r}", "--json", str(out)],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    run = json.loads(out.read_text())["runs"][0]
+    m = run["metrics"]
+    assert run["status"] == "ok"
+    assert 0 < m["near_tip_max_error_pct"] <= m["max_error_pct"]
+    assert 0 < m["faces_max_error_pct"] <= m["boundary_max_error_pct"]
