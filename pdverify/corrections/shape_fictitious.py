@@ -219,15 +219,11 @@ def face_side(face, x) -> np.ndarray:
     return face.sees(x)
 
 
-def crack_ghosts(g, shape, stencil, keep, order: int):
-    """``Closure.ghosts`` of the normal closure on a shape with cracks (module
-    docstring, crack faces): every stencil pair the closure would keep (``keep``) that
-    a crack cuts becomes, from each real end, a one-sided bond to a fictitious node at
-    the other end's position, fitted as a fictitious node of the real end's face: the
-    order-``order`` fit about the other end's closest point on that face (the tip
-    beyond it), over the real nodes on the real end's side of the crack's line only;
-    its dilatation the fit of order - 1 of those nodes' dilatations. None without a
-    crack that cuts a pair."""
+def cut_ends(g, shape, stencil, keep):
+    """The ends of the pairs a crack cuts among those the closure keeps (``keep``), one
+    row per pair and end: ``(pairs, own end is a, own node, other node, [(face,
+    rows)])``, the rows grouped by the face of the own end's side of the first crack
+    that cuts the pair. None without a cut pair."""
     cracks = [c for c in getattr(shape, "cracks", ()) if c.length]
     if not cracks:
         return None
@@ -242,29 +238,50 @@ def crack_ghosts(g, shape, stencil, keep, order: int):
     # bond with no equation at either end, which counts in the face's force flux only
     pairs = np.r_[cut, cut]
     real_a = np.r_[np.ones(cut.size, dtype=bool), np.zeros(cut.size, dtype=bool)]
-    real = np.where(real_a, a[pairs], b[pairs])
+    own = np.where(real_a, a[pairs], b[pairs])
     ghost = np.where(real_a, b[pairs], a[pairs])
+    groups = []
+    done = np.zeros(pairs.size, dtype=bool)
+    for c in cracks:            # the first crack that cuts a pair serves it
+        mine = ~done & c.cuts(g.x[own], g.x[ghost])
+        done |= mine
+        for face in c.faces:
+            sel = np.flatnonzero(mine & (c.side(g.x[own]) == face.plus))
+            if sel.size:
+                groups.append((face, sel))
+    return pairs, real_a, own, ghost, groups
+
+
+def crack_ghosts(g, shape, stencil, keep, order: int):
+    """``Closure.ghosts`` of the normal closure on a shape with cracks (module
+    docstring, crack faces): every stencil pair the closure would keep (``keep``) that
+    a crack cuts becomes, from each end, a one-sided bond to a fictitious node at the
+    other end's position, fitted as a fictitious node of the end's face: the
+    order-``order`` fit about the other end's closest point on that face (the tip
+    beyond it), over the real nodes on the end's side of the crack's line only (the
+    face's side, :func:`face_side`); its dilatation the fit of order - 1 of those
+    nodes' dilatations. None without a crack that cuts a pair."""
+    ends = cut_ends(g, shape, stencil, keep)
+    if ends is None:
+        return None
+    pairs, real_a, _, ghost, groups = ends
     ni, h = g.n_interior, g.spacing
     x_real = g.x[g.interior_ids]
     rows_u, rows_t = [], []
-    done = np.zeros(pairs.size, dtype=bool)
-    for c in cracks:            # the first crack that cuts a pair serves it
-        mine = ~done & c.cuts(g.x[real], g.x[ghost])
-        done |= mine
-        for face in c.faces:
-            sel = np.flatnonzero(mine & (c.side(g.x[real]) == face.plus))
-            if sel.size == 0:
-                continue
-            side = np.flatnonzero(face_side(face, x_real))   # the face's real nodes
-            p, _ = face.closest(g.x[ghost[sel]])
-            for order_k, rows in ((order, rows_u), (order - 1, rows_t)):
-                nodes, w = fit(x_real[side], p, g.x[ghost[sel]], order_k, h)
-                rows.append((sel, side[nodes], w))
+    for face, sel in groups:
+        side = np.flatnonzero(face_side(face, x_real))   # the face's real nodes
+        p, _ = face.closest(g.x[ghost[sel]])
+        for order_k, rows in ((order, rows_u), (order - 1, rows_t)):
+            nodes, w = fit(x_real[side], p, g.x[ghost[sel]], order_k, h)
+            rows.append((sel, side[nodes], w))
+    return pairs, real_a, stacked_rows(rows_u, pairs.size, ni), stacked_rows(
+        rows_t, pairs.size, ni)
 
-    def stacked(rows):
-        parts = [_rows(cols, w, pairs.size, ni, sel) for sel, cols, w in rows]
-        return sum(parts[1:], parts[0]).tocsr()
-    return pairs, real_a, stacked(rows_u), stacked(rows_t)
+
+def stacked_rows(blocks, n_rows: int, n_cols: int) -> sp.csr_matrix:
+    """The sparse rows of ``[(row ids, columns, weights)]`` blocks summed."""
+    parts = [_rows(cols, w, n_rows, n_cols, sel) for sel, cols, w in blocks]
+    return sum(parts[1:], parts[0]).tocsr()
 
 
 def boundary_points(g, shape, samples):
