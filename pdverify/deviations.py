@@ -566,7 +566,9 @@ DEVIATIONS = (
               "2 horizons, against the FEM's K from J; of the node-adding treatments only "
               "Taylor's fictitious nodes run (ours on a slit: one-sided, one fictitious node "
               "per cut bond and end, fitted from that end's side, none past the tip; order 1 "
-              "in the report), the others are refused (crack faces not served yet).",
+              "in the report), the others are refused (surface nodes: served on crack faces "
+              "but not on the scenes' h/2 pins; mirror nodes, PDDO: crack faces not served "
+              "yet).",
               "scenes/cracks.py, pd/cracks.py fit_k, reference_fem/crack_plate.py; "
               "benchmarks/crack_k.py",
               summary="Ours: the full cracked plate, K by the opening fit"),

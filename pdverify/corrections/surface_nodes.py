@@ -359,6 +359,18 @@ def surface_nodes_on_shape(problem, order: int) -> LinearSystem:
       continuum moduli (the flux through a short stretch of an arc is a lattice
       quadrature whose error does not vanish: ``shape_fictitious``).
 
+    - crack faces (issue 54; ``shape_fictitious``, crack faces): surface nodes on each
+      face like any part; every bond the crack cuts becomes, from each end, a one-sided
+      bond to a fictitious node at the other end's place (``Closure.ghosts``), the
+      series about the nearest surface node of the end's own face fitted over the real
+      nodes of the end's side only; the faces' rows (the fit's traction on a face at an
+      angle to the lattice) from one-sided fits; beside an edge crack's mouth the
+      fictitious nodes and the bonds across the crack's line from one side. At the tip
+      as Taylor's: the fictitious nodes stop there, the bonds round it stay real.
+      Exact for the order's polynomials on the crack geometries and one-sided
+      (tests/shapes/test_crack_faces.py). The crack scenes do not offer it: their pins
+      of length h/2 get surface nodes in no equation (``scenes.cracks``).
+
     Exactness kept (tests/shapes/test_shape_methods.py): order N reproduces every
     polynomial field of degree <= N with its body force when the real nodes' complete
     neighbourhoods do (affine: any stencil; quadratic: the moment-corrected one), with
