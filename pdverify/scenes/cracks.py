@@ -126,34 +126,19 @@ def _pull(traction: float):
 #: reference's stated choices)
 _FEM_FIXED = ("kind", "j_radii", "fit_window")
 
-#: the treatments that add nodes and serve crack faces (one-sided: the fictitious nodes
-#: of a face across the slit are fitted from its own side, ``Closure.ghosts``)
-FACE_TREATMENTS = ("taylor-fictitious",)
-
-#: Taylor's orders in the report: order 1 only. Its cost on plate-crack at h = 1/40 is
+#: the orders of a treatment with an ``order`` in the report (Taylor's fictitious nodes,
+#: the one that serves crack faces, ``FamilyTreatment.cracks``): order 1 only. Its cost on plate-crack at h = 1/40 is
 #: 4x the uncorrected model's (17 s against none's ~4 s, ``run`` under a load of ~11;
 #: order 2 took 1.3x order 1's), and the crack scenes may add ~15 s to a full report;
 #: the other orders run with ``run --method taylor-fictitious --set order=N``
-TAYLOR_ORDERS = (1,)
+ORDERS = (1,)
 
 #: why the treatments that add nodes do not run here
 _NO_CRACK_FACES = (
-    "crack faces are not served yet: only taylor-fictitious (and, outside these "
-    "scenes' pins, surface-nodes) have one-sided fictitious nodes on a slit "
-    "(corrections.shape_fictitious, Closure.ghosts); this treatment's shape form would "
-    "see each crack face as a straight part with an outside to put its nodes in (mirror "
-    "nodes: images across the face, which land among the other face's nodes; PDDO: "
-    "boundary rows fitted over both faces' nodes), so it needs the same one-sided fits "
-    "and one-sided ghost bonds (Closure.ghosts) for its own nodes")
-
-
-_NO_PIN_SURFACE_NODES = (
-    "crack faces are served (one-sided surface nodes on the faces, "
-    "corrections.surface_nodes, exact on the crack geometries: "
-    "tests/shapes/test_crack_faces.py), but not these scenes' pins: a pin part of length "
-    "h/2 that holds the rigid motions gets surface nodes whose values no fictitious node "
-    "is extrapolated from, so their columns appear in no equation (measured: a singular "
-    "system on plate-crack); the pins' conditions need imposing another way")
+    "crack faces are not served yet: a treatment that adds nodes serves them when its "
+    "fictitious nodes across a slit are one-sided (fitted from the end's own side, "
+    "Closure.ghosts) and it says so (FamilyTreatment.cracks); a slit has no outside "
+    "to put its nodes in")
 
 
 class CrackScene(ShapeScene):
@@ -217,10 +202,10 @@ class CrackScene(ShapeScene):
         raise NotImplementedError
 
     def default_cases(self):
-        """Every treatment offered here at the default grid, Taylor's fictitious nodes
-        at the orders :data:`TAYLOR_ORDERS` only."""
+        """Every treatment offered here at the default grid, those with an order (Taylor's
+        fictitious nodes) at the orders :data:`ORDERS` only."""
         return [(m, q) for m, q in super().default_cases()
-                if m != "taylor-fictitious" or q.get("order") in TAYLOR_ORDERS]
+                if "order" not in q or q["order"] in ORDERS]
 
     def family_refusal(self, treatment):
         out = super().family_refusal(treatment)
@@ -229,12 +214,10 @@ class CrackScene(ShapeScene):
         if getattr(treatment, "peer", False):
             return ("its code builds its own bonds from the node positions, so it would "
                     "bond across the crack; crack faces are not served yet")
-        name = getattr(treatment, "name", None)
-        if name == "surface-nodes":
-            return _NO_PIN_SURFACE_NODES
-        if not (treatment.kind == "closure" or getattr(treatment, "baseline", False)
-                or name in FACE_TREATMENTS):
-            return _NO_CRACK_FACES
+        if getattr(treatment, "cracks", False):
+            return None
+        if not (treatment.kind == "closure" or getattr(treatment, "baseline", False)):
+            return getattr(treatment, "cracks_why", "") or _NO_CRACK_FACES
         return None
 
     def reference_field(self, p):
@@ -349,7 +332,7 @@ class CrackPlate(CrackScene):
     ``benchmarks/crack_k.py`` (the study this scene repeats). Treatments: the uncorrected
     model, every bond method of the family that serves shapes (their closures drop
     the cut bonds) and Taylor's fictitious nodes (``taylor-fictitious``, order 1 in the
-    report: :data:`TAYLOR_ORDERS`) with one-sided fictitious nodes on the crack faces
+    report: :data:`ORDERS`) with one-sided fictitious nodes on the crack faces
     (``corrections.shape_fictitious``, crack faces: each bond the crack cuts becomes,
     from each end, a bond to a fictitious node at the other end's place fitted from the
     end's own side; they stop at the tip, the bonds round it stay real); the other
