@@ -84,7 +84,10 @@ ADDED_CELLS = (
     | {(sid, m) for sid in ("sheet2d-clamped", "sheet2d-tension", "stiffness2d-sheet",
                             "stiffness3d-box-bond")
        for m in ("taylor-fictitious", "surface-nodes")}
-    | {("block2d-indentation", "virtual-nodes")})
+    | {("block2d-indentation", "virtual-nodes")}
+    # issue 54: Taylor's one-sided fictitious nodes on crack faces
+    | {(sid, "taylor-fictitious") for sid in ("plate-crack", "plate-edge-crack",
+                                              "plate-inclined-crack")})
 
 
 def test_parameter_surface_unchanged():
