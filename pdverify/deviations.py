@@ -563,8 +563,12 @@ DEVIATIONS = (
               "tip kept), not the FEM's quarter (this family would impose the symmetry "
               "plane's component on the node layer ahead of a tip); K_I by the Williams fit "
               "of the opening of the two node rows nearest the crack, outside a tip zone of "
-              "2 horizons, against the FEM's K from J; the node-adding treatments are not "
-              "run (crack faces are not served yet).",
+              "2 horizons, against the FEM's K from J; of the node-adding treatments only "
+              "Taylor's fictitious nodes run (ours on a slit: one-sided, one fictitious node "
+              "per cut bond and end, fitted from that end's side, none past the tip; order 1 "
+              "in the report), the others are refused (surface nodes: served on crack faces "
+              "but not on the scenes' h/2 pins; mirror nodes, PDDO: crack faces not served "
+              "yet).",
               "scenes/cracks.py, pd/cracks.py fit_k, reference_fem/crack_plate.py; "
               "benchmarks/crack_k.py",
               summary="Ours: the full cracked plate, K by the opening fit"),
@@ -573,8 +577,10 @@ DEVIATIONS = (
               "to the lattice (the slit crosses cells; the bonds that cross it are cut, a "
               "staircase of nodes on each face); K_I and K_II by the Williams fit of both "
               "displacement components in an annulus outside a tip zone of 2 horizons "
-              "(orders 1..7 of both modes), against the FEM's interaction integral; the "
-              "node-adding treatments are not run (crack faces are not served yet).",
+              "(orders 1..7 of both modes), against the FEM's interaction integral; of the "
+              "node-adding treatments only Taylor's one-sided fictitious nodes run (as "
+              "plate-crack's; the faces' conditions the one-sided fit's traction, the slit "
+              "being at an angle to the lattice), the others are refused.",
               "scenes/inclined_crack.py, pd/cracks.py fit_k_mixed, "
               "reference_fem/inclined_crack.py; benchmarks/inclined_crack_k.py",
               summary="Ours: the inclined crack, K_I and K_II by the annulus fit"),
@@ -582,8 +588,10 @@ DEVIATIONS = (
               "Ours, not a paper's: the whole single-edge-notched tension strip (H = b, "
               "where the FEM's K is within 3.1e-4 of its long strip's) with its edge crack "
               "as one crack from the mouth, not the FEM's half (as plate-crack); K_I by the "
-              "same opening fit at its one tip; the node-adding treatments are not run "
-              "(crack faces are not served yet).",
+              "same opening fit at its one tip; of the node-adding treatments only Taylor's "
+              "one-sided fictitious nodes run (as plate-crack's; beside the mouth the "
+              "fictitious nodes outside the strip are fitted from one side), the others are "
+              "refused (crack faces not served yet).",
               "scenes/cracks.py EdgeCrackPlate, pd/cracks.py fit_k, "
               "reference_fem/crack_plate.py edge_crack_plate",
               summary="Ours: the whole SENT strip, K by the opening fit"),

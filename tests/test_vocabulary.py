@@ -94,7 +94,10 @@ ADDED_CELLS = (
         "plate-hole", "plate-l", "plate-crack", "plate-edge-crack", "plate-inclined-crack",
         "cylinder3d-tension", "block3d-cavity")}
     | {(sid, m) for sid in ("cylinder3d-tension", "block3d-cavity")
-       for m in ("mirror-nodes", "surface-nodes", "pddo", "taylor-fictitious")})
+       for m in ("mirror-nodes", "surface-nodes", "pddo", "taylor-fictitious")}
+    # issue 54: Taylor's one-sided fictitious nodes on crack faces
+    | {(sid, "taylor-fictitious") for sid in ("plate-crack", "plate-edge-crack",
+                                              "plate-inclined-crack")})
 
 
 def test_parameter_surface_unchanged():

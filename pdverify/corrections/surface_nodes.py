@@ -359,6 +359,18 @@ def surface_nodes_on_shape(problem, order: int) -> LinearSystem:
       continuum moduli (the flux through a short stretch of an arc is a lattice
       quadrature whose error does not vanish: ``shape_fictitious``).
 
+    - crack faces (issue 54; ``shape_fictitious``, crack faces): surface nodes on each
+      face like any part; every bond the crack cuts becomes, from each end, a one-sided
+      bond to a fictitious node at the other end's place (``Closure.ghosts``), the
+      series about the nearest surface node of the end's own face fitted over the real
+      nodes of the end's side only; the faces' rows (the fit's traction on a face at an
+      angle to the lattice) from one-sided fits; beside an edge crack's mouth the
+      fictitious nodes and the bonds across the crack's line from one side. At the tip
+      as Taylor's: the fictitious nodes stop there, the bonds round it stay real.
+      Exact for the order's polynomials on the crack geometries and one-sided
+      (tests/shapes/test_crack_faces.py). The crack scenes do not offer it: their pins
+      of length h/2 get surface nodes in no equation (``scenes.cracks``).
+
     Exactness kept (tests/shapes/test_shape_methods.py): order N reproduces every
     polynomial field of degree <= N with its body force when the real nodes' complete
     neighbourhoods do (affine: any stencil; quadratic: the moment-corrected one), with
@@ -383,9 +395,10 @@ def surface_nodes_on_shape(problem, order: int) -> LinearSystem:
 
     from ..pd.closure import uncut
     from .assembly import boundary_nodes, shape_counts
+    from ..pd.shapes import CrackFace
     from .shape_fictitious import (_rows, boundary_points, bridging, centred_fit,
-                                   crossing_keep, fit, free_rows, prescribed, seen_points,
-                                   traction_rows_3d)
+                                   crossing_keep, cut_ends, face_side, fit, free_rows,
+                                   prescribed, seen_points, stacked_rows, traction_rows_3d)
     g = problem.body.grid(problem.stencil.reach)
     g.node_volume[g.interior_ids] = g.volume      # as the Taylor extension on shapes
     shape, st = problem.shape, problem.stencil
@@ -396,13 +409,50 @@ def surface_nodes_on_shape(problem, order: int) -> LinearSystem:
     x_real = g.x[g.interior_ids]
     tree = cKDTree(pts)
 
-    def extension(xf, p):
+    def centred(xf, p, real_ids=None, surface_ids=None):
+        """The series at ``xf`` about the surface node nearest p (among
+        ``surface_ids``), fitted over the real nodes ``real_ids`` (default: all):
+        ``(columns over the unknowns, weights)`` and the dilatations' ``(real
+        columns, weights)`` about p."""
+        real_ids = np.arange(ni) if real_ids is None else real_ids
+        if surface_ids is None:
+            s = tree.query(p)[1]
+        else:
+            s = surface_ids[cKDTree(pts[surface_ids]).query(p)[1]]
+        cols, w = centred_fit(x_real[real_ids], pts[s], ni + s, xf, order, h)
+        cols = np.c_[cols[:, :1], real_ids[cols[:, 1:]]]
+        nodes, wt = fit(x_real[real_ids], p, xf, order - 1, h)
+        return (cols, w), (real_ids[nodes], wt)
+
+    reach = (g.layers + 3) * h
+
+    def extension(xf, p, owners=None):
         """Rows of the fictitious values at ``xf`` about the surface node nearest p,
-        over the unknowns, and of their dilatations about p over the real nodes."""
-        s = tree.query(p)[1]
-        cols, w = centred_fit(x_real, pts[s], ni + s, xf, order, h)
-        nodes, wt = fit(x_real, p, xf, order - 1, h)
+        over the unknowns, and of their dilatations about p over the real nodes;
+        beside a crack (an edge crack's mouth) from the side of ``owners`` only
+        (default: the nodes themselves; ``shape_fictitious.sided_fit``)."""
+        (cols, w), (nodes, wt) = centred(xf, p)
+        owners = xf if owners is None else owners
+        for c in getattr(shape, "cracks", ()):
+            if not c.length:
+                continue
+            q, _ = c.faces[0].closest(xf)
+            near = np.linalg.norm(xf - q, axis=1) <= reach
+            for face in c.faces:
+                sel = np.flatnonzero(near & (c.side(owners) == face.plus))
+                if sel.size:
+                    (cols[sel], w[sel]), (nodes[sel], wt[sel]) = centred(
+                        xf[sel], p[sel], *face_sets(face))
         return _rows(cols, w, len(xf), nu_), _rows(nodes, wt, len(xf), ni)
+
+    def face_sets(face):
+        """The real nodes and the surface nodes on a crack face's side (its own surface
+        nodes included, the other face's not)."""
+        k_own = shape.part_names.index(face.name)
+        k_other = next(i for i, q in enumerate(shape.parts) if isinstance(q, type(face))
+                       and q.a == face.b and q.b == face.a)
+        allowed = (face_side(face, pts) | (part == k_own)) & (part != k_other)
+        return np.flatnonzero(face_side(face, x_real)), np.flatnonzero(allowed)
 
     fict = np.flatnonzero(g.kind == 1)
     U, T = extension(g.x[fict], shape.closest(g.x[fict])[0])
@@ -415,13 +465,43 @@ def surface_nodes_on_shape(problem, order: int) -> LinearSystem:
     pairs, real, far = bridging(g, shape, a, b, uncut(g, a, b, keep))
     shadow = None
     if pairs.size:
-        shadow = (pairs, *extension(g.x[far], seen_points(g, shape, real, far)[0]))
+        p_seen = seen_points(g, shape, real, far)[0]
+        across = np.zeros(pairs.size, dtype=bool)
+        for c in getattr(shape, "cracks", ()):
+            if c.length:     # past an edge crack's mouth: as shape_fictitious.shadow_rows
+                q, _ = c.faces[0].closest(g.x[far])
+                across |= ((np.linalg.norm(g.x[far] - q, axis=1) <= reach)
+                           & (c.side(g.x[real]) != c.side(g.x[far])))
+        p_seen[across] = shape.closest(g.x[far[across]])[0]
+        shadow = (pairs, *extension(g.x[far], p_seen, g.x[real]))
+    ghosts = None
+    ends = cut_ends(g, shape, st, keep)
+    if ends is not None:      # crack faces: one-sided bonds (shape_fictitious, crack faces)
+        g_pairs, real_a, _, ghost, groups = ends
+        rows_u, rows_t = [], []
+        for face, sel in groups:
+            real_ids, surf = face_sets(face)
+            k_own = shape.part_names.index(face.name)
+            surf = surf[part[surf] == k_own]
+            p_face, _ = face.closest(g.x[ghost[sel]])
+            (cols, w), (nodes, wt) = centred(g.x[ghost[sel]], p_face, real_ids, surf)
+            rows_u.append((sel, cols, w))
+            rows_t.append((sel, nodes, wt))
+        ghosts = (g_pairs, real_a, stacked_rows(rows_u, g_pairs.size, nu_),
+                  stacked_rows(rows_t, g_pairs.size, ni))
     closure = Closure(keep=keep, weighted_volume="complete", displacement_map=A_U,
-                      dilatation_map=A_T, n_unknown_nodes=nu_, shadow=shadow)
+                      dilatation_map=A_T, n_unknown_nodes=nu_, shadow=shadow, ghosts=ghosts)
     model = model_of(problem, g, closure)
     K = model.augmented_stiffness(model.equilibrium_rows())
     cols, _, grad = centred_fit(x_real, pts, ni + np.arange(ns), pts, order, h,
                                 gradient=True)
+    for k, q in enumerate(shape.parts):     # a crack face's points: from its side only
+        on = np.flatnonzero(part == k)
+        if isinstance(q, CrackFace) and on.size:
+            side = np.flatnonzero(face_side(q, x_real))
+            c_k, _, g_k = centred_fit(x_real[side], pts[on], ni + on, pts[on], order, h,
+                                      gradient=True)
+            cols[on], grad[on] = np.c_[c_k[:, :1], side[c_k[:, 1:]]], g_k
     rows, extra = [], K.shape[1] - d * nu_
     rhs = np.zeros((nu_, d))
     rhs[:ni] = problem.body_load(x_real, model.node_volume[g.interior_ids][:, None])

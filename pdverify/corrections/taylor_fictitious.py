@@ -334,6 +334,17 @@ def _taylor_on_shape(problem, order: int) -> LinearSystem:
                            constraints=int(B.shape[0]), boundary_points=int(points),
                            bridging_bonds=closure.info["bridging_bonds"])
     none = np.zeros(0, dtype=int), np.zeros(0)
+    if any(c.length for c in getattr(problem.shape, "cracks", ())):
+        # a cracked plate (issue 54): the augmented system under the problem's solver, as
+        # on the box (nested dissection from the unknowns' coordinates); the form below
+        # took plate-crack at h = 1/40 (19 200 nodes) 156-262 s and 2.3-2.8 GB (orders 2,
+        # 1, under load ~10), past the crack scenes' budget
+        A = model.augmented_stiffness(model.equilibrium_rows())
+        B = sp.hstack([B, sp.csr_matrix((B.shape[0], A.shape[0] - B.shape[1]))]).tocsr()
+        return LinearSystem(model, A, np.r_[rhs, np.zeros(A.shape[0] - rhs.size)], *none,
+                            ni, B=B, c=c, solver=problem.solver,
+                            coords=unknown_coords(model, x_int),
+                            scalars=A.shape[0] - rhs.size, counts=counts)
     # COLAMD: on the hole plate's bordered system SuperLU factors 4-6x faster than with
     # the scenes' minimum degree on A + A^T, whose fill the zero block of the multipliers
     # defeats (record plate_solvers-2026-11-26-hole-plate-bordered)

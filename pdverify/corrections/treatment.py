@@ -125,6 +125,11 @@ class Treatment:
     #: ``shapes3d_why``: why not, when it serves 2D shapes only
     shapes3d: bool = False
     shapes3d_why: str = ""
+    #: True when its shape form serves crack faces (``pdverify.pd.shapes.Crack``: one-
+    #: sided fictitious nodes on a slit, ``Closure.ghosts``); ``cracks_why``: why not,
+    #: when it serves shapes but not the crack scenes (``list`` shows it there)
+    cracks: bool = False
+    cracks_why: str = ""
     #: why not on a scene of a theory it does not take (one line; empty: "THEORY only")
     theory_refusal: str = ""
     #: why its static system does not carry over into the family's dynamic mode

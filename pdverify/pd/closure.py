@@ -75,6 +75,21 @@ class Closure:
       (n_ext + k rows). State-based LPS models only (no ``constitutive``). Default:
       none.
 
+    - ``ghosts``: one-sided bonds across a crack (issue 54: Taylor's fictitious nodes on
+      crack faces), ``(pairs, real_is_a, displacement rows, dilatation rows)``:
+      ``pairs`` (k,) indices into ``bond_pairs(grid.ext_shape, stencil.half_offsets)``
+      of pairs a crack cuts (:func:`uncut` drops them); each adds a bond from its own
+      end (``real_is_a``: end a, else end b; a real node, or a fictitious one whose
+      bond then has no equation at either end and counts in a face's force flux only)
+      to a ghost of the other end (the node's position, volume and m), whose
+      displacement is the k-th row of the displacement rows (k x n_unknown_nodes) and
+      dilatation the k-th row of the dilatation rows (k x n_real). The bond acts on
+      its own end only: the ghost end has no equation and the bond does not enter the
+      other node's dilatation (a pair is listed twice, once from each end). The added
+      bonds follow the kept ones, oriented from the own end (``bond_a``) to the
+      ghost's node (``bond_b``). LPS models without ``constitutive`` or
+      ``displacement_map_full`` only. Default: none.
+
     Flux and constraint rows are built by the correction from the model's bonds after
     construction (e.g. :meth:`StateBasedModel.bond_force_rows`). ``info``: what the
     treatment reports about itself (no effect on the model).
@@ -92,6 +107,7 @@ class Closure:
     force_factor: Callable[[object], np.ndarray] | None = None
     constitutive: object | None = None
     shadow: tuple | None = None
+    ghosts: tuple | None = None
     #: facts the treatment reports beside the run's metrics (e.g. seed 004's
     #: ``end_factors``); no effect on the model
     info: dict = field(default_factory=dict, compare=False)

@@ -154,10 +154,14 @@ class CrackFace(Segment):
 
     def crossings(self, xa, xb):
         """As :meth:`Segment.crossings`, the crossings of the segments that leave this
-        face's side only (sign +1): a bond through the slit crosses the face of the side
-        it starts on, once."""
+        face's side (sign +1): a bond through the slit crosses the face of the side it
+        starts on, once. A segment through the tip point itself (not cut: the tip's
+        bonds stay) crosses both faces there, at the face's end (alpha 1/2), with its
+        sign on each: its force is half each face's force flux, as a bond through the
+        edge between two cell faces is half each's (seed 001)."""
         hit, s, sign, alpha = super().crossings(xa, xb)
-        own = sign > 0
+        tip = self.length if self.plus else 0.0
+        own = (sign > 0) | (np.abs(s - tip) <= END * self.length)
         return hit[own], s[own], sign[own], alpha[own]
 
 

@@ -90,7 +90,7 @@ class StateBasedModel:
         beta_h = stencil.beta[half]
         keep = closure.bond_mask(grid, a, b)
         self._shadow_bonds(closure, grid, a, b, keep)
-        a, b, which = a[keep], b[keep], which[keep]
+        a, b, which = self._ghost_bonds(closure, grid, a, b, which, keep)
         self.bond_a, self.bond_b = a, b
         xi = grid.bond_vectors(a, b)
         x = np.linalg.norm(xi, axis=1)
@@ -143,6 +143,40 @@ class StateBasedModel:
         self.col_a[bond[~real_a]] = cols[~real_a]
         self.col_node = np.r_[self.col_node, np.where(real_a, b[pairs], a[pairs])]
 
+    def _ghost_bonds(self, closure, grid, a, b, which, keep):
+        """The kept pairs, then the one-sided bonds of ``closure.ghosts`` (from the real
+        end to a ghost column n_ext + shadows + g of the other end's node); ``ghost_b``
+        marks the bonds whose end b is a ghost (no equation, no dilatation share)."""
+        ka, kb, kw = a[keep], b[keep], which[keep]
+        self.ghosts = closure.ghosts
+        if closure.ghosts is None:
+            self.ghost_b = np.zeros(ka.size, dtype=bool)
+            return ka, kb, kw
+        if closure.constitutive is not None or closure.displacement_map_full is not None:
+            raise ValueError("ghost bonds need the LPS force state and one map per component")
+        pairs = np.asarray(closure.ghosts[0], dtype=int)
+        real_a = np.asarray(closure.ghosts[1], dtype=bool)
+        if keep[pairs].any():
+            raise ValueError("ghosts: every pair must be a pair a crack cuts, not a bond")
+        ra = np.where(real_a, a[pairs], b[pairs])
+        gn = np.where(real_a, b[pairs], a[pairs])
+        void = getattr(grid, "is_void", None)
+        if void is not None and void[ra].any():
+            raise ValueError("ghosts: the own end of every pair must be a real or fictitious "
+                             "node")
+        cols = self.col_node.size + np.arange(pairs.size)
+        self.col_a = np.r_[self.col_a, ra]
+        self.col_b = np.r_[self.col_b, cols]
+        self.col_node = np.r_[self.col_node, gn]
+        self.ghost_b = np.r_[np.zeros(ka.size, dtype=bool), np.ones(pairs.size, dtype=bool)]
+        return np.r_[ka, ra], np.r_[kb, gn], np.r_[kw, which[pairs]]
+
+    def _real_ends(self):
+        """Which bonds' ends a and b carry an equation and a dilatation share: real
+        nodes, not ghosts (``Closure.ghosts``)."""
+        g = self.grid
+        return g.is_interior[self.bond_a], g.is_interior[self.bond_b] & ~self.ghost_b
+
     # ------------------------------------------------------------------ assembly
     @property
     def dim(self) -> int:
@@ -164,6 +198,8 @@ class StateBasedModel:
         if self.shadow is not None and cl.displacement_map_full is None:
             # the shadow ends' rows (Closure.shadow)
             self.A_U = sp.vstack([self.A_U, sp.csr_matrix(self.shadow[1])]).tocsr()
+        if self.ghosts is not None:     # the ghost ends' rows (Closure.ghosts)
+            self.A_U = sp.vstack([self.A_U, sp.csr_matrix(self.ghosts[2])]).tocsr()
         # bond extension from all-node displacements (component-major columns)
         self.A_e = sp.hstack([sp.csr_matrix((np.r_[-n[:, k], n[:, k]],
                                              (np.r_[rows, rows], np.r_[ca, cb])), shape=(nb, nc))
@@ -186,9 +222,11 @@ class StateBasedModel:
                         else real_identity(g)).tocsr()
         if self.shadow is not None:
             self.A_Theta = sp.vstack([self.A_Theta, sp.csr_matrix(self.shadow[2])]).tocsr()
+        if self.ghosts is not None:
+            self.A_Theta = sp.vstack([self.A_Theta, sp.csr_matrix(self.ghosts[3])]).tocsr()
         # real-node dilatations: every bond counts at each real end, with the other end's V
         coef = c.c_theta * om * x * be
-        ia, ib = g.is_interior[a], g.is_interior[b]
+        ia, ib = self._real_ends()
         self.A_theta = sp.csr_matrix(
             (np.r_[coef[ia] * Vb[ia] / m[a[ia]], coef[ib] * Va[ib] / m[b[ib]]],
              (np.r_[g.interior_number[a[ia]], g.interior_number[b[ib]]],
@@ -218,7 +256,7 @@ class StateBasedModel:
     def equilibrium_rows(self) -> sp.csr_matrix:
         """Minus the internal force of every real node (f_b along a -> b pulls a towards b)."""
         g, a, b = self.grid, self.bond_a, self.bond_b
-        ia, ib = g.is_interior[a], g.is_interior[b]
+        ia, ib = self._real_ends()
         bonds = np.arange(a.size)
         return self.bond_force_rows(
             np.r_[g.interior_number[a[ia]], g.interior_number[b[ib]]],
@@ -373,8 +411,8 @@ class StateBasedModel:
         """
         P = self.equilibrium_rows() if P is None else P
         U, Theta = np.asarray(U_ext, dtype=float), np.asarray(Theta_ext, dtype=float)
-        if self.shadow is not None:   # a shadow column takes its node's given state,
-            if len(U) != self.col_node.size:          # unless it is given its own
+        if self.col_node.size != self.grid.n_ext:   # a shadow or ghost column takes its
+            if len(U) != self.col_node.size:          # node's given state, unless given its own
                 U = U[self.col_node]
             if len(Theta) != self.col_node.size:
                 Theta = Theta[self.col_node]

@@ -22,7 +22,7 @@ from ..errors import InputError
 from ..metrics import rel_l2_error
 from ..pd.cracks import fit_k, opening_pairs
 from ..pd.problem import FaceCondition
-from ..pd.shapes import Crack, polygon
+from ..pd.shapes import Crack, CrackFace, polygon
 from . import register, whole_cells
 from .base import MethodSpec
 from .fem_references import FemAndPD
@@ -31,6 +31,11 @@ from .shapes import ShapeScene, shape_errors
 #: the tip zone left out of the field metrics and of the K fit, in horizons: the nonlocal
 #: zone where a PD tip and LEFM cannot agree (``pdverify.pd.cracks``, fit_k's tip_zone)
 TIP_ZONE = 2.0
+
+#: the outer radius of the ring about the tips, in horizons, whose largest error is the
+#: field near the tip outside the nonlocal zone (``near_tip_max_error_pct``: r in
+#: [TIP_ZONE, NEAR_TIP) horizons of any tip)
+NEAR_TIP = 5.0
 
 
 def plate_outline(width: float, height: float, spacing: float):
@@ -121,13 +126,19 @@ def _pull(traction: float):
 #: reference's stated choices)
 _FEM_FIXED = ("kind", "j_radii", "fit_window")
 
+#: the orders of a treatment with an ``order`` in the report (Taylor's fictitious nodes,
+#: the one that serves crack faces, ``FamilyTreatment.cracks``): order 1 only. Its cost on plate-crack at h = 1/40 is
+#: 4x the uncorrected model's (17 s against none's ~4 s, ``run`` under a load of ~11;
+#: order 2 took 1.3x order 1's), and the crack scenes may add ~15 s to a full report;
+#: the other orders run with ``run --method taylor-fictitious --set order=N``
+ORDERS = (1,)
+
 #: why the treatments that add nodes do not run here
 _NO_CRACK_FACES = (
-    "crack faces are not served yet: the node-adding treatments on shapes "
-    "(corrections.shape_fictitious and the surface-node, mirror-node and PDDO forms built "
-    "on it) would see each crack face as a straight part (fictitious or mirror nodes along "
-    "its normal, across the slit into the other face's material, and boundary rows on it); "
-    "a slit has no outside to extrapolate into")
+    "crack faces are not served yet: a treatment that adds nodes serves them when its "
+    "fictitious nodes across a slit are one-sided (fitted from the end's own side, "
+    "Closure.ghosts) and it says so (FamilyTreatment.cracks); a slit has no outside "
+    "to put its nodes in")
 
 
 class CrackScene(ShapeScene):
@@ -143,7 +154,10 @@ class CrackScene(ShapeScene):
     ``k_handbook`` (the reference's K from J and Tada's), ``opening_error_pct`` (the
     rows nearest the crack behind the fitted tip at r >= 2 horizons), and the field
     errors (``shape_errors``) over the nodes outside the tip zone of every tip,
-    ``tip_zone_nodes`` the nodes left out. Fields beside the error maps: the fitted
+    ``tip_zone_nodes`` the nodes left out; among those, ``near_tip_max_error_pct`` over
+    the ring r in [2, 5) horizons of any tip (the tip's field outside the nonlocal zone)
+    and ``faces_max_error_pct`` over the nodes within a horizon of a crack face whose
+    closest part it is. Fields beside the error maps: the fitted
     tip, the tip zone's radius and the opening profiles (PD and FEM) of the nearest
     rows behind the fitted tip, every r (the figures' data).
     """
@@ -187,6 +201,12 @@ class CrackScene(ShapeScene):
         (``pdverify.pd.cracks.fit_k``'s arguments)."""
         raise NotImplementedError
 
+    def default_cases(self):
+        """Every treatment offered here at the default grid, those with an order (Taylor's
+        fictitious nodes) at the orders :data:`ORDERS` only."""
+        return [(m, q) for m, q in super().default_cases()
+                if "order" not in q or q["order"] in ORDERS]
+
     def family_refusal(self, treatment):
         out = super().family_refusal(treatment)
         if out is not None:
@@ -194,8 +214,10 @@ class CrackScene(ShapeScene):
         if getattr(treatment, "peer", False):
             return ("its code builds its own bonds from the node positions, so it would "
                     "bond across the crack; crack faces are not served yet")
+        if getattr(treatment, "cracks", False):
+            return None
         if not (treatment.kind == "closure" or getattr(treatment, "baseline", False)):
-            return _NO_CRACK_FACES
+            return getattr(treatment, "cracks_why", "") or _NO_CRACK_FACES
         return None
 
     def reference_field(self, p):
@@ -228,9 +250,18 @@ class CrackScene(ShapeScene):
         _, err = shape_errors(x_int, u, u_ref, problem.shape, delta)
         tip_dist = np.min([np.hypot(*(x_int - np.asarray(t)).T) for t in tip_points], axis=0)
         away = tip_dist >= TIP_ZONE * delta
-        metrics, _ = shape_errors(x_int[away], u[away], u_ref[away], problem.shape, delta)
+        metrics, err_away = shape_errors(x_int[away], u[away], u_ref[away], problem.shape,
+                                         delta)
         metrics["rel_l2_error"] = rel_l2_error(u[away], u_ref[away])
         metrics["tip_zone_nodes"] = int(np.count_nonzero(~away))
+        # the tip's field outside the nonlocal zone and the faces' (same scale as the
+        # errors above: max |u_FEM| outside the tip zone)
+        ring = tip_dist[away] < NEAR_TIP * delta
+        _, _, dist, part = problem.shape.closest(x_int[away])
+        faces = np.flatnonzero([isinstance(q, CrackFace) for q in problem.shape.parts])
+        on_face = (dist < delta) & np.isin(part, faces)
+        metrics["near_tip_max_error_pct"] = float(err_away[ring].max())
+        metrics["faces_max_error_pct"] = float(err_away[on_face].max())
         return x_int, u, u_ref, err, metrics
 
     def measure(self, p, problem, system, x, info):
@@ -299,9 +330,14 @@ class CrackPlate(CrackScene):
     ``partial-volume`` quadrature, m = 3, cell-centred nodes at h = 1/40 m (the crack line
     and the tips on cell faces: ``spacing`` must divide W, H and a), as
     ``benchmarks/crack_k.py`` (the study this scene repeats). Treatments: the uncorrected
-    model and every bond method of the family that serves shapes (their closures drop
-    the cut bonds); the treatments that add nodes are refused (``list`` gives the reason:
-    crack faces are not served yet).
+    model, every bond method of the family that serves shapes (their closures drop
+    the cut bonds) and Taylor's fictitious nodes (``taylor-fictitious``, order 1 in the
+    report: :data:`ORDERS`) with one-sided fictitious nodes on the crack faces
+    (``corrections.shape_fictitious``, crack faces: each bond the crack cuts becomes,
+    from each end, a bond to a fictitious node at the other end's place fitted from the
+    end's own side; they stop at the tip, the bonds round it stay real); the other
+    treatments that add nodes are refused (``list`` gives the reason and what each
+    would need).
 
     Metrics: ``k_ratio`` = K_PD / K_FEM (``pdverify.pd.cracks.fit_k`` at the right tip:
     the Williams fit of the opening of the two node rows nearest the crack on each side,
@@ -401,9 +437,12 @@ class EdgeCrackPlate(CrackScene):
     plane-stress constants, ``partial-volume`` quadrature, m = 3, cell-centred nodes at
     h = 1/40 m (the crack line and the tip on cell faces: ``spacing`` must divide b, H
     and a); nested dissection (``fixed_solver`` "auto", as ``plate-crack``'s).
-    Treatments: the uncorrected model and every bond method that serves shapes (their
-    closures drop the cut bonds); the treatments that add nodes and the peer code are
-    refused with ``plate-crack``'s reasons (``list plate-edge-crack``).
+    Treatments: as ``plate-crack`` (the uncorrected model, every bond method that serves
+    shapes, Taylor's one-sided fictitious nodes at order 1; beside the mouth the
+    lattice's fictitious nodes outside x = 0 and the bonds to them across the crack's
+    line are fitted from one side, ``shape_fictitious.sided_fit``); the other
+    node-adding treatments and the peer code are refused with ``plate-crack``'s reasons
+    (``list plate-edge-crack``).
 
     Metrics (:class:`CrackScene`; the headline ``k_net_error_pct``, the comment at
     ``headline``): K at the one tip (a, 0), the fit's window r in

@@ -71,8 +71,11 @@ class InclinedCrackPlate(CrackPlate):
     the large plate within 0.05 % of Tada's K_0), cached; its ``j_radii`` fixed.
 
     PD: as ``plate-crack`` (LPS, hyperbolic influence, ``partial-volume``, m = 3, h = 1/40
-    m; ``spacing`` must divide W and H). Treatments: the uncorrected model and the bond
-    methods; the node-adding ones refused (``list``: crack faces are not served yet).
+    m; ``spacing`` must divide W and H). Treatments: as ``plate-crack`` (the uncorrected
+    model, the bond methods and Taylor's one-sided fictitious nodes at order 1; the
+    faces at an angle to the lattice take the one-sided fit's traction, not the force
+    flux: ``shape_fictitious.lattice_flux``); the other node-adding ones refused
+    (``list``: what each would need).
 
     Metrics: ``k1_ratio``, ``k2_ratio`` = K_PD / K_FEM, K_PD by ``fit_k_mixed`` at the
     right tip (Williams orders 1..5 of both modes and a translation fitted to both

@@ -74,20 +74,22 @@ def test_a_crack_of_zero_length_is_the_uncracked_plate():
 def test_the_list_shows_why_the_node_adding_treatments_and_the_peer_do_not_run(scene_id):
     out = subprocess.run([sys.executable, "-m", "pdverify", "list", scene_id],
                          capture_output=True, text=True, check=True).stdout
-    for method in ("taylor-fictitious", "surface-nodes", "mirror-nodes", "pddo"):
-        assert f"{method}: crack faces are not served yet: the node-adding treatments on " \
-               "shapes" in out, method
+    for method in ("mirror-nodes", "pddo"):
+        assert f"{method}: crack faces are not served yet: its shape form" in out, method
+    assert "surface-nodes: crack faces are served (one-sided surface nodes" in out
+    assert "taylor-fictitious: " not in out.split("not offered here")[1]
     assert "peer:lammps: its code builds its own bonds from the node positions" in out
     offered = set(get_scene(scene_id).offered())
-    assert offered == {"none", "energy", "volume", "pals", "energy-directional"}
+    assert offered == {"none", "energy", "volume", "pals", "energy-directional",
+                       "taylor-fictitious"}
 
 
 def test_the_cases_are_every_method_at_the_defaults_and_the_quick_grid():
     scene = get_scene("plate-crack")
     cases = scene.cases()
     assert {m for m, _ in cases} == {"fem", "none", "energy", "volume", "pals",
-                                     "energy-directional"}
-    assert all(q == {} for _, q in cases)
+                                     "energy-directional", "taylor-fictitious"}
+    assert all(q == ({"order": 1} if m == "taylor-fictitious" else {}) for m, q in cases)
     quick = scene.cases(quick=True)
     assert {m for m, _ in quick} == {m for m, _ in cases}
     assert {q.get("spacing") for m, q in quick if m != "fem"} == {1 / 30}
@@ -131,7 +133,7 @@ def test_the_edge_crack_scene_shares_the_centre_cracks_builder_and_refines_k():
         1.0, 1.0, 0.5, 0.025, 3.0)
     assert edge.reference_params(p)["height"] == 1.0
     cases = edge.cases()
-    methods = {"none", "energy", "volume", "pals", "energy-directional"}
+    methods = {"none", "energy", "volume", "pals", "energy-directional", "taylor-fictitious"}
     assert {m for m, _ in cases} == methods | {"fem"}
     assert sorted({q.get("spacing", 0.025) for m, q in cases if m != "fem"}) == sorted(
         (1 / 60, 0.025, 1 / 30))
@@ -178,3 +180,20 @@ def test_the_edge_scenes_fem_checks_name_the_edge_reference(tmp_path):
                         "--method", "fem", "--set", "cells=1"], capture_output=True, text=True)
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
     assert "plate-edge-crack --method fem: plate-edge-crack: cells must be 2..64" in r.stderr
+
+
+def test_taylor_runs_on_the_edge_crack_with_the_tip_and_face_errors(tmp_path):
+    """Taylor's one-sided fictitious nodes run on a crack scene (order 1, the quick
+    grid); the errors near the tip (the ring of 2 to 5 horizons) and along the faces are
+    parts of the errors outside the tip zone, on its scale."""
+    out = tmp_path / "t.json"
+    r = subprocess.run([sys.executable, "-m", "pdverify", "run", "plate-edge-crack",
+                        "--method", "taylor-fictitious", "--set", "order=1",
+                        "--set", f"spacing={1 / 30!r}", "--json", str(out)],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    run = json.loads(out.read_text())["runs"][0]
+    m = run["metrics"]
+    assert run["status"] == "ok"
+    assert 0 < m["near_tip_max_error_pct"] <= m["max_error_pct"]
+    assert 0 < m["faces_max_error_pct"] <= m["boundary_max_error_pct"]

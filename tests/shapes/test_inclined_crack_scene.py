@@ -89,15 +89,15 @@ def test_the_fit_reads_the_fem_field_to_its_stated_accuracy(tmp_path):
 def test_the_list_shows_why_the_node_adding_treatments_do_not_run():
     out = subprocess.run([sys.executable, "-m", "pdverify", "list", ID],
                          capture_output=True, text=True, check=True).stdout
-    assert "taylor-fictitious: crack faces are not served yet" in out
+    assert "pddo: crack faces are not served yet" in out
     assert set(get_scene(ID).offered()) == {"none", "energy", "volume", "pals",
-                                            "energy-directional"}
+                                            "energy-directional", "taylor-fictitious"}
 
 
 def test_the_cases_are_every_method_at_the_defaults_and_the_quick_grid():
     scene = get_scene(ID)
     assert {m for m, _ in scene.cases()} == {"fem", "none", "energy", "volume", "pals",
-                                             "energy-directional"}
+                                             "energy-directional", "taylor-fictitious"}
     quick = scene.cases(quick=True)
     assert {q.get("spacing") for m, q in quick if m != "fem"} == {1 / 30}
 
