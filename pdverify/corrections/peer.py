@@ -1,5 +1,6 @@
 """``peer:lammps`` as a treatment of the ``static-state`` family and of the bond-based
-scenes that state their problem (the sheets, :data:`BOND_SCENES`; the stiffness scenes,
+scenes that state their problem (the sheets, :data:`BOND_SCENES`; the stiffness scenes
+of both theories,
 :data:`ENERGY_SCENES`, whose atoms LAMMPS evaluates at u = eps . x; seed 004's static bars,
 :data:`BAR_SCENES`): the scene's uncorrected problem solved by LAMMPS
 (:mod:`pdverify.peers.lammps`) instead of pdverify's linear solve, and measured by the
@@ -78,6 +79,8 @@ REPORT_RUNS = {"body3d-traction": {"spacing": 0.1}, "plate2d-clamped": {},
                "sheet2d-clamped": {"m_ratio": 4.0},
                # no solve: one LAMMPS process evaluates every strain state (~0.4 s each)
                "stiffness2d-sheet": {"spacing": 0.002}, "stiffness3d-box-bond": {"spacing": 0.1},
+               # peri/lps, its energy read as lammps.lps_energy_density (~0.1 s each)
+               "stiffness3d-box": {"spacing": 0.1}, "stiffness2d-plate": {"spacing": 0.05},
                # seed 004's bars at the paper's sizes (9 and 17 + 9 + 12 atoms), same model
                "bar1d-homogenization": {}, "bar1d-constraints": {}}
 #: the bond-based scenes that solve through a peer (their own assembly; the static-state
@@ -85,9 +88,13 @@ REPORT_RUNS = {"body3d-traction": {"spacing": 0.1}, "plate2d-clamped": {},
 #: atoms (``fix setforce`` on the group of each prescribed component, the atoms set to
 #: their prescribed positions first), as LAMMPS users hold a grip
 BOND_SCENES = ("sheet2d-tension", "sheet2d-clamped")
-#: the bond-based stiffness scenes: every atom placed at u = eps . x and LAMMPS's
-#: ``compute pe/atom`` read as the node's energy density (:meth:`PeerTreatment.peer_energies`)
-ENERGY_SCENES = ("stiffness2d-sheet", "stiffness3d-box-bond")
+#: the stiffness scenes: every atom placed at u = eps . x and LAMMPS's ``compute pe/atom``
+#: read as the node's energy density (:meth:`PeerTreatment.peer_energies`): peri/pmb's as
+#: it is, peri/lps's corrected with ``compute dilatation/atom``
+#: (:func:`pdverify.peers.lammps.lps_energy_density`: it tallies half of the deviatoric
+#: energy)
+ENERGY_SCENES = ("stiffness2d-sheet", "stiffness3d-box-bond", "stiffness3d-box",
+                 "stiffness2d-plate")
 #: seed 004's static bars: a line of atoms on the x axis (y and z held at zero) with
 #: peri/pmb's c matched to the bar's c1 (pdverify.peers.lammps.bar_types: the triangular
 #: micromodulus by type pair), same-model only (:data:`BAR_AS_USED`)
@@ -117,13 +124,6 @@ REFUSED = {
         "frictionless penalty wall, another contact law); it would take driving LAMMPS "
         "increment by increment (its Python module: minimize, read the top atoms, hold "
         "the caught ones on the indenter, repeat) with the scene's Newton stopping rule"),
-    **{scene: (
-        "peri/lps's compute pe/atom is not the node's energy density: it tallies half of "
-        "the deviatoric energy its forces derive from (pair_peri_lps.cpp: K theta^2 / 2 + "
-        "15 G / (4 m) sum omega e_d^2 V; LPS has 15 G / (2 m)); not wired: it would take "
-        "W_i = 2 pe_i - K theta_i^2 / 2 with compute dilatation/atom, and a check that "
-        "LAMMPS's split of the energy among the atoms is pdverify's (the work of each "
-        "node's own force state)") for scene in ("stiffness3d-box", "stiffness2d-plate")},
 }
 
 
@@ -233,9 +233,11 @@ class PeerTreatment(Treatment):
                 _trouble(result.info, info.get("equilibrium"), not_in_equilibrium))
 
     def peer_energies(self, scene, p, problem, model, states, where):
-        """The bond-based stiffness scenes: ``(ratios, info, metrics, trouble)``, W_i /
-        W_bulk per strain state (``states``: ``(name, eps)`` each) of LAMMPS's peri/pmb (``compute pe/atom`` with every atom
-        at u = eps . x, :func:`pdverify.peers.lammps.energies`) on the uncorrected
+        """The stiffness scenes: ``(ratios, info, metrics, trouble)``, W_i / W_bulk per
+        strain state (``states``: ``(name, eps)`` each) of LAMMPS's peri/pmb (bond-based
+        scenes) or peri/lps (state-based, ``problem`` None; its pe/atom corrected by
+        :func:`pdverify.peers.lammps.lps_energy_density`) with every atom at
+        u = eps . x (:func:`pdverify.peers.lammps.energies`) on the uncorrected
         ``model``'s atoms. W_bulk is the bulk of the setting's own lattice: pdverify's for
         ``same-model``, LAMMPS's ramped one for ``as-used`` (:func:`lammps_bulk_work_density`;
         ``peer_bulk_ratio`` is it over pdverify's, the ramp's toll on the bulk). The
@@ -340,18 +342,17 @@ class PeerTreatment(Treatment):
 
 
 def peer_energies_of(scene, p, problem, model_none, states, where):
-    """The bond-based stiffness scenes through LAMMPS (:meth:`PeerTreatment.peer_energies`)."""
-    from ..nodeset import DISTANCE_FLOOR, DISTANCE_PER_GRADIENT, between_shells
+    """The stiffness scenes through LAMMPS (:meth:`PeerTreatment.peer_energies`): the
+    bond-based ones through peri/pmb, the state-based ones (``problem`` None,
+    ``model_none`` a :class:`~pdverify.pd.statebased.StateBasedModel`) through peri/lps,
+    whose energy is read as :func:`pdverify.peers.lammps.lps_energy_density`."""
+    from ..nodeset import DISTANCE_FLOOR, DISTANCE_PER_GRADIENT
     from ..pd.work import work_density
     g, d = model_none.grid, model_none.dim
     ids = g.interior_ids
     h, m = model_none.spacing, model_none.m_ratio
-    off = np.asarray(model_none.offsets)
-    lm = lammps.Model(g.x[ids], np.asarray(model_none.node_volume)[ids],
-                      np.zeros((len(ids), d)), {}, h, m,
-                      between_shells(h, np.r_[off, -off], d),
-                      h ** d * model_none.thickness, "peri/pmb", (model_none.c,),
-                      model_none.c * model_none.horizon ** (d + 1))
+    state = problem is None
+    lm = energy_model(model_none)
     strains = [eps for _, eps in states]
     setting = p["setting"]
     with tempfile.TemporaryDirectory(prefix="pdverify-lammps-") as folder:
@@ -363,11 +364,17 @@ def peer_energies_of(scene, p, problem, model_none, states, where):
         bulk = [model_none.bulk_work_density(eps) for eps in strains]
         W_own = W_none
     else:
-        bulk = [lammps_bulk_work_density(model_none.c, h, m, d, lm.uniform_volume, eps)
-                for eps in strains]
-        twin = _as_used_twin(problem, lm)
+        if state:
+            bulk = [lammps_lps_bulk_work_density(model_none, lm.uniform_volume, eps)
+                    for eps in strains]
+            twin = _as_used_state_twin(scene, p, lm)
+        else:
+            bulk = [lammps_bulk_work_density(model_none.c, h, m, d, lm.uniform_volume, eps)
+                    for eps in strains]
+            twin = _as_used_twin(problem, lm)
+            twin = None if twin is None else twin.model
         W_own = (None if twin is None else
-                 np.stack([work_density(twin.model, eps)[twin.model.grid.interior_ids]
+                 np.stack([work_density(twin, eps)[twin.grid.interior_ids]
                            for eps in strains]))
         if W_own is not None:
             metrics["peer_gap_volumes"] = _rel(W_own, W_none, scale)
@@ -392,6 +399,73 @@ def peer_energies_of(scene, p, problem, model_none, states, where):
                        f"setting's linear model, above {limit:.3g} ({DISTANCE_PER_GRADIENT:g}"
                        " x the largest relative bond displacement)")
     return ratios, info, metrics, trouble
+
+
+def energy_model(model_none) -> lammps.Model:
+    """The atoms of a stiffness scene's uncorrected model (its real nodes, their volumes,
+    its bonds by the horizon between two lattice shells): peri/lps with
+    :func:`pdverify.peers.lammps.lps_moduli` for a state-based model, peri/pmb with its c
+    for a bond-based one; no loads, nothing held."""
+    from ..nodeset import between_shells
+    g, d = model_none.grid, model_none.dim
+    ids = g.interior_ids
+    h = model_none.spacing
+    state = hasattr(model_none, "constants")
+    off = np.asarray(model_none.stencil.offsets if state else model_none.offsets)
+    if state:
+        K, G = lammps.lps_moduli(model_none.constants)
+        pair, coefficients, stiffness = "peri/lps", (K, G), K + 4 * G / 3
+    else:
+        pair, coefficients = "peri/pmb", (model_none.c,)
+        stiffness = model_none.c * model_none.horizon ** (d + 1)
+    return lammps.Model(g.x[ids], np.asarray(model_none.node_volume)[ids],
+                        np.zeros((len(ids), d)), {}, h, model_none.m_ratio,
+                        between_shells(h, np.r_[off, -off], d),
+                        h ** d * model_none.thickness, pair, coefficients, stiffness)
+
+
+def _as_used_state_twin(scene, p, model):
+    """The state-based linear model of LAMMPS's as-used run (None where there is none):
+    the stiffness box built by the scene under :func:`as_used_closure` (LAMMPS's ramp,
+    whole cells), when every node's volume is LAMMPS's one volume per atom (the
+    cell-centred boxes: always)."""
+    twin = scene.build("none", p, as_used_closure(model))
+    volume = np.asarray(twin.node_volume)[twin.grid.interior_ids]
+    if len(volume) != len(model.x) or not np.allclose(volume, model.uniform_volume,
+                                                      rtol=1e-12, atol=0):
+        return None
+    return twin
+
+
+def lammps_lps_bulk_work_density(model, volume, strain) -> float:
+    """W of an atom with a complete neighbourhood in LAMMPS's as-used lattice under the
+    homogeneous ``strain`` for the linear LPS ``model``'s constants and influence: its
+    bulk form (:meth:`pdverify.pd.statebased.StateBasedModel.bulk_work_density`) with
+    LAMMPS's weights, ramp(|xi|) V on the lattice offsets within (m + 2e-4) h, in m,
+    theta and the forces alike."""
+    from ..pd.bonds import homogeneous_extensions
+    h, d = model.spacing, model.dim
+    k, r = _lattice_within(h, model.m_ratio, d)
+    n = k * h / r[:, None]
+    e = homogeneous_extensions(r, n, np.asarray(strain, dtype=float))
+    horizon = (model.m_ratio + lammps.EXAMPLES_MARGIN) * h
+    c = model.constants
+    w = model.influence.omega(r, model.horizon) * ramp(r, h, horizon) * volume
+    m = float(np.sum(w * r * r))
+    theta = c.c_theta * np.sum(w * r * e) / m
+    return float(0.5 * (c.k_theta * theta ** 2 / c.c_theta + c.k_e * np.sum(w * e * e) / m))
+
+
+def _lattice_within(spacing, m_ratio, dim):
+    """The lattice offsets k (in spacings) within LAMMPS's as-used horizon and their
+    lengths |k| h."""
+    horizon = (m_ratio + lammps.EXAMPLES_MARGIN) * spacing
+    reach = int(np.floor(m_ratio + lammps.EXAMPLES_MARGIN))
+    axes = np.arange(-reach, reach + 1)
+    k = np.stack(np.meshgrid(*([axes] * dim), indexing="ij"), axis=-1).reshape(-1, dim)
+    r = np.linalg.norm(k, axis=1) * spacing
+    keep = (r > 0) & (r <= horizon)
+    return k[keep], r[keep]
 
 
 def _as_used_twin(problem, model):
@@ -457,5 +531,5 @@ def peer_treatments() -> list[Treatment]:
         params=(SETTING,), theories=("state-based", "bond-based"), dims=(1, 2, 3),
         families=("static-state",), shapes=True, unavailable=lammps.unavailable(),
         scope="the static state-based scenes' uncorrected node sets (influence=hyperbolic) "
-              f"and the bond-based {', '.join(BOND_SCENES + ENERGY_SCENES + BAR_SCENES)} "
-              "(micromodulus=constant)")]
+              f"and {', '.join(BOND_SCENES + ENERGY_SCENES + BAR_SCENES)} "
+              "(bond-based: micromodulus=constant)")]

