@@ -25,6 +25,7 @@ linear model (:func:`peer_energies_of`).
 """
 from __future__ import annotations
 
+import dataclasses
 import tempfile
 from dataclasses import dataclass
 
@@ -82,7 +83,9 @@ REPORT_RUNS = {"body3d-traction": {"spacing": 0.1}, "plate2d-clamped": {},
                # peri/lps, its energy read as lammps.lps_energy_density (~0.1 s each)
                "stiffness3d-box": {"spacing": 0.1}, "stiffness2d-plate": {"spacing": 0.05},
                # seed 004's bars at the paper's sizes (9 and 17 + 9 + 12 atoms), same model
-               "bar1d-homogenization": {}, "bar1d-constraints": {}}
+               "bar1d-homogenization": {}, "bar1d-constraints": {},
+               # seed 004's vibrating bar (b) at Table 13's size (100 atoms, ~1,500 steps)
+               "bar1d-vibration": {}}
 #: the bond-based scenes that solve through a peer (their own assembly; the static-state
 #: family's scenes are served through the family): the clamped sheet's clamps are held
 #: atoms (``fix setforce`` on the group of each prescribed component, the atoms set to
@@ -99,6 +102,9 @@ ENERGY_SCENES = ("stiffness2d-sheet", "stiffness3d-box-bond", "stiffness3d-box",
 #: peri/pmb's c matched to the bar's c1 (pdverify.peers.lammps.bar_types: the triangular
 #: micromodulus by type pair), same-model only (:data:`BAR_AS_USED`)
 BAR_SCENES = ("bar1d-homogenization", "bar1d-constraints")
+#: seed 004's vibrating bar: LAMMPS's fix nve against the scene's central differences
+#: (same model only, as the static bars; :meth:`PeerTreatment.peer_dynamic_bar`)
+DYNAMIC_BAR_SCENES = ("bar1d-vibration",)
 #: why a bar has no as-used run
 BAR_AS_USED = ("LAMMPS is a 3D code and its users give peri/pmb the 3D c = 18 K / (pi "
                "delta^4); a line of atoms with it is not seed 004's 1D bar (nothing of the "
@@ -112,11 +118,6 @@ BAR_SETTING = Param("setting", "same-model", "how LAMMPS runs: driven to solve t
 #: the scenes of the bond-based models that LAMMPS cannot run as they are stated, and
 #: what it would take
 REFUSED = {
-    "bar1d-vibration": (
-        "a dynamic run (the pre-strained bar released, its end's history fitted to Rao's "
-        "series): not wired; it would take LAMMPS's fix nve (velocity Verlet, the scene's "
-        "central difference) from the pre-strained atoms at the scene's time step, the "
-        "monitored atom dumped every step, and the bar's c1 matched as on the static bars"),
     "block2d-indentation": (
         "its sticking contact is not a prescribed-displacement set: the top atoms the "
         "indenter reaches are caught after each equilibrium (the set grows with the depth) "
@@ -147,12 +148,13 @@ class PeerTreatment(Treatment):
         over = REPORT_RUNS.get(scene.id)
         if over is None:
             return []
-        settings = ("same-model",) if scene.id in BAR_SCENES else lammps.SETTINGS
+        settings = (("same-model",) if scene.id in BAR_SCENES + DYNAMIC_BAR_SCENES
+                    else lammps.SETTINGS)
         return [{**lammps_overrides(scene), **over, "setting": s} for s in settings]
 
     def params_for(self, scene):
         """:data:`BAR_SETTING` on seed 004's bars, else its own."""
-        return (BAR_SETTING,) if scene.id in BAR_SCENES else self.params
+        return (BAR_SETTING,) if scene.id in BAR_SCENES + DYNAMIC_BAR_SCENES else self.params
 
     def check_bar(self, params, where):
         """A seed-004 bar: same-model only (:data:`BAR_SETTING`'s one choice); any
@@ -162,7 +164,7 @@ class PeerTreatment(Treatment):
                              f"{BAR_AS_USED}")
 
     def why_not(self, scene):
-        if scene.id in BOND_SCENES or scene.id in ENERGY_SCENES or scene.id in BAR_SCENES:
+        if scene.id in BOND_SCENES + ENERGY_SCENES + BAR_SCENES + DYNAMIC_BAR_SCENES:
             return None
         if scene.id in REFUSED:
             return REFUSED[scene.id]
@@ -286,6 +288,47 @@ class PeerTreatment(Treatment):
                        f"the bar's linear solution, above {DISTANCE_FLOOR:g} (a collinear "
                        "bar is geometrically linear: only the stopping rule may move it); "
                        f"relative residual {balance['residual']:.3g}")
+        return u, info, metrics, trouble
+
+    def peer_dynamic_bar(self, scene, p, problem, system, u0, dt, steps, record,
+                         history_none, where):
+        """Seed 004's vibrating bar (:class:`~pdverify.pd.problem.BondSystem` of
+        ``problem``, its held points held) released from ``u0`` ((n,), at rest) and run
+        by LAMMPS in the same model (peri/pmb on a line of atoms, c1 by type pair, each
+        point's volume, the scene's density as the atoms' mass density) with ``fix nve``
+        for ``steps`` steps of the scene's ``dt``: ``(history, info, metrics, trouble)``,
+        ``history`` (steps + 1, len(record)) the displacements of the atoms ``record``,
+        compared with pdverify's own run ``history_none`` (relative L2 over the whole
+        history). Velocity Verlet's positions are the scene's central differences, and a
+        collinear bar is geometrically linear (see :meth:`peer_solve_bar`), so the two
+        histories differ by rounding only: LAMMPS carries absolute positions, so each step
+        may round a displacement by eps max|x| (machine epsilon of the largest
+        coordinate), eps max|x| / max|u0| relative to the motion's amplitude; the run
+        fails, naming it, when the distance exceeds that summed over the steps (the
+        worst case, every rounding in one direction; 3.2e-10 at Table 13's bar (b),
+        1.4e-12 measured)."""
+        from ..nodeset import node_set_of
+        ns = node_set_of(scene, p, problem, system)
+        model = dataclasses.replace(lammps.bond_based_model(ns), density=float(p["density"]))
+        n = len(ns.x)
+        with tempfile.TemporaryDirectory(prefix="pdverify-lammps-") as folder:
+            history, peer = lammps.dynamics(model, np.asarray(u0, float).reshape(n, 1), dt,
+                                            steps, record, folder, where=where)
+        u = history[:, :, 0]
+        diff = _rel(u, history_none, float(np.linalg.norm(history_none)))
+        metrics = {"peer_diff_to_none": diff, "peer_gap_nonlinear": diff}
+        per_step = float(np.finfo(float).eps * np.max(np.abs(ns.x)) / np.max(np.abs(u0)))
+        limit = per_step * steps
+        info = {"peer": peer, "peer_check": {"distance": diff, "limit": limit,
+                                             "in_agreement": bool(diff <= limit)}}
+        trouble = None
+        if peer.get("damage_sum"):
+            trouble = f"LAMMPS lost bonds (damage summed over the atoms {peer['damage_sum']:.3g})"
+        elif not diff <= limit:
+            trouble = (f"LAMMPS's history is {diff:.3g} (relative L2) from the bar's own run, "
+                       f"above {limit:.3g} (rounding: {per_step:.3g} a step over "
+                       f"{steps} steps; a collinear bar is geometrically linear and velocity "
+                       "Verlet's positions are central differences)")
         return u, info, metrics, trouble
 
     def finish_bars(self, outcome, runs, where):
@@ -531,5 +574,5 @@ def peer_treatments() -> list[Treatment]:
         params=(SETTING,), theories=("state-based", "bond-based"), dims=(1, 2, 3),
         families=("static-state",), shapes=True, unavailable=lammps.unavailable(),
         scope="the static state-based scenes' uncorrected node sets (influence=hyperbolic) "
-              f"and {', '.join(BOND_SCENES + ENERGY_SCENES + BAR_SCENES)} "
+              f"and {', '.join(BOND_SCENES + ENERGY_SCENES + BAR_SCENES + DYNAMIC_BAR_SCENES)} "
               "(bond-based: micromodulus=constant)")]

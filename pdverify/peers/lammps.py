@@ -60,6 +60,7 @@ appeared on the 250-atom box before the first minimiser step.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import shutil
@@ -160,6 +161,10 @@ class Model:
     #: :func:`bar_types`)
     types: np.ndarray | None = None
     pair_coefficients: dict | None = None
+    #: the atoms' mass density [kg/m^3]: atom_style peri's "density" column, LAMMPS's
+    #: per-atom mass (its PERI forces are force densities, so a = f / rho); only a
+    #: dynamic run (:func:`dynamics`) reads it
+    density: float = 1.0
 
     @property
     def dim(self) -> int:
@@ -271,7 +276,8 @@ def deck(model: Model, setting: str, *, title: str = "pdverify") -> dict:
     data = [f"{title}: {setting}\n", f"{n} atoms", f"{int(types.max())} atom types", ""]
     data += [f"{f(lo[k])} {f(hi[k])} {a}lo {a}hi" for k, a in enumerate("xyz")]
     data += ["", "Atoms # peri", ""]
-    data += [f"{i + 1} {types[i]} {f(volume[i])} 1.0 {f(X[i, 0])} {f(X[i, 1])} {f(X[i, 2])}"
+    data += [f"{i + 1} {types[i]} {f(volume[i])} {f(model.density)} {f(X[i, 0])} "
+             f"{f(X[i, 1])} {f(X[i, 2])}"
              for i in range(n)]
     loads = [f"set atom {i + 1} d_bx {f(b[i, 0])} d_by {f(b[i, 1])} d_bz {f(b[i, 2])}"
              for i in np.flatnonzero(np.any(b != 0, axis=1))]
@@ -480,7 +486,6 @@ def lps_energy_density(pe, theta, K):
 def replace_loads(model: Model) -> Model:
     """``model`` without loads or prescribed components (a homogeneous strain sets every
     atom)."""
-    import dataclasses
     return dataclasses.replace(model, forces=np.zeros_like(model.forces), fixed={},
                                reference_force=0.0)
 
@@ -516,6 +521,77 @@ def energies(model: Model, setting: str, strains, folder: str, *, where: str,
     if not np.all(np.isfinite(W)):
         raise NumericalError(f"{where}: LAMMPS's energies hold non-finite numbers")
     return W, info
+
+
+# ------------------------------------------------------------------------- dynamics
+def dynamic_deck(model: Model, u0, dt: float, steps: int, record, *,
+                 title: str = "pdverify") -> dict:
+    """The deck's files of a free vibration from rest (same model only): the node set of
+    :func:`deck` (its held components held by ``fix setforce``, no loads), the bond family
+    made at the reference state (``run 0`` twice: the s0 quirk of the module docstring),
+    then the atoms put at x0 + ``u0`` ((n, d)), velocities zero, and ``steps`` steps of
+    ``dt`` of ``fix nve`` (velocity Verlet: its positions are central differences started
+    with u_1 = u_0 + dt^2 a_0 / 2 from rest, pdverify's
+    :func:`pdverify.solvers.explicit.central_difference`), the atoms ``record`` (0-based)
+    dumped every step, step 0 included. Masses are the atoms' density (``Model.density``)."""
+    files = deck(dataclasses.replace(model, forces=np.zeros_like(model.forces)),
+                 "same-model", title=title)
+    head = files["in.lammps"].split("compute damage all damage/atom")[0]
+    n, d = len(model.x), model.dim
+    X = np.zeros((n, 3))
+    X[:, :d] = model.x
+    U = np.zeros((n, 3))
+    U[:, :d] = np.asarray(u0, dtype=float).reshape(n, d)
+    moved = np.flatnonzero(np.any(U != 0, axis=1))
+    files["initial.in"] = "\n".join(
+        f"set atom {i + 1} x {f(X[i, 0] + U[i, 0])} y {f(X[i, 1] + U[i, 1])} "
+        f"z {f(X[i, 2] + U[i, 2])}" for i in moved) + "\n"
+    ids = " ".join(str(int(i) + 1) for i in record)
+    lines = [head.rstrip("\n"), "include initial.in", "velocity all set 0.0 0.0 0.0",
+             "compute damage all damage/atom", "compute lost all reduce sum c_damage",
+             "thermo_style custom step pe ke c_lost", f"thermo {max(int(steps), 1)}",
+             "reset_timestep 0", f"timestep {f(dt)}", "fix step all nve",
+             f"group record id {ids}",
+             "dump history record custom 1 history.dump id x y z",
+             "dump_modify history sort id format float %.17g",
+             f"run {int(steps)}",
+             'print "pdverify-lost-bonds $(c_lost:%.17g)"']
+    files["in.lammps"] = "\n".join(lines) + "\n"
+    return files
+
+
+def dynamics(model: Model, u0, dt: float, steps: int, record, folder: str, *, where: str,
+             timeout: float = TIMEOUT_S) -> tuple[np.ndarray, dict]:
+    """``(history, info)``: the displacements (steps + 1, len(record), d) of the atoms
+    ``record`` at every step of :func:`dynamic_deck`'s run in ``folder`` (an empty folder
+    pdverify made); ``info`` holds the version and the damage LAMMPS reported."""
+    proc, log, executable = _launch(dynamic_deck(model, u0, dt, steps, record, title=where),
+                                    folder, where, timeout)
+    path = os.path.join(folder, "history.dump")
+    if proc.returncode != 0 or not os.path.exists(path):
+        error = next((ln.strip() for ln in (log + proc.stdout + proc.stderr).splitlines()
+                      if ln.startswith("ERROR")), f"exit status {proc.returncode}")
+        raise NumericalError(f"{where}: LAMMPS failed: {error[:300]}")
+    info = {k: v for k, v in parse_log(log).items() if k in ("version", "damage_sum")}
+    info.update({"executable": executable, "setting": "same-model",
+                 "pair_style": model.pair, "integrator": "fix nve", "dt": dt,
+                 "steps": int(steps)})
+    record = np.asarray(record, dtype=int)
+    with open(path, encoding="utf-8") as fh:
+        rows = [ln.split() for ln in fh if ln[:1].isdigit() or ln[:1] == "-"]
+    k = len(record)
+    # each snapshot: timestep, atom count, three box lines (two numbers each), the atoms
+    atoms = np.array([r for r in rows if len(r) == 4], dtype=float)
+    if atoms.shape[0] != (steps + 1) * k:
+        raise NumericalError(f"{where}: LAMMPS dumped {atoms.shape[0]} atom rows, "
+                             f"{(steps + 1) * k} expected ({steps + 1} steps x {k} atoms)")
+    atoms = atoms.reshape(steps + 1, k, 4)
+    order = np.argsort(record)          # the dump is sorted by id
+    history = np.empty((steps + 1, k, model.dim))
+    history[:, order, :] = atoms[:, :, 1:1 + model.dim] - model.x[record[order]][None]
+    if not np.all(np.isfinite(history)):
+        raise NumericalError(f"{where}: LAMMPS's displacements hold non-finite numbers")
+    return history, info
 
 
 def _launch(files: dict, folder: str, where: str, timeout: float):
