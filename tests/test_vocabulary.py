@@ -85,10 +85,13 @@ ADDED_CELLS = (
                             "stiffness3d-box-bond")
        for m in ("taylor-fictitious", "surface-nodes")}
     | {("block2d-indentation", "virtual-nodes")}
-    # LAMMPS's peri/lps energies on the LPS stiffness boxes (pe/atom corrected) and its
-    # fix nve on seed 004's vibrating bar
+    # issue 54/55 (LAMMPS): peri/lps energies on the LPS stiffness boxes (pe/atom
+    # corrected) and its fix nve on seed 004's vibrating bar
     | {("stiffness3d-box", "peer:lammps"), ("stiffness2d-plate", "peer:lammps"),
-       ("bar1d-vibration", "peer:lammps")})
+       ("bar1d-vibration", "peer:lammps")}
+    # and on the crack scenes (atom types keep it from bonding across the slit)
+    | {(sid, "peer:lammps") for sid in ("plate-crack", "plate-edge-crack",
+                                        "plate-inclined-crack")})
 
 
 #: choices a parameter gained since a694eb9, each named by its issue: (scene, param) ->

@@ -85,7 +85,13 @@ REPORT_RUNS = {"body3d-traction": {"spacing": 0.1}, "plate2d-clamped": {},
                # seed 004's bars at the paper's sizes (9 and 17 + 9 + 12 atoms), same model
                "bar1d-homogenization": {}, "bar1d-constraints": {},
                # seed 004's vibrating bar (b) at Table 13's size (100 atoms, ~1,500 steps)
-               "bar1d-vibration": {}}
+               "bar1d-vibration": {},
+               # the crack scenes at the coarsest grids whose K fit has its 8 node pairs
+               # (m = 2: the fit's window starts at 2 horizons; 1,600-4,800 atoms, the
+               # crack kept by atom types: pdverify.peers.lammps.crack_types)
+               "plate-crack": {"spacing": 0.05, "m_ratio": 2.0},
+               "plate-edge-crack": {"spacing": 1 / 30, "m_ratio": 2.0},
+               "plate-inclined-crack": {"spacing": 0.05, "m_ratio": 2.0}}
 #: the bond-based scenes that solve through a peer (their own assembly; the static-state
 #: family's scenes are served through the family): the clamped sheet's clamps are held
 #: atoms (``fix setforce`` on the group of each prescribed component, the atoms set to

@@ -161,6 +161,11 @@ class Model:
     #: :func:`bar_types`)
     types: np.ndarray | None = None
     pair_coefficients: dict | None = None
+    #: which bonds a crack cuts (``severs(xa, xb) -> bool``: a cracked shape's
+    #: :meth:`pdverify.pd.shapes.Shape.severs`; None: no crack): LAMMPS is kept from
+    #: bonding across it by atom types and a zero horizon for the type pairs the crack
+    #: separates (:func:`crack_types`)
+    severs: object = None
     #: the atoms' mass density [kg/m^3]: atom_style peri's "density" column, LAMMPS's
     #: per-atom mass (its PERI forces are force densities, so a = f / rho); only a
     #: dynamic run (:func:`dynamics`) reads it
@@ -181,13 +186,98 @@ def lps_moduli(constants) -> tuple[float, float]:
 
 def state_based_model(ns) -> Model:
     """The :class:`Model` of an exported state-based node set
-    (:class:`pdverify.exchange.NodeSet`)."""
+    (:class:`pdverify.exchange.NodeSet`); a cracked shape's ``severs`` with it."""
     from ..nodeset import written_horizon
     K, G = lps_moduli(ns.problem.constants)
     h, d = ns.spacing, ns.dim
+    shape = getattr(ns.problem, "shape", None)
+    cracked = any(c.length > 0 for c in getattr(shape, "cracks", ()))
     return Model(ns.x, np.asarray(ns.volume, float), ns.forces, ns.fixed, h,
                  ns.horizon / h, written_horizon(ns),
-                 h ** d * float(ns.problem.thickness), "peri/lps", (K, G), K + 4 * G / 3)
+                 h ** d * float(ns.problem.thickness), "peri/lps", (K, G), K + 4 * G / 3,
+                 severs=shape.severs if cracked else None)
+
+
+@dataclass(frozen=True)
+class CrackTypes:
+    """Atom types that keep LAMMPS from bonding across a crack (:func:`crack_types`)."""
+
+    types: np.ndarray      # (n,) atom types 1..T
+    unbonded: tuple        # the type pairs (a, b), a <= b, given a zero horizon
+    pairs: int             # the atom pairs within the horizon
+    cut: int               # of them, the ones the crack cuts (no bond in LAMMPS)
+    sided: int             # atoms with a cut bond of one type per side (types 2, 3)
+    own: int               # atoms with a type of their own (types 4..T)
+
+
+def crack_types(x, horizon: float, severs, *, where: str = "crack") -> CrackTypes:
+    """Atom types such that every type pair's atom pairs within ``horizon`` are either
+    all cut by the crack (``severs``) or all kept, so that LAMMPS, which bonds i and j
+    at the first run when |x_j - x_i|^2 <= the horizon of their type pair squared
+    (``pair_coeff`` per type pair; fix PERI_NEIGH), with a zero horizon for the cut type
+    pairs forms exactly the kept bonds.
+
+    Construction: the cut bonds join the two sides of a crack, so their graph is
+    bipartite: each of its connected components is coloured by the parity of the
+    breadth-first depth (checked: a cut bond between two atoms of one colour fails the
+    run, named). An atom without a cut bond is type 1 (its pairs are all kept); an atom
+    with one whose every pair to an atom of the other colour that has a cut bond is cut
+    is type 2 or 3 by its colour (the faces away from the tips); any other atom (beside a
+    tip, where bonds round the tip are kept) has a type of its own. Then a pair
+    (1, any) is kept, (2, 2) and (3, 3) join atoms of one colour (kept), (2, 3) and
+    (2 or 3, own of the other colour) are cut by the definition of 2 and 3, (2 or 3,
+    own of its colour) kept, and (own, own) is one atom pair. The partition is then
+    checked pair by pair (no type pair holds both a cut and a kept pair): a violation
+    is a NumericalError naming the counts."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import breadth_first_order, connected_components
+    from scipy.spatial import cKDTree
+    x = np.asarray(x, dtype=float)
+    n = len(x)
+    pairs = np.array(sorted(cKDTree(x).query_pairs(horizon)), dtype=np.int64).reshape(-1, 2)
+    a, b = pairs[:, 0], pairs[:, 1]
+    cut = np.asarray(severs(x[a], x[b]), dtype=bool)
+    graph = coo_matrix((np.ones(int(cut.sum())), (a[cut], b[cut])), shape=(n, n)).tocsr()
+    graph = graph + graph.T
+    on = np.zeros(n, dtype=bool)
+    on[a[cut]] = on[b[cut]] = True
+    # colour: breadth-first depth parity from each component's first atom (pointer
+    # doubling over the predecessors; atoms without a cut bond are their own roots)
+    _, label = connected_components(graph, directed=False)
+    atoms = np.flatnonzero(on)
+    _, first = np.unique(label[atoms], return_index=True)
+    parent = np.arange(n)
+    for root in atoms[first]:      # one breadth-first search per component (a few)
+        _, pred = breadth_first_order(graph, int(root), directed=False)
+        reached = pred >= 0
+        parent[reached] = pred[reached]
+    odd = (parent != np.arange(n)).astype(np.int64)
+    jump = parent.copy()
+    for _ in range(max(1, int(np.ceil(np.log2(max(n, 2)))) + 1)):
+        odd = odd ^ odd[jump]
+        jump = jump[jump]
+    colour = odd
+    if np.any(colour[a[cut]] == colour[b[cut]]):
+        raise NumericalError(f"{where}: the cut bonds do not join two sides (an odd cycle "
+                             "of cut bonds): no atom types keep LAMMPS from bonding across "
+                             "the crack")
+    across = on[a] & on[b] & (colour[a] != colour[b])
+    own = np.zeros(n, dtype=bool)
+    own[a[across & ~cut]] = own[b[across & ~cut]] = True
+    types = np.ones(n, dtype=np.int64)
+    types[on & ~own] = 2 + colour[on & ~own]
+    types[own] = 4 + np.arange(int(own.sum()))
+    ta, tb = np.minimum(types[a], types[b]), np.maximum(types[a], types[b])
+    T = int(types.max())
+    key = ta * (T + 1) + tb
+    mixed = np.intersect1d(key[cut], key[~cut])
+    if mixed.size:
+        raise NumericalError(f"{where}: {mixed.size} atom type pairs hold both cut and kept "
+                             "pairs: the crack's types do not separate them")
+    unbonded = np.unique(key[cut])
+    return CrackTypes(types, tuple((int(k // (T + 1)), int(k % (T + 1))) for k in unbonded),
+                      int(len(a)), int(cut.sum()), int(np.count_nonzero(on & ~own)),
+                      int(own.sum()))
 
 
 def bond_based_model(ns) -> Model:
@@ -272,7 +362,13 @@ def deck(model: Model, setting: str, *, title: str = "pdverify") -> dict:
     b = np.zeros((n, 3))
     b[:, :d] = model.forces / volume[:, None]
     lo, hi = X.min(axis=0) - 2 * h, X.max(axis=0) + 2 * h
-    types = np.ones(n, dtype=int) if model.types is None else np.asarray(model.types, int)
+    crack = (None if model.severs is None else
+             crack_types(X[:, :d], horizon, model.severs, where=title))
+    if crack is not None and model.types is not None:
+        raise InputError(f"{title}: a cracked body's atom types are the crack's; a "
+                         "micromodulus by type pair cannot be given with them")
+    types = (crack.types if crack is not None else
+             np.ones(n, dtype=int) if model.types is None else np.asarray(model.types, int))
     data = [f"{title}: {setting}\n", f"{n} atoms", f"{int(types.max())} atom types", ""]
     data += [f"{f(lo[k])} {f(hi[k])} {a}lo {a}hi" for k, a in enumerate("xyz")]
     data += ["", "Atoms # peri", ""]
@@ -307,6 +403,9 @@ def deck(model: Model, setting: str, *, title: str = "pdverify") -> dict:
     tail = f"{f(horizon)} 1e300 0.0  # s00 = 1e300, alpha = 0: no bond breaks"
     if model.pair_coefficients is None:
         pair_coeff = [f"pair_coeff * * {' '.join(f(c) for c in model.coefficients)} {tail}"]
+        if crack is not None:    # the type pairs a crack separates: no bond (horizon 0)
+            pair_coeff += [f"pair_coeff {a} {b} {' '.join(f(c) for c in model.coefficients)}"
+                           " 0.0 1e300 0.0" for a, b in crack.unbonded]
     else:
         pair_coeff = [f"pair_coeff {a} {b} {' '.join(f(c) for c in cs)} {tail}"
                       for (a, b), cs in sorted(model.pair_coefficients.items())]

@@ -192,8 +192,7 @@ class CrackScene(ShapeScene):
         if out is not None:
             return out
         if getattr(treatment, "peer", False):
-            return ("its code builds its own bonds from the node positions, so it would "
-                    "bond across the crack; crack faces are not served yet")
+            return None     # LAMMPS: atom types keep it from bonding across the crack
         if not (treatment.kind == "closure" or getattr(treatment, "baseline", False)):
             return _NO_CRACK_FACES
         return None

@@ -633,3 +633,94 @@ def test_vibration_another_bar_is_a_failed_run(monkeypatch):
     r = get_scene("bar1d-vibration").run(lammps.NAME, {})
     assert r.status == "failed" and "LAMMPS's history is" in r.message
     assert r.metrics["peer_diff_to_none"] > 1e-3
+
+
+# ------------------------------------------------------ cracks (atom types per side)
+CRACK_RUNS = {"plate-crack": {"spacing": 0.05, "m_ratio": 2.0},
+              "plate-edge-crack": {"spacing": 1 / 30, "m_ratio": 2.0},
+              "plate-inclined-crack": {"spacing": 0.05, "m_ratio": 2.0}}
+
+
+def _lammps_bonds(ns, setting):
+    """(LAMMPS's bonds as a set of atom pairs, the candidate pairs, the CrackTypes) of
+    the deck lammps.deck writes for ``setting``: the pairs within its horizon whose type
+    pair keeps its horizon (fix PERI_NEIGH's rule |xi|^2 <= cut(ti, tj)^2)."""
+    from scipy.spatial import cKDTree
+    model = lammps.state_based_model(ns)
+    h = model.spacing
+    horizon = model.horizon if setting == "same-model" else (
+        model.m_ratio + lammps.EXAMPLES_MARGIN) * h
+    ct = lammps.crack_types(ns.x, horizon, model.severs)
+    deck = lammps.deck(model, setting)["in.lammps"]
+    zero = {tuple(map(int, ln.split()[1:3])) for ln in deck.splitlines()
+            if ln.startswith("pair_coeff") and ln.split()[5] == "0.0"}
+    assert zero == set(ct.unbonded)            # the deck states the types' zero horizons
+    pairs = np.array(sorted(cKDTree(ns.x).query_pairs(horizon)))
+    t = ct.types
+    key = list(zip(np.minimum(t[pairs[:, 0]], t[pairs[:, 1]]).tolist(),
+                   np.maximum(t[pairs[:, 0]], t[pairs[:, 1]]).tolist()))
+    bonded = {tuple(p) for p, k in zip(pairs.tolist(), key) if k not in zero}
+    return bonded, {tuple(p) for p in pairs.tolist()}, ct
+
+
+@pytest.mark.parametrize("scene_id", sorted(CRACK_RUNS))
+def test_crack_types_give_lammps_exactly_pdverify_bonds(scene_id):
+    # same model: the atom pairs LAMMPS bonds (its horizon per type pair, zero for the
+    # type pairs the crack separates) are pdverify's bonds of the cracked body, pair for
+    # pair, and the pairs it leaves out are pdverify's cut bonds, every one of them
+    ns = node_set(get_scene(scene_id), {**CRACK_RUNS[scene_id], "influence": "hyperbolic",
+                                        "quadrature": "full-cells"})
+    bonded, candidates, ct = _lammps_bonds(ns, "same-model")
+    m = ns.system.model
+    g = m.grid
+    row = np.full(g.n_ext, -1)
+    row[g.interior_ids] = np.arange(g.n_interior)
+    a, b = row[m.bond_a], row[m.bond_b]
+    assert np.all(a >= 0) and np.all(b >= 0)
+    ours = {(min(i, j), max(i, j)) for i, j in zip(a.tolist(), b.tolist())}
+    assert bonded == ours
+    cut = candidates - ours
+    assert len(cut) == ct.cut > 0
+    assert np.all(ns.problem.shape.severs(ns.x[[i for i, _ in cut]], ns.x[[j for _, j in cut]]))
+    assert ct.sided > 0                        # the faces' two types at least
+
+
+@pytest.mark.parametrize("scene_id", sorted(CRACK_RUNS))
+def test_crack_types_as_used_leave_out_exactly_the_cut_pairs(scene_id):
+    # as LAMMPS's users run it (horizon (m + 2e-4) h): the pairs it bonds are the pairs
+    # within that horizon the crack does not cut (pdverify.pd.shapes's rule), exactly
+    ns = node_set(get_scene(scene_id), {**CRACK_RUNS[scene_id], "influence": "hyperbolic"})
+    bonded, candidates, ct = _lammps_bonds(ns, "as-used")
+    pairs = np.array(sorted(candidates))
+    cut = ns.problem.shape.severs(ns.x[pairs[:, 0]], ns.x[pairs[:, 1]])
+    assert bonded == {tuple(p) for p in pairs[~cut].tolist()}
+    assert int(cut.sum()) == ct.cut > 0
+
+
+@needs_lammps
+def test_crack_same_model_gap_is_nonlinearity_only():
+    # LAMMPS on the cracked strip with the crack's atom types: the gap to pdverify's
+    # none is its geometric nonlinearity, so it falls in proportion to the load (a tenth
+    # of the traction: a tenth of the gap, 0.1 +- 0.02 as on body3d-traction; measured
+    # 2.56e-2 -> 2.5e-3); a bond across the crack would leave a gap of order one at any
+    # load (the next test)
+    over = {**CRACK_RUNS["plate-edge-crack"], **SAME}
+    at_load = _run("plate-edge-crack", **over)
+    tenth = _run("plate-edge-crack", **over, traction=1e5)
+    gap, gap10 = at_load.metrics["peer_diff_to_none"], tenth.metrics["peer_diff_to_none"]
+    assert gap10 / gap == pytest.approx(0.1, abs=0.02)
+    assert at_load.diagnostics["peer"]["stopping"] == "force tolerance"
+
+
+@needs_lammps
+def test_crack_without_its_types_bonds_across_and_fails(monkeypatch):
+    # one atom type, every pair within the horizon bonded (what LAMMPS does with the
+    # node set alone): the slit is closed by bonds and LAMMPS's field is far from the
+    # cracked body's equilibrium: a named failed run
+    def one_type(x, horizon, severs, where="crack"):
+        return lammps.CrackTypes(np.ones(len(x), dtype=np.int64), (), 0, 0, 0, 0)
+    monkeypatch.setattr(lammps, "crack_types", one_type)
+    r = get_scene("plate-inclined-crack").run(
+        lammps.NAME, {**CRACK_RUNS["plate-inclined-crack"], **SAME})
+    assert r.status == "failed" and "not in equilibrium" in r.message
+    assert r.metrics["peer_diff_to_none"] > 0.1
