@@ -92,6 +92,14 @@ REPORT_RUNS = {"body3d-traction": {"spacing": 0.1}, "plate2d-clamped": {},
                "plate-crack": {"spacing": 0.05, "m_ratio": 2.0},
                "plate-edge-crack": {"spacing": 1 / 30, "m_ratio": 2.0},
                "plate-inclined-crack": {"spacing": 0.05, "m_ratio": 2.0}}
+#: the report's settings where not both: the crack scenes same-model only (the
+#: difference to none's K is the number; 1,600-4,800 atoms, 700-1,800 FIRE steps, the
+#: largest peer runs: 2.8-10 s each under a load of ~14 on 2 cores, all ten runs issue
+#: 55 added 31 s of wall and 16 s of CPU there with both settings on the cracks:
+#: benchmarks/records/peers-2026-11-28-issue55-lammps-cracks-dynamics-lps.json); as-used
+#: runs with ``--set setting=as-used`` (tests/peers/test_lammps.py checks it on a crack)
+REPORT_SETTINGS = {scene: ("same-model",) for scene in
+                   ("plate-crack", "plate-edge-crack", "plate-inclined-crack")}
 #: the bond-based scenes that solve through a peer (their own assembly; the static-state
 #: family's scenes are served through the family): the clamped sheet's clamps are held
 #: atoms (``fix setforce`` on the group of each prescribed component, the atoms set to
@@ -155,7 +163,7 @@ class PeerTreatment(Treatment):
         if over is None:
             return []
         settings = (("same-model",) if scene.id in BAR_SCENES + DYNAMIC_BAR_SCENES
-                    else lammps.SETTINGS)
+                    else REPORT_SETTINGS.get(scene.id, lammps.SETTINGS))
         return [{**lammps_overrides(scene), **over, "setting": s} for s in settings]
 
     def params_for(self, scene):

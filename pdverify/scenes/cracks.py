@@ -299,8 +299,10 @@ class CrackPlate(CrackScene):
     and the tips on cell faces: ``spacing`` must divide W, H and a), as
     ``benchmarks/crack_k.py`` (the study this scene repeats). Treatments: the uncorrected
     model and every bond method of the family that serves shapes (their closures drop
-    the cut bonds); the treatments that add nodes are refused (``list`` gives the reason:
-    crack faces are not served yet).
+    the cut bonds), and LAMMPS (``peer:lammps``: atom types and a zero horizon for the
+    type pairs the crack separates keep it from bonding across the slit,
+    ``pdverify.peers.lammps.crack_types``); the treatments that add nodes are refused
+    (``list`` gives the reason: crack faces are not served yet).
 
     Metrics: ``k_ratio`` = K_PD / K_FEM (``pdverify.pd.cracks.fit_k`` at the right tip:
     the Williams fit of the opening of the two node rows nearest the crack on each side,
@@ -401,8 +403,9 @@ class EdgeCrackPlate(CrackScene):
     h = 1/40 m (the crack line and the tip on cell faces: ``spacing`` must divide b, H
     and a); nested dissection (``fixed_solver`` "auto", as ``plate-crack``'s).
     Treatments: the uncorrected model and every bond method that serves shapes (their
-    closures drop the cut bonds); the treatments that add nodes and the peer code are
-    refused with ``plate-crack``'s reasons (``list plate-edge-crack``).
+    closures drop the cut bonds) and LAMMPS (``peer:lammps``, as on ``plate-crack``); the
+    treatments that add nodes are refused with ``plate-crack``'s reason (``list
+    plate-edge-crack``).
 
     Metrics (:class:`CrackScene`; the headline ``k_net_error_pct``, the comment at
     ``headline``): K at the one tip (a, 0), the fit's window r in

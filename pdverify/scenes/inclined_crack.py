@@ -71,8 +71,9 @@ class InclinedCrackPlate(CrackPlate):
     the large plate within 0.05 % of Tada's K_0), cached; its ``j_radii`` fixed.
 
     PD: as ``plate-crack`` (LPS, hyperbolic influence, ``partial-volume``, m = 3, h = 1/40
-    m; ``spacing`` must divide W and H). Treatments: the uncorrected model and the bond
-    methods; the node-adding ones refused (``list``: crack faces are not served yet).
+    m; ``spacing`` must divide W and H). Treatments: the uncorrected model, the bond
+    methods and LAMMPS (as on ``plate-crack``); the node-adding ones refused (``list``:
+    crack faces are not served yet).
 
     Metrics: ``k1_ratio``, ``k2_ratio`` = K_PD / K_FEM, K_PD by ``fit_k_mixed`` at the
     right tip (Williams orders 1..5 of both modes and a translation fitted to both

@@ -724,3 +724,18 @@ def test_crack_without_its_types_bonds_across_and_fails(monkeypatch):
         lammps.NAME, {**CRACK_RUNS["plate-inclined-crack"], **SAME})
     assert r.status == "failed" and "not in equilibrium" in r.message
     assert r.metrics["peer_diff_to_none"] > 0.1
+
+
+@needs_lammps
+def test_crack_as_used_gap_is_attributed():
+    # as LAMMPS's users run it on the inclined crack (the crack's types computed on its
+    # horizon (m + 2e-4) h): the linear twin (the cracked body with LAMMPS's ramp and
+    # whole cells) and the nonlinearity account for the whole gap (triangle inequality);
+    # the nonlinear part is the same-model gap's size (1.9e-3 and 1.8e-3 measured), far
+    # below the ramp's (3.6e-2)
+    r = _run("plate-inclined-crack", **CRACK_RUNS["plate-inclined-crack"],
+             influence="hyperbolic", setting="as-used")
+    m = r.metrics
+    assert m["peer_gap_volumes"] > 1e-2
+    assert m["peer_gap_nonlinear"] < 0.2 * m["peer_gap_volumes"]
+    assert abs(m["peer_diff_to_none"] - m["peer_gap_volumes"]) <= m["peer_gap_nonlinear"]
