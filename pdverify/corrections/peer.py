@@ -1,9 +1,11 @@
-"""``peer:lammps`` as a treatment of the ``static-state`` family and of the bond-based
-scenes that state their problem (the sheets, :data:`BOND_SCENES`; the stiffness scenes
-of both theories,
-:data:`ENERGY_SCENES`, whose atoms LAMMPS evaluates at u = eps . x; seed 004's static bars,
-:data:`BAR_SCENES`): the scene's uncorrected problem solved by LAMMPS
-(:mod:`pdverify.peers.lammps`) instead of pdverify's linear solve, and measured by the
+"""``peer:lammps`` as a treatment of the ``static-state`` family (the cracked shapes
+too: atom types keep LAMMPS from bonding across a crack,
+:func:`pdverify.peers.lammps.crack_types`) and of the scenes that state their problem
+(the sheets, :data:`BOND_SCENES`; the stiffness scenes of both theories,
+:data:`ENERGY_SCENES`, whose atoms LAMMPS evaluates at u = eps . x; seed 004's static
+bars, :data:`BAR_SCENES`, and its vibrating bar, :data:`DYNAMIC_BAR_SCENES`, run by
+``fix nve``): the scene's uncorrected problem solved by LAMMPS
+(:mod:`pdverify.peers.lammps`) instead of pdverify's own solve, and measured by the
 scene's own ``measure``; the bond-based scenes it cannot run say why (:data:`REFUSED`).
 
 Beside the scene's metrics a run records, as metrics (all relative L2 norms over the

@@ -52,6 +52,12 @@ line search on the energy stalls ("linesearch alpha is zero" after 19-42 iterati
 body3d-traction). The result is then checked in pdverify's linear model
 (:func:`pdverify.nodeset.equilibrium`).
 
+Cracks: LAMMPS bonds every pair of atoms within its type pair's horizon at the first
+run, so a cracked body's atoms get the types of :func:`crack_types` and the type pairs
+the crack separates a zero horizon: LAMMPS's bonds are then pdverify's exactly. Dynamics
+(seed 004's vibrating bar): :func:`dynamics`, ``fix nve`` from displaced atoms at rest.
+Energies under homogeneous strains (the stiffness scenes): :func:`energies`.
+
 A LAMMPS quirk handled in the deck: the first setup evaluates the bond-breaking stretch
 s0 before the bond family exists and leaves s0 = 0, so the first bond stretched at the
 next force evaluation breaks; a second ``run 0`` at the reference state sets s0 = s00
