@@ -97,7 +97,30 @@ ADDED_CELLS = (
        for m in ("mirror-nodes", "surface-nodes", "pddo", "taylor-fictitious")}
     # issue 54: Taylor's one-sided fictitious nodes on crack faces
     | {(sid, "taylor-fictitious") for sid in ("plate-crack", "plate-edge-crack",
-                                              "plate-inclined-crack")})
+                                              "plate-inclined-crack")}
+    # issue 54/55 (LAMMPS): peri/lps energies on the LPS stiffness boxes (pe/atom
+    # corrected) and its fix nve on seed 004's vibrating bar
+    | {("stiffness3d-box", "peer:lammps"), ("stiffness2d-plate", "peer:lammps"),
+       ("bar1d-vibration", "peer:lammps")}
+    # and on the crack scenes (atom types keep it from bonding across the slit)
+    | {(sid, "peer:lammps") for sid in ("plate-crack", "plate-edge-crack",
+                                        "plate-inclined-crack")})
+
+
+#: choices a parameter gained since a694eb9, each named by its issue: (scene, param) ->
+#: the added choice (issue 55: whole-cell quadrature on the LPS stiffness boxes, which
+#: LAMMPS's same-model run needs, as on body3d-traction)
+WIDENED_CHOICES = {("stiffness3d-box", "quadrature"): "'full-cells'",
+                   ("stiffness2d-plate", "quadrature"): "'full-cells'"}
+
+
+def _narrowed(sid, q):
+    """A parameter's surface entry without the choice it gained (WIDENED_CHOICES)."""
+    extra = WIDENED_CHOICES.get((sid, q["name"]))
+    if extra is None:
+        return q
+    assert q["choices"][-1] == extra, (sid, q["name"])
+    return {**q, "choices": q["choices"][:-1]}
 
 
 def test_parameter_surface_unchanged():
@@ -112,7 +135,8 @@ def test_parameter_surface_unchanged():
     assert sorted(after) == sorted([*before, *new_scenes])
     added = set()
     for sid in before:
-        assert after[sid]["params"] == before[sid]["params"], sid
+        params = [_narrowed(sid, q) for q in after[sid]["params"]]
+        assert params == before[sid]["params"], sid
         for m, entry in before[sid]["methods"].items():
             assert after[sid]["methods"].get(m) == entry, (sid, m)
         added |= {(sid, m) for m in after[sid]["methods"] if m not in before[sid]["methods"]}

@@ -1,8 +1,11 @@
-"""``peer:lammps`` as a treatment of the ``static-state`` family and of the bond-based
-scenes that state their problem (the sheets, :data:`BOND_SCENES`; the stiffness scenes,
-:data:`ENERGY_SCENES`, whose atoms LAMMPS evaluates at u = eps . x; seed 004's static bars,
-:data:`BAR_SCENES`): the scene's uncorrected problem solved by LAMMPS
-(:mod:`pdverify.peers.lammps`) instead of pdverify's linear solve, and measured by the
+"""``peer:lammps`` as a treatment of the ``static-state`` family (the cracked shapes
+too: atom types keep LAMMPS from bonding across a crack,
+:func:`pdverify.peers.lammps.crack_types`) and of the scenes that state their problem
+(the sheets, :data:`BOND_SCENES`; the stiffness scenes of both theories,
+:data:`ENERGY_SCENES`, whose atoms LAMMPS evaluates at u = eps . x; seed 004's static
+bars, :data:`BAR_SCENES`, and its vibrating bar, :data:`DYNAMIC_BAR_SCENES`, run by
+``fix nve``): the scene's uncorrected problem solved by LAMMPS
+(:mod:`pdverify.peers.lammps`) instead of pdverify's own solve, and measured by the
 scene's own ``measure``; the bond-based scenes it cannot run say why (:data:`REFUSED`).
 
 Beside the scene's metrics a run records, as metrics (all relative L2 norms over the
@@ -24,6 +27,7 @@ linear model (:func:`peer_energies_of`).
 """
 from __future__ import annotations
 
+import dataclasses
 import tempfile
 from dataclasses import dataclass
 
@@ -78,20 +82,45 @@ REPORT_RUNS = {"body3d-traction": {"spacing": 0.1}, "plate2d-clamped": {},
                "sheet2d-clamped": {"m_ratio": 4.0},
                # no solve: one LAMMPS process evaluates every strain state (~0.4 s each)
                "stiffness2d-sheet": {"spacing": 0.002}, "stiffness3d-box-bond": {"spacing": 0.1},
+               # peri/lps, its energy read as lammps.lps_energy_density (~0.1 s each)
+               "stiffness3d-box": {"spacing": 0.1}, "stiffness2d-plate": {"spacing": 0.05},
                # seed 004's bars at the paper's sizes (9 and 17 + 9 + 12 atoms), same model
-               "bar1d-homogenization": {}, "bar1d-constraints": {}}
+               "bar1d-homogenization": {}, "bar1d-constraints": {},
+               # seed 004's vibrating bar (b) at Table 13's size (100 atoms, ~1,500 steps)
+               "bar1d-vibration": {},
+               # the crack scenes at the coarsest grids whose K fit has its 8 node pairs
+               # (m = 2: the fit's window starts at 2 horizons; 1,600-4,800 atoms, the
+               # crack kept by atom types: pdverify.peers.lammps.crack_types)
+               "plate-crack": {"spacing": 0.05, "m_ratio": 2.0},
+               "plate-edge-crack": {"spacing": 1 / 30, "m_ratio": 2.0},
+               "plate-inclined-crack": {"spacing": 0.05, "m_ratio": 2.0}}
+#: the report's settings where not both: the crack scenes same-model only (the
+#: difference to none's K is the number; 1,600-4,800 atoms, 700-1,800 FIRE steps, the
+#: largest peer runs: 2.8-10 s each under a load of ~14 on 2 cores, all ten runs issue
+#: 55 added 31 s of wall and 16 s of CPU there with both settings on the cracks:
+#: benchmarks/records/peers-2026-11-28-issue55-lammps-cracks-dynamics-lps.json); as-used
+#: runs with ``--set setting=as-used`` (tests/peers/test_lammps.py checks it on a crack)
+REPORT_SETTINGS = {scene: ("same-model",) for scene in
+                   ("plate-crack", "plate-edge-crack", "plate-inclined-crack")}
 #: the bond-based scenes that solve through a peer (their own assembly; the static-state
 #: family's scenes are served through the family): the clamped sheet's clamps are held
 #: atoms (``fix setforce`` on the group of each prescribed component, the atoms set to
 #: their prescribed positions first), as LAMMPS users hold a grip
 BOND_SCENES = ("sheet2d-tension", "sheet2d-clamped")
-#: the bond-based stiffness scenes: every atom placed at u = eps . x and LAMMPS's
-#: ``compute pe/atom`` read as the node's energy density (:meth:`PeerTreatment.peer_energies`)
-ENERGY_SCENES = ("stiffness2d-sheet", "stiffness3d-box-bond")
+#: the stiffness scenes: every atom placed at u = eps . x and LAMMPS's ``compute pe/atom``
+#: read as the node's energy density (:meth:`PeerTreatment.peer_energies`): peri/pmb's as
+#: it is, peri/lps's corrected with ``compute dilatation/atom``
+#: (:func:`pdverify.peers.lammps.lps_energy_density`: it tallies half of the deviatoric
+#: energy)
+ENERGY_SCENES = ("stiffness2d-sheet", "stiffness3d-box-bond", "stiffness3d-box",
+                 "stiffness2d-plate")
 #: seed 004's static bars: a line of atoms on the x axis (y and z held at zero) with
 #: peri/pmb's c matched to the bar's c1 (pdverify.peers.lammps.bar_types: the triangular
 #: micromodulus by type pair), same-model only (:data:`BAR_AS_USED`)
 BAR_SCENES = ("bar1d-homogenization", "bar1d-constraints")
+#: seed 004's vibrating bar: LAMMPS's fix nve against the scene's central differences
+#: (same model only, as the static bars; :meth:`PeerTreatment.peer_dynamic_bar`)
+DYNAMIC_BAR_SCENES = ("bar1d-vibration",)
 #: why a bar has no as-used run
 BAR_AS_USED = ("LAMMPS is a 3D code and its users give peri/pmb the 3D c = 18 K / (pi "
                "delta^4); a line of atoms with it is not seed 004's 1D bar (nothing of the "
@@ -105,11 +134,6 @@ BAR_SETTING = Param("setting", "same-model", "how LAMMPS runs: driven to solve t
 #: the scenes of the bond-based models that LAMMPS cannot run as they are stated, and
 #: what it would take
 REFUSED = {
-    "bar1d-vibration": (
-        "a dynamic run (the pre-strained bar released, its end's history fitted to Rao's "
-        "series): not wired; it would take LAMMPS's fix nve (velocity Verlet, the scene's "
-        "central difference) from the pre-strained atoms at the scene's time step, the "
-        "monitored atom dumped every step, and the bar's c1 matched as on the static bars"),
     "block2d-indentation": (
         "its sticking contact is not a prescribed-displacement set: the top atoms the "
         "indenter reaches are caught after each equilibrium (the set grows with the depth) "
@@ -117,13 +141,6 @@ REFUSED = {
         "frictionless penalty wall, another contact law); it would take driving LAMMPS "
         "increment by increment (its Python module: minimize, read the top atoms, hold "
         "the caught ones on the indenter, repeat) with the scene's Newton stopping rule"),
-    **{scene: (
-        "peri/lps's compute pe/atom is not the node's energy density: it tallies half of "
-        "the deviatoric energy its forces derive from (pair_peri_lps.cpp: K theta^2 / 2 + "
-        "15 G / (4 m) sum omega e_d^2 V; LPS has 15 G / (2 m)); not wired: it would take "
-        "W_i = 2 pe_i - K theta_i^2 / 2 with compute dilatation/atom, and a check that "
-        "LAMMPS's split of the energy among the atoms is pdverify's (the work of each "
-        "node's own force state)") for scene in ("stiffness3d-box", "stiffness2d-plate")},
 }
 
 
@@ -147,12 +164,13 @@ class PeerTreatment(Treatment):
         over = REPORT_RUNS.get(scene.id)
         if over is None:
             return []
-        settings = ("same-model",) if scene.id in BAR_SCENES else lammps.SETTINGS
+        settings = (("same-model",) if scene.id in BAR_SCENES + DYNAMIC_BAR_SCENES
+                    else REPORT_SETTINGS.get(scene.id, lammps.SETTINGS))
         return [{**lammps_overrides(scene), **over, "setting": s} for s in settings]
 
     def params_for(self, scene):
         """:data:`BAR_SETTING` on seed 004's bars, else its own."""
-        return (BAR_SETTING,) if scene.id in BAR_SCENES else self.params
+        return (BAR_SETTING,) if scene.id in BAR_SCENES + DYNAMIC_BAR_SCENES else self.params
 
     def check_bar(self, params, where):
         """A seed-004 bar: same-model only (:data:`BAR_SETTING`'s one choice); any
@@ -162,7 +180,7 @@ class PeerTreatment(Treatment):
                              f"{BAR_AS_USED}")
 
     def why_not(self, scene):
-        if scene.id in BOND_SCENES or scene.id in ENERGY_SCENES or scene.id in BAR_SCENES:
+        if scene.id in BOND_SCENES + ENERGY_SCENES + BAR_SCENES + DYNAMIC_BAR_SCENES:
             return None
         if scene.id in REFUSED:
             return REFUSED[scene.id]
@@ -233,9 +251,11 @@ class PeerTreatment(Treatment):
                 _trouble(result.info, info.get("equilibrium"), not_in_equilibrium))
 
     def peer_energies(self, scene, p, problem, model, states, where):
-        """The bond-based stiffness scenes: ``(ratios, info, metrics, trouble)``, W_i /
-        W_bulk per strain state (``states``: ``(name, eps)`` each) of LAMMPS's peri/pmb (``compute pe/atom`` with every atom
-        at u = eps . x, :func:`pdverify.peers.lammps.energies`) on the uncorrected
+        """The stiffness scenes: ``(ratios, info, metrics, trouble)``, W_i / W_bulk per
+        strain state (``states``: ``(name, eps)`` each) of LAMMPS's peri/pmb (bond-based
+        scenes) or peri/lps (state-based, ``problem`` None; its pe/atom corrected by
+        :func:`pdverify.peers.lammps.lps_energy_density`) with every atom at
+        u = eps . x (:func:`pdverify.peers.lammps.energies`) on the uncorrected
         ``model``'s atoms. W_bulk is the bulk of the setting's own lattice: pdverify's for
         ``same-model``, LAMMPS's ramped one for ``as-used`` (:func:`lammps_bulk_work_density`;
         ``peer_bulk_ratio`` is it over pdverify's, the ramp's toll on the bulk). The
@@ -284,6 +304,47 @@ class PeerTreatment(Treatment):
                        f"the bar's linear solution, above {DISTANCE_FLOOR:g} (a collinear "
                        "bar is geometrically linear: only the stopping rule may move it); "
                        f"relative residual {balance['residual']:.3g}")
+        return u, info, metrics, trouble
+
+    def peer_dynamic_bar(self, scene, p, problem, system, u0, dt, steps, record,
+                         history_none, where):
+        """Seed 004's vibrating bar (:class:`~pdverify.pd.problem.BondSystem` of
+        ``problem``, its held points held) released from ``u0`` ((n,), at rest) and run
+        by LAMMPS in the same model (peri/pmb on a line of atoms, c1 by type pair, each
+        point's volume, the scene's density as the atoms' mass density) with ``fix nve``
+        for ``steps`` steps of the scene's ``dt``: ``(history, info, metrics, trouble)``,
+        ``history`` (steps + 1, len(record)) the displacements of the atoms ``record``,
+        compared with pdverify's own run ``history_none`` (relative L2 over the whole
+        history). Velocity Verlet's positions are the scene's central differences, and a
+        collinear bar is geometrically linear (see :meth:`peer_solve_bar`), so the two
+        histories differ by rounding only: LAMMPS carries absolute positions, so each step
+        may round a displacement by eps max|x| (machine epsilon of the largest
+        coordinate), eps max|x| / max|u0| relative to the motion's amplitude; the run
+        fails, naming it, when the distance exceeds that summed over the steps (the
+        worst case, every rounding in one direction; 3.2e-10 at Table 13's bar (b),
+        1.4e-12 measured)."""
+        from ..nodeset import node_set_of
+        ns = node_set_of(scene, p, problem, system)
+        model = dataclasses.replace(lammps.bond_based_model(ns), density=float(p["density"]))
+        n = len(ns.x)
+        with tempfile.TemporaryDirectory(prefix="pdverify-lammps-") as folder:
+            history, peer = lammps.dynamics(model, np.asarray(u0, float).reshape(n, 1), dt,
+                                            steps, record, folder, where=where)
+        u = history[:, :, 0]
+        diff = _rel(u, history_none, float(np.linalg.norm(history_none)))
+        metrics = {"peer_diff_to_none": diff, "peer_gap_nonlinear": diff}
+        per_step = float(np.finfo(float).eps * np.max(np.abs(ns.x)) / np.max(np.abs(u0)))
+        limit = per_step * steps
+        info = {"peer": peer, "peer_check": {"distance": diff, "limit": limit,
+                                             "in_agreement": bool(diff <= limit)}}
+        trouble = None
+        if peer.get("damage_sum"):
+            trouble = f"LAMMPS lost bonds (damage summed over the atoms {peer['damage_sum']:.3g})"
+        elif not diff <= limit:
+            trouble = (f"LAMMPS's history is {diff:.3g} (relative L2) from the bar's own run, "
+                       f"above {limit:.3g} (rounding: {per_step:.3g} a step over "
+                       f"{steps} steps; a collinear bar is geometrically linear and velocity "
+                       "Verlet's positions are central differences)")
         return u, info, metrics, trouble
 
     def finish_bars(self, outcome, runs, where):
@@ -340,18 +401,17 @@ class PeerTreatment(Treatment):
 
 
 def peer_energies_of(scene, p, problem, model_none, states, where):
-    """The bond-based stiffness scenes through LAMMPS (:meth:`PeerTreatment.peer_energies`)."""
-    from ..nodeset import DISTANCE_FLOOR, DISTANCE_PER_GRADIENT, between_shells
+    """The stiffness scenes through LAMMPS (:meth:`PeerTreatment.peer_energies`): the
+    bond-based ones through peri/pmb, the state-based ones (``problem`` None,
+    ``model_none`` a :class:`~pdverify.pd.statebased.StateBasedModel`) through peri/lps,
+    whose energy is read as :func:`pdverify.peers.lammps.lps_energy_density`."""
+    from ..nodeset import DISTANCE_FLOOR, DISTANCE_PER_GRADIENT
     from ..pd.work import work_density
     g, d = model_none.grid, model_none.dim
     ids = g.interior_ids
     h, m = model_none.spacing, model_none.m_ratio
-    off = np.asarray(model_none.offsets)
-    lm = lammps.Model(g.x[ids], np.asarray(model_none.node_volume)[ids],
-                      np.zeros((len(ids), d)), {}, h, m,
-                      between_shells(h, np.r_[off, -off], d),
-                      h ** d * model_none.thickness, "peri/pmb", (model_none.c,),
-                      model_none.c * model_none.horizon ** (d + 1))
+    state = problem is None
+    lm = energy_model(model_none)
     strains = [eps for _, eps in states]
     setting = p["setting"]
     with tempfile.TemporaryDirectory(prefix="pdverify-lammps-") as folder:
@@ -363,11 +423,17 @@ def peer_energies_of(scene, p, problem, model_none, states, where):
         bulk = [model_none.bulk_work_density(eps) for eps in strains]
         W_own = W_none
     else:
-        bulk = [lammps_bulk_work_density(model_none.c, h, m, d, lm.uniform_volume, eps)
-                for eps in strains]
-        twin = _as_used_twin(problem, lm)
+        if state:
+            bulk = [lammps_lps_bulk_work_density(model_none, lm.uniform_volume, eps)
+                    for eps in strains]
+            twin = _as_used_state_twin(scene, p, lm)
+        else:
+            bulk = [lammps_bulk_work_density(model_none.c, h, m, d, lm.uniform_volume, eps)
+                    for eps in strains]
+            twin = _as_used_twin(problem, lm)
+            twin = None if twin is None else twin.model
         W_own = (None if twin is None else
-                 np.stack([work_density(twin.model, eps)[twin.model.grid.interior_ids]
+                 np.stack([work_density(twin, eps)[twin.grid.interior_ids]
                            for eps in strains]))
         if W_own is not None:
             metrics["peer_gap_volumes"] = _rel(W_own, W_none, scale)
@@ -392,6 +458,73 @@ def peer_energies_of(scene, p, problem, model_none, states, where):
                        f"setting's linear model, above {limit:.3g} ({DISTANCE_PER_GRADIENT:g}"
                        " x the largest relative bond displacement)")
     return ratios, info, metrics, trouble
+
+
+def energy_model(model_none) -> lammps.Model:
+    """The atoms of a stiffness scene's uncorrected model (its real nodes, their volumes,
+    its bonds by the horizon between two lattice shells): peri/lps with
+    :func:`pdverify.peers.lammps.lps_moduli` for a state-based model, peri/pmb with its c
+    for a bond-based one; no loads, nothing held."""
+    from ..nodeset import between_shells
+    g, d = model_none.grid, model_none.dim
+    ids = g.interior_ids
+    h = model_none.spacing
+    state = hasattr(model_none, "constants")
+    off = np.asarray(model_none.stencil.offsets if state else model_none.offsets)
+    if state:
+        K, G = lammps.lps_moduli(model_none.constants)
+        pair, coefficients, stiffness = "peri/lps", (K, G), K + 4 * G / 3
+    else:
+        pair, coefficients = "peri/pmb", (model_none.c,)
+        stiffness = model_none.c * model_none.horizon ** (d + 1)
+    return lammps.Model(g.x[ids], np.asarray(model_none.node_volume)[ids],
+                        np.zeros((len(ids), d)), {}, h, model_none.m_ratio,
+                        between_shells(h, np.r_[off, -off], d),
+                        h ** d * model_none.thickness, pair, coefficients, stiffness)
+
+
+def _as_used_state_twin(scene, p, model):
+    """The state-based linear model of LAMMPS's as-used run (None where there is none):
+    the stiffness box built by the scene under :func:`as_used_closure` (LAMMPS's ramp,
+    whole cells), when every node's volume is LAMMPS's one volume per atom (the
+    cell-centred boxes: always)."""
+    twin = scene.build("none", p, as_used_closure(model))
+    volume = np.asarray(twin.node_volume)[twin.grid.interior_ids]
+    if len(volume) != len(model.x) or not np.allclose(volume, model.uniform_volume,
+                                                      rtol=1e-12, atol=0):
+        return None
+    return twin
+
+
+def lammps_lps_bulk_work_density(model, volume, strain) -> float:
+    """W of an atom with a complete neighbourhood in LAMMPS's as-used lattice under the
+    homogeneous ``strain`` for the linear LPS ``model``'s constants and influence: its
+    bulk form (:meth:`pdverify.pd.statebased.StateBasedModel.bulk_work_density`) with
+    LAMMPS's weights, ramp(|xi|) V on the lattice offsets within (m + 2e-4) h, in m,
+    theta and the forces alike."""
+    from ..pd.bonds import homogeneous_extensions
+    h, d = model.spacing, model.dim
+    k, r = _lattice_within(h, model.m_ratio, d)
+    n = k * h / r[:, None]
+    e = homogeneous_extensions(r, n, np.asarray(strain, dtype=float))
+    horizon = (model.m_ratio + lammps.EXAMPLES_MARGIN) * h
+    c = model.constants
+    w = model.influence.omega(r, model.horizon) * ramp(r, h, horizon) * volume
+    m = float(np.sum(w * r * r))
+    theta = c.c_theta * np.sum(w * r * e) / m
+    return float(0.5 * (c.k_theta * theta ** 2 / c.c_theta + c.k_e * np.sum(w * e * e) / m))
+
+
+def _lattice_within(spacing, m_ratio, dim):
+    """The lattice offsets k (in spacings) within LAMMPS's as-used horizon and their
+    lengths |k| h."""
+    horizon = (m_ratio + lammps.EXAMPLES_MARGIN) * spacing
+    reach = int(np.floor(m_ratio + lammps.EXAMPLES_MARGIN))
+    axes = np.arange(-reach, reach + 1)
+    k = np.stack(np.meshgrid(*([axes] * dim), indexing="ij"), axis=-1).reshape(-1, dim)
+    r = np.linalg.norm(k, axis=1) * spacing
+    keep = (r > 0) & (r <= horizon)
+    return k[keep], r[keep]
 
 
 def _as_used_twin(problem, model):
@@ -457,5 +590,5 @@ def peer_treatments() -> list[Treatment]:
         params=(SETTING,), theories=("state-based", "bond-based"), dims=(1, 2, 3),
         families=("static-state",), shapes=True, unavailable=lammps.unavailable(),
         scope="the static state-based scenes' uncorrected node sets (influence=hyperbolic) "
-              f"and the bond-based {', '.join(BOND_SCENES + ENERGY_SCENES + BAR_SCENES)} "
-              "(micromodulus=constant)")]
+              f"and {', '.join(BOND_SCENES + ENERGY_SCENES + BAR_SCENES + DYNAMIC_BAR_SCENES)} "
+              "(bond-based: micromodulus=constant)")]

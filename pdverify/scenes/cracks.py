@@ -212,8 +212,7 @@ class CrackScene(ShapeScene):
         if out is not None:
             return out
         if getattr(treatment, "peer", False):
-            return ("its code builds its own bonds from the node positions, so it would "
-                    "bond across the crack; crack faces are not served yet")
+            return None     # LAMMPS: atom types keep it from bonding across the crack
         if getattr(treatment, "cracks", False):
             return None
         if not (treatment.kind == "closure" or getattr(treatment, "baseline", False)):
@@ -337,7 +336,9 @@ class CrackPlate(CrackScene):
     from each end, a bond to a fictitious node at the other end's place fitted from the
     end's own side; they stop at the tip, the bonds round it stay real); the other
     treatments that add nodes are refused (``list`` gives the reason and what each
-    would need).
+    would need); and LAMMPS (``peer:lammps``: atom types and a zero horizon for the
+    type pairs the crack separates keep it from bonding across the slit,
+    ``pdverify.peers.lammps.crack_types``).
 
     Metrics: ``k_ratio`` = K_PD / K_FEM (``pdverify.pd.cracks.fit_k`` at the right tip:
     the Williams fit of the opening of the two node rows nearest the crack on each side,
@@ -441,8 +442,8 @@ class EdgeCrackPlate(CrackScene):
     shapes, Taylor's one-sided fictitious nodes at order 1; beside the mouth the
     lattice's fictitious nodes outside x = 0 and the bonds to them across the crack's
     line are fitted from one side, ``shape_fictitious.sided_fit``); the other
-    node-adding treatments and the peer code are refused with ``plate-crack``'s reasons
-    (``list plate-edge-crack``).
+    node-adding treatments are refused with ``plate-crack``'s reasons (``list
+    plate-edge-crack``); LAMMPS (``peer:lammps``) runs as on ``plate-crack``.
 
     Metrics (:class:`CrackScene`; the headline ``k_net_error_pct``, the comment at
     ``headline``): K at the one tip (a, 0), the fit's window r in

@@ -74,8 +74,8 @@ class InclinedCrackPlate(CrackPlate):
     m; ``spacing`` must divide W and H). Treatments: as ``plate-crack`` (the uncorrected
     model, the bond methods and Taylor's one-sided fictitious nodes at order 1; the
     faces at an angle to the lattice take the one-sided fit's traction, not the force
-    flux: ``shape_fictitious.lattice_flux``); the other node-adding ones refused
-    (``list``: what each would need).
+    flux: ``shape_fictitious.lattice_flux``) and LAMMPS (as on ``plate-crack``); the
+    other node-adding ones refused (``list``: what each would need).
 
     Metrics: ``k1_ratio``, ``k2_ratio`` = K_PD / K_FEM, K_PD by ``fit_k_mixed`` at the
     right tip (Williams orders 1..5 of both modes and a translation fitted to both

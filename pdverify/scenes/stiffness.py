@@ -183,8 +183,12 @@ class StiffnessScene(Scene):
         if peer is not None:      # another code's energies (pdverify.peers)
             where = f"{self.id}/{method}"
             with timer.phase("solve"):
-                ratios, info, metrics, trouble = peer(self, p, self.bond_problem(p, where),
-                                                      model, strain_states(model.dim), where)
+                # the bond-based scenes describe their problem; the state-based ones
+                # (peri/lps) need the built model only
+                problem = (self.bond_problem(p, where)
+                           if self.closure_theory == "bond-based" else None)
+                ratios, info, metrics, trouble = peer(self, p, problem, model,
+                                                      strain_states(model.dim), where)
             outcome = self.measure_ratios(p, model, ratios)
             outcome.diagnostics = info
             return t.finish(outcome, metrics, trouble, where)
@@ -380,8 +384,10 @@ class _StateStiffness(StiffnessScene, StaticStateScene):
         return NO_EXTRA_NODES if treatment.footprint == "plain" else None
 
     def _by_family(self, method) -> bool:
+        """A treatment of the family that assembles the box (a peer code evaluates the
+        nodes' energies itself: :meth:`StiffnessScene.solve`)."""
         t = self.offered().get(method)
-        return t is not None and t.kind == "family"
+        return t is not None and t.kind == "family" and not getattr(t, "peer", False)
 
     def check(self, method, p):
         StiffnessScene.check(self, method, p)
@@ -443,8 +449,9 @@ class _StateStiffness(StiffnessScene, StaticStateScene):
 STATE_PARAMS = (
     *material_params(200e9, 0.3),
     m_ratio_param(3.0),
-    Param("quadrature", "partial-volume", "weights beta (see body3d-traction)",
-          choices=("partial-volume", "moment-corrected")),
+    Param("quadrature", "partial-volume", "weights beta (see body3d-traction; full-cells: "
+          "every neighbour's whole cell, LAMMPS's same-model run)",
+          choices=("partial-volume", "moment-corrected", "full-cells")),
     Param("influence", "gaussian", "influence function (seed 001, Eq. 7: Gaussian)",
           choices=tuple(sorted(INFLUENCES))),
 )

@@ -91,7 +91,8 @@ def test_the_list_shows_why_the_node_adding_treatments_do_not_run():
                          capture_output=True, text=True, check=True).stdout
     assert "pddo: crack faces are not served yet" in out
     assert set(get_scene(ID).offered()) == {"none", "energy", "volume", "pals",
-                                            "energy-directional", "taylor-fictitious"}
+                                            "energy-directional", "taylor-fictitious",
+                                            "peer:lammps"}
 
 
 def test_the_cases_are_every_method_at_the_defaults_and_the_quick_grid():
