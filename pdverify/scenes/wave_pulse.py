@@ -54,8 +54,9 @@ def dispersion(K, x, volume, rho, i, delta, c_p, c_s):
     the x-x block with the offsets along x, the transverse from the same block with the
     offsets along y, i.e. u_x varying along y)."""
     n = len(x)
-    row = np.asarray(K[i, :n].todense()).ravel()
-    dx, dy = x[:, 0] - x[i, 0], x[:, 1] - x[i, 1]
+    row = K[i, :n].tocsr()
+    cols, row = row.indices, row.data              # the node's neighbours only
+    dx, dy = x[cols, 0] - x[i, 0], x[cols, 1] - x[i, 1]
     kd = np.linspace(0.01, 3.0, 300)
     k = kd / delta
     m = rho * volume[i]
