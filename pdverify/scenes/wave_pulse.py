@@ -21,6 +21,7 @@ from ..pd import StateBasedConstants, get_influence, state_based_stencil
 from ..pd.problem import FaceCondition, StaticProblem
 from ..solvers.dynamics import SAFETY, stable_step, velocity_verlet
 from . import register, whole_cells
+from .base import ExpectedFailure
 from .family import FemStaticStateScene
 from .fem_references import FEM, FemReference
 from .surface_nodes import INFLUENCE, QUADRATURE
@@ -94,6 +95,103 @@ def lowpass(signal, dt, f_c):
     return sosfiltfilt(sos, signal, axis=1)
 
 
+class CondensedSystem:
+    """M u'' + K u = r(t) f of a system some of whose free unknowns carry no mass (the
+    surface nodes' force-flux rows on free faces: algebraic equations K_ss u_s + K_sk
+    u_k = f_s), integrated on the others: u_s = K_ss^-1 (f_s - K_sk u_k) at every step,
+    so K_eff = K_kk - K_ks K_ss^-1 K_sk applied as two sparse products and a solve with
+    one sparse LU of K_ss (a Schur complement formed once would be dense over every
+    face's boundary layer), and f_eff = f_k - K_ks K_ss^-1 f_s. The same attributes as
+    :class:`~pdverify.solvers.dynamics.DynamicSystem` for
+    :func:`~pdverify.solvers.dynamics.velocity_verlet` (``K`` a
+    ``scipy.sparse.linalg.LinearOperator``); ``keep``: the integrated unknowns among the
+    system's, ``condensed``: the others."""
+
+    def __init__(self, K, mass, fixed, massless, shape, r):
+        import scipy.sparse as sp
+        from scipy.sparse.linalg import LinearOperator, splu
+        n = K.shape[0]
+        K = sp.csr_matrix(K)
+        keep = np.setdiff1d(np.arange(n), massless)
+        self.keep, self.condensed = keep, np.asarray(massless)
+        rows_k, rows_s = K[keep], K[massless]
+        Kkk, Kks = rows_k[:, keep], rows_k[:, massless]
+        Ksk, Kss = rows_s[:, keep], rows_s[:, massless]
+        lu = splu(Kss.tocsc())
+
+        def matvec(u):
+            u = np.ravel(u)
+            return Kkk @ u - Kks @ lu.solve(Ksk @ u)
+        self.K = LinearOperator((keep.size, keep.size), matvec=matvec, dtype=float)
+        self.load_shape = shape[keep] - Kks @ lu.solve(shape[massless])
+        self.mass = np.where(mass[keep] > 0, mass[keep], 1.0)
+        prescribed = np.isin(keep, fixed)
+        self.free_mask = ~prescribed
+        self.free, self.fixed = np.flatnonzero(~prescribed), np.flatnonzero(prescribed)
+        self._r = r
+        self._zero = np.zeros(self.fixed.size)
+
+    def load(self, t):
+        return self._r(t) * self.load_shape
+
+    def prescribed(self, t):
+        return self._zero, self._zero, self._zero
+
+    def stable_step(self, where):
+        """2 / omega_max, omega_max^2 the largest-magnitude eigenvalue of M_f^-1 K_eff on
+        the free unknowns (ARPACK ``eigs``, tolerance 1e-8; K_eff is not symmetric); a
+        complex one refuses the explicit scheme, a negative one the model itself (its
+        motion grows exponentially under any integrator). A negative eigenvalue that is
+        not the largest in magnitude is not looked for: the integration then overflows,
+        which the integrator reports as a failed run."""
+        from scipy.sparse.linalg import LinearOperator, eigs
+
+        from ..errors import NumericalError
+        from ..solvers.dynamics import StableStep
+        nk, free, m = self.K.shape[0], self.free, self.mass[self.free]
+
+        def mv(x):
+            full = np.zeros(nk)
+            full[free] = np.ravel(x)
+            return (self.K @ full)[free] / m
+        op = LinearOperator((free.size, free.size), matvec=mv, dtype=float)
+        lam = eigs(op, k=1, which="LM", tol=1e-8, return_eigenvectors=False)[0]
+        if abs(lam.imag) > 1e-6 * abs(lam):
+            raise NumericalError(f"{where}: M^-1 K_eff has the extreme eigenvalue {lam:.6g}"
+                                 " (complex); no explicit step is stable")
+        if lam.real < 0:
+            raise NumericalError(
+                f"{where}: with the massless unknowns condensed, M^-1 K_eff has the "
+                f"eigenvalue {lam.real:.3g} s^-2 (negative, its largest in magnitude): "
+                "the semi-discrete motion grows as exp(t / "
+                f"{1e6 / math.sqrt(-lam.real):.2g} us) under any integrator")
+        w = float(np.sqrt(lam.real))
+        return StableStep(2.0 / w, w, "ARPACK eigs on M^-1 K_eff (massless unknowns "
+                          "condensed per step)", 0.0)
+
+
+def pulse_system(system, density, wavelet, shape, where):
+    """``(dynamic system, integrated unknowns)`` of a treatment's ``system``: as
+    :func:`~pdverify.scenes.waves.dynamic_system` builds it (nothing prescribed moves,
+    the load r(t) ``shape``), or, when free unknowns carry no mass and the system is
+    otherwise of masses, a :class:`CondensedSystem`."""
+    from ..solvers.front import displacement_form
+    from .waves import dynamic_system
+    n = system.dofs
+    g = system.model.grid
+    per_node = np.zeros(system.n_unknown_nodes)
+    per_node[:g.n_interior] = density * system.model.node_volume[g.interior_ids]
+    mass = np.tile(per_node, system.dim)
+    free = np.setdiff1d(np.arange(n), system.fixed)
+    massless = free[mass[free] == 0]
+    if not massless.size or system.B is not None or system.offset is not None:
+        return dynamic_system(system, density, np.zeros(n), wavelet, shape, where), \
+            np.arange(n)
+    K, _ = displacement_form(system)
+    dyn = CondensedSystem(K[:n, :n], mass, system.fixed, massless, shape, wavelet[0])
+    return dyn, dyn.keep
+
+
 @register
 class Wave2DPulse(FemStaticStateScene):
     """A pulse in a plane-strain plate reflecting from a fixed edge, a free edge and a
@@ -153,10 +251,15 @@ class Wave2DPulse(FemStaticStateScene):
     the same for every treatment, and falls by 4 per step halving.
 
     Treatments: the uncorrected model and the bond methods (``energy``, ``volume``,
-    ``pals``; PALS at twice the spacing, :meth:`cases`). Surface nodes (seed 002's form) do not carry over on this plate: on its
-    free edges the surface nodes' rows are the force-flux equations, unknowns without
-    mass, which an explicit step would need to condense (a solve per step); their run
-    fails with that reason (:func:`~pdverify.scenes.waves.dynamic_system`).
+    ``pals``; PALS at twice the spacing, :meth:`cases`), and surface nodes (seed 002's
+    form): on the free edges their unknowns are the force-flux equations' and carry no
+    mass, so they are condensed at every step (:class:`CondensedSystem`; the condensed
+    static system reproduces the full one's solution to 2e-11). Finding: the condensed
+    operator is not stable in time. At h = 0.02 (order 1) M^-1 K_eff has real
+    eigenvalues down to -3.9e11 s^-2 (order 2: -8.4e10), beside the largest positive
+    1.9e11: modes that grow as exp(t / 1.6 us), under any integrator; the run fails
+    naming that eigenvalue. (With every face prescribed, as in the manufactured boxes,
+    no unknown is condensed and the surface nodes carry over.)
     """
 
     id = "wave2d-pulse"
@@ -178,6 +281,12 @@ class Wave2DPulse(FemStaticStateScene):
               "sets the receivers' low-pass cut-off", open_interval(0.0, 1.0)),
     )
     baseline_params = ()
+    #: the surface nodes' condensed operator grows exponentially (class docstring)
+    expected_failures = (
+        ExpectedFailure("with their force-flux rows on the free edges condensed, the "
+                        "surface nodes' operator has negative eigenvalues (down to "
+                        "-3.9e11 s^-2 at h = 0.02): its motion grows exponentially under "
+                        "any integrator (our finding, issue 56)", method="surface-nodes"),)
     quick_spacing = 0.02
     treatments = ("none", "energy", "volume", "pals", "surface-nodes")
 
@@ -240,7 +349,6 @@ class Wave2DPulse(FemStaticStateScene):
         if method == FEM.name:
             return FemReference.solve(self, method, p, timer)
         from ..corrections.registry import plugin_call
-        from .waves import dynamic_system
         where = f"{self.id}/{method}"
         with timer.phase("reference"):
             ref = self.reference_of(p)
@@ -252,8 +360,9 @@ class Wave2DPulse(FemStaticStateScene):
             from ..solvers.front import displacement_form
             K, rhs = displacement_form(system)
             n = system.dofs
-            dyn = dynamic_system(system, p["rho"], np.zeros(n), ricker(q), rhs[:n], where)
-            limit = stable_step(dyn, where=where)
+            dyn, keep = pulse_system(system, p["rho"], ricker(q), rhs[:n], where)
+            limit = (dyn.stable_step(where) if isinstance(dyn, CondensedSystem)
+                     else stable_step(dyn, where=where))
             n0 = q.base_steps()
             T = p["duration"]
             j = max(1, math.ceil(T / (n0 * p["dt_factor"] * limit.dt_limit)))
@@ -261,9 +370,14 @@ class Wave2DPulse(FemStaticStateScene):
             dt = T / steps
             snap = np.rint(ref.snapshot_times / dt).astype(int)
         with timer.phase("solve"):
-            run = velocity_verlet(dyn, np.zeros(n), np.zeros(n), dt, steps,
-                                  sample_steps=np.r_[np.arange(steps + 1)], where=where,
+            nk = keep.size
+            run = velocity_verlet(dyn, np.zeros(nk), np.zeros(nk), dt, steps,
+                                  sample_steps=np.arange(steps + 1), where=where,
                                   limit=limit)
+            if nk < n:       # the condensed unknowns (surface nodes) are not measured
+                full = np.zeros((run.u.shape[0], n))
+                full[:, keep] = run.u
+                run.u = full
         return self.measure_pulse(p, q, ref, system, K, run, snap, limit)
 
     def measure_pulse(self, p, q, ref, system, K, run, snap, limit):
