@@ -102,8 +102,8 @@ class PulseParams:
         _p.require(1 <= self.snapshots <= 100, REFERENCE,
                    f"snapshots must be 1..100, got {self.snapshots}")
         _p.require(0 < self.source_x < self.length and 0 < self.source_y < self.width,
-                   REFERENCE, f"the source ({self.source_x}, {self.source_y}) must lie "
-                   f"inside the plate [0, {self.length}] x [0, {self.width}]")
+                   REFERENCE, f"source_x={self.source_x}, source_y={self.source_y}: the "
+                   f"source must lie inside the plate [0, {self.length}] x [0, {self.width}]")
         for name, L in (("length", self.length), ("width", self.width)):
             n = L / self.spacing
             _p.require(abs(n - round(n)) < 1e-9 * n and round(n) >= 1, REFERENCE,
