@@ -7,7 +7,8 @@ Plain script (no test runner):
 
 Runs ``python -m pdverify report --only wave2d-pulse`` in a fresh process three times:
 with an empty FEM cache (a temporary ``PDVERIFY_CACHE_DIR``), then warm (the same
-cache), then ``--quick`` warm, and records the wall time of each report and, per run,
+cache), then ``--quick`` warm, and records the wall and CPU time (user + system, the
+report's processes) of each report and, per run,
 the run's total time and peak memory from its ``results.json``. The machine's load (the
 harness header) says how far the numbers are from an idle machine's.
 """
@@ -16,6 +17,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import resource
 import subprocess
 import sys
 import tempfile
@@ -31,16 +33,21 @@ def one_report(out: Path, cache: Path, jobs: int, quick: bool) -> dict:
     env = {**os.environ, "PDVERIFY_CACHE_DIR": str(cache),
            "PYTHONPATH": str(harness.ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
     t0 = time.perf_counter()
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     subprocess.run([sys.executable, "-m", "pdverify", "report", "--only", SCENE,
                     "--out", str(out), "--jobs", str(jobs)] + (["--quick"] if quick else []),
                    env=env, check=False, cwd=harness.ROOT, capture_output=True)
     wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    # the CPU time of the report and its workers (user + system): what an idle machine's
+    # run would take at most, load or not
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     res = json.loads((out / "results.json").read_text())
     runs = [{"method": r["method"], "spacing": r["params"].get("spacing"),
              "status": r["status"], "total_s": r["timings"].get("total_s"),
              "peak_rss_gb": (r.get("resources") or {}).get("peak_rss_gb")}
             for r in res["runs"]]
-    return {"wall_s": wall, "runs_s": sum(r["total_s"] or 0 for r in runs), "runs": runs}
+    return {"wall_s": wall, "cpu_s": cpu, "runs_s": sum(r["total_s"] or 0 for r in runs), "runs": runs}
 
 
 def main() -> None:
@@ -55,7 +62,7 @@ def main() -> None:
             rec[label] = r
             rec.save()
             peak = max(x["peak_rss_gb"] or 0 for x in r["runs"])
-            print(f"{label}: report {r['wall_s']:.1f} s wall, runs {r['runs_s']:.1f} s, "
+            print(f"{label}: report {r['wall_s']:.1f} s wall, {r['cpu_s']:.1f} s CPU, runs {r['runs_s']:.1f} s, "
                   f"largest peak {peak:.2f} GB")
             for x in r["runs"]:
                 print(f"  {x['method']:14s} h={x['spacing']} {x['status']:6s} "

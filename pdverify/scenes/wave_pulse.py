@@ -475,7 +475,9 @@ class Wave2DPulse(FemStaticStateScene):
         """Every treatment offered at the default grid (quick: twice the spacing); PALS at twice
         the spacing of the others, beside ``none`` there (PALS's operator has 4x the
         non-zeros and its assembly solves the influence functions' constraint rows: at
-        h = 0.01 it took 77 s of setup and 2.05 GB under load, past the scene's budget)."""
+        h = 0.01 it took 77 s of setup and 2.05 GB under load, past the scene's budget;
+        in --quick at 0.04 m a smoke run only, its horizon 0.12 m a third of the peak
+        wavelength: its errors there are not PALS's at a usable grid)."""
         h = self.quick_spacing if quick else self.default_params()["spacing"]
         runs = [(m, {"spacing": h} if quick else {})
                 for m in ("none", "energy", "energy-directional", "volume", "surface-nodes")]

@@ -33,8 +33,8 @@ def pulse_figures(scene, results, folder):
                     label=lab)
         a, b = np.asarray(first["windows"])[k] * 1e6
         ax.axvspan(a, b, color="0.85", zorder=0)
-        ax.set_title(f"receiver facing the {name} "
-                     f"{'corner' if name == 'corner' else 'edge'}", fontsize=10)
+        ax.set_title(f"receiver facing the {name}"
+                     f"{'' if name == 'corner' else ' edge'}", fontsize=10)
         ax.set_xlabel("t [us]")
         ax.set_ylabel("|u| low-passed [m]")
         ax.grid(alpha=0.3)
