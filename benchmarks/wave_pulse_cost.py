@@ -11,6 +11,12 @@ cache), then ``--quick`` warm, and records the wall and CPU time (user + system,
 report's processes) of each report and, per run,
 the run's total time and peak memory from its ``results.json``. The machine's load (the
 harness header) says how far the numbers are from an idle machine's.
+
+Measured 2026-11-28 under load (load average 14-17 on the 2 cores shared with seven
+other sessions; record ``wave_pulse_cost-2026-11-28-final.json``): cold 104 s wall and
+25.0 s CPU (the FEM study 21.6 s wall of it), warm 84 s wall and 20.2 s CPU (PD runs at
+h = 0.01 21-44 s wall each, the surface nodes' documented failure 6 s), --quick warm
+25 s wall and 6.1 s CPU; every run's peak at most 0.82 GB.
 """
 from __future__ import annotations
 
