@@ -678,6 +678,19 @@ DEVIATIONS = (
               "scenes/waves.py, solvers/dynamics.py; tests/waves/test_waves_manufactured.py",
               summary="Ours: manufactured 2D/3D waves, discrete or continuum body force",
               paper="seed 002: 1D, central differences"),
+    Deviation(("wave2d-pulse",), "choice",
+              "Ours, seed 002's wave in 2D: a Ricker pulse from a curl-free Gaussian body "
+              "force in a plane-strain plate with one fixed and three free edges, against a "
+              "converged elastodynamic FEM (reference_fem.wave_plate: quadratic elements, "
+              "lumped mass, central differences); the receivers' signals compared where "
+              "PD's longitudinal phase velocity (from the run's own operator) is within "
+              "the run's dispersion_tol of the classical one. Finding: the surface nodes' "
+              "force-flux unknowns on the free edges, condensed at every step, leave an "
+              "operator with negative eigenvalues whose motion grows exponentially: a "
+              "documented failure of that run.",
+              "scenes/wave_pulse.py, reference_fem/wave_plate.py; tests/waves/test_wave_pulse.py",
+              summary="Ours: a pulse in a plate against an elastodynamic FEM",
+              paper="seed 002: 1D, central differences"),
 )
 
 

@@ -13,6 +13,7 @@ Public API: one function per reference, each returning its converged, cached res
     inclined_crack(**params) -> InclinedCrackResult   issue 54: inclined centre crack
     cylinder_tension(**params) -> CylinderResult      issue 55: quarter cylinder, tension
     cavity_block(**params)   -> CavityResult          issue 55: block with a spherical cavity
+    plate_pulse(**params)    -> PulseResult           issue 56: a pulse in a plate (dynamics)
 
 Keyword arguments override the fields of the matching ``*Params`` dataclass;
 ``use_cache=False`` recomputes. The cache lives in ``$PDVERIFY_CACHE_DIR`` (default
@@ -42,6 +43,7 @@ from .solid3d import Solid3D, TetField  # noqa: E402
 from .solid3d_refs import (CavityParams, CavityResult, CylinderParams, CylinderResult,  # noqa: E402
                            cavity_block, cylinder_tension)
 from .results import ReferenceResult, RefinementRow  # noqa: E402
+from .wave_plate import PulseParams, PulseResult, plate_pulse  # noqa: E402
 from .tension_sheet import TensionSheetParams, TensionSheetResult, tension_sheet  # noqa: E402
 
 REFERENCES = {
@@ -56,18 +58,19 @@ REFERENCES = {
     "plate-inclined-crack": inclined_crack,
     "cylinder3d-tension": cylinder_tension,
     "block3d-cavity": cavity_block,
+    "plate-pulse": plate_pulse,
 }
 
 __all__ = [
     "__version__", "REFERENCES", "cache_dir", "cache_key",
     "clamped_plate", "tension_sheet", "clamped_sheet", "indentation", "hole_plate", "l_plate",
-    "crack_plate", "edge_crack_plate", "inclined_crack", "cylinder_tension", "cavity_block",
+    "crack_plate", "edge_crack_plate", "inclined_crack", "cylinder_tension", "cavity_block", "plate_pulse",
     "PlateParams", "TensionSheetParams", "ClampedSheetParams", "IndentationParams",
     "HolePlateParams", "LPlateParams", "CrackPlateParams", "InclinedCrackParams",
-    "CylinderParams", "CavityParams",
+    "CylinderParams", "CavityParams", "PulseParams",
     "PlateResult", "TensionSheetResult", "ClampedSheetResult", "IndentationResult",
     "HolePlateResult", "LPlateResult", "CrackPlateResult", "InclinedCrackResult",
-    "CylinderResult", "CavityResult",
+    "CylinderResult", "CavityResult", "PulseResult",
     "ReferenceResult", "RefinementRow", "Material", "TensorElasticity", "FieldSolution",
     "MeshElasticity", "MeshField", "Solid3D", "TetField",
 ]

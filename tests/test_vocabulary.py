@@ -131,7 +131,7 @@ def test_parameter_surface_unchanged():
     before = json.loads((DATA / "param_surface_a694eb9.json").read_text())
     after = json.loads(json.dumps(surface()))
     # scenes added since, each named by its issue (their own tests cover their params)
-    new_scenes = {"wave2d-manufactured", "wave3d-manufactured"}       # issue 56
+    new_scenes = {"wave2d-manufactured", "wave3d-manufactured", "wave2d-pulse"}   # issue 56
     assert sorted(after) == sorted([*before, *new_scenes])
     added = set()
     for sid in before:

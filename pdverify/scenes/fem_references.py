@@ -25,7 +25,10 @@ def _float_check(default):
 FEM_UNITS = {"width": "m", "height": "m", "length": "m", "radius": "m", "depth": "m",
              "crack": "m", "horizon": "m", "thickness": "m", "spacing": "m",
              "fine_half_width": "m", "fine_depth": "m", "sample_spacing": "m", "E": "Pa",
-             "traction": "Pa", "body_force": "N/m^3", "angle": "deg"}
+             "traction": "Pa", "body_force": "N/m^3", "angle": "deg",
+             # the elastodynamic pulse (reference_fem.wave_plate)
+             "rho": "kg/m^3", "source_x": "m", "source_y": "m", "source_width": "m",
+             "wavelength": "m", "receiver_offset": "m", "duration": "s"}
 
 
 def _field_param(name, field, cls_name) -> Param:

@@ -143,7 +143,7 @@ def test_treatment_plugin_serves_every_scene_of_its_family(treatment_env):
     import pdverify.scenes as scenes
     family = sorted(s.id for s in scenes.all_scenes()
                     if s.family == "static-state" and not s.has_shape)
-    assert len(family) == 12    # 10 static boxes and issue 56's two wave boxes
+    assert len(family) == 13    # 10 static boxes, issue 56's two wave boxes and pulse plate
     r = cli(treatment_env, "list")
     assert r.returncode == 0, r.stderr
     matrix = r.stdout.split("method x scene:\n", 1)[1].splitlines()

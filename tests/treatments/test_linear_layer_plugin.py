@@ -90,15 +90,22 @@ def test_it_runs_on_every_scene_of_its_family(registered):
     import pdverify.scenes as scenes
     family = [s for s in scenes.all_scenes() if s.family == "static-state"]
     boxes = [s for s in family if not s.has_shape]
-    # 12 boxes: 10 static ones and issue 56's two wave boxes (the family's dynamic mode);
-    # the shapes: hole, L, three cracks, two 3D bodies
-    assert len(boxes) == 12 and len(family) == 19
+    # 13 boxes: 10 static ones and issue 56's two wave boxes and pulse plate (the
+    # family's dynamic mode); the shapes: hole, L, three cracks, two 3D bodies
+    assert len(boxes) == 13 and len(family) == 20
     for scene in family:
         why = registered.why_not(scene)
         if scene.has_shape:
             assert why is not None and "curved or cut boundary" in why, (scene.id, why)
             continue
         assert why is None, (scene.id, why)
+        if scene.id == "wave2d-pulse":
+            # surface-node unknowns on free edges: condensed per step, and the condensed
+            # operator of the built-in surface nodes grows (a documented failure there);
+            # the plugin's runs at the quick grid, ok or failing the same named way
+            res = scene.run(NAME, {"spacing": 0.02})
+            assert res.status == "ok" or "negative" in res.message, res.message
+            continue
         res = scene.run(NAME, _coarse(scene))
         assert res.status == "ok", (scene.id, res.message)
         assert res.params["extrapolation"] == "linear", scene.id   # its own default
@@ -151,4 +158,4 @@ print(sum(t.why_not(s) is None for s in scenes.all_scenes()), len(t.answers))
     offered, answered = map(int, out.stdout.split())
     import pdverify.scenes as scenes
     assert answered == len(scenes.all_scenes())
-    assert offered == 12     # the twelve boxes of the static-state family (the test above)
+    assert offered == 13     # the thirteen boxes of the static-state family (the test above)
