@@ -191,6 +191,26 @@ def check_bond_box(cells, p, where) -> None:
                          f"App. D needs nodes > 2 * order (order <= {(n - 1) // 2})")
 
 
+def bordered(K, rhs, rows, values, coords):
+    """``(op, op_rhs, coords, n_rows)``: K u = rhs bordered by the constraint ``rows``
+    (sparse blocks over K's columns) = ``values`` with Lagrange multipliers, and the
+    coordinates of the unknowns (a multiplier at the weighted mean of its row's nodes,
+    for the nested-dissection ordering). Every constraint row is scaled to the
+    stiffness's scale: the value rows (weights of order 1) beside bond stiffnesses of
+    order E h^(d-1) made the bordered system look singular to the LU (condition estimate
+    1e18 on the tension sheet; 1e3 once scaled); the multipliers scale with them and are
+    not reported."""
+    if not rows:
+        return K.tocsc(), rhs, coords, 0
+    B = sp.vstack(rows).tocsr()
+    scale = abs(K).max() / np.maximum(abs(B).max(axis=1).toarray().ravel(), 1e-300)
+    B = (sp.diags(scale) @ B).tocsr()
+    op = sp.bmat([[K, B.T], [B, None]], format="csc")
+    W = abs(B).tocsr()
+    return (op, np.r_[rhs, scale * np.concatenate(values)],
+            np.r_[coords, (W @ coords) / np.asarray(W.sum(axis=1))], B.shape[0])
+
+
 def assemble_bond_box(problem: BondProblem, order: int, anchor: str) -> BondBoxSystem:
     """The system of ``problem`` (its :class:`~pdverify.pd.problem.SurfaceConditions`)
     under Taylor's fictitious nodes (``anchor="real"``) or the surface nodes
@@ -278,24 +298,8 @@ def assemble_bond_box(problem: BondProblem, order: int, anchor: str) -> BondBoxS
     planes = _plane_rows(g, sc.planes, n_unk)
     rows += planes
     vals += [np.zeros(r.shape[0]) for r in planes]
-    if rows:
-        B = sp.vstack(rows).tocsr()
-        # every constraint row to the stiffness's scale: the value rows (weights of
-        # order 1) beside bond stiffnesses of order E h^(d-1) made the bordered system
-        # look singular to the LU (condition estimate 1e18 on the tension sheet; 1e3
-        # once scaled); the multipliers scale with them and are not reported
-        scale = abs(K).max() / np.maximum(abs(B).max(axis=1).toarray().ravel(), 1e-300)
-        B = (sp.diags(scale) @ B).tocsr()
-        op = sp.bmat([[K, B.T], [B, None]], format="csc")
-        op_rhs = np.r_[rhs, scale * np.concatenate(vals)]
-    else:
-        B, op, op_rhs = None, K.tocsc(), rhs
-    n_rows = 0 if B is None else B.shape[0]
     at = g.x[g.interior_ids] if anchor == "real" else np.r_[g.x[g.interior_ids], g.surface_x]
-    coords = np.tile(at, (d, 1))
-    if B is not None:
-        W = abs(B).tocsr()
-        coords = np.r_[coords, (W @ coords) / np.asarray(W.sum(axis=1))]
+    op, op_rhs, coords, n_rows = bordered(K, rhs, rows, vals, np.tile(at, (d, 1)))
     counts.update(constraints=int(n_rows), unknowns=int(op.shape[0]))
     parts = {f.name: np.flatnonzero(~g.is_interior & (
         (g.index[:, f.axis] < 0) if f.side == 0

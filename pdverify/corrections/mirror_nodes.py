@@ -76,7 +76,7 @@ from ..pd.build import build_model
 from ..pd.closure import Closure, real_identity
 from ..pd.problem import Face, LinearSystem, box_faces
 from .assembly import model_of, padded, traction_of, unknown_coords
-from .bond_fictitious import BondBoxSystem, _plane_rows, bond_force_matrix
+from .bond_fictitious import BondBoxSystem, _plane_rows, bond_force_matrix, bordered
 from .surface_nodes import crossing_bonds, face_crossings
 from .taylor_fictitious import _surface_flux
 
@@ -728,23 +728,13 @@ def assemble_mirror_bond_box(problem, neumann: str = "full-traction",
         K = (K_real @ A).tocsr()
         rhs = -(K_real @ offset)
         planes = _plane_rows(g, sc.planes, ni)
-        if planes:
-            B = sp.vstack(planes).tocsr()
-            # the plane rows to the stiffness's scale, as bond_fictitious does
-            scale = abs(K).max() / np.maximum(abs(B).max(axis=1).toarray().ravel(), 1e-300)
-            B = (sp.diags(scale) @ B).tocsr()
-            op = sp.bmat([[K, B.T], [B, None]], format="csc")
-            op_rhs = np.r_[rhs, np.zeros(B.shape[0])]
-        else:
-            B, op, op_rhs = None, K.tocsc(), rhs
-        coords = np.tile(g.x[g.interior_ids], (d, 1))
-        if B is not None:
-            W = abs(B).tocsr()
-            coords = np.r_[coords, (W @ coords) / np.asarray(W.sum(axis=1))]
+        op, op_rhs, coords, n_rows = bordered(K, rhs, planes,
+                                              [np.zeros(b.shape[0]) for b in planes],
+                                              np.tile(g.x[g.interior_ids], (d, 1)))
         flux = face_crossings(g, model.bond_a, model.bond_b)
         face_rows = (_surface_flux(model, flux, ns) @ bond_force_matrix(model)).tocsr()
         return op, op_rhs, face_rows, coords, {
-            "constraints": 0 if B is None else int(B.shape[0]), "unknowns": int(op.shape[0])}
+            "constraints": int(n_rows), "unknowns": int(op.shape[0])}
 
     counts = {"real_nodes": int(ni), "fictitious_nodes": int(ne - ni)}
     parts = {f.name: np.flatnonzero(~g.is_interior & (

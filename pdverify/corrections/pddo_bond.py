@@ -62,7 +62,7 @@ import scipy.sparse as sp
 from ..pd.build import build_model
 from ..pd.faces import box_faces
 from ..pd.problem import BondProblem
-from .bond_fictitious import BondBoxSystem, _plane_rows
+from .bond_fictitious import BondBoxSystem, _plane_rows, bordered
 from .mirror_nodes import prescribed_parts
 from .pddo import _choose_faces, _d2, derivative_operators
 
@@ -163,17 +163,8 @@ def assemble_bond_pddo(problem: BondProblem) -> BondBoxSystem:
     K = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                       shape=(d * n, d * n))
     planes = _plane_rows(g, sc.planes, n)
-    coords = np.tile(x, (d, 1))
-    if planes:
-        B = sp.vstack(planes).tocsr()
-        scale = abs(K).max() / np.maximum(abs(B).max(axis=1).toarray().ravel(), 1e-300)
-        B = (sp.diags(scale) @ B).tocsr()
-        op = sp.bmat([[K, B.T], [B, None]], format="csc")
-        op_rhs = np.r_[rhs, np.zeros(B.shape[0])]
-        W = abs(B).tocsr()
-        coords = np.r_[coords, (W @ coords) / np.asarray(W.sum(axis=1))]
-    else:
-        op, op_rhs = K.tocsc(), rhs
+    op, op_rhs, coords, _ = bordered(K, rhs, planes, [np.zeros(b.shape[0]) for b in planes],
+                                     np.tile(x, (d, 1)))
     counts.update(constraints=int(op.shape[0] - d * n), unknowns=int(op.shape[0]))
     parts = {f.name: np.flatnonzero(touches[:, fi]) for fi, f in enumerate(faces)}
     return BondBoxSystem(model, np.zeros(d * n), np.zeros(0, dtype=int), np.zeros(0), parts,
@@ -203,7 +194,7 @@ def face_flux_rows(g, C, D, area) -> sp.csr_matrix:
     over the grid's surface nodes) as rows over the real nodes' displacements: the
     PDDO traction at the cell face's centre from its owner node (the real node of the
     boundary cell), times the cell face's area."""
-    d, n, ns = g.dim, g.n_interior, g.n_surface
+    d, n = g.dim, g.n_interior
     out = [[None] * d for _ in range(d)]
     blocks = {i: {k: [] for k in range(d)} for i in range(d)}
     order = []
