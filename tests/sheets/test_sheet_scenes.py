@@ -88,7 +88,7 @@ BAD_INPUT = [
     (("sheet2d-clamped", "--method", "none", "--set", "micromodulus=cubic"),
      "allowed: constant, conical"),
     (("sheet2d-tension", "--method", "virtual-nodes"),
-     "allowed: fem, none, taylor-fictitious, surface-nodes, pddo, mirror-nodes, energy, energy-directional"),
+     "allowed: fem, none, taylor-fictitious, surface-nodes, mirror-nodes, pddo, energy, energy-directional"),
     (("sheet2d-clamped", "--method", "energy-directional", "--set", "nu=0.3"), "nu = 1/3"),
 ]
 
