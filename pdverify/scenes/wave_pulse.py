@@ -269,6 +269,13 @@ class Wave2DPulse(FemStaticStateScene):
     """
 
     id = "wave2d-pulse"
+    #: the report's error for this scene: the receivers' low-passed signals against the
+    #: FEM's, the wavelengths where PD and classical agree (class docstring)
+    headline = "receiver_max_error_pct"
+    #: the compact table beside it (report.html): the reflections' arrival errors and
+    #: Verlet's energy balance
+    table_metrics = ("fixed_arrival_error_pct", "corner_arrival_error_pct",
+                     "energy_balance_pct")
     #: the numbers the docstring quotes from this report's runs (pdverify.quotes)
     doc_quotes = {k: Q(metric, method, {"spacing": 0.01}, ".2g") for k, metric, method in (
         ("none_fixed", "fixed_arrival_error_pct", "none"),
