@@ -104,7 +104,9 @@ ADDED_CELLS = (
        ("bar1d-vibration", "peer:lammps")}
     # and on the crack scenes (atom types keep it from bonding across the slit)
     | {(sid, "peer:lammps") for sid in ("plate-crack", "plate-edge-crack",
-                                        "plate-inclined-crack")})
+                                        "plate-inclined-crack")}
+    # and on the 3D shapes (their node sets and parts as on the 2D shapes)
+    | {(sid, "peer:lammps") for sid in ("cylinder3d-tension", "block3d-cavity")})
 
 
 #: choices a parameter gained since a694eb9, each named by its issue: (scene, param) ->

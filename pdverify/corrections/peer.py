@@ -93,15 +93,19 @@ REPORT_RUNS = {"body3d-traction": {"spacing": 0.1}, "plate2d-clamped": {},
                # crack kept by atom types: pdverify.peers.lammps.crack_types)
                "plate-crack": {"spacing": 0.05, "m_ratio": 2.0},
                "plate-edge-crack": {"spacing": 1 / 30, "m_ratio": 2.0},
-               "plate-inclined-crack": {"spacing": 0.05, "m_ratio": 2.0}}
-#: the report's settings where not both: the crack scenes same-model only (the
+               "plate-inclined-crack": {"spacing": 0.05, "m_ratio": 2.0},
+               # the 3D shapes at their report grids (832 and 983 atoms, 5-8 s of FIRE)
+               "cylinder3d-tension": {}, "block3d-cavity": {}}
+#: the report's settings where not both: the crack scenes and the 3D shapes same-model
+#: only (the
 #: difference to none's K is the number; 1,600-4,800 atoms, 700-1,800 FIRE steps, the
 #: largest peer runs: 2.8-10 s each under a load of ~14 on 2 cores, all ten runs issue
 #: 55 added 31 s of wall and 16 s of CPU there with both settings on the cracks:
 #: benchmarks/records/peers-2026-11-28-issue55-lammps-cracks-dynamics-lps.json); as-used
 #: runs with ``--set setting=as-used`` (tests/peers/test_lammps.py checks it on a crack)
 REPORT_SETTINGS = {scene: ("same-model",) for scene in
-                   ("plate-crack", "plate-edge-crack", "plate-inclined-crack")}
+                   ("plate-crack", "plate-edge-crack", "plate-inclined-crack",
+                    "cylinder3d-tension", "block3d-cavity")}
 #: the bond-based scenes that solve through a peer (their own assembly; the static-state
 #: family's scenes are served through the family): the clamped sheet's clamps are held
 #: atoms (``fix setforce`` on the group of each prescribed component, the atoms set to
@@ -588,7 +592,7 @@ def peer_treatments() -> list[Treatment]:
         "or driven to solve pdverify's discrete model", "LAMMPS (Thompson et al., CPC 271 "
         "(2022) 108171), PERI package (Parks, Lehoucq, Plimpton, Silling 2008)",
         params=(SETTING,), theories=("state-based", "bond-based"), dims=(1, 2, 3),
-        families=("static-state",), shapes=True, unavailable=lammps.unavailable(),
+        families=("static-state",), shapes=True, shapes3d=True, unavailable=lammps.unavailable(),
         scope="the static state-based scenes' uncorrected node sets (influence=hyperbolic) "
               f"and {', '.join(BOND_SCENES + ENERGY_SCENES + BAR_SCENES + DYNAMIC_BAR_SCENES)} "
               "(bond-based: micromodulus=constant)")]

@@ -11,7 +11,8 @@ of the family run on it: ``none``, the bond/closure methods (``energy``, ``volum
 meets, ``pdverify.pd.rays``) and the node-adding ones along the local normal in 3D
 (``mirror-nodes``, ``surface-nodes``, ``taylor-fictitious``, ``pddo``: our
 generalisations, each stated and tested for exactness in its module; the ordered ones at
-order 1, see :meth:`Shape3DScene.default_cases`).
+order 1, see :meth:`Shape3DScene.default_cases`); and LAMMPS (``peer:lammps``,
+same-model in the report: ``pdverify.corrections.peer.REPORT_RUNS``).
 
 Choices common to both (the issue is silent): octants by symmetry, on the PD side too
 (the symmetry planes are roller parts, a prescribed normal component on the real nodes
