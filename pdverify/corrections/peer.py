@@ -106,6 +106,9 @@ REPORT_RUNS = {"body3d-traction": {"spacing": 0.1}, "plate2d-clamped": {},
 REPORT_SETTINGS = {scene: ("same-model",) for scene in
                    ("plate-crack", "plate-edge-crack", "plate-inclined-crack",
                     "cylinder3d-tension", "block3d-cavity")}
+#: the scenes whose quick report runs the peer at the scene's own quick grid (every other
+#: method runs there too): the 3D shapes (their default grids cost LAMMPS 5-8 s)
+QUICK_AT_SCENE_GRID = ("cylinder3d-tension", "block3d-cavity")
 #: the bond-based scenes that solve through a peer (their own assembly; the static-state
 #: family's scenes are served through the family): the clamped sheet's clamps are held
 #: atoms (``fix setforce`` on the group of each prescribed component, the atoms set to
@@ -170,6 +173,8 @@ class PeerTreatment(Treatment):
             return []
         settings = (("same-model",) if scene.id in BAR_SCENES + DYNAMIC_BAR_SCENES
                     else REPORT_SETTINGS.get(scene.id, lammps.SETTINGS))
+        if quick and scene.id in QUICK_AT_SCENE_GRID:
+            over = {**over, "spacing": scene.quick_spacing}
         return [{**lammps_overrides(scene), **over, "setting": s} for s in settings]
 
     def params_for(self, scene):
