@@ -368,8 +368,22 @@ def surface_nodes_on_shape(problem, order: int) -> LinearSystem:
       fictitious nodes and the bonds across the crack's line from one side. At the tip
       as Taylor's: the fictitious nodes stop there, the bonds round it stay real.
       Exact for the order's polynomials on the crack geometries and one-sided
-      (tests/shapes/test_crack_faces.py). The crack scenes do not offer it: their pins
-      of length h/2 get surface nodes in no equation (``scenes.cracks``).
+      (tests/shapes/test_crack_faces.py). The tips carry no surface node of their own:
+      a tip is a face's end, its nearest surface nodes the faces' last ones.
+    - pins (issue 54: the crack scenes' parts of length h/2 holding the rigid motions):
+      a surface node that no fictitious value is extrapolated from and that no row of
+      its own reads (on a straight edge the flux rows are over bond forces; its
+      boundary node's fictitious nodes all take another part's nearer surface node)
+      has a column in no equation, so its conditions are imposed on its partner, the
+      nearest surface node that is read (:func:`unread_surface_nodes`; on the pins the
+      same boundary node's point on the adjacent edge part, h/2 away): a component
+      the pin prescribes is prescribed on the partner (the problem's exact value at
+      the partner's point; the partner's own row of it dropped), a free component's
+      flux row is added to the partner's (the flux through both stretches equal to the
+      resultant over both), and the unread surface node's free components equal the
+      partner's. Only systems with such a surface node change (none but the crack
+      scenes' among the report's: the other shapes' surface-node runs are unchanged
+      bit for bit).
 
     Exactness kept (tests/shapes/test_shape_methods.py): order N reproduces every
     polynomial field of degree <= N with its body force when the real nodes' complete

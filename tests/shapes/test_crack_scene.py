@@ -138,7 +138,8 @@ def test_the_edge_crack_scene_shares_the_centre_cracks_builder_and_refines_k():
         1.0, 1.0, 0.5, 0.025, 3.0)
     assert edge.reference_params(p)["height"] == 1.0
     cases = edge.cases()
-    methods = {"none", "energy", "volume", "pals", "energy-directional", "taylor-fictitious"}
+    methods = {"none", "energy", "volume", "pals", "energy-directional", "taylor-fictitious",
+               "surface-nodes"}
     assert {m for m, _ in cases} == methods | {"fem"}
     assert sorted({q.get("spacing", 0.025) for m, q in cases if m != "fem"}) == sorted(
         (1 / 60, 0.025, 1 / 30))
