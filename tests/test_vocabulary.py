@@ -98,6 +98,9 @@ ADDED_CELLS = (
     # issue 54: Taylor's one-sided fictitious nodes on crack faces
     | {(sid, "taylor-fictitious") for sid in ("plate-crack", "plate-edge-crack",
                                               "plate-inclined-crack")}
+    # issue 54: surface nodes on crack faces, the pins' conditions on their partners
+    | {(sid, "surface-nodes") for sid in ("plate-crack", "plate-edge-crack",
+                                          "plate-inclined-crack")}
     # issue 54/55 (LAMMPS): peri/lps energies on the LPS stiffness boxes (pe/atom
     # corrected) and its fix nve on seed 004's vibrating bar
     | {("stiffness3d-box", "peer:lammps"), ("stiffness2d-plate", "peer:lammps"),

@@ -244,14 +244,7 @@ def family_treatments() -> list[Treatment]:
             "Scabbia, Zaccariotto, Galvanetto 2023 (seed 001); seed 002",
             params=(SURFACE_ORDER,), theories=BOTH, families=FAMILY, footprint="surface",
             build=_surface, checker=_check_surface, shapes=True, shapes3d=True,
-            cracks_why="crack faces are served (one-sided surface nodes on the faces, "
-                       "corrections.surface_nodes, exact on the crack geometries: "
-                       "tests/shapes/test_crack_faces.py), but not the crack scenes' pins: "
-                       "a pin part of length h/2 that holds the rigid motions gets surface "
-                       "nodes whose values no fictitious node is extrapolated from, so their "
-                       "columns appear in no equation (measured: a singular system on "
-                       "plate-crack and plate-edge-crack); the pins' conditions need "
-                       "imposing another way",
+            cracks=True,
             scope="state-based boxes, shapes and 1D waves; on a shape the surface nodes sit "
                   "at the boundary nodes' points on each part, the series about the nearest "
                   "one runs along the local normal with derivatives from a least-squares "

@@ -368,8 +368,22 @@ def surface_nodes_on_shape(problem, order: int) -> LinearSystem:
       fictitious nodes and the bonds across the crack's line from one side. At the tip
       as Taylor's: the fictitious nodes stop there, the bonds round it stay real.
       Exact for the order's polynomials on the crack geometries and one-sided
-      (tests/shapes/test_crack_faces.py). The crack scenes do not offer it: their pins
-      of length h/2 get surface nodes in no equation (``scenes.cracks``).
+      (tests/shapes/test_crack_faces.py). The tips carry no surface node of their own:
+      a tip is a face's end, its nearest surface nodes the faces' last ones.
+    - pins (issue 54: the crack scenes' parts of length h/2 holding the rigid motions):
+      a surface node that no fictitious value is extrapolated from and that no row of
+      its own reads (on a straight edge the flux rows are over bond forces; its
+      boundary node's fictitious nodes all take another part's nearer surface node)
+      has a column in no equation, so its conditions are imposed on its partner, the
+      nearest surface node that is read (:func:`unread_surface_nodes`; on the pins the
+      same boundary node's point on the adjacent edge part, h/2 away): a component
+      the pin prescribes is prescribed on the partner (the problem's exact value at
+      the partner's point; the partner's own row of it dropped), a free component's
+      flux row is added to the partner's (the flux through both stretches equal to the
+      resultant over both), and the unread surface node's free components equal the
+      partner's. Only systems with such a surface node change (none but the crack
+      scenes' among the report's: the other shapes' surface-node runs are unchanged
+      bit for bit).
 
     Exactness kept (tests/shapes/test_shape_methods.py): order N reproduces every
     polynomial field of degree <= N with its body force when the real nodes' complete
@@ -502,20 +516,50 @@ def surface_nodes_on_shape(problem, order: int) -> LinearSystem:
             c_k, _, g_k = centred_fit(x_real[side], pts[on], ni + on, pts[on], order, h,
                                       gradient=True)
             cols[on], grad[on] = np.c_[c_k[:, :1], side[c_k[:, 1:]]], g_k
-    rows, extra = [], K.shape[1] - d * nu_
-    rhs = np.zeros((nu_, d))
-    rhs[:ni] = problem.body_load(x_real, model.node_volume[g.interior_ids][:, None])
+    extra = K.shape[1] - d * nu_
+    body = problem.body_load(x_real, model.node_volume[g.interior_ids][:, None])
     points = (pts, nrm, part, group)
     free = (free_rows(model, problem, samples, points, cols, grad, nu_) if d == 2
             else traction_rows_3d(problem, points, cols, grad, nu_))
-    for k, blocks in enumerate(free):
-        for ids, R, c in blocks:
-            R = sp.hstack([R, sp.csr_matrix((R.shape[0], extra))]).tocoo()
-            rows.append(sp.csr_matrix((R.data, (k * nu_ + ni + ids[R.row], R.col)),
-                                      shape=K.shape))
-            rhs[ni + ids, k] = c
-    K = (K + sum(rows)).tocsr() if rows else K
+
+    def conditions(pres, partner=None):
+        """The surface nodes' rows added to K and the right-hand side; with ``partner``
+        (:func:`unread_surface_nodes`) an unread surface node's free rows join its
+        partner's (their sum: the flux through both stretches equal to the resultant
+        over both) and its own rows tie its free components to the partner's."""
+        rows, rhs = [], np.zeros((nu_, d))
+        rhs[:ni] = body
+        for k, blocks in enumerate(free):
+            for ids, R, c in blocks:
+                if partner is not None:
+                    to = partner[ids]
+                    keep = ~pres[to, k]
+                    ids, R = to[keep], R.tocsr()[keep]
+                    c = np.broadcast_to(c, keep.shape)[keep]
+                R = sp.hstack([R, sp.csr_matrix((R.shape[0], extra))]).tocoo()
+                rows.append(sp.csr_matrix((R.data, (k * nu_ + ni + ids[R.row], R.col)),
+                                          shape=K.shape))
+                if partner is None:
+                    rhs[ni + ids, k] = c
+                else:
+                    np.add.at(rhs[:, k], ni + ids, c)
+        if partner is not None:
+            for k in range(d):
+                s = unread[~pres_own[unread, k]]
+                r = k * nu_ + ni + np.r_[s, s]
+                c = k * nu_ + ni + np.r_[s, partner[s]]
+                v = np.r_[np.ones(s.size), -np.ones(s.size)]
+                rows.append(sp.csr_matrix((v, (r, c)), shape=K.shape))
+        return (K + sum(rows)).tocsr() if rows else K, rhs
+
     pres = prescribed(problem, part)
+    K_all, rhs = conditions(pres)
+    unread, partner = unread_surface_nodes(K_all, pts, ni, nu_, d)
+    if partner is not None:    # a pin: its conditions on the partner (docstring)
+        pres_own, pres = pres, pres.copy()
+        np.logical_or.at(pres, partner[unread], pres_own[unread])
+        K_all, rhs = conditions(pres, partner)
+    K = K_all
     exact = problem.exact(pts)
     fixed = [k * nu_ + ni + np.flatnonzero(pres[:, k]) for k in range(d)]
     values = [exact[pres[:, k], k] for k in range(d)]
@@ -523,6 +567,30 @@ def surface_nodes_on_shape(problem, order: int) -> LinearSystem:
                           bridging_bonds=int(pairs.size))
     return eliminated(problem, model, K, rhs, fixed, values, np.r_[x_real, pts], {},
                       extra_x=pts, counts=counts, ordering=ORDERING_ON_SHAPE)
+
+
+def unread_surface_nodes(K, pts, ni, nu_, d):
+    """``(unread, partner)``: the surface nodes whose columns are empty in the system
+    ``K`` (every row in place: no fictitious value is extrapolated from them and no row
+    of theirs reads them, as a pin part of length h/2 on a straight edge, whose
+    flux rows are over bond forces and whose every fictitious node's nearest surface node
+    is another part's), and for every surface node the nearest one that is read (itself
+    if read); ``partner`` is None when every surface node is read."""
+    used = np.zeros(nu_ - ni, dtype=bool)
+    Kc = K.tocsc(copy=True)
+    Kc.eliminate_zeros()
+    cols = Kc.indptr
+    for k in range(d):
+        lo = k * nu_ + ni
+        used |= np.diff(cols[lo:lo + nu_ - ni + 1]) > 0
+    unread = np.flatnonzero(~used)
+    if not unread.size:
+        return unread, None
+    from scipy.spatial import cKDTree
+    read = np.flatnonzero(used)
+    partner = np.arange(nu_ - ni)
+    partner[unread] = read[cKDTree(pts[read]).query(pts[unread])[1]]
+    return unread, partner
 
 
 def _place(block, rows, n_rows) -> sp.csr_matrix:

@@ -126,8 +126,9 @@ def _pull(traction: float):
 #: reference's stated choices)
 _FEM_FIXED = ("kind", "j_radii", "fit_window")
 
-#: the orders of a treatment with an ``order`` in the report (Taylor's fictitious nodes,
-#: the one that serves crack faces, ``FamilyTreatment.cracks``): order 1 only. Its cost on plate-crack at h = 1/40 is
+#: the orders of a treatment with an ``order`` in the report (Taylor's fictitious nodes
+#: and the surface nodes, the ones that serve crack faces, ``FamilyTreatment.cracks``):
+#: order 1 only. Taylor's cost on plate-crack at h = 1/40 is
 #: 4x the uncorrected model's (17 s against none's ~4 s, ``run`` under a load of ~11;
 #: order 2 took 1.3x order 1's), and the crack scenes may add ~15 s to a full report;
 #: the other orders run with ``run --method taylor-fictitious --set order=N``
@@ -334,8 +335,11 @@ class CrackPlate(CrackScene):
     report: :data:`ORDERS`) with one-sided fictitious nodes on the crack faces
     (``corrections.shape_fictitious``, crack faces: each bond the crack cuts becomes,
     from each end, a bond to a fictitious node at the other end's place fitted from the
-    end's own side; they stop at the tip, the bonds round it stay real); the other
-    treatments that add nodes are refused (``list`` gives the reason and what each
+    end's own side; they stop at the tip, the bonds round it stay real), the surface
+    nodes (``surface-nodes``, order 1 as Taylor's; one-sided on the crack faces, a
+    pin's conditions imposed on the nearest surface node a fictitious node reads:
+    ``corrections.surface_nodes.surface_nodes_on_shape``); the other treatments that
+    add nodes are refused (``list`` gives the reason and what each
     would need); and LAMMPS (``peer:lammps``: atom types and a zero horizon for the
     type pairs the crack separates keep it from bonding across the slit,
     ``pdverify.peers.lammps.crack_types``).

@@ -76,22 +76,25 @@ def test_the_list_shows_why_the_node_adding_treatments_do_not_run(scene_id):
                          capture_output=True, text=True, check=True).stdout
     for method in ("mirror-nodes", "pddo"):
         assert f"{method}: crack faces are not served yet: its shape form" in out, method
-    assert "surface-nodes: crack faces are served (one-sided surface nodes" in out
-    assert "taylor-fictitious: " not in out.split("not offered here")[1]
+    refused = out.split("not offered here")[1]
+    assert "taylor-fictitious: " not in refused
+    assert "surface-nodes: " not in refused         # its pins: surface_nodes_on_shape
     # LAMMPS runs here (its atom types keep it from bonding across the crack:
     # tests/peers/test_lammps.py)
     assert "peer:lammps: its code builds its own bonds" not in out
     offered = set(get_scene(scene_id).offered())
     assert offered == {"none", "energy", "volume", "pals", "energy-directional",
-                       "taylor-fictitious", "peer:lammps"}
+                       "taylor-fictitious", "surface-nodes", "peer:lammps"}
 
 
 def test_the_cases_are_every_method_at_the_defaults_and_the_quick_grid():
     scene = get_scene("plate-crack")
     cases = scene.cases()
     assert {m for m, _ in cases} == {"fem", "none", "energy", "volume", "pals",
-                                     "energy-directional", "taylor-fictitious"}
-    assert all(q == ({"order": 1} if m == "taylor-fictitious" else {}) for m, q in cases)
+                                     "energy-directional", "taylor-fictitious",
+                                     "surface-nodes"}
+    ordered = ("taylor-fictitious", "surface-nodes")
+    assert all(q == ({"order": 1} if m in ordered else {}) for m, q in cases)
     quick = scene.cases(quick=True)
     assert {m for m, _ in quick} == {m for m, _ in cases}
     assert {q.get("spacing") for m, q in quick if m != "fem"} == {1 / 30}
@@ -135,7 +138,8 @@ def test_the_edge_crack_scene_shares_the_centre_cracks_builder_and_refines_k():
         1.0, 1.0, 0.5, 0.025, 3.0)
     assert edge.reference_params(p)["height"] == 1.0
     cases = edge.cases()
-    methods = {"none", "energy", "volume", "pals", "energy-directional", "taylor-fictitious"}
+    methods = {"none", "energy", "volume", "pals", "energy-directional", "taylor-fictitious",
+               "surface-nodes"}
     assert {m for m, _ in cases} == methods | {"fem"}
     assert sorted({q.get("spacing", 0.025) for m, q in cases if m != "fem"}) == sorted(
         (1 / 60, 0.025, 1 / 30))
@@ -184,13 +188,17 @@ def test_the_edge_scenes_fem_checks_name_the_edge_reference(tmp_path):
     assert "plate-edge-crack --method fem: plate-edge-crack: cells must be 2..64" in r.stderr
 
 
-def test_taylor_runs_on_the_edge_crack_with_the_tip_and_face_errors(tmp_path):
-    """Taylor's one-sided fictitious nodes run on a crack scene (order 1, the quick
-    grid); the errors near the tip (the ring of 2 to 5 horizons) and along the faces are
-    parts of the errors outside the tip zone, on its scale."""
+@pytest.mark.parametrize("method", ["taylor-fictitious", "surface-nodes"])
+def test_taylor_runs_on_the_edge_crack_with_the_tip_and_face_errors(tmp_path, method):
+    """Taylor's one-sided fictitious nodes and the surface nodes run on a crack scene
+    (order 1, the quick grid; the surface nodes' pin, of length h/2, read by no
+    fictitious node, imposes its conditions on its partner: surface_nodes_on_shape,
+    a singular system without it); the errors near the tip (the ring of 2 to 5
+    horizons) and along the faces are parts of the errors outside the tip zone, on its
+    scale."""
     out = tmp_path / "t.json"
     r = subprocess.run([sys.executable, "-m", "pdverify", "run", "plate-edge-crack",
-                        "--method", "taylor-fictitious", "--set", "order=1",
+                        "--method", method, "--set", "order=1",
                         "--set", f"spacing={1 / 30!r}", "--json", str(out)],
                        capture_output=True, text=True)
     assert r.returncode == 0, r.stderr

@@ -92,13 +92,14 @@ def test_the_list_shows_why_the_node_adding_treatments_do_not_run():
     assert "pddo: crack faces are not served yet" in out
     assert set(get_scene(ID).offered()) == {"none", "energy", "volume", "pals",
                                             "energy-directional", "taylor-fictitious",
-                                            "peer:lammps"}
+                                            "surface-nodes", "peer:lammps"}
 
 
 def test_the_cases_are_every_method_at_the_defaults_and_the_quick_grid():
     scene = get_scene(ID)
     assert {m for m, _ in scene.cases()} == {"fem", "none", "energy", "volume", "pals",
-                                             "energy-directional", "taylor-fictitious"}
+                                             "energy-directional", "taylor-fictitious",
+                                             "surface-nodes"}
     quick = scene.cases(quick=True)
     assert {q.get("spacing") for m, q in quick if m != "fem"} == {1 / 30}
 
