@@ -566,9 +566,10 @@ DEVIATIONS = (
               "2 horizons, against the FEM's K from J; of the node-adding treatments only "
               "Taylor's fictitious nodes run (ours on a slit: one-sided, one fictitious node "
               "per cut bond and end, fitted from that end's side, none past the tip; order 1 "
-              "in the report), the others are refused (surface nodes: served on crack faces "
-              "but not on the scenes' h/2 pins; mirror nodes, PDDO: crack faces not served "
-              "yet).",
+              "in the report) and the surface nodes (one-sided too; a pin of length h/2, "
+              "whose surface nodes no row reads, hands its conditions to the nearest surface "
+              "node that is read); mirror nodes and PDDO are refused (crack faces not served "
+              "yet: list says what each needs).",
               "scenes/cracks.py, pd/cracks.py fit_k, reference_fem/crack_plate.py; "
               "benchmarks/crack_k.py",
               summary="Ours: the full cracked plate, K by the opening fit"),
@@ -578,9 +579,10 @@ DEVIATIONS = (
               "staircase of nodes on each face); K_I and K_II by the Williams fit of both "
               "displacement components in an annulus outside a tip zone of 2 horizons "
               "(orders 1..7 of both modes), against the FEM's interaction integral; of the "
-              "node-adding treatments only Taylor's one-sided fictitious nodes run (as "
-              "plate-crack's; the faces' conditions the one-sided fit's traction, the slit "
-              "being at an angle to the lattice), the others are refused.",
+              "node-adding treatments Taylor's one-sided fictitious nodes (as plate-crack's; "
+              "the faces' conditions the one-sided fit's traction, the slit being at an "
+              "angle to the lattice) and the surface nodes run, mirror nodes and PDDO are "
+              "refused.",
               "scenes/inclined_crack.py, pd/cracks.py fit_k_mixed, "
               "reference_fem/inclined_crack.py; benchmarks/inclined_crack_k.py",
               summary="Ours: the inclined crack, K_I and K_II by the annulus fit"),
@@ -588,10 +590,10 @@ DEVIATIONS = (
               "Ours, not a paper's: the whole single-edge-notched tension strip (H = b, "
               "where the FEM's K is within 3.1e-4 of its long strip's) with its edge crack "
               "as one crack from the mouth, not the FEM's half (as plate-crack); K_I by the "
-              "same opening fit at its one tip; of the node-adding treatments only Taylor's "
-              "one-sided fictitious nodes run (as plate-crack's; beside the mouth the "
-              "fictitious nodes outside the strip are fitted from one side), the others are "
-              "refused (crack faces not served yet).",
+              "same opening fit at its one tip; of the node-adding treatments Taylor's "
+              "one-sided fictitious nodes (as plate-crack's; beside the mouth the "
+              "fictitious nodes outside the strip are fitted from one side) and the surface "
+              "nodes run, mirror nodes and PDDO are refused (crack faces not served yet).",
               "scenes/cracks.py EdgeCrackPlate, pd/cracks.py fit_k, "
               "reference_fem/crack_plate.py edge_crack_plate",
               summary="Ours: the whole SENT strip, K by the opening fit"),
@@ -611,6 +613,28 @@ DEVIATIONS = (
               "pd/rays.py, corrections/energy_directional.py; tests/shapes/test_rays.py, "
               "tests/treatments/test_energy_directional_cells.py",
               summary="Ours: seed 003's ray distance to the first part the ray meets"),
+    Deviation(("plate-edge-crack",), "finding",
+              "The surface nodes on the crack faces (ours, one-sided; the pins' conditions "
+              "on the nearest surface node that is read) give the largest K errors of the "
+              "node-adding methods on the three cracks, and on the edge crack they do not "
+              "settle with the spacing: the largest error {{e30}}, {{e40}} and {{e60}} % at "
+              "h = 1/30, 1/40 and 1/60 m, on the faces, the net K error {{k30}}, {{k40}} "
+              "and {{k60}} %. Not explained yet. With them the edge crack's mode I field "
+              "is not mirror-symmetric about the crack line to the solver's accuracy "
+              "(several ten-thousandths of max |u| at h = 0.05 m, largest near a loaded "
+              "end's corner), nor with Taylor's one-sided nodes (whose condition number "
+              "leaves the round-off bound no test); the uncorrected model and the bond "
+              "methods are (tests/shapes/test_crack_symmetry.py). Read the node-adding "
+              "methods' edge-crack numbers as provisional.",
+              "scenes/cracks.py EdgeCrackPlate, corrections/surface_nodes.py, "
+              "corrections/shape_fictitious.py sided_fit",
+              key="054-edge-crack-surface-nodes",
+              quotes={**{f"e{n}": Q("max_error_pct", "surface-nodes", {"spacing": 1 / n},
+                                    ".2g", scene="plate-edge-crack") for n in (30, 40, 60)},
+                      **{f"k{n}": Q("k_net_error_pct", "surface-nodes", {"spacing": 1 / n},
+                                    ".2g", scene="plate-edge-crack") for n in (30, 40, 60)}},
+              summary="surface nodes on the edge crack: errors that do not settle with h; "
+                      "its mirror symmetry"),
     Deviation(("block3d-cavity",), "finding",
               "energy-directional (the state-based reading on a 3D shape) lowers the error "
               "near the cavity against the uncorrected model but raises the largest error, "

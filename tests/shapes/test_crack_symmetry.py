@@ -67,3 +67,19 @@ def test_the_mode_i_solution_is_mirror_symmetric_about_the_crack_line(scene_id, 
         mx = _mirror(x, 0)
         assert np.abs(u[mx, 0] + u[:, 0]).max() <= tol
         assert np.abs(u[mx, 1] - u[:, 1]).max() <= tol
+
+
+def test_finding_the_edge_crack_mouth_breaks_the_surface_nodes_symmetry():
+    """Finding ``054-edge-crack-surface-nodes`` (pdverify.deviations): with the surface
+    nodes the edge crack's mode I field is not mirror-symmetric about the crack line to
+    the solver's accuracy (measured 5.9e-4 of max |u| at h = 0.05 m, against a round-off
+    bound of 2.9e-9; largest near a loaded end's corner). Measured, not explained: this
+    test fails once the defect falls to round-off (then the finding goes)."""
+    x, u, kappa = _solve("plate-edge-crack", "surface-nodes")
+    scale = np.abs(u).max()
+    tol = np.finfo(float).eps * kappa * scale
+    m = _mirror(x, 1)
+    defect = np.maximum(np.abs(u[m, 0] - u[:, 0]), np.abs(u[m, 1] + u[:, 1]))
+    print(f"kappa_1 {kappa:.3g}, tol {tol / scale:.2g}, defect {defect.max() / scale:.2g} "
+          f"of max|u| at {x[np.argmax(defect)]}")
+    assert defect.max() > 10 * tol
