@@ -204,11 +204,7 @@ def pddo_system(model, dirichlet, exact, traction, moduli, body_load=None,
                             M = M + mu * grad_B(k)
                         blocks[j] = scale * M
                     rhs[k * n + nodes] = h ** (d - 1) * traction(xB, nrm, face)[:, k]
-                for j, M in blocks.items():
-                    M = sp.coo_matrix(M)
-                    rows.append(k * n + nodes[M.row])
-                    cols.append(j * n + M.col)
-                    vals.append(M.data)
+                scatter_blocks(blocks, k, nodes, n, rows, cols, vals)
     A = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                       shape=(d * n, d * n))
     return A, rhs, {"outer_nodes": int(outer.sum()), "layer_nodes": int(layer.sum()),
@@ -374,15 +370,22 @@ def pddo_shape_system(model, problem, body_load, bulk_model="lps"):
                 blocks[j] = M if j not in blocks else blocks[j] + M
             value[free] = scale * traction[chosen[free], k]
         rhs[k * n + nodes] = value
-        for j, M in blocks.items():
-            M = sp.coo_matrix(M)
-            rows.append(k * n + nodes[M.row])
-            cols.append(j * n + M.col)
-            vals.append(M.data)
+        scatter_blocks(blocks, k, nodes, n, rows, cols, vals)
     A = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                       shape=(d * n, d * n))
     return A, rhs, {"outer_nodes": int(outer.sum()), "layer_nodes": int(layer.sum()),
                     "bulk_nodes": int(bulk.sum()), "boundary_points": int(len(pts))}
+
+
+def scatter_blocks(blocks, k, nodes, n, rows, cols, vals) -> None:
+    """Append to the triplets ``rows, cols, vals`` the row blocks of component ``k`` at
+    ``nodes``: ``blocks[j]`` (one row per node, over the n nodes of component j) placed
+    at rows ``k n + nodes`` and columns ``j n + ...``."""
+    for j, M in blocks.items():
+        M = sp.coo_matrix(M)
+        rows.append(k * n + nodes[M.row])
+        cols.append(j * n + M.col)
+        vals.append(M.data)
 
 
 def _traction_at_points(problem, x, n, xpart):

@@ -64,7 +64,7 @@ from ..pd.faces import box_faces
 from ..pd.problem import BondProblem
 from .bond_fictitious import BondBoxSystem, _plane_rows, bordered
 from .mirror_nodes import prescribed_parts
-from .pddo import _choose_faces, _d2, derivative_operators
+from .pddo import _choose_faces, _d2, derivative_operators, scatter_blocks
 
 
 def lattice_tensor(model) -> np.ndarray:
@@ -155,11 +155,7 @@ def assemble_bond_pddo(problem: BondProblem) -> BondBoxSystem:
                     t = (np.zeros_like(xB) if cond is None or cond.traction is None
                          else cond.traction(xB, nrm))
                     rhs[i_c * n + nodes] = area * t[:, i_c]
-                for j, M in blocks.items():
-                    M = sp.coo_matrix(M)
-                    rows.append(i_c * n + nodes[M.row])
-                    cols.append(j * n + M.col)
-                    vals.append(M.data)
+                scatter_blocks(blocks, i_c, nodes, n, rows, cols, vals)
     K = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                       shape=(d * n, d * n))
     planes = _plane_rows(g, sc.planes, n)
